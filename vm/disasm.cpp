@@ -1,0 +1,125 @@
+// Disassembler: one line per instruction (address, T-states, name, operands),
+// a label at each function and the source line above the code it produced.
+// One small helper per operand shape, as in craftinginterpreters' debug.c.
+#include <bit>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "vm/cost.h"
+#include "vm/vm.h"
+
+namespace simbot::vm {
+
+namespace {
+
+uint32_t readU16(const Image& img, uint32_t at) {
+  return img.code[at] | (img.code[at + 1] << 8);
+}
+uint32_t readU32(const Image& img, uint32_t at) {
+  return readU16(img, at) | (readU16(img, at + 2) << 16);
+}
+
+std::string noOperand(const Image&, uint32_t) { return ""; }
+std::string u8Operand(const Image& img, uint32_t at) { return fmt::format("{}", img.code[at]); }
+std::string u16Operand(const Image& img, uint32_t at) {
+  return fmt::format("0x{:04x}", readU16(img, at));
+}
+std::string rel16Operand(const Image& img, uint32_t at) {
+  const int16_t rel = static_cast<int16_t>(readU16(img, at));
+  return fmt::format("-> {:04x}", at + 2 + rel);
+}
+std::string i32Operand(const Image& img, uint32_t at) {
+  return fmt::format("{}", static_cast<int32_t>(readU32(img, at)));
+}
+std::string f32Operand(const Image& img, uint32_t at) {
+  return fmt::format("{}", std::bit_cast<float>(readU32(img, at)));
+}
+std::string libOperand(const Image& img, uint32_t at) {
+  const int id = img.code[at];
+  const std::string_view name = id < kLibCount ? kLibInfo[id].name : "?";
+  return fmt::format("{}, {} args", name, img.code[at + 1]);
+}
+
+std::string operandText(Shape shape, const Image& img, uint32_t at) {
+  switch (shape) {
+    case Shape::NONE: return noOperand(img, at);
+    case Shape::U8: return u8Operand(img, at);
+    case Shape::U16: return u16Operand(img, at);
+    case Shape::REL16: return rel16Operand(img, at);
+    case Shape::I32: return i32Operand(img, at);
+    case Shape::F32: return f32Operand(img, at);
+    case Shape::LIB: return libOperand(img, at);
+  }
+  return "";
+}
+
+// Names a data address or a code address where the symbol table knows it.
+std::string annotate(const Image& img, Op op, uint32_t at) {
+  const Shape shape = info(op).shape;
+  if (shape != Shape::U16) return "";
+  const uint32_t value = readU16(img, at);
+  const bool codeAddress = op == Op::CALL;
+  const bool dataAddress = op == Op::LDGB || op == Op::LDGW || op == Op::LDGL || op == Op::STGB ||
+                           op == Op::STGW || op == Op::STGL || op == Op::INCGW ||
+                           op == Op::DECGW || op == Op::INCGL;
+  for (const auto& s : img.symbols) {
+    const bool isCode = s.kind == Symbol::Kind::Function || s.kind == Symbol::Kind::Handler;
+    if (codeAddress && isCode && s.address == value) return s.name;
+    if (dataAddress && !isCode && s.kind != Symbol::Kind::Auto && s.kind != Symbol::Kind::Param &&
+        value >= s.address && value < s.address + std::max<uint32_t>(1, s.size))
+      return value == s.address ? s.name : fmt::format("{}+{}", s.name, value - s.address);
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string disassemble(const Image& img) {
+  const CostTable costs = makeCostTable(calibratedKnobs());
+  std::map<uint32_t, std::string> labels;
+  for (const auto& s : img.symbols)
+    if (s.kind == Symbol::Kind::Function || s.kind == Symbol::Kind::Handler)
+      labels[s.address] = s.kind == Symbol::Kind::Handler ? s.name + " (interrupt)" : s.name;
+
+  std::string out = fmt::format("; {}: {} code bytes, {} data bytes at 0x{:04x}\n",
+                                img.sourceName, img.code.size(), img.data.size(), kDataBase);
+  for (const auto& v : img.vectors)
+    out += fmt::format("; vector 0x{:02x} -> {} at {:04x}\n", v.vector, v.handlerName, v.handler);
+  out += "; addr  T-st  op       operands\n";
+  int lastLine = -1;
+  uint32_t at = 0;
+  while (at < img.code.size()) {
+    if (auto it = labels.find(at); it != labels.end()) out += fmt::format("\n{}:\n", it->second);
+    const int line = img.lineAt(at);
+    if (line != lastLine && line > 0) {
+      const std::string text = line <= static_cast<int>(img.sourceLines.size())
+                                   ? img.sourceLines[line - 1]
+                                   : std::string();
+      out += fmt::format("                          ; {:>4} | {}\n", line, text);
+      lastLine = line;
+    }
+    const uint8_t byte = img.code[at];
+    if (byte >= kOpCount) {
+      out += fmt::format("  {:04x}        .byte {}\n", at, byte);
+      ++at;
+      continue;
+    }
+    const Op op = static_cast<Op>(byte);
+    const int size = instructionSize(op);
+    if (at + size > img.code.size()) {
+      out += fmt::format("  {:04x}        {} (truncated)\n", at, info(op).name);
+      break;
+    }
+    std::string operands = operandText(info(op).shape, img, at + 1);
+    const std::string note = annotate(img, op, at + 1);
+    if (!note.empty()) operands += fmt::format("  ({})", note);
+    uint32_t cost = costs.op[byte];
+    if (op == Op::LIB && img.code[at + 1] < kLibCount) cost += costs.libCall[img.code[at + 1]];
+    out += fmt::format("  {:04x}  {:>4}  {:<8} {}\n", at, cost, info(op).name, operands);
+    at += static_cast<uint32_t>(size);
+  }
+  return out;
+}
+
+}  // namespace simbot::vm

@@ -1,0 +1,63 @@
+// A compiled program: what the compiler produces and the VM loads.
+// Code bytes with a parallel line table (one source line per code byte, as in
+// craftinginterpreters' chunk.h), the initial contents of robot memory, the
+// interrupt vector table and the symbol table.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace simbot::vm {
+
+// Robot memory map (64 KiB, 16-bit addresses). Documented in the README.
+inline constexpr uint32_t kMemorySize = 0x10000;
+inline constexpr uint16_t kNullPageEnd = 0x0100;  // 0x0000-0x00FF: access faults
+inline constexpr uint16_t kDataBase = 0x0100;     // globals and statics from here
+inline constexpr uint16_t kStackTop = 0xFFFF;     // auto frames grow down from here
+
+// Port addresses of the Tiny Giant's I/O bus that programs name without
+// declaring them (assumption: the thesis gives no addresses).
+inline constexpr uint16_t kPortPIODA = 0x48;
+inline constexpr uint16_t kPortPIODB = 0x49;
+inline constexpr uint16_t kPortPIOCA = 0x4A;
+inline constexpr uint16_t kPortPIOCB = 0x4B;
+inline constexpr uint16_t kPortENB485 = 0xC0;
+// Interrupt vector names (IM2 vector bytes a program writes to the PIO).
+inline constexpr uint8_t kVecPIOA = 0x10;
+
+struct VectorBinding {
+  uint8_t vector;        // IM2 vector byte
+  uint16_t handler;      // code address of the interrupt reti function
+  std::string handlerName;
+};
+
+struct Symbol {
+  enum class Kind : uint8_t { Function, Handler, Global, Static, Auto, Param };
+  std::string name;      // for statics and autos: "function.name"
+  Kind kind;
+  uint32_t address;      // code address (functions), memory address (data),
+                         // frame offset (autos)
+  uint32_t size;         // bytes (data) or code bytes (functions)
+  std::string type;      // C type as written, e.g. "unsigned long"
+  int line;
+};
+
+struct Image {
+  std::string sourceName;
+  std::vector<std::string> sourceLines;  // for the disassembly
+  std::vector<uint8_t> code;
+  std::vector<int32_t> lines;  // source line of each code byte (1-based)
+  uint16_t entry = 0;          // code address of main
+  // Initial memory: bytes [kDataBase, kDataBase + data.size()) hold the
+  // globals' and statics' initial values (zeros where not initialised).
+  std::vector<uint8_t> data;
+  std::vector<VectorBinding> vectors;
+  std::vector<Symbol> symbols;
+  // First code address of each function, for profiles and fault messages.
+  const Symbol* functionAt(uint32_t codeAddress) const;
+  int lineAt(uint32_t codeAddress) const {
+    return codeAddress < lines.size() ? lines[codeAddress] : 0;
+  }
+};
+
+}  // namespace simbot::vm

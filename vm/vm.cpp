@@ -1,0 +1,956 @@
+// The VM's dispatch loop. One set of handlers (the CASE blocks below) builds
+// as a switch or, with GCC/Clang, as computed goto (SIMBOT_COMPUTED_GOTO).
+//
+// Each step of the loop is an instruction boundary: first the horizon test,
+// then interrupt acceptance, then one bytecode instruction or one step of a
+// long library call. An instruction's cost is charged when it starts and its
+// effects (bus accesses included) happen at its end tick.
+//
+// Faults (documented in the README): division by zero (Dynamic C's run-time
+// error handler stops the program), access to the null page 0x0000-0x00FF
+// (an assumption: on the target that is the vector area, so a stray pointer
+// would corrupt it silently; simbot stops the robot instead), a multi-byte
+// access past 0xFFFF, the auto/return stack growing into the data area
+// ("stack overflow"), an interrupt through a vector with no #INT_VEC handler.
+// A fault stops only that robot; the host carries on.
+#include "vm/vm.h"
+
+// Computed goto (labels as values) is a GNU extension used on purpose.
+#pragma GCC diagnostic ignored "-Wpedantic"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <optional>
+
+#include <fmt/format.h>
+
+#ifndef SIMBOT_COMPUTED_GOTO
+#if defined(__GNUC__)
+#define SIMBOT_COMPUTED_GOTO 1
+#else
+#define SIMBOT_COMPUTED_GOTO 0
+#endif
+#endif
+
+namespace simbot::vm {
+
+namespace {
+
+constexpr int kEvalSlots = 8192;
+// No function's own expressions and arguments need more than this many slots
+// (the compiler caps nesting), so a check per call is enough.
+constexpr int kEvalHeadroom = 1024;
+constexpr int kMaxInterruptNesting = 16;
+constexpr uint32_t kMaxStepTstates = 100;  // long library calls: boundary spacing
+constexpr int kMaxLibArgs = 32;
+// Robot stack bytes: CALL pushes the return address and IX; acceptance
+// pushes PC, AF, BC, DE, HL, IX, IY.
+constexpr uint32_t kCallFrameBytes = 4;
+constexpr uint32_t kInterruptFrameBytes = 14;
+
+struct LibCall {
+  bool active = false;
+  Lib id{};
+  uint32_t pc = 0;  // address of the LIB instruction (for traces)
+  int argc = 0;
+  uint32_t args[kMaxLibArgs]{};
+  uint32_t setup = 0;      // T-states of the call sequence still to run
+  uint32_t index = 0;      // bytes processed
+  uint32_t remaining = 0;  // T-states still to burn (A/D, printf)
+  uint32_t result = 0;
+  std::string text;  // printf's formatted output
+};
+
+struct CallFrame {
+  uint32_t retPc;
+  uint32_t msp;
+  uint32_t mfp;
+};
+
+struct InterruptFrame {
+  uint32_t retPc;
+  Irq irq;
+  uint32_t msp;
+  uint32_t mfp;
+  int evalSp;
+  int callDepth;
+  bool halted;
+  uint32_t burn;
+  LibCall lib;
+};
+
+float asFloat(uint32_t bits) { return std::bit_cast<float>(bits); }
+uint32_t fromFloat(float f) { return std::bit_cast<uint32_t>(f); }
+int16_t asInt16(uint32_t v) { return static_cast<int16_t>(static_cast<uint16_t>(v)); }
+uint32_t w(int32_t v) { return static_cast<uint32_t>(v) & 0xFFFFu; }
+
+int64_t truncToRange(float f, double lo, double hi) {
+  if (std::isnan(f)) return 0;
+  double t = std::trunc(static_cast<double>(f));
+  return static_cast<int64_t>(std::clamp(t, lo, hi));
+}
+
+}  // namespace
+
+std::string_view irqName(Irq irq) {
+  switch (irq) {
+    case Irq::Pio: return "pio_a";
+    case Irq::SerialTx: return "serial_tx";
+    case Irq::Timer: return "timer";
+  }
+  return "?";
+}
+
+struct Vm::State {
+  State(const Image& img, Bus& b, const CostTable& c) : image(img), bus(b), costs(c) {}
+
+  const Image& image;
+  Bus& bus;
+  CostTable costs;
+  std::vector<uint8_t> mem = std::vector<uint8_t>(kMemorySize, 0);
+  std::vector<uint32_t> eval = std::vector<uint32_t>(kEvalSlots, 0);
+  int sp = 0;  // eval stack: next free slot
+  std::vector<CallFrame> calls;
+  std::vector<InterruptFrame> ints;
+  uint32_t pc = 0;
+  Tick now = 0;
+  uint32_t msp = kMemorySize;  // robot stack pointer (grows down)
+  uint32_t mfp = kMemorySize;  // auto frame pointer
+  uint32_t stackLimit = kDataBase;
+  bool iff1 = true;  // Dynamic C's BIOS runs main with interrupts enabled
+  bool iff2 = true;
+  bool eiShadow = false;
+  bool halted = false;
+  bool busTouched = false;
+  std::array<bool, kIrqCount> pend{};
+  std::array<uint8_t, kIrqCount> vec{};
+  bool anyPending = false;
+  std::array<int32_t, 256> handlerFor{};
+  std::optional<Fault> fault;
+  LibCall lib;
+  // T-states still to run of an opcode longer than kMaxStepTstates (a CALL
+  // into a run-time routine): its effect is done, its time passes in steps
+  // with an instruction boundary between them.
+  uint32_t burn = 0;
+  uint32_t burnPc = 0;
+  VmStats stats;
+  std::vector<uint8_t> breakpoints;  // one flag per code byte
+  bool anyBreakpoint = false;
+  bool resumeAtBreakpoint = false;
+  bool profiling = false;
+  std::vector<uint64_t> profile;
+  uint64_t serialIsrCycles = 0;
+  std::string consoleLine;
+  Vm* self = nullptr;
+
+  // ---- faults and memory ----
+  void raiseFault(std::string message, uint32_t atPc) {
+    if (fault) return;
+    fault = Fault{std::move(message), now, image.lineAt(atPc)};
+  }
+  // Checks a pointer access of `size` bytes; false (and a fault) if invalid.
+  bool checkAccess(uint32_t address, uint32_t size, uint32_t atPc) {
+    if (address < kNullPageEnd) {
+      raiseFault(fmt::format("null pointer access at 0x{:04x}", address), atPc);
+      return false;
+    }
+    if (address + size > kMemorySize) {
+      raiseFault(fmt::format("access outside memory at 0x{:04x} ({} bytes)", address, size), atPc);
+      return false;
+    }
+    return true;
+  }
+  uint8_t rd8(uint32_t a) const { return mem[a & 0xFFFF]; }
+  uint16_t rd16(uint32_t a) const {
+    return static_cast<uint16_t>(mem[a & 0xFFFF] | (mem[(a + 1) & 0xFFFF] << 8));
+  }
+  uint32_t rd32(uint32_t a) const {
+    return rd16(a) | (static_cast<uint32_t>(rd16(a + 2)) << 16);
+  }
+  void wr8(uint32_t a, uint32_t v) { mem[a & 0xFFFF] = static_cast<uint8_t>(v); }
+  void wr16(uint32_t a, uint32_t v) {
+    wr8(a, v);
+    wr8(a + 1, v >> 8);
+  }
+  void wr32(uint32_t a, uint32_t v) {
+    wr16(a, v);
+    wr16(a + 2, v >> 16);
+  }
+
+  // ---- console ----
+  void emitConsole(std::string_view text) {
+    for (char c : text) {
+      if (c == '\n') {
+        bus.console(now, consoleLine);
+        consoleLine.clear();
+      } else {
+        consoleLine.push_back(c);
+      }
+    }
+  }
+  void flushConsole() {
+    if (!consoleLine.empty()) {
+      bus.console(now, consoleLine);
+      consoleLine.clear();
+    }
+  }
+
+  // ---- interrupts ----
+  void updatePending() {
+    anyPending = std::any_of(pend.begin(), pend.end(), [](bool p) { return p; });
+  }
+  // Accepts the highest-priority pending request at the current boundary.
+  void accept();
+  // ---- library ----
+  void libCall(Lib id, int argc, uint32_t instructionPc);
+  void libBegin();
+  void libStep();
+  void libFinish(bool pushResult);
+  std::string formatPrintf(uint32_t instructionPc);
+
+  template <bool kProfile>
+  Stop run(Tick until);
+};
+
+void Vm::State::accept() {
+  int i = 0;
+  while (!pend[i]) ++i;
+  const Irq irq = static_cast<Irq>(i);
+  pend[i] = false;
+  updatePending();
+  ++stats.interrupts[i];
+  const uint32_t interruptedPc = lib.active ? lib.pc : burn ? burnPc : pc;
+  if (irq == Irq::SerialTx) {
+    // The serial library's own ISR: short and atomic, leaves IFF1 set.
+    bus.interruptAccepted(now, irq, interruptedPc);
+    now += costs.serialIsr;
+    serialIsrCycles += costs.serialIsr;
+    bus.serialTxService(now, *self);
+    bus.interruptReturned(now, irq);
+    busTouched = true;
+    return;
+  }
+  const int32_t handler = handlerFor[vec[i]];
+  if (handler < 0) {
+    raiseFault(fmt::format("{} interrupt through vector 0x{:02x}, which no #INT_VEC binds",
+                           irqName(irq), vec[i]),
+               interruptedPc);
+    return;
+  }
+  if (static_cast<int>(ints.size()) >= kMaxInterruptNesting) {
+    raiseFault("interrupts nested too deeply", interruptedPc);
+    return;
+  }
+  if (msp < stackLimit + kInterruptFrameBytes) {
+    raiseFault("stack overflow (interrupt frame)", interruptedPc);
+    return;
+  }
+  ints.push_back(InterruptFrame{pc, irq, msp, mfp, sp, static_cast<int>(calls.size()), halted,
+                                burn, std::move(lib)});
+  lib = LibCall{};
+  burn = 0;
+  resumeAtBreakpoint = false;
+  msp -= kInterruptFrameBytes;
+  halted = false;
+  iff1 = iff2 = false;
+  bus.interruptAccepted(now, irq, interruptedPc);
+  now += costs.interruptAccept;
+  if (profiling) profile[handler] += costs.interruptAccept;
+  pc = static_cast<uint32_t>(handler);
+}
+
+// ---- library calls -------------------------------------------------------
+
+std::string Vm::State::formatPrintf(uint32_t instructionPc) {
+  std::string out;
+  uint32_t f = lib.args[0];
+  int next = 1;
+  auto arg = [&]() -> uint32_t { return next < lib.argc ? lib.args[next++] : 0; };
+  auto readString = [&](uint32_t a, size_t limit) {
+    std::string s;
+    while (s.size() < limit) {
+      if (!checkAccess(a, 1, instructionPc)) break;
+      char c = static_cast<char>(rd8(a++));
+      if (c == 0) break;
+      s.push_back(c);
+    }
+    return s;
+  };
+  const std::string format = readString(f, 4096);
+  char buf[512];
+  for (size_t i = 0; i < format.size(); ++i) {
+    char c = format[i];
+    if (c != '%') {
+      out.push_back(c);
+      continue;
+    }
+    // %[flags][width][.precision][l]conv
+    std::string spec = "%";
+    size_t j = i + 1;
+    while (j < format.size() && std::strchr("-0+ #", format[j])) spec.push_back(format[j++]);
+    while (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j])) &&
+           spec.size() < 8)
+      spec.push_back(format[j++]);
+    if (j < format.size() && format[j] == '.') {
+      spec.push_back(format[j++]);
+      while (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j])) &&
+             spec.size() < 12)
+        spec.push_back(format[j++]);
+    }
+    bool isLong = false;
+    if (j < format.size() && format[j] == 'l') {
+      isLong = true;
+      ++j;
+    }
+    if (j >= format.size()) {
+      out += format.substr(i);
+      break;
+    }
+    char conv = format[j];
+    i = j;
+    switch (conv) {
+      case 'd':
+      case 'i':
+        if (isLong)
+          std::snprintf(buf, sizeof buf, (spec + "ld").c_str(),
+                        static_cast<long>(static_cast<int32_t>(arg())));
+        else
+          std::snprintf(buf, sizeof buf, (spec + "d").c_str(), static_cast<int>(asInt16(arg())));
+        out += buf;
+        break;
+      case 'u':
+      case 'x':
+      case 'X':
+        if (isLong)
+          std::snprintf(buf, sizeof buf, (spec + "l" + conv).c_str(),
+                        static_cast<unsigned long>(arg()));
+        else
+          std::snprintf(buf, sizeof buf, (spec + conv).c_str(),
+                        static_cast<unsigned>(arg() & 0xFFFF));
+        out += buf;
+        break;
+      case 'c':
+        std::snprintf(buf, sizeof buf, (spec + "c").c_str(), static_cast<int>(arg() & 0xFF));
+        out += buf;
+        break;
+      case 's': {
+        std::string s = readString(arg(), 4096);
+        std::snprintf(buf, sizeof buf, (spec + "s").c_str(), s.c_str());
+        out += buf;
+        break;
+      }
+      case 'f':
+      case 'e':
+      case 'g':
+        std::snprintf(buf, sizeof buf, (spec + conv).c_str(),
+                      static_cast<double>(asFloat(arg())));
+        out += buf;
+        break;
+      case '%':
+        out.push_back('%');
+        break;
+      default:
+        out += spec;
+        out.push_back(conv);
+        break;
+    }
+  }
+  return out;
+}
+
+// LIB: the call sequence runs first (in steps when it is longer than
+// kMaxStepTstates); the routine's effect happens at the end of it.
+void Vm::State::libCall(Lib id, int argc, uint32_t instructionPc) {
+  lib.id = id;
+  lib.pc = instructionPc;
+  lib.argc = argc;
+  for (int k = argc - 1; k >= 0; --k) lib.args[k] = eval[--sp];
+  lib.index = 0;
+  lib.remaining = 0;
+  lib.result = 0;
+  const uint32_t callCost = costs.libCall[static_cast<int>(id)];
+  const uint32_t first = std::min(kMaxStepTstates, callCost);
+  now += first;
+  if (profiling) profile[instructionPc] += first;
+  lib.setup = callCost - first;
+  if (lib.setup > 0) {
+    lib.active = true;
+    return;
+  }
+  libBegin();
+}
+
+void Vm::State::libBegin() {
+  lib.active = false;
+  const Lib id = lib.id;
+  const uint32_t instructionPc = lib.pc;
+  const uint32_t* a = lib.args;
+  switch (id) {
+    case Lib::AD_RD8:
+      // Sampled at the start of the conversion, which then takes its time.
+      lib.result = w(bus.adSample(now, static_cast<int>(asInt16(a[0]))));
+      lib.remaining = costs.adConversion;
+      busTouched = true;
+      lib.active = lib.remaining > 0;
+      if (!lib.active) eval[sp++] = lib.result;
+      return;
+    case Lib::OUTPORT:
+      bus.out(now, static_cast<uint16_t>(a[0]), static_cast<uint8_t>(a[1]));
+      busTouched = true;
+      return;
+    case Lib::INPORT:
+      eval[sp++] = bus.in(now, static_cast<uint16_t>(a[0]));
+      busTouched = true;
+      return;
+    case Lib::SER_INIT_Z1:
+      bus.serialInit(now, asInt16(a[0]), asInt16(a[1]));
+      iff1 = iff2 = true;  // the routine ends with EI
+      busTouched = true;
+      return;
+    case Lib::SER_SEND_Z1:
+      bus.serialSend(now, static_cast<uint16_t>(a[0]), static_cast<uint16_t>(a[1]));
+      busTouched = true;
+      return;
+    case Lib::HV_ENB:
+      bus.hvEnable(now);
+      busTouched = true;
+      return;
+    case Lib::ABS: {
+      int16_t v = asInt16(a[0]);
+      eval[sp++] = w(v < 0 ? -v : v);
+      return;
+    }
+    case Lib::FABS:
+      eval[sp++] = a[0] & 0x7FFFFFFFu;
+      return;
+    case Lib::STRCPY:
+    case Lib::MEMSET:
+    case Lib::MEMCPY:
+      lib.result = a[0] & 0xFFFF;
+      lib.active = true;
+      return;
+    case Lib::STRLEN:
+    case Lib::STRCMP:
+      lib.active = true;
+      return;
+    case Lib::PRINTF:
+      lib.text = formatPrintf(instructionPc);
+      if (fault) return;
+      lib.result = w(static_cast<int32_t>(lib.text.size()));
+      lib.remaining = static_cast<uint32_t>(lib.text.size()) * costs.printfChar;
+      lib.active = true;
+      return;
+    case Lib::Count_:
+      break;
+  }
+}
+
+void Vm::State::libFinish(bool pushResult) {
+  lib.active = false;
+  if (pushResult) eval[sp++] = lib.result;
+}
+
+// One step of a long library call: at most kMaxStepTstates T-states.
+void Vm::State::libStep() {
+  const int id = static_cast<int>(lib.id);
+  const uint32_t unit = std::max<uint32_t>(1, costs.libStep[id]);
+  const uint32_t perStep = std::max<uint32_t>(1, kMaxStepTstates / unit);
+  const uint32_t* a = lib.args;
+  ++stats.instructions;
+  if (lib.setup > 0) {
+    const uint32_t step = std::min(kMaxStepTstates, lib.setup);
+    now += step;
+    if (profiling) profile[lib.pc] += step;
+    lib.setup -= step;
+    if (lib.setup == 0) libBegin();
+    return;
+  }
+  switch (lib.id) {
+    case Lib::AD_RD8:
+    case Lib::PRINTF: {
+      const uint32_t step = std::min(kMaxStepTstates, lib.remaining);
+      now += step;
+      if (profiling) profile[lib.pc] += step;
+      lib.remaining -= step;
+      if (lib.remaining == 0) {
+        if (lib.id == Lib::PRINTF) {
+          emitConsole(lib.text);
+          lib.text.clear();
+          busTouched = true;
+        }
+        libFinish(true);
+      }
+      return;
+    }
+    default:
+      break;
+  }
+  uint32_t done = 0;
+  bool finished = false;
+  while (done < perStep && !finished) {
+    const uint32_t i = lib.index;
+    switch (lib.id) {
+      case Lib::STRCPY: {
+        if (!checkAccess(a[1] + i, 1, lib.pc) || !checkAccess(a[0] + i, 1, lib.pc)) return;
+        const uint8_t c = rd8(a[1] + i);
+        wr8(a[0] + i, c);
+        finished = c == 0;
+        break;
+      }
+      case Lib::STRLEN: {
+        if (!checkAccess(a[0] + i, 1, lib.pc)) return;
+        if (rd8(a[0] + i) == 0) {
+          lib.result = w(static_cast<int32_t>(i));
+          finished = true;
+        }
+        break;
+      }
+      case Lib::STRCMP: {
+        if (!checkAccess(a[0] + i, 1, lib.pc) || !checkAccess(a[1] + i, 1, lib.pc)) return;
+        const int x = rd8(a[0] + i), y = rd8(a[1] + i);
+        if (x != y || x == 0) {
+          lib.result = w(x - y);
+          finished = true;
+        }
+        break;
+      }
+      case Lib::MEMSET:
+      case Lib::MEMCPY: {
+        const uint32_t n = a[2] & 0xFFFF;
+        if (i >= n) {
+          finished = true;
+          continue;
+        }
+        if (!checkAccess(a[0] + i, 1, lib.pc)) return;
+        if (lib.id == Lib::MEMSET) {
+          wr8(a[0] + i, a[1]);
+        } else {
+          if (!checkAccess(a[1] + i, 1, lib.pc)) return;
+          wr8(a[0] + i, rd8(a[1] + i));
+        }
+        finished = i + 1 >= n;
+        break;
+      }
+      default:
+        finished = true;
+        break;
+    }
+    ++lib.index;
+    ++done;
+  }
+  const uint32_t cost = done * unit;
+  now += cost;
+  if (profiling) profile[lib.pc] += cost;
+  if (finished) libFinish(true);
+}
+
+// ---- dispatch ---------------------------------------------------------------
+
+template <bool kProfile>
+Stop Vm::State::run(Tick until) {
+  if (fault) return Stop::Fault;
+  const uint8_t* const code = image.code.data();
+  const uint32_t codeSize = static_cast<uint32_t>(image.code.size());
+  const uint32_t* const opCost = costs.op.data();
+  busTouched = false;
+
+#if SIMBOT_COMPUTED_GOTO
+  static void* const kLabels[] = {
+#define OP(name, shape, pop, push, seq) &&L_##name,
+#include "vm/opcodes.def"
+#undef OP
+  };
+#define CASE(name) L_##name:
+#else
+#define CASE(name) case Op::name:
+#endif
+#define NEXT goto boundary
+
+  uint32_t opPc;
+  uint8_t op;
+  for (;;) {
+  boundary:
+    if (fault) return Stop::Fault;
+    if (busTouched) {
+      busTouched = false;
+      return Stop::Io;
+    }
+    if (now >= until) return halted ? Stop::Halted : Stop::Horizon;
+    if (anyPending && iff1 && !eiShadow) {
+      accept();
+      continue;
+    }
+    if (burn) {
+      const uint32_t step = std::min(kMaxStepTstates, burn);
+      now += step;
+      burn -= step;
+      eiShadow = false;
+      continue;
+    }
+    if (lib.active) {
+      eiShadow = false;
+      libStep();
+      continue;
+    }
+    if (halted) {
+      now = until;  // HALT: idle until the horizon or the next interrupt
+      return Stop::Halted;
+    }
+    if (pc >= codeSize) {
+      raiseFault(fmt::format("jump outside the program (0x{:04x})", pc), pc);
+      continue;
+    }
+    if (anyBreakpoint && breakpoints[pc] && !resumeAtBreakpoint) {
+      resumeAtBreakpoint = true;
+      return Stop::Breakpoint;
+    }
+    resumeAtBreakpoint = false;
+    opPc = pc;
+    op = code[pc];
+    if (op >= kOpCount) {
+      raiseFault(fmt::format("invalid opcode {}", op), pc);
+      continue;
+    }
+    if (opCost[op] <= kMaxStepTstates) {
+      now += opCost[op];
+    } else {
+      now += kMaxStepTstates;
+      burn = opCost[op] - kMaxStepTstates;
+      burnPc = opPc;
+    }
+    if constexpr (kProfile) profile[opPc] += opCost[op];
+    ++stats.instructions;
+    eiShadow = false;
+    {
+      const uint8_t* operand = code + pc + 1;
+      auto u16 = [operand]() -> uint32_t { return operand[0] | (operand[1] << 8); };
+      auto i32 = [operand]() -> uint32_t {
+        return operand[0] | (operand[1] << 8) | (operand[2] << 16) |
+               (static_cast<uint32_t>(operand[3]) << 24);
+      };
+      pc += static_cast<uint32_t>(instructionSize(static_cast<Op>(op)));
+      uint32_t* const e = eval.data();
+#define TOP e[sp - 1]
+#define POPV e[--sp]
+#define PUSHV(v) e[sp++] = (v)
+#define BINARY(expr)        \
+  {                         \
+    const uint32_t b = POPV; \
+    const uint32_t a = TOP;  \
+    TOP = (expr);           \
+  }                         \
+  NEXT
+#if SIMBOT_COMPUTED_GOTO
+      goto* kLabels[op];
+#else
+      switch (static_cast<Op>(op)) {
+#endif
+      CASE(PUSHW) PUSHV(u16()); NEXT;
+      CASE(PUSHL) PUSHV(i32()); NEXT;
+      CASE(PUSHF) PUSHV(i32()); NEXT;
+      CASE(POP) --sp; NEXT;
+      CASE(DUP) { const uint32_t v = TOP; PUSHV(v); } NEXT;
+      CASE(TUCK) {
+        const uint32_t b = POPV, a = POPV;
+        PUSHV(b); PUSHV(a); PUSHV(b);
+      } NEXT;
+      CASE(LDGB) PUSHV(rd8(u16())); NEXT;
+      CASE(LDGW) PUSHV(rd16(u16())); NEXT;
+      CASE(LDGL) PUSHV(rd32(u16())); NEXT;
+      CASE(STGB) wr8(u16(), POPV); NEXT;
+      CASE(STGW) wr16(u16(), POPV); NEXT;
+      CASE(STGL) wr32(u16(), POPV); NEXT;
+      CASE(INCGW) { const uint32_t a = u16(); wr16(a, rd16(a) + 1u); } NEXT;
+      CASE(DECGW) { const uint32_t a = u16(); wr16(a, rd16(a) - 1u); } NEXT;
+      CASE(INCGL) { const uint32_t a = u16(); wr32(a, rd32(a) + 1u); } NEXT;
+      CASE(LDLB) { const uint32_t a = mfp + u16(); if (!checkAccess(a, 1, opPc)) NEXT; PUSHV(rd8(a)); } NEXT;
+      CASE(LDLW) { const uint32_t a = mfp + u16(); if (!checkAccess(a, 2, opPc)) NEXT; PUSHV(rd16(a)); } NEXT;
+      CASE(LDLL) { const uint32_t a = mfp + u16(); if (!checkAccess(a, 4, opPc)) NEXT; PUSHV(rd32(a)); } NEXT;
+      CASE(STLB) { const uint32_t a = mfp + u16(); const uint32_t v = POPV; if (!checkAccess(a, 1, opPc)) NEXT; wr8(a, v); } NEXT;
+      CASE(STLW) { const uint32_t a = mfp + u16(); const uint32_t v = POPV; if (!checkAccess(a, 2, opPc)) NEXT; wr16(a, v); } NEXT;
+      CASE(STLL) { const uint32_t a = mfp + u16(); const uint32_t v = POPV; if (!checkAccess(a, 4, opPc)) NEXT; wr32(a, v); } NEXT;
+      CASE(LEAL) PUSHV((mfp + u16()) & 0xFFFF); NEXT;
+      CASE(LDIB) { const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 1, opPc)) NEXT; TOP = rd8(a); } NEXT;
+      CASE(LDIW) { const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 2, opPc)) NEXT; TOP = rd16(a); } NEXT;
+      CASE(LDIL) { const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 4, opPc)) NEXT; TOP = rd32(a); } NEXT;
+      CASE(STIB) { const uint32_t v = POPV; const uint32_t a = POPV & 0xFFFF; if (!checkAccess(a, 1, opPc)) NEXT; wr8(a, v); } NEXT;
+      CASE(STIW) { const uint32_t v = POPV; const uint32_t a = POPV & 0xFFFF; if (!checkAccess(a, 2, opPc)) NEXT; wr16(a, v); } NEXT;
+      CASE(STIL) { const uint32_t v = POPV; const uint32_t a = POPV & 0xFFFF; if (!checkAccess(a, 4, opPc)) NEXT; wr32(a, v); } NEXT;
+      CASE(STIBK) { const uint32_t v = POPV; const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 1, opPc)) NEXT; wr8(a, v); TOP = v & 0xFF; } NEXT;
+      CASE(STIWK) { const uint32_t v = POPV; const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 2, opPc)) NEXT; wr16(a, v); TOP = v & 0xFFFF; } NEXT;
+      CASE(STILK) { const uint32_t v = POPV; const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 4, opPc)) NEXT; wr32(a, v); TOP = v; } NEXT;
+      CASE(COPY) {
+        const uint32_t n = u16();
+        const uint32_t src = POPV & 0xFFFF, dst = POPV & 0xFFFF;
+        if (!checkAccess(src, n, opPc) || !checkAccess(dst, n, opPc)) NEXT;
+        std::memmove(&mem[dst], &mem[src], n);
+      } NEXT;
+
+      CASE(ADDW) BINARY((a + b) & 0xFFFF);
+      CASE(SUBW) BINARY((a - b) & 0xFFFF);
+      CASE(MULW) BINARY((a * b) & 0xFFFF);
+      CASE(DIVW) {
+        const int32_t b = asInt16(POPV), a = asInt16(TOP);
+        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        TOP = w(a / b);
+      } NEXT;
+      CASE(DIVUW) {
+        const uint32_t b = POPV & 0xFFFF, a = TOP & 0xFFFF;
+        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        TOP = a / b;
+      } NEXT;
+      CASE(MODW) {
+        const int32_t b = asInt16(POPV), a = asInt16(TOP);
+        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        TOP = w(a % b);
+      } NEXT;
+      CASE(MODUW) {
+        const uint32_t b = POPV & 0xFFFF, a = TOP & 0xFFFF;
+        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        TOP = a % b;
+      } NEXT;
+      CASE(ANDW) BINARY(a & b & 0xFFFF);
+      CASE(ORW) BINARY((a | b) & 0xFFFF);
+      CASE(XORW) BINARY((a ^ b) & 0xFFFF);
+      // Shift counts come from an 8-bit loop counter: 16 or more shifts
+      // leave nothing (or the sign) behind.
+      CASE(SHLW) BINARY((b & 0xFF) >= 16 ? 0u : (a << (b & 0xFF)) & 0xFFFF);
+      CASE(SHRW) BINARY(w(asInt16(a) >> std::min<uint32_t>(b & 0xFF, 15)));
+      CASE(SHRUW) BINARY((b & 0xFF) >= 16 ? 0u : (a & 0xFFFF) >> (b & 0xFF));
+      CASE(NEGW) TOP = w(-static_cast<int32_t>(TOP)); NEXT;
+      CASE(NOTW) TOP = ~TOP & 0xFFFF; NEXT;
+      CASE(LNOTW) TOP = (TOP & 0xFFFF) == 0; NEXT;
+      CASE(W2B) TOP &= 0xFF; NEXT;
+      CASE(EQW) BINARY((a & 0xFFFF) == (b & 0xFFFF));
+      CASE(NEW) BINARY((a & 0xFFFF) != (b & 0xFFFF));
+      CASE(LTW) BINARY(asInt16(a) < asInt16(b));
+      CASE(LEW) BINARY(asInt16(a) <= asInt16(b));
+      CASE(GTW) BINARY(asInt16(a) > asInt16(b));
+      CASE(GEW) BINARY(asInt16(a) >= asInt16(b));
+      CASE(LTUW) BINARY((a & 0xFFFF) < (b & 0xFFFF));
+      CASE(LEUW) BINARY((a & 0xFFFF) <= (b & 0xFFFF));
+      CASE(GTUW) BINARY((a & 0xFFFF) > (b & 0xFFFF));
+      CASE(GEUW) BINARY((a & 0xFFFF) >= (b & 0xFFFF));
+
+      CASE(ADDL) BINARY(a + b);
+      CASE(SUBL) BINARY(a - b);
+      CASE(MULL) BINARY(a * b);
+      CASE(DIVL) {
+        const int64_t b = static_cast<int32_t>(POPV), a = static_cast<int32_t>(TOP);
+        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        TOP = static_cast<uint32_t>(a / b);  // INT32_MIN / -1 wraps
+      } NEXT;
+      CASE(DIVUL) {
+        const uint32_t b = POPV, a = TOP;
+        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        TOP = a / b;
+      } NEXT;
+      CASE(MODL) {
+        const int64_t b = static_cast<int32_t>(POPV), a = static_cast<int32_t>(TOP);
+        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        TOP = static_cast<uint32_t>(a % b);
+      } NEXT;
+      CASE(MODUL) {
+        const uint32_t b = POPV, a = TOP;
+        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        TOP = a % b;
+      } NEXT;
+      CASE(ANDL) BINARY(a & b);
+      CASE(ORL) BINARY(a | b);
+      CASE(XORL) BINARY(a ^ b);
+      CASE(SHLL) BINARY((b & 0xFF) >= 32 ? 0u : a << (b & 0xFF));
+      CASE(SHRL) BINARY(static_cast<uint32_t>(static_cast<int32_t>(a) >> std::min<uint32_t>(b & 0xFF, 31)));
+      CASE(SHRUL) BINARY((b & 0xFF) >= 32 ? 0u : a >> (b & 0xFF));
+      CASE(NEGL) TOP = 0u - TOP; NEXT;
+      CASE(NOTL) TOP = ~TOP; NEXT;
+      CASE(TESTL) TOP = TOP != 0; NEXT;
+      CASE(EQL) BINARY(a == b);
+      CASE(NEL) BINARY(a != b);
+      CASE(LTL) BINARY(static_cast<int32_t>(a) < static_cast<int32_t>(b));
+      CASE(LEL) BINARY(static_cast<int32_t>(a) <= static_cast<int32_t>(b));
+      CASE(GTL) BINARY(static_cast<int32_t>(a) > static_cast<int32_t>(b));
+      CASE(GEL) BINARY(static_cast<int32_t>(a) >= static_cast<int32_t>(b));
+      CASE(LTUL) BINARY(a < b);
+      CASE(LEUL) BINARY(a <= b);
+      CASE(GTUL) BINARY(a > b);
+      CASE(GEUL) BINARY(a >= b);
+
+      CASE(ADDF) BINARY(fromFloat(asFloat(a) + asFloat(b)));
+      CASE(SUBF) BINARY(fromFloat(asFloat(a) - asFloat(b)));
+      CASE(MULF) BINARY(fromFloat(asFloat(a) * asFloat(b)));
+      CASE(DIVF) {
+        const float b = asFloat(POPV), a = asFloat(TOP);
+        if (b == 0.0f) { raiseFault("division by zero", opPc); NEXT; }
+        TOP = fromFloat(a / b);
+      } NEXT;
+      CASE(NEGF) TOP ^= 0x80000000u; NEXT;
+      CASE(TESTF) TOP = asFloat(TOP) != 0.0f; NEXT;
+      CASE(EQF) BINARY(asFloat(a) == asFloat(b));
+      CASE(NEF) BINARY(asFloat(a) != asFloat(b));
+      CASE(LTF) BINARY(asFloat(a) < asFloat(b));
+      CASE(LEF) BINARY(asFloat(a) <= asFloat(b));
+      CASE(GTF) BINARY(asFloat(a) > asFloat(b));
+      CASE(GEF) BINARY(asFloat(a) >= asFloat(b));
+
+      CASE(W2L) TOP = static_cast<uint32_t>(static_cast<int32_t>(asInt16(TOP))); NEXT;
+      CASE(UW2L) TOP &= 0xFFFF; NEXT;
+      CASE(L2W) TOP &= 0xFFFF; NEXT;
+      CASE(W2F) TOP = fromFloat(static_cast<float>(asInt16(TOP))); NEXT;
+      CASE(UW2F) TOP = fromFloat(static_cast<float>(TOP & 0xFFFF)); NEXT;
+      CASE(L2F) TOP = fromFloat(static_cast<float>(static_cast<int32_t>(TOP))); NEXT;
+      CASE(UL2F) TOP = fromFloat(static_cast<float>(TOP)); NEXT;
+      CASE(F2W) TOP = static_cast<uint32_t>(truncToRange(asFloat(TOP), -2147483648.0, 2147483647.0)) & 0xFFFF; NEXT;
+      CASE(F2L) TOP = static_cast<uint32_t>(truncToRange(asFloat(TOP), -2147483648.0, 2147483647.0)); NEXT;
+      CASE(F2UL) TOP = static_cast<uint32_t>(truncToRange(asFloat(TOP), -2147483648.0, 4294967295.0)); NEXT;
+
+      CASE(JMP) pc = static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16())); NEXT;
+      CASE(JZ) {
+        const uint32_t target = static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
+        if ((POPV & 0xFFFF) == 0) pc = target;
+      } NEXT;
+      CASE(JNZ) {
+        const uint32_t target = static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
+        if ((POPV & 0xFFFF) != 0) pc = target;
+      } NEXT;
+      CASE(CALL) {
+        if (msp < stackLimit + kCallFrameBytes) { raiseFault("stack overflow", opPc); NEXT; }
+        if (sp > kEvalSlots - kEvalHeadroom) { raiseFault("stack overflow (expression stack)", opPc); NEXT; }
+        calls.push_back(CallFrame{pc, msp, mfp});
+        msp -= kCallFrameBytes;
+        pc = u16();
+      } NEXT;
+      CASE(ENTER) {
+        const uint32_t size = u16();
+        if (msp < stackLimit + size) { raiseFault("stack overflow", opPc); NEXT; }
+        msp -= size;
+        mfp = msp;
+      } NEXT;
+      CASE(RET) {
+        if (calls.empty() ||
+            (!ints.empty() && static_cast<int>(calls.size()) <= ints.back().callDepth)) {
+          raiseFault("return with no caller", opPc);
+          NEXT;
+        }
+        const CallFrame f = calls.back();
+        calls.pop_back();
+        pc = f.retPc;
+        msp = f.msp;
+        mfp = f.mfp;
+      } NEXT;
+      CASE(RETI) {
+        if (ints.empty() || static_cast<int>(calls.size()) != ints.back().callDepth) {
+          raiseFault("RETI outside an interrupt handler", opPc);
+          NEXT;
+        }
+        InterruptFrame& f = ints.back();
+        if (f.evalSp != sp) { raiseFault("internal error: stack imbalance at RETI", opPc); NEXT; }
+        pc = f.retPc;
+        msp = f.msp;
+        mfp = f.mfp;
+        halted = f.halted;
+        burn = f.burn;
+        lib = std::move(f.lib);
+        const Irq irq = f.irq;
+        ints.pop_back();
+        if (costs.knobs.epilogueEi) iff1 = iff2 = true;
+        bus.interruptReturned(now, irq);
+        busTouched = true;
+      } NEXT;
+      CASE(HALT) {
+        pc = opPc;  // stays on HALT; an interrupt returns here
+        if (!halted) flushConsole();
+        halted = true;
+      } NEXT;
+      CASE(LIB) {
+        const int id = operand[0];
+        const int argc = operand[1];
+        if (id >= kLibCount || argc > kMaxLibArgs || argc > sp) {
+          raiseFault("invalid library call", opPc);
+          NEXT;
+        }
+        libCall(static_cast<Lib>(id), argc, opPc);
+      } NEXT;
+      CASE(EI) iff1 = iff2 = true; eiShadow = true; NEXT;
+      CASE(DI) iff1 = iff2 = false; NEXT;
+      CASE(DBG) NEXT;
+#if !SIMBOT_COMPUTED_GOTO
+        case Op::Count_: break;
+      }
+#endif
+#undef TOP
+#undef POPV
+#undef PUSHV
+#undef BINARY
+    }
+  }
+#undef CASE
+#undef NEXT
+}
+
+// ---- public interface ---------------------------------------------------
+
+Vm::Vm(const Image& image, Bus& bus, const CostTable& costs)
+    : s_(std::make_unique<State>(image, bus, costs)) {
+  State& s = *s_;
+  s.self = this;
+  std::copy(image.data.begin(), image.data.end(), s.mem.begin() + kDataBase);
+  s.stackLimit = kDataBase + static_cast<uint32_t>(image.data.size());
+  s.pc = image.entry;
+  s.handlerFor.fill(-1);
+  for (const auto& v : image.vectors) s.handlerFor[v.vector] = v.handler;
+  s.calls.reserve(kMemorySize / kCallFrameBytes);
+  s.ints.reserve(kMaxInterruptNesting);
+}
+
+Vm::~Vm() = default;
+
+Stop Vm::run(Tick until) {
+  return s_->profiling ? s_->run<true>(until) : s_->run<false>(until);
+}
+
+void Vm::request(Irq irq, uint8_t vector) {
+  const int i = static_cast<int>(irq);
+  s_->pend[i] = true;
+  s_->vec[i] = vector;
+  s_->anyPending = true;
+}
+
+void Vm::cancelRequest(Irq irq) {
+  s_->pend[static_cast<int>(irq)] = false;
+  s_->updatePending();
+}
+
+bool Vm::pending(Irq irq) const { return s_->pend[static_cast<int>(irq)]; }
+Tick Vm::now() const { return s_->now; }
+bool Vm::halted() const { return s_->halted; }
+const Fault* Vm::fault() const { return s_->fault ? &*s_->fault : nullptr; }
+bool Vm::interruptsEnabled() const { return s_->iff1; }
+uint32_t Vm::pc() const {
+  return s_->lib.active ? s_->lib.pc : s_->burn ? s_->burnPc : s_->pc;
+}
+int Vm::line() const { return s_->image.lineAt(pc()); }
+uint8_t Vm::read8(uint16_t a) const { return s_->rd8(a); }
+void Vm::write8(uint16_t a, uint8_t v) { s_->wr8(a, v); }
+uint16_t Vm::read16(uint16_t a) const { return s_->rd16(a); }
+uint32_t Vm::read32(uint16_t a) const { return s_->rd32(a); }
+const VmStats& Vm::stats() const { return s_->stats; }
+const Image& Vm::image() const { return s_->image; }
+
+void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
+  State& s = *s_;
+  if (s.breakpoints.empty()) s.breakpoints.assign(s.image.code.size() + 1, 0);
+  if (codeAddress < s.breakpoints.size()) s.breakpoints[codeAddress] = enabled ? 1 : 0;
+  s.anyBreakpoint = std::any_of(s.breakpoints.begin(), s.breakpoints.end(), [](uint8_t b) { return b != 0; });
+}
+
+void Vm::enableProfile() {
+  s_->profiling = true;
+  s_->profile.assign(s_->image.code.size() + 1, 0);
+}
+const std::vector<uint64_t>& Vm::profile() const { return s_->profile; }
+uint64_t Vm::serialIsrCycles() const { return s_->serialIsrCycles; }
+
+}  // namespace simbot::vm

@@ -1,0 +1,134 @@
+// The cycle-counted VM: runs one robot's Image against an I/O bus that the
+// host implements. It knows nothing of robots; it sees port reads and writes,
+// A/D samples, the serial library's hooks and interrupt requests.
+//
+// Time is the robot's clock in ticks of 9.216 MHz (one Z180 T-state). Every
+// instruction and library step adds its cost from the CostTable.
+//
+// Interrupts (DESIGN.md "Interrupts"): a request made at tick c is accepted
+// at the first instruction boundary b >= c at which IFF1 is set (never
+// inside the instruction after EI: the EI shadow). Acceptance clears
+// IFF1/IFF2, pushes the interrupted state and charges the acceptance cost;
+// the handler's first instruction starts at b + that cost. RETI restores,
+// and the compiler's epilogue sets IFF1 again unless the knob drops it.
+// Pending requests are taken in priority order Pio, SerialTx, Timer. Long
+// library calls run as steps of <= 100 T-states with a boundary between
+// steps; a handler accepted there resumes the call when it returns.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vm/cost.h"
+#include "vm/image.h"
+
+namespace simbot::vm {
+
+using Tick = int64_t;
+inline constexpr Tick kTicksPerSecond = 9'216'000;
+
+// Interrupt sources in priority order (0 = highest).
+enum class Irq : uint8_t { Pio = 0, SerialTx = 1, Timer = 2 };
+inline constexpr int kIrqCount = 3;
+std::string_view irqName(Irq irq);  // "pio_a", "serial_tx", "timer"
+
+class Vm;
+
+// What the host provides. Every call carries the exact tick of the access.
+class Bus {
+ public:
+  virtual ~Bus() = default;
+  virtual void out(Tick t, uint16_t port, uint8_t value) = 0;
+  virtual uint8_t in(Tick t, uint16_t port) = 0;
+  // ad_rd8(channel): the value it returns, sampled at t, the start of the
+  // conversion.
+  virtual int adSample(Tick t, int channel) = 0;
+  virtual void hvEnable(Tick) {}
+  virtual void serialInit(Tick, int /*mode*/, int /*baudDivisor*/) {}
+  // ser_send_z1 returned at t (T0) having pointed the library at buf/cc.
+  virtual void serialSend(Tick, uint16_t /*buf*/, uint16_t /*ccAddress*/) {}
+  // The serial library's transmit interrupt service, running at t (after
+  // acceptance); it reads the next byte from robot memory through vm.
+  virtual void serialTxService(Tick, Vm&) {}
+  virtual void console(Tick, std::string_view /*line*/) {}
+  // Notifications for traces and device logic (PIO "under service").
+  virtual void interruptAccepted(Tick, Irq, uint32_t /*interruptedPc*/) {}
+  virtual void interruptReturned(Tick, Irq) {}
+};
+
+struct Fault {
+  std::string message;
+  Tick tick = 0;
+  int line = 0;
+};
+
+enum class Stop : uint8_t {
+  Horizon,  // reached `until`: the next instruction starts at or after it
+  Io,       // an instruction touched the bus; host may schedule and resume
+  Halted,   // main returned (interrupts still run on later calls)
+  Fault,    // the robot faulted; it never runs again
+  Breakpoint,  // the next instruction is at a breakpoint; run() again to go on
+};
+
+struct VmStats {
+  uint64_t instructions = 0;  // bytecode instructions and library steps
+  std::array<uint64_t, kIrqCount> interrupts{};
+};
+
+class Vm {
+ public:
+  Vm(const Image& image, Bus& bus, const CostTable& costs);
+  ~Vm();
+  Vm(const Vm&) = delete;
+  Vm& operator=(const Vm&) = delete;
+
+  // Executes every instruction that starts before `until`. Returns early
+  // after an instruction that touched the bus.
+  Stop run(Tick until);
+
+  // Raise a request now (at now()); it stays pending until accepted. For
+  // vectored sources the vector byte selects the #INT_VEC handler.
+  void request(Irq irq, uint8_t vector = 0);
+  void cancelRequest(Irq irq);
+  bool pending(Irq irq) const;
+
+  Tick now() const;
+  bool halted() const;
+  const Fault* fault() const;  // null unless faulted
+  bool interruptsEnabled() const;
+  uint32_t pc() const;
+  int line() const;  // source line of the next instruction
+
+  // Robot memory, for the host (serial ISR, tests, watches).
+  uint8_t read8(uint16_t address) const;
+  void write8(uint16_t address, uint8_t value);
+  uint16_t read16(uint16_t address) const;
+  uint32_t read32(uint16_t address) const;
+
+  const VmStats& stats() const;
+  const Image& image() const;
+
+  // Stop before executing the instruction at `codeAddress` (used for
+  // program-point injection and for tests). The next run() executes it.
+  void setBreakpoint(uint32_t codeAddress, bool enabled = true);
+
+  // Profile: cycles charged at each code address (instruction start), when
+  // enabled before running. Interrupt acceptance is charged to the handler's
+  // first instruction; serial ISR time to `serialIsrCycles`.
+  void enableProfile();
+  const std::vector<uint64_t>& profile() const;
+  uint64_t serialIsrCycles() const;
+
+  struct State;
+
+ private:
+  std::unique_ptr<State> s_;
+};
+
+// Disassembly of an image, interleaving source lines (vm/disasm.cpp).
+std::string disassemble(const Image& image);
+
+}  // namespace simbot::vm
