@@ -37,13 +37,17 @@ enum class Shape : uint8_t { NONE, U8, U16, REL16, I32, F32, LIB };
 
 constexpr int operandBytes(Shape s) {
   switch (s) {
-    case Shape::NONE: return 0;
-    case Shape::U8: return 1;
+    case Shape::NONE:
+      return 0;
+    case Shape::U8:
+      return 1;
     case Shape::U16:
     case Shape::REL16:
-    case Shape::LIB: return 2;
+    case Shape::LIB:
+      return 2;
     case Shape::I32:
-    case Shape::F32: return 4;
+    case Shape::F32:
+      return 4;
   }
   return 0;
 }
@@ -51,8 +55,8 @@ constexpr int operandBytes(Shape s) {
 struct OpInfo {
   std::string_view name;
   Shape shape;
-  int8_t pop;   // -1: depends on operands
-  int8_t push;  // -1: depends on operands
+  int8_t pop;             // -1: depends on operands
+  int8_t push;            // -1: depends on operands
   std::string_view z180;  // the Z180 sequence whose T-states are its cost
 };
 

@@ -1,10 +1,10 @@
 // Disassembler: one line per instruction (address, T-states, name, operands),
 // a label at each function and the source line above the code it produced.
 // One small helper per operand shape, as in craftinginterpreters' debug.c.
+#include <fmt/format.h>
+
 #include <bit>
 #include <map>
-
-#include <fmt/format.h>
 
 #include "vm/cost.h"
 #include "vm/vm.h"
@@ -13,9 +13,7 @@ namespace simbot::vm {
 
 namespace {
 
-uint32_t readU16(const Image& img, uint32_t at) {
-  return img.code[at] | (img.code[at + 1] << 8);
-}
+uint32_t readU16(const Image& img, uint32_t at) { return img.code[at] | (img.code[at + 1] << 8); }
 uint32_t readU32(const Image& img, uint32_t at) {
   return readU16(img, at) | (readU16(img, at + 2) << 16);
 }
@@ -43,13 +41,20 @@ std::string libOperand(const Image& img, uint32_t at) {
 
 std::string operandText(Shape shape, const Image& img, uint32_t at) {
   switch (shape) {
-    case Shape::NONE: return noOperand(img, at);
-    case Shape::U8: return u8Operand(img, at);
-    case Shape::U16: return u16Operand(img, at);
-    case Shape::REL16: return rel16Operand(img, at);
-    case Shape::I32: return i32Operand(img, at);
-    case Shape::F32: return f32Operand(img, at);
-    case Shape::LIB: return libOperand(img, at);
+    case Shape::NONE:
+      return noOperand(img, at);
+    case Shape::U8:
+      return u8Operand(img, at);
+    case Shape::U16:
+      return u16Operand(img, at);
+    case Shape::REL16:
+      return rel16Operand(img, at);
+    case Shape::I32:
+      return i32Operand(img, at);
+    case Shape::F32:
+      return f32Operand(img, at);
+    case Shape::LIB:
+      return libOperand(img, at);
   }
   return "";
 }
@@ -61,8 +66,8 @@ std::string annotate(const Image& img, Op op, uint32_t at) {
   const uint32_t value = readU16(img, at);
   const bool codeAddress = op == Op::CALL;
   const bool dataAddress = op == Op::LDGB || op == Op::LDGW || op == Op::LDGL || op == Op::STGB ||
-                           op == Op::STGW || op == Op::STGL || op == Op::INCGW ||
-                           op == Op::DECGW || op == Op::INCGL;
+                           op == Op::STGW || op == Op::STGL || op == Op::INCGW || op == Op::DECGW ||
+                           op == Op::INCGL;
   for (const auto& s : img.symbols) {
     const bool isCode = s.kind == Symbol::Kind::Function || s.kind == Symbol::Kind::Handler;
     if (codeAddress && isCode && s.address == value) return s.name;
@@ -82,8 +87,8 @@ std::string disassemble(const Image& img) {
     if (s.kind == Symbol::Kind::Function || s.kind == Symbol::Kind::Handler)
       labels[s.address] = s.kind == Symbol::Kind::Handler ? s.name + " (interrupt)" : s.name;
 
-  std::string out = fmt::format("; {}: {} code bytes, {} data bytes at 0x{:04x}\n",
-                                img.sourceName, img.code.size(), img.data.size(), kDataBase);
+  std::string out = fmt::format("; {}: {} code bytes, {} data bytes at 0x{:04x}\n", img.sourceName,
+                                img.code.size(), img.data.size(), kDataBase);
   for (const auto& v : img.vectors)
     out += fmt::format("; vector 0x{:02x} -> {} at {:04x}\n", v.vector, v.handlerName, v.handler);
   out += "; addr  T-st  op       operands\n";

@@ -26,19 +26,19 @@ inline constexpr uint16_t kPortENB485 = 0xC0;
 inline constexpr uint8_t kVecPIOA = 0x10;
 
 struct VectorBinding {
-  uint8_t vector;        // IM2 vector byte
-  uint16_t handler;      // code address of the interrupt reti function
+  uint8_t vector;    // IM2 vector byte
+  uint16_t handler;  // code address of the interrupt reti function
   std::string handlerName;
 };
 
 struct Symbol {
   enum class Kind : uint8_t { Function, Handler, Global, Static, Auto, Param };
-  std::string name;      // for statics and autos: "function.name"
+  std::string name;  // for statics and autos: "function.name"
   Kind kind;
-  uint32_t address;      // code address (functions), memory address (data),
-                         // frame offset (autos)
-  uint32_t size;         // bytes (data) or code bytes (functions)
-  std::string type;      // C type as written, e.g. "unsigned long"
+  uint32_t address;  // code address (functions), memory address (data),
+                     // frame offset (autos)
+  uint32_t size;     // bytes (data) or code bytes (functions)
+  std::string type;  // C type as written, e.g. "unsigned long"
   int line;
 };
 

@@ -18,14 +18,14 @@
 // Computed goto (labels as values) is a GNU extension used on purpose.
 #pragma GCC diagnostic ignored "-Wpedantic"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <optional>
-
-#include <fmt/format.h>
 
 #ifndef SIMBOT_COMPUTED_GOTO
 #if defined(__GNUC__)
@@ -97,9 +97,12 @@ int64_t truncToRange(float f, double lo, double hi) {
 
 std::string_view irqName(Irq irq) {
   switch (irq) {
-    case Irq::Pio: return "pio_a";
-    case Irq::SerialTx: return "serial_tx";
-    case Irq::Timer: return "timer";
+    case Irq::Pio:
+      return "pio_a";
+    case Irq::SerialTx:
+      return "serial_tx";
+    case Irq::Timer:
+      return "timer";
   }
   return "?";
 }
@@ -167,9 +170,7 @@ struct Vm::State {
   uint16_t rd16(uint32_t a) const {
     return static_cast<uint16_t>(mem[a & 0xFFFF] | (mem[(a + 1) & 0xFFFF] << 8));
   }
-  uint32_t rd32(uint32_t a) const {
-    return rd16(a) | (static_cast<uint32_t>(rd16(a + 2)) << 16);
-  }
+  uint32_t rd32(uint32_t a) const { return rd16(a) | (static_cast<uint32_t>(rd16(a + 2)) << 16); }
   void wr8(uint32_t a, uint32_t v) { mem[a & 0xFFFF] = static_cast<uint8_t>(v); }
   void wr16(uint32_t a, uint32_t v) {
     wr8(a, v);
@@ -248,8 +249,8 @@ void Vm::State::accept() {
     raiseFault("stack overflow (interrupt frame)", interruptedPc);
     return;
   }
-  ints.push_back(InterruptFrame{pc, irq, msp, mfp, sp, static_cast<int>(calls.size()), halted,
-                                burn, std::move(lib)});
+  ints.push_back(InterruptFrame{pc, irq, msp, mfp, sp, static_cast<int>(calls.size()), halted, burn,
+                                std::move(lib)});
   lib = LibCall{};
   burn = 0;
   resumeAtBreakpoint = false;
@@ -345,8 +346,7 @@ std::string Vm::State::formatPrintf(uint32_t instructionPc) {
       case 'f':
       case 'e':
       case 'g':
-        std::snprintf(buf, sizeof buf, (spec + conv).c_str(),
-                      static_cast<double>(asFloat(arg())));
+        std::snprintf(buf, sizeof buf, (spec + conv).c_str(), static_cast<double>(asFloat(arg())));
         out += buf;
         break;
       case '%':
@@ -636,82 +636,216 @@ Stop Vm::State::run(Tick until) {
 #define TOP e[sp - 1]
 #define POPV e[--sp]
 #define PUSHV(v) e[sp++] = (v)
-#define BINARY(expr)        \
-  {                         \
+#define BINARY(expr)         \
+  {                          \
     const uint32_t b = POPV; \
     const uint32_t a = TOP;  \
-    TOP = (expr);           \
-  }                         \
+    TOP = (expr);            \
+  }                          \
   NEXT
 #if SIMBOT_COMPUTED_GOTO
       goto* kLabels[op];
 #else
       switch (static_cast<Op>(op)) {
 #endif
-      CASE(PUSHW) PUSHV(u16()); NEXT;
-      CASE(PUSHL) PUSHV(i32()); NEXT;
-      CASE(PUSHF) PUSHV(i32()); NEXT;
-      CASE(POP) --sp; NEXT;
-      CASE(DUP) { const uint32_t v = TOP; PUSHV(v); } NEXT;
+      CASE(PUSHW) PUSHV(u16());
+      NEXT;
+      CASE(PUSHL) PUSHV(i32());
+      NEXT;
+      CASE(PUSHF) PUSHV(i32());
+      NEXT;
+      CASE(POP)-- sp;
+      NEXT;
+      CASE(DUP) {
+        const uint32_t v = TOP;
+        PUSHV(v);
+      }
+      NEXT;
       CASE(TUCK) {
         const uint32_t b = POPV, a = POPV;
-        PUSHV(b); PUSHV(a); PUSHV(b);
-      } NEXT;
-      CASE(LDGB) PUSHV(rd8(u16())); NEXT;
-      CASE(LDGW) PUSHV(rd16(u16())); NEXT;
-      CASE(LDGL) PUSHV(rd32(u16())); NEXT;
-      CASE(STGB) wr8(u16(), POPV); NEXT;
-      CASE(STGW) wr16(u16(), POPV); NEXT;
-      CASE(STGL) wr32(u16(), POPV); NEXT;
-      CASE(INCGW) { const uint32_t a = u16(); wr16(a, rd16(a) + 1u); } NEXT;
-      CASE(DECGW) { const uint32_t a = u16(); wr16(a, rd16(a) - 1u); } NEXT;
-      CASE(INCGL) { const uint32_t a = u16(); wr32(a, rd32(a) + 1u); } NEXT;
-      CASE(LDLB) { const uint32_t a = mfp + u16(); if (!checkAccess(a, 1, opPc)) NEXT; PUSHV(rd8(a)); } NEXT;
-      CASE(LDLW) { const uint32_t a = mfp + u16(); if (!checkAccess(a, 2, opPc)) NEXT; PUSHV(rd16(a)); } NEXT;
-      CASE(LDLL) { const uint32_t a = mfp + u16(); if (!checkAccess(a, 4, opPc)) NEXT; PUSHV(rd32(a)); } NEXT;
-      CASE(STLB) { const uint32_t a = mfp + u16(); const uint32_t v = POPV; if (!checkAccess(a, 1, opPc)) NEXT; wr8(a, v); } NEXT;
-      CASE(STLW) { const uint32_t a = mfp + u16(); const uint32_t v = POPV; if (!checkAccess(a, 2, opPc)) NEXT; wr16(a, v); } NEXT;
-      CASE(STLL) { const uint32_t a = mfp + u16(); const uint32_t v = POPV; if (!checkAccess(a, 4, opPc)) NEXT; wr32(a, v); } NEXT;
-      CASE(LEAL) PUSHV((mfp + u16()) & 0xFFFF); NEXT;
-      CASE(LDIB) { const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 1, opPc)) NEXT; TOP = rd8(a); } NEXT;
-      CASE(LDIW) { const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 2, opPc)) NEXT; TOP = rd16(a); } NEXT;
-      CASE(LDIL) { const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 4, opPc)) NEXT; TOP = rd32(a); } NEXT;
-      CASE(STIB) { const uint32_t v = POPV; const uint32_t a = POPV & 0xFFFF; if (!checkAccess(a, 1, opPc)) NEXT; wr8(a, v); } NEXT;
-      CASE(STIW) { const uint32_t v = POPV; const uint32_t a = POPV & 0xFFFF; if (!checkAccess(a, 2, opPc)) NEXT; wr16(a, v); } NEXT;
-      CASE(STIL) { const uint32_t v = POPV; const uint32_t a = POPV & 0xFFFF; if (!checkAccess(a, 4, opPc)) NEXT; wr32(a, v); } NEXT;
-      CASE(STIBK) { const uint32_t v = POPV; const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 1, opPc)) NEXT; wr8(a, v); TOP = v & 0xFF; } NEXT;
-      CASE(STIWK) { const uint32_t v = POPV; const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 2, opPc)) NEXT; wr16(a, v); TOP = v & 0xFFFF; } NEXT;
-      CASE(STILK) { const uint32_t v = POPV; const uint32_t a = TOP & 0xFFFF; if (!checkAccess(a, 4, opPc)) NEXT; wr32(a, v); TOP = v; } NEXT;
+        PUSHV(b);
+        PUSHV(a);
+        PUSHV(b);
+      }
+      NEXT;
+      CASE(LDGB) PUSHV(rd8(u16()));
+      NEXT;
+      CASE(LDGW) PUSHV(rd16(u16()));
+      NEXT;
+      CASE(LDGL) PUSHV(rd32(u16()));
+      NEXT;
+      CASE(STGB) wr8(u16(), POPV);
+      NEXT;
+      CASE(STGW) wr16(u16(), POPV);
+      NEXT;
+      CASE(STGL) wr32(u16(), POPV);
+      NEXT;
+      CASE(INCGW) {
+        const uint32_t a = u16();
+        wr16(a, rd16(a) + 1u);
+      }
+      NEXT;
+      CASE(DECGW) {
+        const uint32_t a = u16();
+        wr16(a, rd16(a) - 1u);
+      }
+      NEXT;
+      CASE(INCGL) {
+        const uint32_t a = u16();
+        wr32(a, rd32(a) + 1u);
+      }
+      NEXT;
+      CASE(LDLB) {
+        const uint32_t a = mfp + u16();
+        if (!checkAccess(a, 1, opPc)) NEXT;
+        PUSHV(rd8(a));
+      }
+      NEXT;
+      CASE(LDLW) {
+        const uint32_t a = mfp + u16();
+        if (!checkAccess(a, 2, opPc)) NEXT;
+        PUSHV(rd16(a));
+      }
+      NEXT;
+      CASE(LDLL) {
+        const uint32_t a = mfp + u16();
+        if (!checkAccess(a, 4, opPc)) NEXT;
+        PUSHV(rd32(a));
+      }
+      NEXT;
+      CASE(STLB) {
+        const uint32_t a = mfp + u16();
+        const uint32_t v = POPV;
+        if (!checkAccess(a, 1, opPc)) NEXT;
+        wr8(a, v);
+      }
+      NEXT;
+      CASE(STLW) {
+        const uint32_t a = mfp + u16();
+        const uint32_t v = POPV;
+        if (!checkAccess(a, 2, opPc)) NEXT;
+        wr16(a, v);
+      }
+      NEXT;
+      CASE(STLL) {
+        const uint32_t a = mfp + u16();
+        const uint32_t v = POPV;
+        if (!checkAccess(a, 4, opPc)) NEXT;
+        wr32(a, v);
+      }
+      NEXT;
+      CASE(LEAL) PUSHV((mfp + u16()) & 0xFFFF);
+      NEXT;
+      CASE(LDIB) {
+        const uint32_t a = TOP & 0xFFFF;
+        if (!checkAccess(a, 1, opPc)) NEXT;
+        TOP = rd8(a);
+      }
+      NEXT;
+      CASE(LDIW) {
+        const uint32_t a = TOP & 0xFFFF;
+        if (!checkAccess(a, 2, opPc)) NEXT;
+        TOP = rd16(a);
+      }
+      NEXT;
+      CASE(LDIL) {
+        const uint32_t a = TOP & 0xFFFF;
+        if (!checkAccess(a, 4, opPc)) NEXT;
+        TOP = rd32(a);
+      }
+      NEXT;
+      CASE(STIB) {
+        const uint32_t v = POPV;
+        const uint32_t a = POPV & 0xFFFF;
+        if (!checkAccess(a, 1, opPc)) NEXT;
+        wr8(a, v);
+      }
+      NEXT;
+      CASE(STIW) {
+        const uint32_t v = POPV;
+        const uint32_t a = POPV & 0xFFFF;
+        if (!checkAccess(a, 2, opPc)) NEXT;
+        wr16(a, v);
+      }
+      NEXT;
+      CASE(STIL) {
+        const uint32_t v = POPV;
+        const uint32_t a = POPV & 0xFFFF;
+        if (!checkAccess(a, 4, opPc)) NEXT;
+        wr32(a, v);
+      }
+      NEXT;
+      CASE(STIBK) {
+        const uint32_t v = POPV;
+        const uint32_t a = TOP & 0xFFFF;
+        if (!checkAccess(a, 1, opPc)) NEXT;
+        wr8(a, v);
+        TOP = v & 0xFF;
+      }
+      NEXT;
+      CASE(STIWK) {
+        const uint32_t v = POPV;
+        const uint32_t a = TOP & 0xFFFF;
+        if (!checkAccess(a, 2, opPc)) NEXT;
+        wr16(a, v);
+        TOP = v & 0xFFFF;
+      }
+      NEXT;
+      CASE(STILK) {
+        const uint32_t v = POPV;
+        const uint32_t a = TOP & 0xFFFF;
+        if (!checkAccess(a, 4, opPc)) NEXT;
+        wr32(a, v);
+        TOP = v;
+      }
+      NEXT;
       CASE(COPY) {
         const uint32_t n = u16();
         const uint32_t src = POPV & 0xFFFF, dst = POPV & 0xFFFF;
         if (!checkAccess(src, n, opPc) || !checkAccess(dst, n, opPc)) NEXT;
         std::memmove(&mem[dst], &mem[src], n);
-      } NEXT;
+      }
+      NEXT;
 
       CASE(ADDW) BINARY((a + b) & 0xFFFF);
       CASE(SUBW) BINARY((a - b) & 0xFFFF);
       CASE(MULW) BINARY((a * b) & 0xFFFF);
       CASE(DIVW) {
         const int32_t b = asInt16(POPV), a = asInt16(TOP);
-        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        if (b == 0) {
+          raiseFault("division by zero", opPc);
+          NEXT;
+        }
         TOP = w(a / b);
-      } NEXT;
+      }
+      NEXT;
       CASE(DIVUW) {
         const uint32_t b = POPV & 0xFFFF, a = TOP & 0xFFFF;
-        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        if (b == 0) {
+          raiseFault("division by zero", opPc);
+          NEXT;
+        }
         TOP = a / b;
-      } NEXT;
+      }
+      NEXT;
       CASE(MODW) {
         const int32_t b = asInt16(POPV), a = asInt16(TOP);
-        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        if (b == 0) {
+          raiseFault("division by zero", opPc);
+          NEXT;
+        }
         TOP = w(a % b);
-      } NEXT;
+      }
+      NEXT;
       CASE(MODUW) {
         const uint32_t b = POPV & 0xFFFF, a = TOP & 0xFFFF;
-        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        if (b == 0) {
+          raiseFault("division by zero", opPc);
+          NEXT;
+        }
         TOP = a % b;
-      } NEXT;
+      }
+      NEXT;
       CASE(ANDW) BINARY(a & b & 0xFFFF);
       CASE(ORW) BINARY((a | b) & 0xFFFF);
       CASE(XORW) BINARY((a ^ b) & 0xFFFF);
@@ -720,10 +854,14 @@ Stop Vm::State::run(Tick until) {
       CASE(SHLW) BINARY((b & 0xFF) >= 16 ? 0u : (a << (b & 0xFF)) & 0xFFFF);
       CASE(SHRW) BINARY(w(asInt16(a) >> std::min<uint32_t>(b & 0xFF, 15)));
       CASE(SHRUW) BINARY((b & 0xFF) >= 16 ? 0u : (a & 0xFFFF) >> (b & 0xFF));
-      CASE(NEGW) TOP = w(-static_cast<int32_t>(TOP)); NEXT;
-      CASE(NOTW) TOP = ~TOP & 0xFFFF; NEXT;
-      CASE(LNOTW) TOP = (TOP & 0xFFFF) == 0; NEXT;
-      CASE(W2B) TOP &= 0xFF; NEXT;
+      CASE(NEGW) TOP = w(-static_cast<int32_t>(TOP));
+      NEXT;
+      CASE(NOTW) TOP = ~TOP & 0xFFFF;
+      NEXT;
+      CASE(LNOTW) TOP = (TOP & 0xFFFF) == 0;
+      NEXT;
+      CASE(W2B) TOP &= 0xFF;
+      NEXT;
       CASE(EQW) BINARY((a & 0xFFFF) == (b & 0xFFFF));
       CASE(NEW) BINARY((a & 0xFFFF) != (b & 0xFFFF));
       CASE(LTW) BINARY(asInt16(a) < asInt16(b));
@@ -740,33 +878,53 @@ Stop Vm::State::run(Tick until) {
       CASE(MULL) BINARY(a * b);
       CASE(DIVL) {
         const int64_t b = static_cast<int32_t>(POPV), a = static_cast<int32_t>(TOP);
-        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        if (b == 0) {
+          raiseFault("division by zero", opPc);
+          NEXT;
+        }
         TOP = static_cast<uint32_t>(a / b);  // INT32_MIN / -1 wraps
-      } NEXT;
+      }
+      NEXT;
       CASE(DIVUL) {
         const uint32_t b = POPV, a = TOP;
-        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        if (b == 0) {
+          raiseFault("division by zero", opPc);
+          NEXT;
+        }
         TOP = a / b;
-      } NEXT;
+      }
+      NEXT;
       CASE(MODL) {
         const int64_t b = static_cast<int32_t>(POPV), a = static_cast<int32_t>(TOP);
-        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        if (b == 0) {
+          raiseFault("division by zero", opPc);
+          NEXT;
+        }
         TOP = static_cast<uint32_t>(a % b);
-      } NEXT;
+      }
+      NEXT;
       CASE(MODUL) {
         const uint32_t b = POPV, a = TOP;
-        if (b == 0) { raiseFault("division by zero", opPc); NEXT; }
+        if (b == 0) {
+          raiseFault("division by zero", opPc);
+          NEXT;
+        }
         TOP = a % b;
-      } NEXT;
+      }
+      NEXT;
       CASE(ANDL) BINARY(a & b);
       CASE(ORL) BINARY(a | b);
       CASE(XORL) BINARY(a ^ b);
       CASE(SHLL) BINARY((b & 0xFF) >= 32 ? 0u : a << (b & 0xFF));
-      CASE(SHRL) BINARY(static_cast<uint32_t>(static_cast<int32_t>(a) >> std::min<uint32_t>(b & 0xFF, 31)));
+      CASE(SHRL)
+      BINARY(static_cast<uint32_t>(static_cast<int32_t>(a) >> std::min<uint32_t>(b & 0xFF, 31)));
       CASE(SHRUL) BINARY((b & 0xFF) >= 32 ? 0u : a >> (b & 0xFF));
-      CASE(NEGL) TOP = 0u - TOP; NEXT;
-      CASE(NOTL) TOP = ~TOP; NEXT;
-      CASE(TESTL) TOP = TOP != 0; NEXT;
+      CASE(NEGL) TOP = 0u - TOP;
+      NEXT;
+      CASE(NOTL) TOP = ~TOP;
+      NEXT;
+      CASE(TESTL) TOP = TOP != 0;
+      NEXT;
       CASE(EQL) BINARY(a == b);
       CASE(NEL) BINARY(a != b);
       CASE(LTL) BINARY(static_cast<int32_t>(a) < static_cast<int32_t>(b));
@@ -783,11 +941,17 @@ Stop Vm::State::run(Tick until) {
       CASE(MULF) BINARY(fromFloat(asFloat(a) * asFloat(b)));
       CASE(DIVF) {
         const float b = asFloat(POPV), a = asFloat(TOP);
-        if (b == 0.0f) { raiseFault("division by zero", opPc); NEXT; }
+        if (b == 0.0f) {
+          raiseFault("division by zero", opPc);
+          NEXT;
+        }
         TOP = fromFloat(a / b);
-      } NEXT;
-      CASE(NEGF) TOP ^= 0x80000000u; NEXT;
-      CASE(TESTF) TOP = asFloat(TOP) != 0.0f; NEXT;
+      }
+      NEXT;
+      CASE(NEGF) TOP ^= 0x80000000u;
+      NEXT;
+      CASE(TESTF) TOP = asFloat(TOP) != 0.0f;
+      NEXT;
       CASE(EQF) BINARY(asFloat(a) == asFloat(b));
       CASE(NEF) BINARY(asFloat(a) != asFloat(b));
       CASE(LTF) BINARY(asFloat(a) < asFloat(b));
@@ -795,39 +959,68 @@ Stop Vm::State::run(Tick until) {
       CASE(GTF) BINARY(asFloat(a) > asFloat(b));
       CASE(GEF) BINARY(asFloat(a) >= asFloat(b));
 
-      CASE(W2L) TOP = static_cast<uint32_t>(static_cast<int32_t>(asInt16(TOP))); NEXT;
-      CASE(UW2L) TOP &= 0xFFFF; NEXT;
-      CASE(L2W) TOP &= 0xFFFF; NEXT;
-      CASE(W2F) TOP = fromFloat(static_cast<float>(asInt16(TOP))); NEXT;
-      CASE(UW2F) TOP = fromFloat(static_cast<float>(TOP & 0xFFFF)); NEXT;
-      CASE(L2F) TOP = fromFloat(static_cast<float>(static_cast<int32_t>(TOP))); NEXT;
-      CASE(UL2F) TOP = fromFloat(static_cast<float>(TOP)); NEXT;
-      CASE(F2W) TOP = static_cast<uint32_t>(truncToRange(asFloat(TOP), -2147483648.0, 2147483647.0)) & 0xFFFF; NEXT;
-      CASE(F2L) TOP = static_cast<uint32_t>(truncToRange(asFloat(TOP), -2147483648.0, 2147483647.0)); NEXT;
-      CASE(F2UL) TOP = static_cast<uint32_t>(truncToRange(asFloat(TOP), -2147483648.0, 4294967295.0)); NEXT;
+      CASE(W2L) TOP = static_cast<uint32_t>(static_cast<int32_t>(asInt16(TOP)));
+      NEXT;
+      CASE(UW2L) TOP &= 0xFFFF;
+      NEXT;
+      CASE(L2W) TOP &= 0xFFFF;
+      NEXT;
+      CASE(W2F) TOP = fromFloat(static_cast<float>(asInt16(TOP)));
+      NEXT;
+      CASE(UW2F) TOP = fromFloat(static_cast<float>(TOP & 0xFFFF));
+      NEXT;
+      CASE(L2F) TOP = fromFloat(static_cast<float>(static_cast<int32_t>(TOP)));
+      NEXT;
+      CASE(UL2F) TOP = fromFloat(static_cast<float>(TOP));
+      NEXT;
+      CASE(F2W)
+      TOP = static_cast<uint32_t>(truncToRange(asFloat(TOP), -2147483648.0, 2147483647.0)) & 0xFFFF;
+      NEXT;
+      CASE(F2L)
+      TOP = static_cast<uint32_t>(truncToRange(asFloat(TOP), -2147483648.0, 2147483647.0));
+      NEXT;
+      CASE(F2UL)
+      TOP = static_cast<uint32_t>(truncToRange(asFloat(TOP), -2147483648.0, 4294967295.0));
+      NEXT;
 
-      CASE(JMP) pc = static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16())); NEXT;
+      CASE(JMP) pc = static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
+      NEXT;
       CASE(JZ) {
-        const uint32_t target = static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
+        const uint32_t target =
+            static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
         if ((POPV & 0xFFFF) == 0) pc = target;
-      } NEXT;
+      }
+      NEXT;
       CASE(JNZ) {
-        const uint32_t target = static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
+        const uint32_t target =
+            static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
         if ((POPV & 0xFFFF) != 0) pc = target;
-      } NEXT;
+      }
+      NEXT;
       CASE(CALL) {
-        if (msp < stackLimit + kCallFrameBytes) { raiseFault("stack overflow", opPc); NEXT; }
-        if (sp > kEvalSlots - kEvalHeadroom) { raiseFault("stack overflow (expression stack)", opPc); NEXT; }
+        if (msp < stackLimit + kCallFrameBytes) {
+          raiseFault("stack overflow", opPc);
+          NEXT;
+        }
+        if (sp > kEvalSlots - kEvalHeadroom) {
+          raiseFault("stack overflow (expression stack)", opPc);
+          NEXT;
+        }
         calls.push_back(CallFrame{pc, msp, mfp});
         msp -= kCallFrameBytes;
         pc = u16();
-      } NEXT;
+      }
+      NEXT;
       CASE(ENTER) {
         const uint32_t size = u16();
-        if (msp < stackLimit + size) { raiseFault("stack overflow", opPc); NEXT; }
+        if (msp < stackLimit + size) {
+          raiseFault("stack overflow", opPc);
+          NEXT;
+        }
         msp -= size;
         mfp = msp;
-      } NEXT;
+      }
+      NEXT;
       CASE(RET) {
         if (calls.empty() ||
             (!ints.empty() && static_cast<int>(calls.size()) <= ints.back().callDepth)) {
@@ -839,14 +1032,18 @@ Stop Vm::State::run(Tick until) {
         pc = f.retPc;
         msp = f.msp;
         mfp = f.mfp;
-      } NEXT;
+      }
+      NEXT;
       CASE(RETI) {
         if (ints.empty() || static_cast<int>(calls.size()) != ints.back().callDepth) {
           raiseFault("RETI outside an interrupt handler", opPc);
           NEXT;
         }
         InterruptFrame& f = ints.back();
-        if (f.evalSp != sp) { raiseFault("internal error: stack imbalance at RETI", opPc); NEXT; }
+        if (f.evalSp != sp) {
+          raiseFault("internal error: stack imbalance at RETI", opPc);
+          NEXT;
+        }
         pc = f.retPc;
         msp = f.msp;
         mfp = f.mfp;
@@ -858,12 +1055,14 @@ Stop Vm::State::run(Tick until) {
         if (costs.knobs.epilogueEi) iff1 = iff2 = true;
         bus.interruptReturned(now, irq);
         busTouched = true;
-      } NEXT;
+      }
+      NEXT;
       CASE(HALT) {
         pc = opPc;  // stays on HALT; an interrupt returns here
         if (!halted) flushConsole();
         halted = true;
-      } NEXT;
+      }
+      NEXT;
       CASE(LIB) {
         const int id = operand[0];
         const int argc = operand[1];
@@ -872,20 +1071,25 @@ Stop Vm::State::run(Tick until) {
           NEXT;
         }
         libCall(static_cast<Lib>(id), argc, opPc);
-      } NEXT;
-      CASE(EI) iff1 = iff2 = true; eiShadow = true; NEXT;
-      CASE(DI) iff1 = iff2 = false; NEXT;
+      }
+      NEXT;
+      CASE(EI) iff1 = iff2 = true;
+      eiShadow = true;
+      NEXT;
+      CASE(DI) iff1 = iff2 = false;
+      NEXT;
       CASE(DBG) NEXT;
 #if !SIMBOT_COMPUTED_GOTO
-        case Op::Count_: break;
-      }
+      case Op::Count_:
+        break;
+    }
 #endif
 #undef TOP
 #undef POPV
 #undef PUSHV
 #undef BINARY
-    }
   }
+}
 #undef CASE
 #undef NEXT
 }
@@ -907,9 +1111,7 @@ Vm::Vm(const Image& image, Bus& bus, const CostTable& costs)
 
 Vm::~Vm() = default;
 
-Stop Vm::run(Tick until) {
-  return s_->profiling ? s_->run<true>(until) : s_->run<false>(until);
-}
+Stop Vm::run(Tick until) { return s_->profiling ? s_->run<true>(until) : s_->run<false>(until); }
 
 void Vm::request(Irq irq, uint8_t vector) {
   const int i = static_cast<int>(irq);
@@ -928,9 +1130,7 @@ Tick Vm::now() const { return s_->now; }
 bool Vm::halted() const { return s_->halted; }
 const Fault* Vm::fault() const { return s_->fault ? &*s_->fault : nullptr; }
 bool Vm::interruptsEnabled() const { return s_->iff1; }
-uint32_t Vm::pc() const {
-  return s_->lib.active ? s_->lib.pc : s_->burn ? s_->burnPc : s_->pc;
-}
+uint32_t Vm::pc() const { return s_->lib.active ? s_->lib.pc : s_->burn ? s_->burnPc : s_->pc; }
 int Vm::line() const { return s_->image.lineAt(pc()); }
 uint8_t Vm::read8(uint16_t a) const { return s_->rd8(a); }
 void Vm::write8(uint16_t a, uint8_t v) { s_->wr8(a, v); }
@@ -943,7 +1143,8 @@ void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
   State& s = *s_;
   if (s.breakpoints.empty()) s.breakpoints.assign(s.image.code.size() + 1, 0);
   if (codeAddress < s.breakpoints.size()) s.breakpoints[codeAddress] = enabled ? 1 : 0;
-  s.anyBreakpoint = std::any_of(s.breakpoints.begin(), s.breakpoints.end(), [](uint8_t b) { return b != 0; });
+  s.anyBreakpoint =
+      std::any_of(s.breakpoints.begin(), s.breakpoints.end(), [](uint8_t b) { return b != 0; });
 }
 
 void Vm::enableProfile() {

@@ -66,10 +66,10 @@ struct Fault {
 };
 
 enum class Stop : uint8_t {
-  Horizon,  // reached `until`: the next instruction starts at or after it
-  Io,       // an instruction touched the bus; host may schedule and resume
-  Halted,   // main returned (interrupts still run on later calls)
-  Fault,    // the robot faulted; it never runs again
+  Horizon,     // reached `until`: the next instruction starts at or after it
+  Io,          // an instruction touched the bus; host may schedule and resume
+  Halted,      // main returned (interrupts still run on later calls)
+  Fault,       // the robot faulted; it never runs again
   Breakpoint,  // the next instruction is at a breakpoint; run() again to go on
 };
 
