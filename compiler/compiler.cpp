@@ -1,0 +1,89 @@
+// The driver: source text through the preprocessor, parser and code
+// generator to an Image, or the first error as a Diagnostic. Nothing escapes
+// compile(): compile errors, resource exhaustion and internal faults all come
+// back as a Diagnostic.
+#include "compiler/compiler.h"
+
+#include <fstream>
+#include <new>
+#include <sstream>
+
+#include "compiler/ast.h"
+#include "compiler/preprocess.h"
+
+namespace simbot::compiler {
+
+namespace {
+
+std::vector<std::string> splitLines(const std::string& source) {
+  std::vector<std::string> lines;
+  size_t start = 0;
+  for (;;) {
+    size_t end = source.find('\n', start);
+    std::string line =
+        source.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    lines.push_back(std::move(line));
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  if (!lines.empty() && lines.back().empty() && !source.empty() && source.back() == '\n')
+    lines.pop_back();
+  return lines;
+}
+
+Diagnostic makeDiagnostic(const std::string& fileName, const std::vector<std::string>& lines,
+                          Pos pos, std::string message) {
+  Diagnostic d;
+  d.file = fileName;
+  d.line = pos.line < 1 ? 1 : pos.line;
+  d.column = pos.col < 1 ? 1 : pos.col;
+  d.message = std::move(message);
+  if (d.line >= 1 && static_cast<size_t>(d.line) <= lines.size()) d.sourceLine = lines[d.line - 1];
+  return d;
+}
+
+}  // namespace
+
+Result compile(const std::string& source, const std::string& fileName, const Options& options) {
+  Result result;
+  std::vector<std::string> lines = splitLines(source);
+  try {
+    Preprocessor pp(source, fileName);
+    Program prog;
+    parse(pp, options, prog);
+    vm::Image image = generate(prog);
+    image.sourceName = fileName;
+    image.sourceLines = std::move(lines);
+    result.image = std::move(image);
+  } catch (const CompileError& e) {
+    result.errors.push_back(makeDiagnostic(fileName, lines, e.pos, e.message));
+  } catch (const std::bad_alloc&) {
+    result.errors.push_back(makeDiagnostic(fileName, lines, Pos{}, "out of memory"));
+  } catch (const std::exception& e) {
+    result.errors.push_back(makeDiagnostic(fileName, lines, Pos{},
+                                           std::string("internal compiler error: ") + e.what()));
+  } catch (...) {
+    result.errors.push_back(makeDiagnostic(fileName, lines, Pos{}, "internal compiler error"));
+  }
+  return result;
+}
+
+Result compileFile(const std::string& path, const Options& options) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  if (in) text << in.rdbuf();
+  if (!in || in.bad()) {
+    Result r;
+    Diagnostic d;
+    d.file = path;
+    d.line = 1;
+    d.column = 1;
+    d.message = "cannot read file";
+    r.errors.push_back(d);
+    return r;
+  }
+  return compile(text.str(), path, options);
+}
+
+}  // namespace simbot::compiler

@@ -1,0 +1,39 @@
+// The Dynamic C compiler: source text in, Image out.
+// Stages (one file each): preprocess.cpp, lexer.cpp, parser.cpp (builds the
+// AST and checks types), codegen.cpp (emits bytecode), disasm lives in vm/.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vm/image.h"
+
+namespace simbot::compiler {
+
+struct Diagnostic {
+  std::string file;
+  int line = 0;
+  int column = 0;
+  std::string message;
+  std::string sourceLine;  // the offending line's text, without newline
+  // "FILE:LINE:COL: error: MESSAGE\nSOURCE LINE\n    ^\n"
+  std::string format() const;
+};
+
+struct Options {
+  // Debug build: a DBG (RST 28h) at the start of every statement, except in
+  // `nodebug` functions or after `#nodebug`. Dynamic C's default.
+  bool debug = true;
+};
+
+struct Result {
+  std::optional<vm::Image> image;
+  std::vector<Diagnostic> errors;  // empty iff image is set
+};
+
+// Compile `source` whose name (for messages and #include) is `fileName`.
+Result compile(const std::string& source, const std::string& fileName, const Options& options = {});
+// Read and compile a file; a missing or unreadable file is a Diagnostic.
+Result compileFile(const std::string& path, const Options& options = {});
+
+}  // namespace simbot::compiler

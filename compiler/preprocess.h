@@ -1,0 +1,73 @@
+// The preprocessor (internal): a token stream with directives executed and
+// macros expanded. The parser pulls tokens one at a time with next().
+//
+// Dynamic C directives that change code generation rather than text
+// (#class auto/static, #nodebug/#debug) come out as Pragma tokens in stream
+// order, so the parser applies them exactly where they stood. #INT_VEC
+// bindings are collected for the end of compilation, when their handler
+// names can be resolved.
+#pragma once
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "compiler/lexer.h"
+
+namespace simbot::compiler {
+
+struct IntVecDirective {
+  Pos pos;           // the '#'
+  int vector = -1;   // IM2 vector byte
+  std::string name;  // handler name
+  Pos namePos;
+};
+
+class Preprocessor {
+ public:
+  Preprocessor(std::string_view src, std::string fileName);
+  // The next token after preprocessing; Eof (repeatedly) at the end.
+  Token next();
+  const std::vector<IntVecDirective>& intVecs() const { return intVecs_; }
+
+ private:
+  struct Macro {
+    bool funcLike = false;
+    bool variadic = false;
+    std::vector<std::string> params;
+    std::vector<Token> body;
+  };
+  struct Cond {
+    Pos pos;
+    bool included = false;  // some branch has been taken
+    bool inElse = false;
+  };
+
+  Token raw(bool lenient = false);
+  void unget(Token t) { pending_.push_back(std::move(t)); }
+  std::vector<Token> readLine(bool lenient = false);
+  void skipLine() { readLine(true); }
+  void directive(const Token& hash);
+  void skipGroup();
+  void define(const Token& nameTok, const std::vector<Token>& line);
+  bool evalIf(const Token& dirTok, std::vector<Token> line);
+  std::string libraryName(const Token& dirTok, const std::vector<Token>& line);
+  void intVec(const Token& hash, const std::vector<Token>& line);
+  bool expand(const Token& t);
+  std::vector<Token> expandList(std::vector<Token> toks, const Token& at);
+  std::vector<Token> substitute(const Macro& m, const std::vector<std::vector<Token>>& args,
+                                const Token& at);
+  void pushExpansion(std::vector<Token> toks, const HideSet& hs, const Token& at);
+
+  Lexer lex_;
+  std::string fileName_;
+  std::vector<Token> pending_;  // pushed-back or expanded tokens, back() first
+  bool noLexer_ = false;        // expanding an isolated token list
+  std::unordered_map<std::string, Macro> macros_;
+  std::vector<Cond> conds_;
+  std::vector<IntVecDirective> intVecs_;
+  int expandDepth_ = 0;
+  long expandedTokens_ = 0;
+};
+
+}  // namespace simbot::compiler
