@@ -1,8 +1,8 @@
 // The cycle table: each opcode's cost is the sum of the Z180 sequence written
 // beside it, with the Z180's published T-states; knobs act globally.
-#include <gtest/gtest.h>
-
 #include "vm/cost.h"
+
+#include <gtest/gtest.h>
 
 using namespace simbot::vm;
 
@@ -12,12 +12,12 @@ uint32_t opCost(const CostTable& t, Op op) { return t.op[static_cast<int>(op)]; 
 
 TEST(Cost, SequencesSumPublishedTstates) {
   const auto t = makeCostTable(uncalibratedKnobs());
-  EXPECT_EQ(opCost(t, Op::LDGW), 11u + 15u);       // PUSH HL; LD HL,(nn)
-  EXPECT_EQ(opCost(t, Op::STGW), 16u + 9u);        // LD (nn),HL; POP HL
-  EXPECT_EQ(opCost(t, Op::INCGW), 15u + 4u + 16u); // LD HL,(nn); INC HL; LD (nn),HL
+  EXPECT_EQ(opCost(t, Op::LDGW), 11u + 15u);        // PUSH HL; LD HL,(nn)
+  EXPECT_EQ(opCost(t, Op::STGW), 16u + 9u);         // LD (nn),HL; POP HL
+  EXPECT_EQ(opCost(t, Op::INCGW), 15u + 4u + 16u);  // LD HL,(nn); INC HL; LD (nn),HL
   EXPECT_EQ(opCost(t, Op::JMP), 9u);
   EXPECT_EQ(opCost(t, Op::CALL), 16u);
-  EXPECT_EQ(opCost(t, Op::RET), 12u + 9u);         // POP IX; RET
+  EXPECT_EQ(opCost(t, Op::RET), 12u + 9u);  // POP IX; RET
   EXPECT_EQ(opCost(t, Op::EI), 3u);
   EXPECT_EQ(opCost(t, Op::DBG), 11u + static_cast<uint32_t>(uncalibratedKnobs().debugHookTstates));
   // IM2 acknowledge and the six register saves of an interrupt function.

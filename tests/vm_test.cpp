@@ -7,8 +7,8 @@
 #include "support/test_host.h"
 
 using namespace simbot;
-using simbot::testing::Assembler;
-using simbot::testing::TestHost;
+using simbot::testkit::Assembler;
+using simbot::testkit::TestHost;
 using vm::Irq;
 using vm::Op;
 using vm::Stop;
@@ -224,8 +224,8 @@ TEST(Vm, StrcpyIsInterruptibleAndCompletesAfterTheHandler) {
   const auto img = a.finish();
   TestHost host;
   vm::Vm v(img, host, costs());
-  const vm::Tick callEnd = 2 * cost(Op::PUSHW) + cost(Op::LIB) +
-                           costs().libCall[static_cast<int>(vm::Lib::STRCPY)];
+  const vm::Tick callEnd =
+      2 * cost(Op::PUSHW) + cost(Op::LIB) + costs().libCall[static_cast<int>(vm::Lib::STRCPY)];
   host.schedule(callEnd + 150, Irq::Pio);
   host.runUntil(v, 100'000);
   ASSERT_FALSE(host.events.empty());

@@ -8,7 +8,7 @@
 #include "vm/bytecode.h"
 #include "vm/image.h"
 
-namespace simbot::testing {
+namespace simbot::testkit {
 
 class Assembler {
  public:
@@ -74,4 +74,4 @@ class Assembler {
   std::multimap<uint32_t, std::string> fixups_;
 };
 
-}  // namespace simbot::testing
+}  // namespace simbot::testkit
