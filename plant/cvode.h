@@ -1,0 +1,109 @@
+// plant/cvode.h -- internal: RAII owners for the SUNDIALS 6.x objects.
+//
+// CVODE hands out raw handles that must be freed in the right order (the
+// CVODE memory and the linear solver refer to the vector, matrix and
+// context). Each wrapper owns one handle, is move-only, and frees it in its
+// destructor; Arena::Impl declares them in creation order so C++'s reverse
+// destruction order frees them correctly. A failing SUNDIALS call throws
+// std::runtime_error naming the call: these are programming errors, not
+// user input errors.
+#pragma once
+
+#include <cvode/cvode.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace simbot::plant::cv {
+
+inline void check(int flag, const char* what) {
+  if (flag < 0)
+    throw std::runtime_error(std::string("SUNDIALS: ") + what + " failed, flag " +
+                             std::to_string(flag));
+}
+
+class Context {
+ public:
+  Context() { check(SUNContext_Create(nullptr, &ctx_), "SUNContext_Create"); }
+  ~Context() {
+    if (ctx_) SUNContext_Free(&ctx_);
+  }
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+  SUNContext get() const { return ctx_; }
+
+ private:
+  SUNContext ctx_ = nullptr;
+};
+
+class Vector {
+ public:
+  Vector(sunindextype n, SUNContext ctx) : v_(N_VNew_Serial(n, ctx)) {
+    if (!v_) throw std::runtime_error("SUNDIALS: N_VNew_Serial failed");
+  }
+  ~Vector() {
+    if (v_) N_VDestroy(v_);
+  }
+  Vector(const Vector&) = delete;
+  Vector& operator=(const Vector&) = delete;
+  N_Vector get() const { return v_; }
+  double* data() const { return N_VGetArrayPointer(v_); }
+
+ private:
+  N_Vector v_;
+};
+
+class DenseMatrix {
+ public:
+  DenseMatrix(sunindextype n, SUNContext ctx) : m_(SUNDenseMatrix(n, n, ctx)) {
+    if (!m_) throw std::runtime_error("SUNDIALS: SUNDenseMatrix failed");
+  }
+  ~DenseMatrix() {
+    if (m_) SUNMatDestroy(m_);
+  }
+  DenseMatrix(const DenseMatrix&) = delete;
+  DenseMatrix& operator=(const DenseMatrix&) = delete;
+  SUNMatrix get() const { return m_; }
+
+ private:
+  SUNMatrix m_;
+};
+
+class DenseLinearSolver {
+ public:
+  DenseLinearSolver(N_Vector y, SUNMatrix a, SUNContext ctx) : s_(SUNLinSol_Dense(y, a, ctx)) {
+    if (!s_) throw std::runtime_error("SUNDIALS: SUNLinSol_Dense failed");
+  }
+  ~DenseLinearSolver() {
+    if (s_) SUNLinSolFree(s_);
+  }
+  DenseLinearSolver(const DenseLinearSolver&) = delete;
+  DenseLinearSolver& operator=(const DenseLinearSolver&) = delete;
+  SUNLinearSolver get() const { return s_; }
+
+ private:
+  SUNLinearSolver s_;
+};
+
+class Memory {
+ public:
+  Memory(int lmm, SUNContext ctx) : mem_(CVodeCreate(lmm, ctx)) {
+    if (!mem_) throw std::runtime_error("SUNDIALS: CVodeCreate failed");
+  }
+  ~Memory() {
+    if (mem_) CVodeFree(&mem_);
+  }
+  Memory(const Memory&) = delete;
+  Memory& operator=(const Memory&) = delete;
+  void* get() const { return mem_; }
+
+ private:
+  void* mem_;
+};
+
+}  // namespace simbot::plant::cv

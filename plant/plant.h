@@ -1,0 +1,327 @@
+// plant/plant.h -- the whole public interface of simbot's plant.
+//
+// The plant is everything physical in the 1997 NPS Robot Wars arena: the
+// 16 x 16 ft field with its edge wire and divider, one or two robots (base,
+// motor controller, bumpers, edge detectors, eyes, guns) and the balls in
+// flight. It knows nothing of bytecode: the scheduler hands it latched motor
+// frames and port B writes at exact ticks, asks it to integrate ahead with
+// advance(), and samples sensors at exact ticks. Time in this interface is
+// always integer ticks of the 9.216 MHz clock; seconds exist only inside the
+// integrator (see DESIGN.md "Time and determinism"). Every physical number
+// comes from a TOML profile (profiles/*.toml) that the loader checks key by
+// key; per-robot hardware files bind port B bits and may override the
+// robot's own values.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace simbot::plant {
+
+// ---------------------------------------------------------------- time
+inline constexpr std::int64_t kTicksPerSecond = 9'216'000;
+
+// Tick of a continuous-time event found at t seconds: ceil(t * 9,216,000),
+// the ceiling of the exact real product (not of the rounded double product).
+std::int64_t eventTickFromSeconds(double t);
+// The double nearest to tick / 9,216,000 (used to hand times to CVODE).
+double secondsFromTick(std::int64_t tick);
+
+// ---------------------------------------------------------------- profiles
+// Internal units: feet, seconds, feet per second, degrees for angles that
+// the user sees (headings, turn angle), dimensionless ratios, A/D readings.
+struct Pose {
+  double x_ft = 0;         // +x east, origin at the field's centre
+  double y_ft = 0;         // +y north (away from the starting end)
+  double heading_deg = 0;  // clockwise from +y, in [0, 360)
+};
+
+struct RobotParams {
+  // body
+  double body_diameter_ft = 0;
+  double target_height_ft = 0;
+  double edge_detector_inset_ft = 0;  // detector inside the body edge
+  // base and motor controller
+  double wheel_diameter_ft = 0;              // informational: the speed table is ground speed
+  double track_ft = 0;                       // distance between the wheels
+  std::array<double, 16> speed_table_fps{};  // ground speed for steps 0..f
+  double left_trim = 1, right_trim = 1;      // per-wheel multiplicative trim
+  double motor_lag_s = 0;                    // first-order lag; 0 = instant
+  // bumper reflex (hard-wired in the motor controller)
+  double reflex_distance_ft = 0;
+  int reflex_speed_step = 15;
+  // eyes
+  double eye_max = 0, eye_background = 0, eye_saturation_ft = 0;
+  double left_eye_width = 0, right_eye_width = 0, eye_nose = 0;  // same unit
+  double noise_sigma = 0;              // A/D readings, Gaussian, before quantising
+  double bad_reading_probability = 0;  // reading replaced by a random A/D value
+  bool thesis_swapped_eyes = false;    // Appendix C: far eye gets the full value
+  // guns
+  double gun_wheel_lag_s = 0;   // first-order spin-up/down; 0 = instant
+  double stroke_s = 0;          // solenoid rising edge -> launch
+  double muzzle_speed_fps = 0;  // at full gun-wheel speed
+  double launch_height_ft = 0;
+  int balls_per_gun = 0;
+};
+
+struct FieldParams {
+  double size_ft = 0;              // square side
+  double wire_inset_ft = 0;        // wire ring inside the edge
+  double wire_sensitivity_ft = 0;  // detector reads low within this of the wire
+  bool field_walls = true;         // a body touching the field edge trips a bumper
+  double divider_x_ft = 0, divider_south_ft = 0, divider_north_ft = 0;
+  double divider_thickness_ft = 0, divider_height_ft = 0;
+  std::array<Pose, 2> start{};  // A, B
+  double gravity_fps2 = 0;
+  bool count_floor_skips = false;
+};
+
+struct RefereeParams {
+  int reflex_limit = 3;  // more than this many reflexes in the window -> turn
+  int event_limit = 5;   // more than this many bumper+edge events -> turn
+  double window_s = 10;
+  double putback_ft = 1.5;  // inside the wire
+  double turn_deg = 45;
+};
+
+struct Profile {
+  std::string name;
+  std::string file;  // where it was loaded from
+  FieldParams field;
+  RefereeParams referee;
+  double round_length_s = 180;
+  RobotParams robot;
+};
+
+// Port B bindings of one robot (bits 0..7).
+struct Hardware {
+  std::array<int, 2> gun_motor_bit{3, 7};
+  std::array<int, 2> gun_solenoid_bit{4, 5};
+  int disc_shooter_bit = 6;  // logged only
+};
+
+// Any loader error; what() is "FILE:LINE:COL: error: MESSAGE".
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+Profile loadProfile(const std::string& path);
+Profile parseProfile(std::string_view text, const std::string& sourceName);
+// Reads a hardware file: port bindings, plus overrides of per-robot profile
+// values (sections [robot], [bumper], [eyes], [gun]) applied to `params`.
+Hardware loadHardware(const std::string& path, RobotParams& params);
+Hardware parseHardware(std::string_view text, const std::string& sourceName, RobotParams& params);
+
+// ---------------------------------------------------------------- motor frames
+struct WheelCommand {
+  int speed = 0;        // 0..15
+  bool forward = true;  // 'f' / 'r'
+  bool go = false;      // 'g' / 's'
+  char counter = '0';   // distance counter byte (unused)
+  bool operator==(const WheelCommand&) const = default;
+};
+struct MotorFrame {
+  WheelCommand left, right;
+  bool operator==(const MotorFrame&) const = default;
+};
+// Parses the 8 characters the controller latched. nullopt if the length is
+// not 8 or any character is invalid (speed 0-9a-f lowercase, f/r, g/s,
+// counter any non-NUL byte).
+std::optional<MotorFrame> parseMotorFrame(std::string_view chars);
+// Signed ground speed (ft/s) one wheel runs at for a command: speed table,
+// direction, go/stop, the wheel's trim.
+double wheelSpeedFps(const WheelCommand& cmd, const RobotParams& p, bool leftWheel);
+
+// ---------------------------------------------------------------- optics
+struct EyeReadings {
+  int left = 16;   // channel 0
+  int right = 16;  // channel 1
+};
+// Source of raw random bits (one seeded generator per purpose, owned by the
+// caller). The plant turns bits into numbers with its own code.
+class RandomBits {
+ public:
+  virtual ~RandomBits() = default;
+  virtual std::uint64_t next() = 0;
+};
+// SplitMix64, a small reference generator for tests and callers.
+class SplitMix64 final : public RandomBits {
+ public:
+  explicit SplitMix64(std::uint64_t seed) : s_(seed) {}
+  std::uint64_t next() override;
+
+ private:
+  std::uint64_t s_;
+};
+
+// The eye model of DESIGN.md (thesis VII.C, Appendix C). `opponent` null:
+// no beacon in the arena (background on both eyes).
+EyeReadings computeEyes(const Pose& self, const Pose* opponent, const RobotParams& eyes,
+                        const FieldParams& field, RandomBits* noise = nullptr);
+// Unquantised signal S of the near eye and the far-eye fraction f; exposed
+// for tests and the viewer. seen=false when out of view or blocked.
+struct EyeGeometry {
+  bool seen = false;
+  double range_ft = 0;
+  double gamma_deg = 0;  // bearing off the centre line, + = opponent to the right
+  double near_signal = 0;
+  double far_fraction = 0;
+};
+EyeGeometry eyeGeometry(const Pose& self, const Pose& opponent, const RobotParams& eyes,
+                        const FieldParams& field);
+// True if the segment between the two centres passes through the divider.
+bool dividerBlocks(double ax, double ay, double bx, double by, const FieldParams& field);
+
+// ---------------------------------------------------------------- events
+enum class Detector : std::uint8_t { Fore = 0, Aft = 1 };
+enum class Bumper : std::uint8_t { Front = 0, Back = 1 };
+enum class ContactWith : std::uint8_t { None, Robot, Divider, Wall };
+enum class MissReason : std::uint8_t { None, Floor, Divider, LeftField };
+
+enum class EventKind : std::uint8_t {
+  EdgeEnter,       // robot, detector: detector now reads low
+  EdgeLeave,       // robot, detector: detector reads high again
+  Contact,         // robot, bumper, with (other = the other robot, if Robot)
+  ContactEnd,      // robot, with
+  ReflexStart,     // robot, bumper
+  ReflexEnd,       // robot, bumper
+  BallLaunch,      // robot = shooter, gun, ball (slot)
+  BallHit,         // robot = shooter, gun, ball, other = target
+  BallMiss,        // robot = shooter, gun, ball, miss
+  RefereePutBack,  // robot: centre left the field, put back inside the wire
+  RefereeTurn,     // robot: too many reflexes/events, turned by turn_deg
+  SolenoidStroke,  // (from setPortB) robot, gun: launch due after the stroke
+  GunEmpty,        // (from setPortB) robot, gun: solenoid fired, magazine empty
+  DiscShooter,     // (from setPortB) robot: disc shooter bit rose (logged only)
+};
+const char* eventKindName(EventKind k);
+
+struct Event {
+  EventKind kind{};
+  std::int8_t robot = 0;
+  std::int8_t other = -1;
+  Detector detector = Detector::Fore;
+  Bumper bumper = Bumper::Front;
+  ContactWith with = ContactWith::None;
+  MissReason miss = MissReason::None;
+  std::int8_t gun = -1;
+  std::int8_t ball = -1;
+};
+
+// Fixed-capacity list: nothing allocated while advancing.
+class EventList {
+ public:
+  static constexpr std::size_t kCapacity = 128;
+  void push(const Event& e) {
+    if (n_ < kCapacity) items_[n_++] = e;
+  }
+  void clear() { n_ = 0; }
+  std::size_t size() const { return n_; }
+  bool empty() const { return n_ == 0; }
+  const Event& operator[](std::size_t i) const { return items_[i]; }
+  const Event* begin() const { return items_.data(); }
+  const Event* end() const { return items_.data() + n_; }
+
+ private:
+  std::array<Event, kCapacity> items_{};
+  std::size_t n_ = 0;
+};
+
+struct AdvanceResult {
+  std::int64_t tick = 0;  // tick reached
+  EventList events;       // discrete plant events at that tick (may be empty)
+};
+
+struct IntegratorStats {
+  long steps = 0;
+  long rhs_evals = 0;
+  long reinits = 0;
+  long roots = 0;
+};
+
+// Continuous state of one robot at a tick (for tests, traces, the viewer).
+struct RobotState {
+  Pose pose;
+  double left_fps = 0, right_fps = 0;  // wheel ground speeds
+  double odometer_ft = 0;              // signed path length
+  std::array<double, 2> gun_wheel{};   // fraction of full speed
+};
+
+struct BallView {
+  int shooter = 0, gun = 0, slot = 0;
+  double x_ft = 0, y_ft = 0, z_ft = 0;
+};
+
+// ---------------------------------------------------------------- arena
+struct RobotSetup {
+  RobotParams params;
+  Hardware hardware;
+  Pose start;
+};
+struct ArenaConfig {
+  FieldParams field;
+  RefereeParams referee;
+  std::vector<RobotSetup> robots;  // 1 (solo: no beacon to see) or 2
+};
+// Config with both (or one) robots from one profile, default hardware and
+// the profile's start poses.
+ArenaConfig makeArenaConfig(const Profile& profile, int robotCount);
+
+// The arena integrates all robots and balls with one CVODE instance.
+//
+// Protocol (all ticks): advance(stop) integrates from now() towards stop and
+// returns at the first tick that has discrete events, or at stop. Those
+// events are a prediction: they are applied when the scheduler proceeds
+// (the next advance(), or a setWheels/setPortB at that same tick, which
+// applies them first). A setWheels/setPortB at an earlier tick c (not before
+// the last re-initialisation) that changes the plant discards the
+// prediction and re-initialises at c from dense output. Queries take any
+// tick from the last re-initialisation to now(); at a tick with events they
+// describe the state after the events.
+class Arena {
+ public:
+  explicit Arena(const ArenaConfig& config);
+  ~Arena();
+  Arena(const Arena&) = delete;
+  Arena& operator=(const Arena&) = delete;
+
+  int robotCount() const;
+  std::int64_t now() const;             // tick reached by the integrator
+  std::int64_t lastReinitTick() const;  // earliest tick queries accept
+
+  // A latched motor frame. Returns false (and does nothing, no reinit) if it
+  // equals the frame already latched.
+  bool setWheels(int robot, const MotorFrame& frame, std::int64_t tick);
+  // A write to PIO port B. Returns the immediate events (solenoid strokes,
+  // empty guns, disc shooter); launches come later from advance().
+  EventList setPortB(int robot, std::uint8_t value, std::int64_t tick);
+
+  AdvanceResult advance(std::int64_t stopTick);
+
+  Pose pose(int robot, std::int64_t tick) const;
+  RobotState state(int robot, std::int64_t tick) const;
+  bool edgeDetectorLow(int robot, Detector d, std::int64_t tick) const;
+  EyeReadings eyeReadings(int robot, std::int64_t tick, RandomBits* noise = nullptr) const;
+  std::vector<BallView> balls(std::int64_t tick) const;
+
+  bool inReflex(int robot) const;  // at now(), after any pending events
+  int ballsLeft(int robot, int gun) const;
+  int shots(int robot) const;
+  int hits(int robot) const;
+  IntegratorStats stats() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace simbot::plant

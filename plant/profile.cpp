@@ -1,0 +1,492 @@
+// plant/profile.cpp -- loading and checking TOML profiles and hardware files.
+//
+// Every physical number is an inline table { value, unit, source } so that a
+// reader of the file sees where each number came from; options are
+// { value = true/false, source = ... }. One table (kKeys) lists every key
+// once: its section, kind (which fixes the accepted units and the range
+// check), and where it lands in Profile. The loader walks the parsed
+// document against that table, so an unknown key, a missing key, a wrong
+// type or a unit that does not fit the kind is always caught, and reported
+// as FILE:LINE:COL: error: MESSAGE with toml++'s source positions (parse
+// errors from toml++ are formatted the same way). Values are converted to
+// the internal units at load: ft, s, ft/s, ft/s^2, degrees for user-facing
+// angles, plain ratios and A/D readings.
+//
+// A hardware file has an optional [ports] section (port B bit numbers) and
+// may override the per-robot sections ([robot], [bumper], [eyes], [gun])
+// with the same key names and the same checks; every key there is optional.
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <functional>
+
+#include "plant/plant.h"
+
+namespace simbot::plant {
+namespace {
+
+enum class Kind {
+  Length,       // ft, in, m, cm, mm
+  Speed,        // ft/s, in/s, m/s
+  Time,         // s, ms
+  Angle,        // deg, rad  (stored in degrees)
+  Accel,        // ft/s^2, m/s^2
+  Ratio,        // "1"
+  Probability,  // "1", in [0, 1]
+  Reading,      // "reading" (A/D reading units)
+  Count,        // "count", integer >= 0
+  Step,         // "step", integer 0..15
+  Bit,          // "bit", integer 0..7
+  Bool,         // no unit
+  SpeedTable,   // array of 16 speeds
+};
+
+enum class Range { Any, NonNeg, Pos };
+
+struct Target {
+  double* d = nullptr;
+  int* i = nullptr;
+  bool* b = nullptr;
+  std::array<double, 16>* table = nullptr;
+};
+
+struct KeyDef {
+  const char* section;
+  const char* key;
+  Kind kind;
+  Range range;
+  bool perRobot;
+  std::function<Target(Profile&, Hardware&)> target;
+};
+
+#define D(expr)                 \
+  [](Profile& p, Hardware& h) { \
+    (void)p;                    \
+    (void)h;                    \
+    Target t;                   \
+    t.d = &(expr);              \
+    return t;                   \
+  }
+#define I(expr)                 \
+  [](Profile& p, Hardware& h) { \
+    (void)p;                    \
+    (void)h;                    \
+    Target t;                   \
+    t.i = &(expr);              \
+    return t;                   \
+  }
+#define B(expr)                 \
+  [](Profile& p, Hardware& h) { \
+    (void)p;                    \
+    (void)h;                    \
+    Target t;                   \
+    t.b = &(expr);              \
+    return t;                   \
+  }
+
+const std::vector<KeyDef>& keyTable() {
+  static const std::vector<KeyDef> keys = {
+      {"field", "size", Kind::Length, Range::Pos, false, D(p.field.size_ft)},
+      {"field", "wire_inset", Kind::Length, Range::NonNeg, false, D(p.field.wire_inset_ft)},
+      {"field", "wire_sensitivity", Kind::Length, Range::Pos, false,
+       D(p.field.wire_sensitivity_ft)},
+      {"field", "field_walls", Kind::Bool, Range::Any, false, B(p.field.field_walls)},
+      {"field", "divider_x", Kind::Length, Range::Any, false, D(p.field.divider_x_ft)},
+      {"field", "divider_south", Kind::Length, Range::Any, false, D(p.field.divider_south_ft)},
+      {"field", "divider_north", Kind::Length, Range::Any, false, D(p.field.divider_north_ft)},
+      {"field", "divider_thickness", Kind::Length, Range::NonNeg, false,
+       D(p.field.divider_thickness_ft)},
+      {"field", "divider_height", Kind::Length, Range::NonNeg, false, D(p.field.divider_height_ft)},
+      {"start", "a_x", Kind::Length, Range::Any, false, D(p.field.start[0].x_ft)},
+      {"start", "a_y", Kind::Length, Range::Any, false, D(p.field.start[0].y_ft)},
+      {"start", "a_heading", Kind::Angle, Range::Any, false, D(p.field.start[0].heading_deg)},
+      {"start", "b_x", Kind::Length, Range::Any, false, D(p.field.start[1].x_ft)},
+      {"start", "b_y", Kind::Length, Range::Any, false, D(p.field.start[1].y_ft)},
+      {"start", "b_heading", Kind::Angle, Range::Any, false, D(p.field.start[1].heading_deg)},
+      {"robot", "body_diameter", Kind::Length, Range::Pos, true, D(p.robot.body_diameter_ft)},
+      {"robot", "target_height", Kind::Length, Range::Pos, true, D(p.robot.target_height_ft)},
+      {"robot", "edge_detector_inset", Kind::Length, Range::NonNeg, true,
+       D(p.robot.edge_detector_inset_ft)},
+      {"robot", "wheel_diameter", Kind::Length, Range::Pos, true, D(p.robot.wheel_diameter_ft)},
+      {"robot", "track", Kind::Length, Range::Pos, true, D(p.robot.track_ft)},
+      {"robot", "speed_table", Kind::SpeedTable, Range::NonNeg, true,
+       [](Profile& p, Hardware&) {
+         Target t;
+         t.table = &p.robot.speed_table_fps;
+         return t;
+       }},
+      {"robot", "left_trim", Kind::Ratio, Range::Pos, true, D(p.robot.left_trim)},
+      {"robot", "right_trim", Kind::Ratio, Range::Pos, true, D(p.robot.right_trim)},
+      {"robot", "motor_lag", Kind::Time, Range::NonNeg, true, D(p.robot.motor_lag_s)},
+      {"bumper", "reflex_distance", Kind::Length, Range::Pos, true, D(p.robot.reflex_distance_ft)},
+      {"bumper", "reflex_speed_step", Kind::Step, Range::Any, true, I(p.robot.reflex_speed_step)},
+      {"eyes", "max", Kind::Reading, Range::Pos, true, D(p.robot.eye_max)},
+      {"eyes", "background", Kind::Reading, Range::NonNeg, true, D(p.robot.eye_background)},
+      {"eyes", "saturation_distance", Kind::Length, Range::Pos, true, D(p.robot.eye_saturation_ft)},
+      {"eyes", "left_width", Kind::Length, Range::Pos, true, D(p.robot.left_eye_width)},
+      {"eyes", "right_width", Kind::Length, Range::Pos, true, D(p.robot.right_eye_width)},
+      {"eyes", "nose", Kind::Length, Range::Pos, true, D(p.robot.eye_nose)},
+      {"eyes", "noise_sigma", Kind::Reading, Range::NonNeg, true, D(p.robot.noise_sigma)},
+      {"eyes", "bad_reading_probability", Kind::Probability, Range::NonNeg, true,
+       D(p.robot.bad_reading_probability)},
+      {"eyes", "thesis_swapped_eyes", Kind::Bool, Range::Any, true, B(p.robot.thesis_swapped_eyes)},
+      {"gun", "wheel_lag", Kind::Time, Range::NonNeg, true, D(p.robot.gun_wheel_lag_s)},
+      {"gun", "stroke_time", Kind::Time, Range::NonNeg, true, D(p.robot.stroke_s)},
+      {"gun", "muzzle_speed", Kind::Speed, Range::Pos, true, D(p.robot.muzzle_speed_fps)},
+      {"gun", "launch_height", Kind::Length, Range::Pos, true, D(p.robot.launch_height_ft)},
+      {"gun", "balls_per_gun", Kind::Count, Range::Any, true, I(p.robot.balls_per_gun)},
+      {"projectile", "gravity", Kind::Accel, Range::Pos, false, D(p.field.gravity_fps2)},
+      {"projectile", "count_floor_skips", Kind::Bool, Range::Any, false,
+       B(p.field.count_floor_skips)},
+      {"referee", "reflex_limit", Kind::Count, Range::Any, false, I(p.referee.reflex_limit)},
+      {"referee", "event_limit", Kind::Count, Range::Any, false, I(p.referee.event_limit)},
+      {"referee", "window", Kind::Time, Range::Pos, false, D(p.referee.window_s)},
+      {"referee", "putback", Kind::Length, Range::NonNeg, false, D(p.referee.putback_ft)},
+      {"referee", "turn", Kind::Angle, Range::Any, false, D(p.referee.turn_deg)},
+      {"match", "round_length", Kind::Time, Range::Pos, false, D(p.round_length_s)},
+  };
+  return keys;
+}
+
+const std::vector<KeyDef>& portTable() {
+  static const std::vector<KeyDef> keys = {
+      {"ports", "gun1_motor", Kind::Bit, Range::Any, true, I(h.gun_motor_bit[0])},
+      {"ports", "gun1_solenoid", Kind::Bit, Range::Any, true, I(h.gun_solenoid_bit[0])},
+      {"ports", "gun2_motor", Kind::Bit, Range::Any, true, I(h.gun_motor_bit[1])},
+      {"ports", "gun2_solenoid", Kind::Bit, Range::Any, true, I(h.gun_solenoid_bit[1])},
+      {"ports", "disc_shooter", Kind::Bit, Range::Any, true, I(h.disc_shooter_bit)},
+  };
+  return keys;
+}
+
+#undef D
+#undef I
+#undef B
+
+// Conversion factor to the internal unit, or NaN if the unit is not allowed.
+double unitFactor(Kind k, std::string_view u) {
+  switch (k) {
+    case Kind::Length:
+      if (u == "ft") return 1.0;
+      if (u == "in") return 1.0 / 12.0;
+      if (u == "m") return 1.0 / 0.3048;
+      if (u == "cm") return 1.0 / 30.48;
+      if (u == "mm") return 1.0 / 304.8;
+      break;
+    case Kind::Speed:
+    case Kind::SpeedTable:
+      if (u == "ft/s") return 1.0;
+      if (u == "in/s") return 1.0 / 12.0;
+      if (u == "m/s") return 1.0 / 0.3048;
+      break;
+    case Kind::Time:
+      if (u == "s") return 1.0;
+      if (u == "ms") return 1e-3;
+      break;
+    case Kind::Angle:
+      if (u == "deg") return 1.0;
+      if (u == "rad") return 180.0 / 3.14159265358979323846;
+      break;
+    case Kind::Accel:
+      if (u == "ft/s^2") return 1.0;
+      if (u == "m/s^2") return 1.0 / 0.3048;
+      break;
+    case Kind::Ratio:
+    case Kind::Probability:
+      if (u == "1") return 1.0;
+      break;
+    case Kind::Reading:
+      if (u == "reading") return 1.0;
+      break;
+    case Kind::Count:
+      if (u == "count") return 1.0;
+      break;
+    case Kind::Step:
+      if (u == "step") return 1.0;
+      break;
+    case Kind::Bit:
+      if (u == "bit") return 1.0;
+      break;
+    case Kind::Bool:
+      break;
+  }
+  return std::nan("");
+}
+
+const char* allowedUnits(Kind k) {
+  switch (k) {
+    case Kind::Length:
+      return "ft, in, m, cm, mm";
+    case Kind::Speed:
+    case Kind::SpeedTable:
+      return "ft/s, in/s, m/s";
+    case Kind::Time:
+      return "s, ms";
+    case Kind::Angle:
+      return "deg, rad";
+    case Kind::Accel:
+      return "ft/s^2, m/s^2";
+    case Kind::Ratio:
+    case Kind::Probability:
+      return "1";
+    case Kind::Reading:
+      return "reading";
+    case Kind::Count:
+      return "count";
+    case Kind::Step:
+      return "step";
+    case Kind::Bit:
+      return "bit";
+    case Kind::Bool:
+      return "(none)";
+  }
+  return "";
+}
+
+class Checker {
+ public:
+  explicit Checker(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const toml::source_region& where, const std::string& msg) const {
+    throw ConfigError(fmt::format("{}:{}:{}: error: {}", file_,
+                                  where.begin.line == 0 ? 1 : where.begin.line,
+                                  where.begin.column == 0 ? 1 : where.begin.column, msg));
+  }
+
+  toml::table parse(std::string_view text) const {
+    try {
+      return toml::parse(text, file_);
+    } catch (const toml::parse_error& e) {
+      fail(e.source(), std::string(e.description()));
+    }
+  }
+
+  // Applies one entry (an inline table) to its target.
+  void apply(const KeyDef& def, const toml::node& node, Target t) const {
+    const std::string name = fmt::format("{}.{}", def.section, def.key);
+    const toml::table* tbl = node.as_table();
+    if (!tbl)
+      fail(node.source(), fmt::format("'{}' must be a table {{ value = ..., {}source = \"...\" }}",
+                                      name, def.kind == Kind::Bool ? "" : "unit = \"...\", "));
+    const toml::node* value = nullptr;
+    const toml::node* unit = nullptr;
+    const toml::node* source = nullptr;
+    for (auto&& [k, v] : *tbl) {
+      if (k.str() == "value") {
+        value = &v;
+      } else if (k.str() == "unit" && def.kind != Kind::Bool) {
+        unit = &v;
+      } else if (k.str() == "source") {
+        source = &v;
+      } else {
+        fail(k.source(), fmt::format("unknown field '{}' in '{}'", k.str(), name));
+      }
+    }
+    if (!value) fail(node.source(), fmt::format("'{}' has no 'value'", name));
+    if (!source) fail(node.source(), fmt::format("'{}' has no 'source'", name));
+    if (!source->is_string())
+      fail(source->source(), fmt::format("'{}.source' must be a string", name));
+
+    double factor = 1.0;
+    if (def.kind != Kind::Bool) {
+      if (!unit)
+        fail(node.source(),
+             fmt::format("'{}' has no 'unit' (one of: {})", name, allowedUnits(def.kind)));
+      if (!unit->is_string()) fail(unit->source(), fmt::format("'{}.unit' must be a string", name));
+      const std::string u = *unit->value<std::string>();
+      factor = unitFactor(def.kind, u);
+      if (std::isnan(factor))
+        fail(unit->source(), fmt::format("wrong unit '{}' for '{}' (expected one of: {})", u, name,
+                                         allowedUnits(def.kind)));
+    }
+
+    switch (def.kind) {
+      case Kind::Bool:
+        if (!value->is_boolean())
+          fail(value->source(), fmt::format("'{}' must be true or false", name));
+        *t.b = *value->value<bool>();
+        return;
+      case Kind::Count:
+      case Kind::Step:
+      case Kind::Bit: {
+        if (!value->is_integer())
+          fail(value->source(), fmt::format("'{}' must be an integer", name));
+        const std::int64_t v = *value->value<std::int64_t>();
+        const std::int64_t hi = def.kind == Kind::Step ? 15 : def.kind == Kind::Bit ? 7 : 1000000;
+        if (v < 0 || v > hi) fail(value->source(), fmt::format("'{}' must be in 0..{}", name, hi));
+        *t.i = static_cast<int>(v);
+        return;
+      }
+      case Kind::SpeedTable: {
+        const toml::array* arr = value->as_array();
+        if (!arr) fail(value->source(), fmt::format("'{}' must be an array of 16 numbers", name));
+        if (arr->size() != 16)
+          fail(value->source(),
+               fmt::format("'{}' must have 16 entries (steps 0..f), has {}", name, arr->size()));
+        for (std::size_t i = 0; i < 16; ++i) {
+          const toml::node& e = *arr->get(i);
+          if (!e.is_number()) fail(e.source(), fmt::format("'{}[{}]' must be a number", name, i));
+          const double v = *e.value<double>() * factor;
+          if (v < 0) fail(e.source(), fmt::format("'{}[{}]' must not be negative", name, i));
+          (*t.table)[i] = v;
+        }
+        return;
+      }
+      default: {
+        if (!value->is_number()) fail(value->source(), fmt::format("'{}' must be a number", name));
+        const double v = *value->value<double>() * factor;
+        if (!std::isfinite(v)) fail(value->source(), fmt::format("'{}' must be finite", name));
+        if (def.range == Range::NonNeg && v < 0)
+          fail(value->source(), fmt::format("'{}' must not be negative", name));
+        if (def.range == Range::Pos && !(v > 0))
+          fail(value->source(), fmt::format("'{}' must be positive", name));
+        if (def.kind == Kind::Probability && v > 1)
+          fail(value->source(), fmt::format("'{}' must be at most 1", name));
+        *t.d = v;
+        return;
+      }
+    }
+  }
+
+  // Walks the document. `required`: every listed key must be present.
+  // `allowed` filters which keys may appear at all.
+  void walk(const toml::table& doc, const std::vector<const KeyDef*>& defs, bool required,
+            const std::vector<std::string>& plainStrings, Profile& p, Hardware& h,
+            std::vector<std::string>* seenStrings) const {
+    std::vector<const KeyDef*> seen;
+    for (auto&& [sk, sv] : doc) {
+      const std::string section(sk.str());
+      if (std::find(plainStrings.begin(), plainStrings.end(), section) != plainStrings.end()) {
+        if (!sv.is_string()) fail(sv.source(), fmt::format("'{}' must be a string", section));
+        if (seenStrings) seenStrings->push_back(section);
+        if (section == "name") p.name = *sv.value<std::string>();
+        continue;
+      }
+      bool known = false;
+      for (const KeyDef* d : defs) known = known || section == d->section;
+      if (!known) fail(sk.source(), fmt::format("unknown section or key '{}'", section));
+      const toml::table* st = sv.as_table();
+      if (!st) fail(sv.source(), fmt::format("'{}' must be a table", section));
+      for (auto&& [k, v] : *st) {
+        const KeyDef* def = nullptr;
+        for (const KeyDef* d : defs)
+          if (section == d->section && k.str() == d->key) def = d;
+        if (!def) fail(k.source(), fmt::format("unknown key '{}' in [{}]", k.str(), section));
+        apply(*def, v, def->target(p, h));
+        seen.push_back(def);
+      }
+    }
+    if (!required) return;
+    for (const KeyDef* d : defs) {
+      if (std::find(seen.begin(), seen.end(), d) != seen.end()) continue;
+      const toml::node* sec = doc.get(d->section);
+      fail(sec ? sec->source() : doc.source(),
+           fmt::format("missing key '{}' in [{}]", d->key, d->section));
+    }
+  }
+
+ private:
+  std::string file_;
+};
+
+std::string readFile(const std::string& path) {
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw ConfigError(fmt::format("{}:1:1: error: cannot open file", path));
+  std::string s;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) s.append(buf, n);
+  std::fclose(f);
+  return s;
+}
+
+void crossChecks(const Profile& p, const Checker& c, const toml::table& doc) {
+  // Checks between keys; reported at the section that holds the second key.
+  auto where = [&](const char* section) {
+    const toml::node* n = doc.get(section);
+    return n ? n->source() : doc.source();
+  };
+  if (p.field.wire_inset_ft * 2 >= p.field.size_ft)
+    c.fail(where("field"), "wire_inset leaves no field inside the wire");
+  if (p.field.divider_north_ft < p.field.divider_south_ft)
+    c.fail(where("field"), "divider_north must not be south of divider_south");
+  if (p.robot.edge_detector_inset_ft * 2 >= p.robot.body_diameter_ft)
+    c.fail(where("robot"), "edge_detector_inset puts the detectors past the centre");
+  if (p.referee.reflex_limit > 15 || p.referee.event_limit > 15)
+    c.fail(where("referee"), "reflex_limit and event_limit must be at most 15");
+  if (p.robot.balls_per_gun > 16) c.fail(where("gun"), "balls_per_gun must be at most 16");
+  if (p.referee.putback_ft * 2 >= p.field.size_ft - 2 * p.field.wire_inset_ft)
+    c.fail(where("referee"), "putback leaves no room inside the wire");
+}
+
+}  // namespace
+
+Profile parseProfile(std::string_view text, const std::string& sourceName) {
+  Checker c(sourceName);
+  const toml::table doc = c.parse(text);
+  Profile p;
+  Hardware h;
+  std::vector<const KeyDef*> defs;
+  for (const KeyDef& d : keyTable()) defs.push_back(&d);
+  std::vector<std::string> strings;
+  c.walk(doc, defs, true, {"name", "description"}, p, h, &strings);
+  if (std::find(strings.begin(), strings.end(), "name") == strings.end())
+    c.fail(doc.source(), "missing key 'name'");
+  crossChecks(p, c, doc);
+  p.file = sourceName;
+  return p;
+}
+
+Profile loadProfile(const std::string& path) { return parseProfile(readFile(path), path); }
+
+Hardware parseHardware(std::string_view text, const std::string& sourceName, RobotParams& params) {
+  Checker c(sourceName);
+  const toml::table doc = c.parse(text);
+  Profile p;
+  p.robot = params;
+  Hardware h;
+  std::vector<const KeyDef*> defs;
+  for (const KeyDef& d : portTable()) defs.push_back(&d);
+  for (const KeyDef& d : keyTable())
+    if (d.perRobot) defs.push_back(&d);
+  // Field-wide keys are not per robot: name them in the error.
+  for (auto&& [sk, sv] : doc) {
+    for (const KeyDef& d : keyTable())
+      if (!d.perRobot && sk.str() == d.section)
+        c.fail(sk.source(),
+               fmt::format("[{}] is arena-wide and cannot be overridden per robot", d.section));
+  }
+  c.walk(doc, defs, false, {"name", "description"}, p, h, nullptr);
+  std::array<int, 5> bits = {h.gun_motor_bit[0], h.gun_solenoid_bit[0], h.gun_motor_bit[1],
+                             h.gun_solenoid_bit[1], h.disc_shooter_bit};
+  for (std::size_t i = 0; i < bits.size(); ++i)
+    for (std::size_t j = i + 1; j < bits.size(); ++j)
+      if (bits[i] == bits[j]) {
+        const toml::node* n = doc.get("ports");
+        c.fail(n ? n->source() : doc.source(),
+               fmt::format("port B bit {} is bound twice", bits[i]));
+      }
+  if (p.robot.balls_per_gun > 16) {
+    const toml::node* n = doc.get("gun");
+    c.fail(n ? n->source() : doc.source(), "balls_per_gun must be at most 16");
+  }
+  params = p.robot;
+  return h;
+}
+
+Hardware loadHardware(const std::string& path, RobotParams& params) {
+  return parseHardware(readFile(path), path, params);
+}
+
+ArenaConfig makeArenaConfig(const Profile& profile, int robotCount) {
+  ArenaConfig c;
+  c.field = profile.field;
+  c.referee = profile.referee;
+  for (int i = 0; i < robotCount && i < 2; ++i)
+    c.robots.push_back(
+        RobotSetup{profile.robot, Hardware{}, profile.field.start[static_cast<std::size_t>(i)]});
+  return c;
+}
+
+}  // namespace simbot::plant

@@ -1,0 +1,249 @@
+// Motor frames and the TOML profile and hardware loaders.
+#include <fstream>
+#include <regex>
+
+#include "plant_support.h"
+
+using namespace plant_test;
+
+namespace {
+
+TEST(MotorFrame, ValidFrames) {
+  auto f = parseMotorFrame("ffgrffgr");
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->left.speed, 15);
+  EXPECT_TRUE(f->left.forward);
+  EXPECT_TRUE(f->left.go);
+  EXPECT_EQ(f->left.counter, 'r');
+  f = parseMotorFrame("0rs 9fgx");
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->left.speed, 0);
+  EXPECT_FALSE(f->left.forward);
+  EXPECT_FALSE(f->left.go);
+  EXPECT_EQ(f->right.speed, 9);
+  f = parseMotorFrame(
+      "arg\xff"
+      "cfs1");
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->left.speed, 10);
+  EXPECT_EQ(f->right.speed, 12);
+}
+
+TEST(MotorFrame, InvalidFramesAreRejected) {
+  EXPECT_FALSE(parseMotorFrame("gfgrffgr"));                        // speed out of 0-f
+  EXPECT_FALSE(parseMotorFrame("Ffgrffgr"));                        // uppercase hex
+  EXPECT_FALSE(parseMotorFrame("fxgrffgr"));                        // direction
+  EXPECT_FALSE(parseMotorFrame("ffqrffgr"));                        // go/stop
+  EXPECT_FALSE(parseMotorFrame("ffgrffg"));                         // too short
+  EXPECT_FALSE(parseMotorFrame("ffgrffgrr"));                       // too long
+  EXPECT_FALSE(parseMotorFrame(std::string_view("ffg\0ffgr", 8)));  // NUL counter
+  EXPECT_FALSE(parseMotorFrame("ffgrff r"));
+}
+
+TEST(MotorFrame, SpeedTableTrimDirectionAndStop) {
+  const Profile d = defaults();
+  auto f = *parseMotorFrame("7fg0crg0");
+  EXPECT_DOUBLE_EQ(wheelSpeedFps(f.left, d.robot, true),
+                   d.robot.speed_table_fps[7] * d.robot.left_trim);
+  EXPECT_DOUBLE_EQ(wheelSpeedFps(f.right, d.robot, false),
+                   -d.robot.speed_table_fps[12] * d.robot.right_trim);
+  f = *parseMotorFrame("ffs0ffs0");
+  EXPECT_EQ(wheelSpeedFps(f.left, d.robot, true), 0.0);
+  const Profile t = thesis();
+  for (int k = 0; k < 16; ++k)
+    EXPECT_NEAR(t.robot.speed_table_fps[static_cast<std::size_t>(k)], 1.5 * k / 15, 1e-12);
+}
+
+TEST(Profiles, BothShippedProfilesLoad) {
+  const Profile t = thesis();
+  EXPECT_EQ(t.name, "thesis-1997");
+  EXPECT_DOUBLE_EQ(t.field.size_ft, 16.0);
+  EXPECT_DOUBLE_EQ(t.field.wire_inset_ft, 5.0 / 12);
+  EXPECT_DOUBLE_EQ(t.field.divider_thickness_ft, 0.75 / 12);
+  EXPECT_DOUBLE_EQ(t.robot.body_diameter_ft, 12.75 / 12);
+  EXPECT_DOUBLE_EQ(t.robot.track_ft, 0.75);
+  EXPECT_EQ(t.robot.motor_lag_s, 0.0);
+  EXPECT_EQ(t.robot.eye_max, 4080);
+  EXPECT_EQ(t.robot.balls_per_gun, 15);
+  EXPECT_DOUBLE_EQ(t.robot.muzzle_speed_fps, 105);
+  EXPECT_DOUBLE_EQ(t.field.gravity_fps2, 32.174);
+  EXPECT_EQ(t.referee.reflex_limit, 3);
+  EXPECT_EQ(t.referee.event_limit, 5);
+  EXPECT_DOUBLE_EQ(t.round_length_s, 180);
+  EXPECT_DOUBLE_EQ(t.field.start[1].x_ft, 6.5);
+  EXPECT_FALSE(t.robot.thesis_swapped_eyes);
+  EXPECT_FALSE(t.field.count_floor_skips);
+  const Profile d = defaults();
+  EXPECT_EQ(d.name, "default");
+  EXPECT_GT(d.robot.motor_lag_s, 0);
+  EXPECT_EQ(d.robot.noise_sigma, 0);
+}
+
+std::string shipped() {
+  std::ifstream in(profilePath("thesis-1997"));
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// Replaces the first occurrence of `from` in the shipped text.
+std::string edit(const std::string& from, const std::string& to) {
+  std::string s = shipped();
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  s.replace(at, from.size(), to);
+  return s;
+}
+
+int lineOf(const std::string& text, const std::string& needle) {
+  const auto at = text.find(needle);
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+}
+
+std::string errorOf(const std::string& text, const char* file = "test.toml") {
+  try {
+    parseProfile(text, file);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const std::regex kFormat(R"(^test\.toml:(\d+):(\d+): error: .+$)");
+
+int errLine(const std::string& msg) {
+  std::smatch m;
+  if (!std::regex_match(msg, m, kFormat)) return -1;
+  return std::stoi(m[1]);
+}
+
+TEST(Profiles, UnknownKeyIsReportedAtItsPosition) {
+  const std::string text =
+      edit("[eyes]\n", "[eyes]\nsquint = { value = 1.0, unit = \"1\", source = \"x\" }\n");
+  const std::string msg = errorOf(text);
+  EXPECT_EQ(errLine(msg), lineOf(text, "squint")) << msg;
+  EXPECT_NE(msg.find("unknown key 'squint'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(":1: error"), std::string::npos) << msg;  // column 1
+}
+
+TEST(Profiles, WrongUnitIsReportedAtTheUnit) {
+  const std::string text = edit("unit = \"in\", source = \"thesis VI.B.1: approximately 9",
+                                "unit = \"s\", source = \"thesis VI.B.1: approximately 9");
+  const std::string msg = errorOf(text);
+  EXPECT_EQ(errLine(msg), lineOf(text, "track ")) << msg;
+  EXPECT_NE(msg.find("wrong unit 's' for 'robot.track'"), std::string::npos) << msg;
+}
+
+TEST(Profiles, MalformedFileGivesAParseErrorPosition) {
+  const std::string text = edit("[gun]\n", "[gun\n");
+  const std::string msg = errorOf(text);
+  EXPECT_EQ(errLine(msg), lineOf(text, "[gun")) << msg;
+}
+
+TEST(Profiles, MissingAndWrongTypeAndRange) {
+  std::string text = shipped();
+  const auto at = text.find("nose ");
+  text.erase(at, text.find('\n', at) - at + 1);
+  std::string msg = errorOf(text);
+  EXPECT_GT(errLine(msg), 0) << msg;
+  EXPECT_NE(msg.find("missing key 'nose' in [eyes]"), std::string::npos) << msg;
+
+  text = edit("value = 15,  unit = \"step\"", "value = \"15\",  unit = \"step\"");
+  msg = errorOf(text);
+  EXPECT_EQ(errLine(msg), lineOf(text, "reflex_speed_step")) << msg;
+  EXPECT_NE(msg.find("must be an integer"), std::string::npos) << msg;
+
+  text = edit("value = 180.0, unit = \"s\"", "value = -1, unit = \"s\"");
+  msg = errorOf(text);
+  EXPECT_NE(msg.find("must be positive"), std::string::npos) << msg;
+
+  text = edit("value = 0.0, unit = \"s\", source = \"thesis VI.C.1: acceleration ignored\"",
+              "value = 0.0, unit = \"s\"");
+  msg = errorOf(text);
+  EXPECT_NE(msg.find("has no 'source'"), std::string::npos) << msg;
+
+  text = edit("unit = \"ft/s\", source = \"thesis VI.C.1 linear",
+              "unit = \"ft\", source = \"thesis VI.C.1 linear");
+  msg = errorOf(text);
+  EXPECT_NE(msg.find("wrong unit 'ft'"), std::string::npos) << msg;
+}
+
+TEST(Profiles, UnitsAreConverted) {
+  std::string text = edit("size              = { value = 16.0,  unit = \"ft\"",
+                          "size              = { value = 4.8768,  unit = \"m\"");
+  EXPECT_NEAR(parseProfile(text, "x.toml").field.size_ft, 16.0, 1e-12);
+  text = edit("turn         = { value = 45.0, unit = \"deg\"",
+              "turn         = { value = 0.7853981633974483, unit = \"rad\"");
+  EXPECT_NEAR(parseProfile(text, "x.toml").referee.turn_deg, 45.0, 1e-12);
+}
+
+TEST(Profiles, MissingFileIsAnError) {
+  EXPECT_THROW(loadProfile("/nonexistent/profile.toml"), ConfigError);
+}
+
+TEST(Hardware, BindsPortsAndOverridesRobotValues) {
+  RobotParams params = thesis().robot;
+  const Hardware h = parseHardware(R"(
+[ports]
+gun1_motor = { value = 0, unit = "bit", source = "our wiring" }
+gun1_solenoid = { value = 1, unit = "bit", source = "our wiring" }
+
+[gun]
+muzzle_speed = { value = 30, unit = "m/s", source = "measured" }
+
+[eyes]
+max = { value = 2040, unit = "reading", source = "other circuit" }
+)",
+                                   "hw.toml", params);
+  EXPECT_EQ(h.gun_motor_bit[0], 0);
+  EXPECT_EQ(h.gun_solenoid_bit[0], 1);
+  EXPECT_EQ(h.gun_motor_bit[1], 7);  // default kept
+  EXPECT_EQ(h.disc_shooter_bit, 6);
+  EXPECT_NEAR(params.muzzle_speed_fps, 30 / 0.3048, 1e-9);
+  EXPECT_EQ(params.eye_max, 2040);
+  EXPECT_EQ(params.balls_per_gun, 15);
+}
+
+TEST(Hardware, ErrorsArePositioned) {
+  RobotParams params = thesis().robot;
+  auto err = [&](const char* text) {
+    try {
+      parseHardware(text, "hw.toml", params);
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(err("[ports]\ngun1_motor = { value = 9, unit = \"bit\", source = \"x\" }\n")
+                .find("hw.toml:2:"),
+            std::string::npos);
+  EXPECT_NE(err("[field]\nsize = { value = 9, unit = \"ft\", source = \"x\" }\n")
+                .find("hw.toml:1:2: error: [field] is arena-wide"),
+            std::string::npos);
+  EXPECT_NE(err("[ports]\ngun1_motor = { value = 5, unit = \"bit\", source = \"x\" }\n")
+                .find("bound twice"),
+            std::string::npos);
+  EXPECT_NE(
+      err("[gun]\nstroke_time = { value = 1, unit = \"ft\", source = \"x\" }\n").find("hw.toml:2:"),
+      std::string::npos);
+}
+
+TEST(Hardware, GunBitsDriveTheArena) {
+  Profile p = thesis();
+  ArenaConfig c = makeArenaConfig(p, 1);
+  c.robots[0].hardware.gun_motor_bit[0] = 0;
+  c.robots[0].hardware.gun_solenoid_bit[0] = 1;
+  Arena a(c);
+  EventList ev = a.setPortB(0, 0x01, 0);
+  EXPECT_TRUE(ev.empty());
+  ev = a.setPortB(0, 0x03, 0);
+  ASSERT_EQ(ev.size(), 1u);
+  EXPECT_EQ(ev[0].kind, EventKind::SolenoidStroke);
+  ev = a.setPortB(0, 0x43, 0);  // disc shooter: logged only
+  ASSERT_EQ(ev.size(), 1u);
+  EXPECT_EQ(ev[0].kind, EventKind::DiscShooter);
+  AdvanceResult r = a.advance(1000);
+  ASSERT_EQ(r.events.size(), 1u);
+  EXPECT_EQ(r.events[0].kind, EventKind::BallLaunch);
+  EXPECT_EQ(r.tick, 0);
+}
+
+}  // namespace

@@ -1,0 +1,191 @@
+// The discrete devices: the serial link (double-buffered ASCI, Dynamic C's
+// interrupt-driven send, the motor controller's framing) and the Z80 PIO's
+// port A in mode 3.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstring>
+
+#include "plant/pio.h"
+#include "plant/serial_link.h"
+
+using namespace simbot::plant;
+
+namespace {
+
+class Memory : public RobotMemory {
+ public:
+  std::array<uint8_t, 65536> bytes{};
+  uint8_t read8(uint16_t a) const override { return bytes[a]; }
+  void write8(uint16_t a, uint8_t v) override { bytes[a] = v; }
+  void put(uint16_t a, const char* s) { std::memcpy(&bytes[a], s, std::strlen(s) + 1); }
+};
+
+constexpr uint16_t kBuf = 0x200, kCc = 0x300;
+
+// Drives a link with an ISR that runs `latency` ticks after each request.
+struct Driver {
+  SerialLink link;
+  Memory mem;
+  std::vector<std::pair<Tick, ReceivedFrame>> frames;
+  Tick latency = 50;
+  bool interruptsEnabled = true;
+
+  void send(Tick t0, const char* text, uint8_t count) {
+    mem.put(kBuf, text);
+    mem.bytes[kCc] = count;
+    link.send(t0, kBuf, kCc, mem);
+  }
+  // Runs until `end`, servicing requests and finishing bytes in tick order.
+  void runUntil(Tick end, Tick from) {
+    Tick t = from;
+    while (t <= end) {
+      if (interruptsEnabled && link.requestingInterrupt()) {
+        t += latency;
+        link.service(t, mem);
+        continue;
+      }
+      auto done = link.nextByteDone();
+      if (!done || *done > end) break;
+      t = *done;
+      if (auto f = link.byteDone(t)) frames.emplace_back(t, *f);
+    }
+  }
+};
+
+TEST(SerialLink, PlatformLatchesNineCharactersAfterT0) {
+  Driver d;
+  d.send(1000, "4fgr4rgr", 9);
+  d.runUntil(1'000'000, 1000);
+  ASSERT_EQ(d.frames.size(), 1u);
+  EXPECT_EQ(d.frames[0].first, 1000 + 9 * 9600);
+  EXPECT_TRUE(d.frames[0].second.command.has_value());
+  EXPECT_EQ(d.frames[0].second.bytes, "4fgr4rgr");
+  EXPECT_EQ(d.frames[0].second.command->left.speed, 4);
+  EXPECT_TRUE(d.frames[0].second.command->left.forward);
+  EXPECT_FALSE(d.frames[0].second.command->right.forward);
+  EXPECT_EQ(d.mem.bytes[kCc], 0);
+}
+
+TEST(SerialLink, SecondSendMidwayWinsAndFirstIsNeverLatched) {
+  Driver d;
+  d.send(0, "4fgr4rgr", 9);
+  d.runUntil(3 * 9600 + 100, 0);  // three bytes out, one in the TSR, one in TDR
+  d.send(3 * 9600 + 200, "cfgrcfgr", 9);
+  d.runUntil(2'000'000, 3 * 9600 + 200);
+  ASSERT_EQ(d.frames.size(), 1u);
+  EXPECT_TRUE(d.frames[0].second.command.has_value());
+  EXPECT_EQ(d.frames[0].second.bytes, "cfgrcfgr");
+  // Bytes 0..4 of the first string went out (shift and data registers), then
+  // all nine of the second: 14 characters from T0.
+  EXPECT_EQ(d.frames[0].first, 14 * 9600);
+}
+
+TEST(SerialLink, StrcpyIntoBufferDuringSendChangesTheFrame) {
+  Driver d;
+  d.send(0, "4fgr4rgr", 9);
+  d.runUntil(2 * 9600 + 10, 0);
+  std::memcpy(&d.mem.bytes[kBuf], "cfgrcfgr", 8);  // strcpy halfway through
+  d.runUntil(2'000'000, 2 * 9600 + 10);
+  ASSERT_EQ(d.frames.size(), 1u);
+  // Bytes 0..3 were fetched already (shift, data register, ISR ahead).
+  EXPECT_EQ(d.frames[0].second.bytes, "4fgrcfgr");
+  EXPECT_TRUE(d.frames[0].second.command.has_value());
+}
+
+TEST(SerialLink, SendStallsWhileInterruptsAreOffAndResumes) {
+  Driver d;
+  d.interruptsEnabled = false;
+  d.send(0, "4fgr4rgr", 9);
+  d.runUntil(1'000'000, 0);
+  EXPECT_TRUE(d.frames.empty());
+  EXPECT_EQ(d.link.bytesSent(), 1u);  // only the byte the call itself loaded
+  EXPECT_TRUE(d.link.idle());
+  d.interruptsEnabled = true;  // EI at tick 1,000,000
+  d.runUntil(3'000'000, 1'000'000);
+  ASSERT_EQ(d.frames.size(), 1u);
+  EXPECT_EQ(d.frames[0].second.bytes, "4fgr4rgr");
+  EXPECT_EQ(d.frames[0].first, 1'000'000 + d.latency + 8 * 9600);
+}
+
+TEST(SerialLink, ShortOrInvalidFramesAreRejected) {
+  Driver d;
+  d.send(0, "4fgr", 5);
+  d.runUntil(1'000'000, 0);
+  ASSERT_EQ(d.frames.size(), 1u);
+  EXPECT_FALSE(d.frames[0].second.command.has_value());
+  d.send(2'000'000, "4fxr4rgr", 9);
+  d.runUntil(3'000'000, 2'000'000);
+  ASSERT_EQ(d.frames.size(), 2u);
+  EXPECT_FALSE(d.frames[1].second.command.has_value());
+}
+
+// ICEMAN's set-up of port A.
+PioPortA icemanPort() {
+  PioPortA p;
+  for (uint8_t w : {0xff, 0xff, 0x10, 0x97, 0xfc, 0x87}) p.control(w);
+  return p;
+}
+
+TEST(Pio, IcemanSetupRequestsOnFallingDetector) {
+  PioPortA p = icemanPort();
+  EXPECT_EQ(p.mode(), 3);
+  EXPECT_EQ(p.vector(), 0x10);
+  EXPECT_TRUE(p.interruptEnabled());
+  EXPECT_FALSE(p.setInputs(0xFF));
+  EXPECT_TRUE(p.setInputs(0xFD));  // fore detector low: condition true
+  EXPECT_EQ(p.read(), 253);
+  EXPECT_FALSE(p.setInputs(0xFC));  // still true: no new request
+  EXPECT_FALSE(p.setInputs(0xFF));
+  EXPECT_TRUE(p.setInputs(0xFE));  // aft
+}
+
+struct PioCase {
+  uint8_t icw, mask;
+  uint8_t lines;
+  bool request;
+};
+
+TEST(Pio, ControlWordMatrix) {
+  const PioCase cases[] = {
+      {0x97, 0xfc, 0xFD, true},   // OR, active low, bit 1 low
+      {0x97, 0xfc, 0xFB, false},  // OR, active low, a masked bit low
+      {0xD7, 0xfc, 0xFD, false},  // AND, active low, only one of two low
+      {0xD7, 0xfc, 0xFC, true},   // AND, active low, both low
+      {0xB7, 0xfc, 0x01, false},  // OR, active high: from all-low lines...
+      {0x17, 0xfc, 0xFD, false},  // interrupts disabled in the control word
+  };
+  for (const auto& c : cases) {
+    PioPortA p;
+    for (uint8_t w : {0xff, 0xff, 0x10}) p.control(w);
+    p.control(c.icw);
+    p.control(c.mask);
+    p.setInputs(0xFF);
+    EXPECT_EQ(p.setInputs(c.lines), c.request)
+        << std::hex << "icw " << int(c.icw) << " lines " << int(c.lines);
+  }
+  // Active high: a monitored bit rising from low makes the condition true.
+  PioPortA p;
+  for (uint8_t w : {0xff, 0xff, 0x10, 0xB7, 0xfc}) p.control(w);
+  EXPECT_FALSE(p.setInputs(0x00));
+  EXPECT_TRUE(p.setInputs(0x02));
+}
+
+TEST(Pio, NoRequestWhileUnderServiceHeldUntilReti) {
+  PioPortA p = icemanPort();
+  EXPECT_TRUE(p.setInputs(0xFD));
+  p.accepted();
+  EXPECT_FALSE(p.setInputs(0xFF));
+  EXPECT_FALSE(p.setInputs(0xFE));  // becomes true while in service: held
+  EXPECT_TRUE(p.returned());        // raised at RETI
+  EXPECT_FALSE(p.returned());
+}
+
+TEST(Pio, UnarmedPortNeverRequests) {
+  PioPortA p;  // fig92 never programs port A
+  EXPECT_FALSE(p.setInputs(0xFF));
+  EXPECT_FALSE(p.setInputs(0xFD));
+  EXPECT_FALSE(p.setInputs(0xFC));
+}
+
+}  // namespace

@@ -1,0 +1,369 @@
+// Continuous motion against closed forms: straight runs, spins, the motor
+// lag's step response, the wire-detector crossing tick, projectile flight,
+// a hit's tick, the bumper reflex, the referee, rewinds and determinism.
+#include <cmath>
+#include <cstring>
+
+#include "plant_support.h"
+
+using namespace plant_test;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+void expectRel(double actual, double expected, double rel, const char* what) {
+  const double tol = rel * std::max(1.0, std::abs(expected));
+  EXPECT_NEAR(actual, expected, tol) << what;
+}
+
+TEST(Time, EventTickIsCeilingOfExactProduct) {
+  for (std::int64_t k : {0LL, 1LL, 7LL, 9216000LL, 123456789LL, 1658880000LL, 1658879999LL}) {
+    const double t = secondsFromTick(k);
+    // t is k/N rounded; the exact product t*N is within an ulp of k on
+    // either side, so the ceiling is k or k+1 depending on that side.
+    const std::int64_t got = eventTickFromSeconds(t);
+    const long double exact = static_cast<long double>(t) * 9216000.0L;
+    const std::int64_t want = static_cast<std::int64_t>(std::ceil(exact));
+    EXPECT_EQ(got, want) << k;
+    EXPECT_TRUE(got == k || got == k + 1);
+  }
+  EXPECT_EQ(eventTickFromSeconds(1.0), 9216000);
+  EXPECT_EQ(eventTickFromSeconds(std::nextafter(1.0, 2.0)), 9216001);
+  EXPECT_EQ(eventTickFromSeconds(0.5), 4608000);
+}
+
+TEST(Motion, StraightRunMatchesClosedForm) {
+  const Profile p = thesis();
+  Arena a(config(p, {Pose{-6.5, -6.5, 0}}));
+  const double v = p.robot.speed_table_fps[15];
+  ASSERT_TRUE(a.setWheels(0, frame("ffg0ffg0"), 0));
+  EXPECT_FALSE(a.setWheels(0, frame("ffg0ffg0"), 0));  // unchanged: no-op
+  const auto stop = ticks(3.0);
+  AdvanceResult r = a.advance(stop);
+  ASSERT_EQ(r.tick, stop);
+  EXPECT_TRUE(r.events.empty());
+  for (double t : {0.0, 0.3, 1.234567, 2.5, 3.0}) {
+    const Pose q = a.pose(0, ticks(t));
+    const double tt = secondsFromTick(ticks(t));
+    expectRel(q.x_ft, -6.5, 1e-6, "x");
+    expectRel(q.y_ft, -6.5 + v * tt, 1e-6, "y");
+    EXPECT_NEAR(q.heading_deg, 0.0, 1e-9);
+  }
+}
+
+TEST(Motion, HeadingRunAndArc) {
+  // Heading 60 deg: direction (sin 60, cos 60).
+  const Profile p = thesis();
+  Arena a(config(p, {Pose{-2, -2, 60}}));
+  a.setWheels(0, frame("afg0afg0"), 0);
+  a.advance(ticks(2));
+  const double v = p.robot.speed_table_fps[10];
+  const double t = secondsFromTick(ticks(2));
+  const Pose q = a.pose(0, ticks(2));
+  expectRel(q.x_ft, -2 + v * t * std::sin(kPi / 3), 1e-6, "x");
+  expectRel(q.y_ft, -2 + v * t * std::cos(kPi / 3), 1e-6, "y");
+}
+
+TEST(Motion, SpinInPlaceMatchesClosedForm) {
+  const Profile p = thesis();
+  Arena a(config(p, {Pose{1, 1, 10}}));
+  a.setWheels(0, frame("afg0arg0"), 0);  // left forward, right reverse: clockwise
+  const double v = p.robot.speed_table_fps[10];
+  const double omegaDeg = (2 * v / p.robot.track_ft) * 180 / kPi;
+  a.advance(ticks(1.5));
+  for (double t : {0.25, 0.7, 1.5}) {
+    const double tt = secondsFromTick(ticks(t));
+    const Pose q = a.pose(0, ticks(t));
+    const double want = std::fmod(10 + omegaDeg * tt, 360.0);
+    expectRel(q.heading_deg, want, 1e-6, "heading");
+    EXPECT_NEAR(q.x_ft, 1, 1e-9);
+    EXPECT_NEAR(q.y_ft, 1, 1e-9);
+  }
+}
+
+TEST(Motion, WheelLagStepResponse) {
+  Profile p = defaults();
+  p.robot.motor_lag_s = 0.2;
+  p.robot.left_trim = p.robot.right_trim = 1.0;
+  Arena a(config(p, {Pose{0, 0, 0}}));
+  const auto t0 = ticks(0.1);
+  a.advance(t0);
+  a.setWheels(0, frame("cfg0crg0"), t0);  // spin: stays far from everything
+  const double vl = p.robot.speed_table_fps[12];
+  a.advance(ticks(1.2));
+  for (double t : {0.1, 0.15, 0.3, 0.5, 1.0, 1.2}) {
+    const double dt = secondsFromTick(ticks(t)) - secondsFromTick(t0);
+    const RobotState s = a.state(0, ticks(t));
+    expectRel(s.left_fps, vl * (1 - std::exp(-dt / 0.2)), 1e-6, "left");
+    expectRel(s.right_fps, -vl * (1 - std::exp(-dt / 0.2)), 1e-6, "right");
+  }
+}
+
+TEST(Motion, ForeDetectorEntersWireRangeAtClosedFormTick) {
+  const Profile p = thesis();
+  Arena a(config(p, {Pose{-6.5, -6.5, 0}}));
+  a.setWheels(0, frame("ffg0ffg0"), 0);
+  const double v = p.robot.speed_table_fps[15];
+  const double R = p.robot.body_diameter_ft / 2;
+  const double wire = p.field.size_ft / 2 - p.field.wire_inset_ft;
+  const double yd0 = -6.5 + R - p.robot.edge_detector_inset_ft;
+  const double t = (wire - p.field.wire_sensitivity_ft - yd0) / v;
+  const std::int64_t want = static_cast<std::int64_t>(std::ceil(t * kTicksPerSecond));
+  auto f = runUntil(a, EventKind::EdgeEnter, ticks(20));
+  ASSERT_TRUE(f.has_value());
+  EXPECT_EQ(f->event.detector, Detector::Fore);
+  EXPECT_NEAR(static_cast<double>(f->tick), static_cast<double>(want), 10.0);
+  EXPECT_TRUE(a.edgeDetectorLow(0, Detector::Fore, f->tick));
+  EXPECT_FALSE(a.edgeDetectorLow(0, Detector::Fore, f->tick - 1));
+  EXPECT_FALSE(a.edgeDetectorLow(0, Detector::Aft, f->tick));
+}
+
+TEST(Motion, ProjectileFlightTimeAndRange) {
+  Profile p = thesis();
+  p.robot.muzzle_speed_fps = 10.0;  // lands inside the field
+  Arena a(config(p, {Pose{-2, 0, 90}}));
+  a.setPortB(0, 0x08, 0);  // gun 1 motor on (instant in thesis-1997)
+  const auto fire = ticks(0.5);
+  a.advance(fire);
+  EventList ev = a.setPortB(0, 0x18, fire);  // solenoid rising edge
+  ASSERT_EQ(ev.size(), 1u);
+  EXPECT_EQ(ev[0].kind, EventKind::SolenoidStroke);
+  auto launch = runUntil(a, EventKind::BallLaunch, ticks(5));
+  ASSERT_TRUE(launch.has_value());
+  EXPECT_EQ(launch->tick, fire);  // stroke time 0
+  const double h = p.robot.launch_height_ft, g = p.field.gravity_fps2;
+  const double tf = std::sqrt(2 * h / g);
+  const auto miss = runUntil(a, EventKind::BallMiss, ticks(5));
+  ASSERT_TRUE(miss.has_value());
+  EXPECT_EQ(miss->event.miss, MissReason::Floor);
+  const double tLaunch = secondsFromTick(fire);
+  EXPECT_NEAR(static_cast<double>(miss->tick), std::ceil((tLaunch + tf) * kTicksPerSecond), 10.0);
+  // Ball position at the tick before the floor: on the line, height ~0.
+  const auto before = miss->tick - 1;
+  const auto balls = a.balls(before);
+  ASSERT_EQ(balls.size(), 1u);
+  const double dt = secondsFromTick(before) - tLaunch;
+  const double muzzleX = -2 + p.robot.body_diameter_ft / 2;
+  expectRel(balls[0].x_ft, muzzleX + 10.0 * dt, 1e-6, "ball x");
+  expectRel(balls[0].z_ft + 1.0, h - 0.5 * g * dt * dt + 1.0, 1e-6, "ball z");
+  // Range at the floor: muzzle + v * sqrt(2h/g).
+  EXPECT_NEAR(balls[0].x_ft, muzzleX + 10.0 * tf, 1e-4);
+  EXPECT_EQ(a.shots(0), 1);
+  EXPECT_EQ(a.ballsLeft(0, 0), 14);
+}
+
+TEST(Motion, HitTickMatchesClosedForm) {
+  const Profile p = thesis();
+  Arena a(config(p, {Pose{-3, 0, 90}, Pose{3, 0, 270}}));
+  a.setPortB(0, 0x08, 0);
+  const auto fire = ticks(0.25);
+  a.advance(fire);
+  a.setPortB(0, 0x18, fire);
+  const auto hit = runUntil(a, EventKind::BallHit, ticks(2));
+  ASSERT_TRUE(hit.has_value());
+  const double R = p.robot.body_diameter_ft / 2;
+  const double flight = (6.0 - 2 * R) / p.robot.muzzle_speed_fps;
+  const double want = std::ceil((secondsFromTick(fire) + flight) * kTicksPerSecond);
+  EXPECT_NEAR(static_cast<double>(hit->tick), want, 10.0);
+  EXPECT_EQ(hit->event.robot, 0);
+  EXPECT_EQ(hit->event.other, 1);
+  a.advance(hit->tick + 1);
+  EXPECT_EQ(a.hits(0), 1);
+}
+
+TEST(Motion, FloorSkipsCountOnlyWithTheOption) {
+  for (bool skips : {false, true}) {
+    Profile p = thesis();
+    p.robot.muzzle_speed_fps = 10.0;  // lands about 3 ft out, short of B
+    p.field.count_floor_skips = skips;
+    Arena a(config(p, {Pose{-3, 0, 90}, Pose{3, 0, 270}}));
+    a.setPortB(0, 0x08, 0);
+    a.setPortB(0, 0x18, 0);
+    bool hit = false, miss = false;
+    while (a.now() < ticks(2)) {
+      AdvanceResult r = a.advance(ticks(2));
+      for (const Event& e : r.events) {
+        hit = hit || e.kind == EventKind::BallHit;
+        miss = miss || e.kind == EventKind::BallMiss;
+      }
+    }
+    EXPECT_EQ(hit, skips);
+    EXPECT_EQ(miss, !skips);
+  }
+}
+
+TEST(Motion, UnchangedInputsDoNotReinitialise) {
+  const Profile p = thesis();
+  Arena a(config(p, {Pose{0, 0, 0}}));
+  a.setWheels(0, frame("5fg05fg0"), 0);
+  a.advance(ticks(0.5));
+  const long before = a.stats().reinits;
+  EXPECT_FALSE(a.setWheels(0, frame("5fg05fg0"), ticks(0.5)));
+  EXPECT_TRUE(a.setWheels(0, frame("5fgx5fgy"), ticks(0.5)));  // counter bytes only
+  EXPECT_TRUE(a.setPortB(0, 0x40, ticks(0.5)).size() == 1);    // disc shooter: logged only
+  EXPECT_EQ(a.stats().reinits, before);
+  EXPECT_EQ(a.now(), ticks(0.5));
+  a.setWheels(0, frame("9fg05fg0"), ticks(0.5));
+  EXPECT_EQ(a.stats().reinits, before + 1);
+}
+
+TEST(Motion, DividerStopsLowBall) {
+  Profile p = thesis();
+  p.robot.launch_height_ft = 0.5;  // below the divider's top
+  Arena a(config(p, {Pose{-3, -6, 90}, Pose{3, -6, 270}}));
+  a.setPortB(0, 0x08, 0);
+  a.setPortB(0, 0x18, 0);
+  const auto miss = runUntil(a, EventKind::BallMiss, ticks(2));
+  ASSERT_TRUE(miss.has_value());
+  EXPECT_EQ(miss->event.miss, MissReason::Divider);
+  EXPECT_EQ(a.hits(0), 0);
+}
+
+TEST(Motion, BumperReflexBacksOffProfileDistance) {
+  const Profile p = thesis();
+  Arena a(config(p, {Pose{2, 0, 90}}));  // east, towards the wall
+  a.setWheels(0, frame("ffg0ffg0"), 0);
+  const double R = p.robot.body_diameter_ft / 2, v = p.robot.speed_table_fps[15];
+  auto contact = runUntil(a, EventKind::Contact, ticks(20));
+  ASSERT_TRUE(contact.has_value());
+  EXPECT_EQ(contact->event.with, ContactWith::Wall);
+  EXPECT_EQ(contact->event.bumper, Bumper::Front);
+  const double tContact = (8 - R - 2) / v;
+  EXPECT_NEAR(static_cast<double>(contact->tick), std::ceil(tContact * kTicksPerSecond), 10.0);
+  const Pose atContact = a.pose(0, contact->tick);
+  EXPECT_NEAR(atContact.x_ft, 8 - R, 1e-6);
+  a.advance(contact->tick + 1);
+  EXPECT_TRUE(a.inReflex(0));
+  // A frame latched during the reflex takes effect at its end.
+  EXPECT_TRUE(a.setWheels(0, frame("0fs00fs0"), a.now()));
+  auto end = runUntil(a, EventKind::ReflexEnd, ticks(30));
+  ASSERT_TRUE(end.has_value());
+  const Pose atEnd = a.pose(0, end->tick);
+  EXPECT_NEAR(atContact.x_ft - atEnd.x_ft, p.robot.reflex_distance_ft, 1e-6);
+  EXPECT_NEAR(atEnd.heading_deg, 90, 1e-9);
+  EXPECT_NEAR(static_cast<double>(end->tick - contact->tick),
+              p.robot.reflex_distance_ft / v * kTicksPerSecond, 10.0);
+  a.advance(end->tick + ticks(1));
+  EXPECT_FALSE(a.inReflex(0));
+  EXPECT_NEAR(a.pose(0, a.now()).x_ft, atEnd.x_ft, 1e-9);  // stopped
+}
+
+TEST(Motion, RobotsBumpingBothReflex) {
+  const Profile p = thesis();
+  Arena a(config(p, {Pose{-2, 2, 90}, Pose{2, 2, 270}}));
+  a.setWheels(0, frame("ffg0ffg0"), 0);
+  auto c = runUntil(a, EventKind::Contact, ticks(10));
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->event.with, ContactWith::Robot);
+  AdvanceResult r = a.advance(c->tick);  // applies the pending events
+  (void)r;
+  EXPECT_TRUE(a.inReflex(0));
+  EXPECT_TRUE(a.inReflex(1));
+  const double R = p.robot.body_diameter_ft / 2;
+  EXPECT_NEAR(a.pose(0, c->tick).x_ft, 2 - 2 * R, 1e-6);
+}
+
+TEST(Motion, RefereePutsBackARobotThatLeftTheField) {
+  Profile p = thesis();
+  p.field.field_walls = false;
+  Arena a(config(p, {Pose{5, 0, 90}}));
+  a.setWheels(0, frame("ffg0ffg0"), 0);
+  auto f = runUntil(a, EventKind::RefereePutBack, ticks(20));
+  ASSERT_TRUE(f.has_value());
+  const double wire = p.field.size_ft / 2 - p.field.wire_inset_ft;
+  const Pose q = a.pose(0, f->tick);
+  EXPECT_NEAR(q.x_ft, wire - p.referee.putback_ft, 1e-12);
+  EXPECT_NEAR(q.y_ft, 0, 1e-9);
+  EXPECT_NEAR(q.heading_deg, 90, 1e-9);
+  EXPECT_NEAR(static_cast<double>(f->tick), std::ceil(3.0 / 1.5 * kTicksPerSecond), 10.0);
+}
+
+TEST(Motion, RefereeTurnsARobotStuckOnTheWall) {
+  const Profile p = thesis();
+  Arena a(config(p, {Pose{5, 0, 90}}));
+  a.setWheels(0, frame("ffg0ffg0"), 0);
+  auto f = runUntil(a, EventKind::RefereeTurn, ticks(30));
+  ASSERT_TRUE(f.has_value());
+  a.advance(f->tick);
+  EXPECT_NEAR(a.pose(0, f->tick).heading_deg, 135, 1e-6);
+}
+
+TEST(Motion, RewindToAnEarlierTickMatchesInOrderInputs) {
+  const Profile p = thesis();
+  Arena ahead(config(p, {Pose{0, 0, 0}}));
+  Arena inOrder(config(p, {Pose{0, 0, 0}}));
+  for (Arena* a : {&ahead, &inOrder}) a->setWheels(0, frame("afg0ffg0"), 0);
+  ahead.advance(ticks(1.0));
+  inOrder.advance(ticks(0.5));
+  ahead.setWheels(0, frame("ffg0afg0"), ticks(0.5));  // earlier than now()
+  inOrder.setWheels(0, frame("ffg0afg0"), ticks(0.5));
+  EXPECT_EQ(ahead.now(), ticks(0.5));
+  ahead.advance(ticks(2));
+  inOrder.advance(ticks(2));
+  const Pose x = ahead.pose(0, ticks(2)), y = inOrder.pose(0, ticks(2));
+  EXPECT_NEAR(x.x_ft, y.x_ft, 1e-8);
+  EXPECT_NEAR(x.y_ft, y.y_ft, 1e-8);
+  EXPECT_NEAR(x.heading_deg, y.heading_deg, 1e-7);
+}
+
+// One scripted match; `query` adds sensor reads at many ticks.
+std::vector<double> scripted(bool query, IntegratorStats* stats) {
+  const Profile p = defaults();
+  Arena a(makeArenaConfig(p, 2));
+  std::vector<double> out;
+  const char* frames[] = {"ffg0cfg0", "8rg08fg0", "ffg0ffg0", "3fg0frg0", "ffg0ffg0"};
+  std::int64_t t = 0;
+  a.setPortB(0, 0x08, 0);
+  a.setPortB(1, 0x88, 0);
+  for (int step = 0; step < 40; ++step) {
+    const std::int64_t next = t + ticks(0.73);
+    while (a.now() < next) {
+      a.advance(next);
+      if (query)
+        for (std::int64_t q = a.lastReinitTick(); q <= a.now(); q += 99991) {
+          (void)a.eyeReadings(0, q);
+          (void)a.pose(1, q);
+        }
+    }
+    t = next;
+    a.setWheels(step % 2, frame(frames[step % 5]), t);
+    if (step % 7 == 3) a.setPortB(step % 2, static_cast<std::uint8_t>(step % 2 ? 0x98 : 0x18), t);
+    if (step % 7 == 4) a.setPortB(step % 2, static_cast<std::uint8_t>(step % 2 ? 0x88 : 0x08), t);
+    for (int r = 0; r < 2; ++r) {
+      const Pose q = a.pose(r, t);
+      out.insert(out.end(), {q.x_ft, q.y_ft, q.heading_deg});
+    }
+  }
+  *stats = a.stats();
+  return out;
+}
+
+TEST(Determinism, SameCallsGiveBitIdenticalPosesWhetherQueriedOrNot) {
+  IntegratorStats s1, s2, s3;
+  const auto a = scripted(false, &s1);
+  const auto b = scripted(false, &s2);
+  const auto c = scripted(true, &s3);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.size(), c.size());
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0);
+  EXPECT_EQ(std::memcmp(a.data(), c.data(), a.size() * sizeof(double)), 0);
+  EXPECT_EQ(s1.steps, s3.steps);
+  EXPECT_EQ(s1.rhs_evals, s3.rhs_evals);
+  EXPECT_EQ(s1.reinits, s3.reinits);
+  EXPECT_EQ(s1.roots, s3.roots);
+  EXPECT_GT(s1.steps, 0);
+  EXPECT_GT(s1.reinits, 0);
+}
+
+TEST(Queries, OutsideTheWindowThrow) {
+  const Profile p = thesis();
+  Arena a(config(p, {Pose{0, 0, 0}}));
+  a.advance(ticks(1));
+  EXPECT_THROW(a.pose(0, ticks(2)), std::out_of_range);
+  a.setWheels(0, frame("ffg0ffg0"), ticks(1));
+  EXPECT_THROW(a.pose(0, ticks(0.5)), std::out_of_range);
+  EXPECT_NO_THROW(a.pose(0, ticks(1)));
+}
+
+}  // namespace

@@ -1,0 +1,153 @@
+// The eyes against DESIGN.md's formulas, computed independently here.
+#include <cmath>
+
+#include "plant_support.h"
+
+using namespace plant_test;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Opponent pose at range r and bearing gamma (deg, + = right) from self.
+Pose place(const Pose& self, double r, double gammaDeg) {
+  const double b = (self.heading_deg + gammaDeg) * kPi / 180;
+  return Pose{self.x_ft + r * std::sin(b), self.y_ft + r * std::cos(b), 0};
+}
+
+int expectedReading(double s, double max) {
+  return static_cast<int>(std::clamp(16 * std::floor(s / 16), 16.0, max));
+}
+
+TEST(Optics, GridOfBearingsAndRanges) {
+  const Profile p = thesis();
+  const RobotParams& e = p.robot;
+  const double kappa = (e.eye_max - e.eye_background) * e.eye_saturation_ft * e.eye_saturation_ft;
+  const double phi = std::atan(e.right_eye_width / e.eye_nose) * 180 / kPi;  // widths equal
+  const Pose self{2, 3, 30};  // north-east quadrant: the divider is far away
+  int checked = 0;
+  for (double r : {0.5, 1.0, 2.9, 2.999, 3.001, 3.1, 4.0, 6.0, 9.5}) {
+    for (double g = -89; g <= 89; g += 4.25) {
+      const Pose opp = place(self, r, g);
+      const EyeReadings got = computeEyes(self, &opp, e, p.field);
+      const double s = r <= 3.0 ? e.eye_max : kappa / (r * r) + e.eye_background;
+      const double f = std::max(0.0, 1 - std::abs(g) / phi);
+      const int nearR = expectedReading(s, e.eye_max), farR = expectedReading(s * f, e.eye_max);
+      if (g < 0) {
+        EXPECT_EQ(got.left, nearR) << r << " " << g;
+        EXPECT_EQ(got.right, farR) << r << " " << g;
+      } else {
+        EXPECT_EQ(got.right, nearR) << r << " " << g;
+        EXPECT_EQ(got.left, farR) << r << " " << g;
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 300);
+  EXPECT_NEAR(phi, 33.69, 0.01);  // thesis III.B: "limiting angle 33 deg"
+}
+
+TEST(Optics, OpponentOnTheLeftMakesTheLeftEyeBrighter) {
+  const Profile p = thesis();
+  const Pose self{0, 2, 0};
+  const Pose opp = place(self, 5, -20);
+  ASSERT_LT(opp.x_ft, 0);  // heading north, the opponent is west: left
+  const EyeReadings r = computeEyes(self, &opp, p.robot, p.field);
+  EXPECT_GT(r.left, r.right);
+  const EyeGeometry g = eyeGeometry(self, opp, p.robot, p.field);
+  EXPECT_NEAR(g.gamma_deg, -20, 1e-9);
+  // Appendix C's swap gives the brighter value to the far eye.
+  RobotParams swapped = p.robot;
+  swapped.thesis_swapped_eyes = true;
+  const EyeReadings s = computeEyes(self, &opp, swapped, p.field);
+  EXPECT_EQ(s.left, r.right);
+  EXPECT_EQ(s.right, r.left);
+}
+
+TEST(Optics, DeadAheadGivesBothEyesTheFullSignal) {
+  const Profile p = thesis();
+  const Pose self{0, 0, 0}, opp{0, 6, 180};
+  const EyeReadings r = computeEyes(self, &opp, p.robot, p.field);
+  const double kappa = (4080.0 - 16) * 9;
+  EXPECT_EQ(r.left, expectedReading(kappa / 36 + 16, 4080));
+  EXPECT_EQ(r.right, r.left);
+}
+
+TEST(Optics, TheDividerHidesTheBeacon) {
+  const Profile p = thesis();
+  const Pose self{-3, -6, 90}, opp{3, -6, 270};
+  EXPECT_TRUE(dividerBlocks(self.x_ft, self.y_ft, opp.x_ft, opp.y_ft, p.field));
+  const EyeReadings r = computeEyes(self, &opp, p.robot, p.field);
+  EXPECT_EQ(r.left, 16);
+  EXPECT_EQ(r.right, 16);
+  const Pose above{3, -2, 270};  // line of sight passes north of the divider's end
+  const Pose selfN{-3, -2, 90};
+  EXPECT_FALSE(dividerBlocks(selfN.x_ft, selfN.y_ft, above.x_ft, above.y_ft, p.field));
+  EXPECT_GT(computeEyes(selfN, &above, p.robot, p.field).left, 16);
+}
+
+TEST(Optics, OutsideNinetyDegreesSeesBackground) {
+  const Profile p = thesis();
+  const Pose self{1, 1, 45};
+  for (double g : {90.0, -90.0, 91.0, 135.0, -170.0, 180.0}) {
+    const Pose opp = place(self, 2.0, g);
+    const EyeReadings r = computeEyes(self, &opp, p.robot, p.field);
+    EXPECT_EQ(r.left, 16) << g;
+    EXPECT_EQ(r.right, 16) << g;
+  }
+  // No opponent at all (solo).
+  const EyeReadings none = computeEyes(self, nullptr, p.robot, p.field);
+  EXPECT_EQ(none.left, 16);
+  EXPECT_EQ(none.right, 16);
+}
+
+// DESIGN.md's quantiser, clamp(16 floor(S / 16), 16, max), tops out at 2032
+// for the 2040 circuit (2040 is not a multiple of 16).
+TEST(Optics, MaxOf2040Clamps) {
+  Profile p = thesis();
+  p.robot.eye_max = 2040;
+  const Pose self{0, 0, 0}, opp{0, 1, 0};
+  const EyeReadings r = computeEyes(self, &opp, p.robot, p.field);
+  EXPECT_EQ(r.left, 2032);
+  EXPECT_EQ(r.right, 2032);
+}
+
+TEST(Optics, SeededNoiseIsReproducibleAndChangesReadings) {
+  Profile p = thesis();
+  p.robot.noise_sigma = 40;
+  p.robot.bad_reading_probability = 0.1;
+  const Pose self{0, 0, 0}, opp{1, 7, 0};
+  SplitMix64 a(42), b(42);
+  int differs = 0, bad = 0;
+  const EyeReadings clean = computeEyes(self, &opp, p.robot, p.field);
+  for (int i = 0; i < 500; ++i) {
+    const EyeReadings x = computeEyes(self, &opp, p.robot, p.field, &a);
+    const EyeReadings y = computeEyes(self, &opp, p.robot, p.field, &b);
+    EXPECT_EQ(x.left, y.left);
+    EXPECT_EQ(x.right, y.right);
+    differs += x.left != clean.left;
+    bad += std::abs(x.left - clean.left) > 400;
+    EXPECT_EQ(x.left % 16, 0);
+    EXPECT_GE(x.left, 16);
+    EXPECT_LE(x.left, 4080);
+  }
+  EXPECT_GT(differs, 250);
+  EXPECT_GT(bad, 10);
+  EXPECT_LT(bad, 120);
+}
+
+TEST(Optics, ArenaEyesFollowThePoses) {
+  const Profile p = thesis();
+  Arena a(makeArenaConfig(p, 2));
+  // A at (-6.5,-6.5) and B at (6.5,-6.5), both facing north; B is to A's
+  // right at 90 deg exactly: out of view. The divider also hides it.
+  EyeReadings r = a.eyeReadings(0, 0);
+  EXPECT_EQ(r.left, 16);
+  EXPECT_EQ(r.right, 16);
+  Arena b(config(p, {Pose{-3, 2, 90}, Pose{3, 2, 0}}));
+  r = b.eyeReadings(0, 0);
+  EXPECT_EQ(r.left, r.right);
+  EXPECT_GT(r.left, 16);
+}
+
+}  // namespace
