@@ -1,5 +1,7 @@
 #include "plant/serial_link.h"
 
+#include <algorithm>
+
 namespace simbot::plant {
 
 void SerialLink::send(Tick t0, uint16_t buf, uint16_t ccAddress, RobotMemory& memory) {
@@ -25,6 +27,7 @@ void SerialLink::service(Tick t, RobotMemory& memory) {
 void SerialLink::loadTdr(Tick t, uint8_t byte) {
   tdr_ = byte;
   tdrFull_ = true;
+  tdrLoadedAt_ = t;
   if (!tsrBusy_) moveTdrToTsr(t);
 }
 
@@ -40,7 +43,9 @@ std::optional<ReceivedFrame> SerialLink::byteDone(Tick t) {
   tsrBusy_ = false;
   ++bytesSent_;
   const uint8_t byte = tsr_;
-  if (tdrFull_) moveTdrToTsr(t);
+  // The host may learn of a load a little after the tick it happened at
+  // (an ISR that ended past the horizon); the TSR takes it when it is there.
+  if (tdrFull_) moveTdrToTsr(std::max(t, tdrLoadedAt_));
   if (byte != 0) {
     received_.push_back(static_cast<char>(byte));
     return std::nullopt;

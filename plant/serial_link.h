@@ -78,6 +78,7 @@ class SerialLink {
   // port state
   bool tdrFull_ = false;
   uint8_t tdr_ = 0;
+  Tick tdrLoadedAt_ = 0;  // a byte never leaves the TDR before it arrived
   bool tsrBusy_ = false;
   uint8_t tsr_ = 0;
   Tick tsrDoneAt_ = 0;

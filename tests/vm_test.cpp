@@ -311,6 +311,24 @@ TEST(VmFault, InterruptThroughUnboundVector) {
   EXPECT_NE(v.fault()->message.find("0x20"), std::string::npos);
 }
 
+TEST(Vm, BusAccessNeverHappensAtOrAfterTheHorizon) {
+  Assembler a;
+  a.op(Op::PUSHW, vm::kPortPIODB).op(Op::PUSHW, 0x88).lib(vm::Lib::OUTPORT, 2).op(Op::HALT);
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  const vm::Tick callEnd =
+      2 * cost(Op::PUSHW) + cost(Op::LIB) + costs().libCall[static_cast<int>(vm::Lib::OUTPORT)];
+  // The horizon falls inside the call sequence: the write waits for the
+  // next run, and happens at the end of the sequence.
+  EXPECT_EQ(v.run(callEnd - 1), Stop::Horizon);
+  EXPECT_TRUE(host.outs.empty());
+  EXPECT_EQ(v.run(callEnd + 1), Stop::Io);
+  ASSERT_EQ(host.outs.size(), 1u);
+  EXPECT_EQ(host.outs[0].tick, callEnd);
+  EXPECT_EQ(host.outs[0].value, 0x88);
+}
+
 TEST(Vm, BreakpointStopsBeforeAndResumes) {
   Assembler a;
   const uint16_t n = a.data(2);

@@ -57,7 +57,11 @@ struct LibCall {
   uint32_t pc = 0;  // address of the LIB instruction (for traces)
   int argc = 0;
   uint32_t args[kMaxLibArgs]{};
-  uint32_t setup = 0;      // T-states of the call sequence still to run
+  uint32_t setup = 0;  // T-states of the call sequence still to run
+  // The call sequence has run; its effect happens at the next boundary, so
+  // that a bus access is always at a boundary that starts before the
+  // horizon (the host never sees an access past the tick it ran us to).
+  bool awaitingBegin = false;
   uint32_t index = 0;      // bytes processed
   uint32_t remaining = 0;  // T-states still to burn (A/D, printf)
   uint32_t result = 0;
@@ -376,15 +380,13 @@ void Vm::State::libCall(Lib id, int argc, uint32_t instructionPc) {
   now += first;
   if (profiling) profile[instructionPc] += first;
   lib.setup = callCost - first;
-  if (lib.setup > 0) {
-    lib.active = true;
-    return;
-  }
-  libBegin();
+  lib.active = true;
+  lib.awaitingBegin = lib.setup == 0;
 }
 
 void Vm::State::libBegin() {
   lib.active = false;
+  lib.awaitingBegin = false;
   const Lib id = lib.id;
   const uint32_t instructionPc = lib.pc;
   const uint32_t* a = lib.args;
@@ -465,7 +467,7 @@ void Vm::State::libStep() {
     now += step;
     if (profiling) profile[lib.pc] += step;
     lib.setup -= step;
-    if (lib.setup == 0) libBegin();
+    lib.awaitingBegin = lib.setup == 0;
     return;
   }
   switch (lib.id) {
@@ -579,6 +581,10 @@ Stop Vm::State::run(Tick until) {
       return Stop::Io;
     }
     if (now >= until) return halted ? Stop::Halted : Stop::Horizon;
+    if (lib.awaitingBegin) {  // the end of a library call's sequence: no boundary
+      libBegin();
+      continue;
+    }
     if (anyPending && iff1 && !eiShadow) {
       accept();
       continue;
