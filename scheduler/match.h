@@ -1,0 +1,93 @@
+// The scheduler: runs one match (or a solo run) of robot programs in the
+// arena, interleaving their VMs with the serial links, the PIO, the guns and
+// the plant's continuous motion. It owns time; the VMs know nothing of
+// robots and the plant knows nothing of bytecode.
+//
+// Co-simulation protocol, one round at a time (t = the earliest VM clock):
+//   1. h = min(next queued event, t + 9,600). The lookahead of one character
+//      time is exact: a robot's program reaches another robot only through
+//      a latched motor frame, which happens when a NUL leaves the shift
+//      register, at least 9,600 ticks after the byte entered it; so no event
+//      another VM could observe is created inside a round.
+//   2. The plant integrates ahead to h; its first root, if earlier, caps h.
+//   3. Each VM runs to h (every instruction starting before h; bus accesses
+//      happen at boundaries before h). Port reads see device state as of the
+//      last processed event; eye readings come from dense output at their
+//      exact tick. Port B writes are collected.
+//   4. Port B writes go to the plant in tick order (they may re-initialise
+//      the integrator at their tick; robot motion does not depend on them).
+//   5. Plant events at h, then queued events at h, in the queue's order
+//      (event_queue.h); interrupt requests they cause are raised at h, so
+//      each is accepted at the first boundary at or after h.
+// Trace samples never move a horizon: they are read from dense output after
+// the fact, so a run with --trace gives the same results as one without.
+#pragma once
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "plant/plant.h"
+#include "vm/cost.h"
+#include "vm/image.h"
+#include "vm/vm.h"
+
+namespace simbot::scheduler {
+
+using Tick = int64_t;
+inline constexpr Tick kTicksPerSecond = 9'216'000;
+
+struct RobotSpec {
+  std::string name;     // "A", "B"
+  std::string program;  // path as given
+  vm::Image image;
+};
+
+struct MatchConfig {
+  std::vector<RobotSpec> robots;  // 1 (solo) or 2
+  plant::ArenaConfig arena;
+  Tick endTick = 180 * kTicksPerSecond;
+  uint64_t seed = 1;
+  bool stopWhenAllExited = false;  // solo: until main returns
+  vm::CostKnobs knobs = vm::calibratedKnobs();
+  bool trace = false;
+  Tick sampleInterval = kTicksPerSecond / 20;  // trace samples: 20 Hz
+};
+
+struct FaultInfo {
+  std::string message;
+  double timeS = 0;
+  int line = 0;
+};
+
+struct RobotResult {
+  std::string name, program;
+  int hits = 0, shots = 0;
+  int framesLatched = 0, framesRejected = 0;
+  std::map<std::string, uint64_t> interrupts;  // per source
+  uint64_t cycles = 0;
+  std::optional<FaultInfo> fault;
+  plant::Pose finalPose;
+  std::vector<std::string> console;
+  bool exited = false;
+  Tick exitTick = 0;
+};
+
+struct MatchResult {
+  Tick endTick = 0;
+  std::vector<RobotResult> robots;
+  plant::IntegratorStats integrator;
+  std::string winner;  // "A"/"B"; empty for solo
+  bool tieBrokenByCoin = false;
+  uint64_t rounds = 0;
+  std::vector<std::string> trace;  // JSONL lines in tick order (if enabled)
+};
+
+MatchResult runMatch(const MatchConfig& config);
+
+// Seeded stream for one purpose (DESIGN.md: one generator per purpose).
+uint64_t streamSeed(uint64_t seed, const std::string& purpose);
+
+}  // namespace simbot::scheduler

@@ -1,0 +1,161 @@
+// The match engine end to end: determinism, trace independence, serial
+// timing in co-simulation, edge interrupts through the PIO.
+#include "scheduler/match.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "compiler/compiler.h"
+#include "plant/plant.h"
+
+using namespace simbot;
+
+namespace {
+
+vm::Image compileFile(const std::string& path) {
+  auto r = compiler::compileFile(path);
+  if (!r.image) throw std::runtime_error(r.errors[0].format());
+  return std::move(*r.image);
+}
+
+vm::Image compileSource(const std::string& source) {
+  auto r = compiler::compile(source, "test.dc");
+  if (!r.image) throw std::runtime_error(r.errors[0].format());
+  return std::move(*r.image);
+}
+
+const std::string kIceman = SIMBOT_SHARED_DIR "/programs/iceman.dc";
+const std::string kFig92 = SIMBOT_SHARED_DIR "/programs/fig92.dc";
+
+scheduler::MatchConfig matchConfig(std::vector<scheduler::RobotSpec> robots, double seconds,
+                                   const std::string& profile = "default") {
+  scheduler::MatchConfig c;
+  c.arena =
+      plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/" + profile + ".toml"),
+                             static_cast<int>(robots.size()));
+  c.robots = std::move(robots);
+  c.endTick = static_cast<scheduler::Tick>(seconds * scheduler::kTicksPerSecond);
+  return c;
+}
+
+std::string summary(const scheduler::MatchResult& r) {
+  std::ostringstream s;
+  s.precision(17);
+  s << r.endTick << ' ' << r.winner << ' ' << r.tieBrokenByCoin << ' ' << r.integrator.steps << ' '
+    << r.integrator.rhs_evals << ' ' << r.integrator.reinits << ' ' << r.integrator.roots;
+  for (const auto& rr : r.robots) {
+    s << ' ' << rr.hits << ' ' << rr.shots << ' ' << rr.framesLatched << ' ' << rr.framesRejected
+      << ' ' << rr.cycles << ' ' << rr.finalPose.x_ft << ' ' << rr.finalPose.y_ft << ' '
+      << rr.finalPose.heading_deg;
+    for (const auto& [k, v] : rr.interrupts) s << ' ' << k << '=' << v;
+  }
+  return s.str();
+}
+
+TEST(Match, IcemanAgainstFig92IsDeterministicAndTraceDoesNotChangeIt) {
+  auto make = [] {
+    return matchConfig({{"A", kIceman, compileFile(kIceman)}, {"B", kFig92, compileFile(kFig92)}},
+                       60);
+  };
+  auto plain = make();
+  auto traced = make();
+  traced.trace = true;
+  const auto r1 = scheduler::runMatch(plain);
+  const auto r2 = scheduler::runMatch(traced);
+  const auto r3 = scheduler::runMatch(traced);
+  EXPECT_EQ(summary(r1), summary(r2));
+  EXPECT_EQ(r2.trace, r3.trace);
+  EXPECT_FALSE(r2.trace.empty());
+  EXPECT_GT(r1.robots[0].framesLatched, 0);
+  EXPECT_GT(r1.robots[1].framesLatched, 0);
+  EXPECT_EQ(r1.robots[1].interrupts.at("pio_a"), 0u);  // fig92 never arms port A
+  EXPECT_GT(r1.integrator.steps, 0);
+}
+
+struct TraceRecord {
+  long long t;
+  std::string type;
+  nlohmann::json json;
+};
+
+std::vector<TraceRecord> parse(const std::vector<std::string>& lines) {
+  std::vector<TraceRecord> out;
+  for (const auto& line : lines) {
+    auto j = nlohmann::json::parse(line);
+    out.push_back({j.at("t").get<long long>(), j.at("type").get<std::string>(), j});
+  }
+  return out;
+}
+
+TEST(Match, IcemanAloneTakesEdgeInterruptsAtTheWire) {
+  auto config = matchConfig({{"A", kIceman, compileFile(kIceman)}}, 12);
+  config.trace = true;
+  const auto r = scheduler::runMatch(config);
+  EXPECT_GE(r.robots[0].interrupts.at("pio_a"), 1u);
+  const auto trace = parse(r.trace);
+  auto find = [&](const std::string& type, long long after) {
+    for (const auto& rec : trace)
+      if (rec.type == type && rec.t >= after) return rec;
+    throw std::runtime_error("no " + type);
+  };
+  const auto enter = find("edge_enter", 0);
+  const auto accepted = find("interrupt_accepted", enter.t);
+  EXPECT_EQ(accepted.json.at("source"), "pio_a");
+  // Accepted at the next boundary: within one instruction or library step.
+  EXPECT_LE(accepted.t - enter.t, 100);
+  // The handler's first platform() sends "crgrcrgr"; it latches 9 characters
+  // after the send ends.
+  const auto send = find("serial_send", accepted.t);
+  const auto latched = find("frame_latched", send.t);
+  EXPECT_EQ(latched.json.at("bytes"), "crgrcrgr");
+  EXPECT_EQ(latched.t - send.t, 9 * 9600);
+}
+
+// platform() twice in a row: the second send restarts the first midway.
+const char* kTwoSends = R"(char buf[9];
+char cc;
+int z;
+platform()
+{
+    cc = sizeof(buf);
+    outport(ENB485, 1);
+    ser_send_z1(buf, &cc);
+}
+main()
+{
+    ser_init_z1(0, 9600/1200);
+    strcpy(buf, "4fgr4rgr");
+    platform();
+    for (z = 0; z < 100; z++);
+    strcpy(buf, "cfgrcfgr");
+    platform();
+    for (z = 0; z < 2000; z++);
+}
+)";
+
+TEST(Match, SecondPlatformBeforeTheFirstFinishesWins) {
+  auto config = matchConfig({{"A", "two.dc", compileSource(kTwoSends)}}, 1);
+  config.trace = true;
+  const auto r = scheduler::runMatch(config);
+  const auto trace = parse(r.trace);
+  std::vector<TraceRecord> sends, frames;
+  for (const auto& rec : trace) {
+    if (rec.type == "serial_send") sends.push_back(rec);
+    if (rec.type == "frame_latched" || rec.type == "frame_rejected") frames.push_back(rec);
+  }
+  ASSERT_EQ(sends.size(), 2u);
+  ASSERT_EQ(frames.size(), 1u);  // the first string is never latched
+  EXPECT_EQ(frames[0].type, "frame_latched");
+  EXPECT_EQ(frames[0].json.at("bytes"), "cfgrcfgr");
+  // The bytes already in the shift and data registers still went out: the
+  // NUL of the second string ends at a whole number of characters from T0.
+  const long long first = sends[0].t;
+  EXPECT_EQ((frames[0].t - first) % 9600, 0);
+  EXPECT_GT(frames[0].t, sends[1].t + 9 * 9600 - 1);
+  EXPECT_EQ(r.robots[0].framesLatched, 1);
+}
+
+}  // namespace
