@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -155,6 +156,74 @@ TEST(Match, SecondPlatformBeforeTheFirstFinishesWins) {
   const long long first = sends[0].t;
   EXPECT_EQ((frames[0].t - first) % 9600, 0);
   EXPECT_GT(frames[0].t, sends[1].t + 9 * 9600 - 1);
+  EXPECT_EQ(r.robots[0].framesLatched, 1);
+}
+
+// A beacon that never moves: a program that sends nothing.
+const char* kBeacon = "main()\n{\n    while (1);\n}\n";
+
+// Thesis chapter X: with the opponent where only one of ICEMAN's eyes sees
+// it, ICEMAN sends no motor string (its main loop has no one-eye case).
+TEST(Match, IcemanSendsNothingWhileOnlyOneEyeSeesTheOpponent) {
+  auto run = [](double bearingDeg) {
+    auto config = matchConfig(
+        {{"A", kIceman, compileFile(kIceman)}, {"B", "beacon.dc", compileSource(kBeacon)}}, 20);
+    const double range = 4, rad = bearingDeg * 3.14159265358979323846 / 180;
+    config.arena.robots[0].start = {0, 1, 0};
+    config.arena.robots[1].start = {range * std::sin(rad), 1 + range * std::cos(rad), 0};
+    config.trace = true;
+    return scheduler::runMatch(config);
+  };
+  const auto oneEye = run(-50);  // left of ICEMAN, beyond the far eye's cone
+  int sends = 0;
+  bool leftSees = false, rightSees = false;
+  for (const auto& rec : parse(oneEye.trace)) {
+    if (rec.type == "serial_send" && rec.json.at("robot") == "A") ++sends;
+    if (rec.type == "sample" && rec.json.at("robot") == "A") {
+      leftSees = leftSees || rec.json.at("eye_left").get<int>() > 48;
+      rightSees = rightSees || rec.json.at("eye_right").get<int>() > 48;
+    }
+  }
+  EXPECT_TRUE(leftSees);
+  EXPECT_FALSE(rightSees);
+  EXPECT_EQ(sends, 0);
+  EXPECT_EQ(oneEye.robots[0].framesLatched, 0);
+  // Control: dead ahead, both eyes see it and ICEMAN drives.
+  EXPECT_GT(run(0).robots[0].framesLatched, 0);
+}
+
+// With interrupts disabled the send stalls once the byte the library loaded
+// has gone; EI() lets the transmit interrupt finish it.
+const char* kStall = R"(char buf[9];
+char cc;
+int z;
+main()
+{
+    ser_init_z1(0, 9600/1200);
+    strcpy(buf, "4fgr4rgr");
+    cc = sizeof(buf);
+    DI();
+    ser_send_z1(buf, &cc);
+    for (z = 0; z < 2000; z++);
+    EI();
+    for (z = 0; z < 2000; z++);
+}
+)";
+
+TEST(Match, SendStallsWhileInterruptsAreDisabledAndResumesOnEi) {
+  auto config = matchConfig({{"A", "stall.dc", compileSource(kStall)}}, 1);
+  config.trace = true;
+  const auto r = scheduler::runMatch(config);
+  const auto trace = parse(r.trace);
+  long long send = -1, latched = -1;
+  for (const auto& rec : trace) {
+    if (rec.type == "serial_send") send = rec.t;
+    if (rec.type == "frame_latched") latched = rec.t;
+  }
+  ASSERT_GE(send, 0);
+  ASSERT_GE(latched, 0);
+  // 2000 delay passes with interrupts off last far longer than 9 characters.
+  EXPECT_GT(latched - send, 2000LL * 100);
   EXPECT_EQ(r.robots[0].framesLatched, 1);
 }
 
