@@ -701,110 +701,60 @@ Stop Vm::State::run(Tick until) {
         wr32(a, rd32(a) + 1u);
       }
       NEXT;
-      CASE(LDLB) {
-        const uint32_t a = mfp + u16();
-        if (!checkAccess(a, 1, opPc)) NEXT;
-        PUSHV(rd8(a));
-      }
-      NEXT;
-      CASE(LDLW) {
-        const uint32_t a = mfp + u16();
-        if (!checkAccess(a, 2, opPc)) NEXT;
-        PUSHV(rd16(a));
-      }
-      NEXT;
-      CASE(LDLL) {
-        const uint32_t a = mfp + u16();
-        if (!checkAccess(a, 4, opPc)) NEXT;
-        PUSHV(rd32(a));
-      }
-      NEXT;
-      CASE(STLB) {
-        const uint32_t a = mfp + u16();
-        const uint32_t v = POPV;
-        if (!checkAccess(a, 1, opPc)) NEXT;
-        wr8(a, v);
-      }
-      NEXT;
-      CASE(STLW) {
-        const uint32_t a = mfp + u16();
-        const uint32_t v = POPV;
-        if (!checkAccess(a, 2, opPc)) NEXT;
-        wr16(a, v);
-      }
-      NEXT;
-      CASE(STLL) {
-        const uint32_t a = mfp + u16();
-        const uint32_t v = POPV;
-        if (!checkAccess(a, 4, opPc)) NEXT;
-        wr32(a, v);
-      }
-      NEXT;
+      // One shape per addressing mode; the width picks rd/wr and the mask.
+#define LOAD_LOCAL(bytes, read)             \
+  {                                         \
+    const uint32_t a = mfp + u16();         \
+    if (!checkAccess(a, bytes, opPc)) NEXT; \
+    PUSHV(read(a));                         \
+  }                                         \
+  NEXT
+#define STORE_LOCAL(bytes, write)           \
+  {                                         \
+    const uint32_t a = mfp + u16();         \
+    const uint32_t v = POPV;                \
+    if (!checkAccess(a, bytes, opPc)) NEXT; \
+    write(a, v);                            \
+  }                                         \
+  NEXT
+#define LOAD_INDIRECT(bytes, read)          \
+  {                                         \
+    const uint32_t a = TOP & 0xFFFF;        \
+    if (!checkAccess(a, bytes, opPc)) NEXT; \
+    TOP = read(a);                          \
+  }                                         \
+  NEXT
+      // addr value -- ; or, keeping the value: addr value -- value
+#define STORE_INDIRECT(bytes, write, mask, keep)     \
+  {                                                  \
+    const uint32_t v = POPV;                         \
+    const uint32_t a = (keep ? TOP : POPV) & 0xFFFF; \
+    if (!checkAccess(a, bytes, opPc)) NEXT;          \
+    write(a, v);                                     \
+    if (keep) TOP = v & (mask);                      \
+  }                                                  \
+  NEXT
+      CASE(LDLB) LOAD_LOCAL(1, rd8);
+      CASE(LDLW) LOAD_LOCAL(2, rd16);
+      CASE(LDLL) LOAD_LOCAL(4, rd32);
+      CASE(STLB) STORE_LOCAL(1, wr8);
+      CASE(STLW) STORE_LOCAL(2, wr16);
+      CASE(STLL) STORE_LOCAL(4, wr32);
       CASE(LEAL) PUSHV((mfp + u16()) & 0xFFFF);
       NEXT;
-      CASE(LDIB) {
-        const uint32_t a = TOP & 0xFFFF;
-        if (!checkAccess(a, 1, opPc)) NEXT;
-        TOP = rd8(a);
-      }
-      NEXT;
-      CASE(LDIW) {
-        const uint32_t a = TOP & 0xFFFF;
-        if (!checkAccess(a, 2, opPc)) NEXT;
-        TOP = rd16(a);
-      }
-      NEXT;
-      CASE(LDIL) {
-        const uint32_t a = TOP & 0xFFFF;
-        if (!checkAccess(a, 4, opPc)) NEXT;
-        TOP = rd32(a);
-      }
-      NEXT;
-      CASE(STIB) {
-        const uint32_t v = POPV;
-        const uint32_t a = POPV & 0xFFFF;
-        if (!checkAccess(a, 1, opPc)) NEXT;
-        wr8(a, v);
-      }
-      NEXT;
-      CASE(STIW) {
-        const uint32_t v = POPV;
-        const uint32_t a = POPV & 0xFFFF;
-        if (!checkAccess(a, 2, opPc)) NEXT;
-        wr16(a, v);
-      }
-      NEXT;
-      CASE(STIL) {
-        const uint32_t v = POPV;
-        const uint32_t a = POPV & 0xFFFF;
-        if (!checkAccess(a, 4, opPc)) NEXT;
-        wr32(a, v);
-      }
-      NEXT;
-      CASE(STIBK) {
-        const uint32_t v = POPV;
-        const uint32_t a = TOP & 0xFFFF;
-        if (!checkAccess(a, 1, opPc)) NEXT;
-        wr8(a, v);
-        TOP = v & 0xFF;
-      }
-      NEXT;
-      CASE(STIWK) {
-        const uint32_t v = POPV;
-        const uint32_t a = TOP & 0xFFFF;
-        if (!checkAccess(a, 2, opPc)) NEXT;
-        wr16(a, v);
-        TOP = v & 0xFFFF;
-      }
-      NEXT;
-      CASE(STILK) {
-        const uint32_t v = POPV;
-        const uint32_t a = TOP & 0xFFFF;
-        if (!checkAccess(a, 4, opPc)) NEXT;
-        wr32(a, v);
-        TOP = v;
-      }
-      NEXT;
+      CASE(LDIB) LOAD_INDIRECT(1, rd8);
+      CASE(LDIW) LOAD_INDIRECT(2, rd16);
+      CASE(LDIL) LOAD_INDIRECT(4, rd32);
+      CASE(STIB) STORE_INDIRECT(1, wr8, 0xFFu, false);
+      CASE(STIW) STORE_INDIRECT(2, wr16, 0xFFFFu, false);
+      CASE(STIL) STORE_INDIRECT(4, wr32, 0xFFFFFFFFu, false);
+      CASE(STIBK) STORE_INDIRECT(1, wr8, 0xFFu, true);
+      CASE(STIWK) STORE_INDIRECT(2, wr16, 0xFFFFu, true);
+      CASE(STILK) STORE_INDIRECT(4, wr32, 0xFFFFFFFFu, true);
+#undef LOAD_LOCAL
+#undef STORE_LOCAL
+#undef LOAD_INDIRECT
+#undef STORE_INDIRECT
       CASE(COPY) {
         const uint32_t n = u16();
         const uint32_t src = POPV & 0xFFFF, dst = POPV & 0xFFFF;
