@@ -22,8 +22,9 @@ double seconds(Tick t) { return static_cast<double>(t) / kTicksPerSecond; }
 
 // Queued events; the plant's own events come from Arena::advance.
 struct QueuedEvent {
-  enum class Kind : uint8_t { SerialByte, EndOfRound } kind;
+  enum class Kind : uint8_t { SerialByte, Inject, ReleaseEdge, EndOfRound } kind;
   int robot = 0;
+  int index = 0;  // injection number, or the detector bit to release
 };
 
 class Trace {
@@ -86,7 +87,12 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   // Runs the VM to `horizon` (its clock ends at or after it).
   void runTo(Tick horizon);
   void byteDone(Tick t);
-  void setEdgeLines(Tick t, uint8_t lines);
+  // Port A's edge lines: low while the plant says so or an injection holds.
+  void updateEdgeLines();
+  void inject(Tick t, const Injection& injection);
+  uint8_t plantLow = 0, injectedLow = 0;
+  std::map<uint32_t, std::vector<int>> lineInjections;  // code address -> injections
+  std::map<uint32_t, int> lineHits;
   void scheduleSerial();
   void updateSerialRequest();
 
@@ -116,7 +122,30 @@ class Match {
     for (size_t i = 0; i < config.robots.size(); ++i)
       robots_.push_back(std::make_unique<Robot>(*this, static_cast<int>(i), config.robots[i],
                                                 costs_, config.seed));
-    queue_.schedule(config.endTick, EventClass::EndOfRound, {QueuedEvent::Kind::EndOfRound, 0});
+    queue_.schedule(config.endTick, EventClass::EndOfRound, {QueuedEvent::Kind::EndOfRound, 0, 0});
+    for (size_t k = 0; k < config.injections.size(); ++k) {
+      const Injection& in = config.injections[k];
+      if (in.robot < 0 || in.robot >= static_cast<int>(robots_.size()))
+        throw std::invalid_argument("injection for a robot that is not in this run: " + in.text);
+      if (in.source == InjectSource::BumperFront || in.source == InjectSource::BumperBack)
+        throw std::invalid_argument(in.text +
+                                    ": bumper injection is not built yet (the plant has no "
+                                    "entry point for an injected reflex)");
+      Robot& r = *robots_[static_cast<size_t>(in.robot)];
+      if (in.line > 0) {
+        const auto& lines = r.spec.image.lines;
+        const auto at = std::find(lines.begin(), lines.end(), in.line);
+        if (at == lines.end())
+          throw std::invalid_argument(
+              fmt::format("{}: line {} of {} has no code", in.text, in.line, r.spec.program));
+        const auto address = static_cast<uint32_t>(at - lines.begin());
+        r.lineInjections[address].push_back(static_cast<int>(k));
+        r.vm_.setBreakpoint(address);
+      } else {
+        queue_.schedule(in.tick, EventClass::Injection,
+                        {QueuedEvent::Kind::Inject, in.robot, static_cast<int>(k)});
+      }
+    }
   }
 
   MatchResult run();
@@ -125,6 +154,13 @@ class Match {
   Trace& trace() { return trace_; }
   EventQueue<QueuedEvent>& queue() { return queue_; }
   std::vector<PortBWrite>& portB() { return portBWrites_; }
+  struct ReflexRequest {
+    Tick tick;
+    int robot;
+    plant::Bumper bumper;
+  };
+  std::vector<ReflexRequest>& reflexes() { return reflexRequests_; }
+  const Injection& injection(int k) const { return config_.injections[static_cast<size_t>(k)]; }
   const std::string& name(int robot) const {
     return config_.robots[static_cast<size_t>(robot)].name;
   }
@@ -144,6 +180,7 @@ class Match {
   EventQueue<QueuedEvent> queue_;
   std::vector<std::unique_ptr<Robot>> robots_;
   std::vector<PortBWrite> portBWrites_;
+  std::vector<ReflexRequest> reflexRequests_;
   Tick nextSample_ = 0;
   uint64_t rounds_ = 0;
 };
@@ -175,10 +212,16 @@ void Robot::runTo(Tick horizon) {
       }
       return;
     }
-    if (stop == vm::Stop::Breakpoint && vm_.pc() == mainReturn) {
+    if (stop != vm::Stop::Breakpoint) continue;
+    if (vm_.pc() == mainReturn) {
       result.exited = true;
       result.exitTick = vm_.now();
       match.trace().add(vm_.now(), {{"type", "exit"}, {"robot", spec.name}});
+    }
+    if (auto it = lineInjections.find(vm_.pc()); it != lineInjections.end()) {
+      const int hit = ++lineHits[vm_.pc()];
+      for (int k : it->second)
+        if (match.injection(k).count == hit) inject(vm_.now(), match.injection(k));
     }
   }
 }
@@ -227,7 +270,8 @@ void Robot::scheduleSerial() {
   const auto done = link.nextByteDone();
   if (done && *done != serialEventAt) {
     serialEventAt = *done;
-    match.queue().schedule(*done, EventClass::SerialByte, {QueuedEvent::Kind::SerialByte, index});
+    match.queue().schedule(*done, EventClass::SerialByte,
+                           {QueuedEvent::Kind::SerialByte, index, 0});
   }
 }
 
@@ -255,9 +299,34 @@ void Robot::byteDone(Tick t) {
   updateSerialRequest();
 }
 
-void Robot::setEdgeLines(Tick, uint8_t lines) {
-  edgeLines = lines;
-  if (pio.setInputs(lines)) vm_.request(vm::Irq::Pio, pio.vector());
+void Robot::updateEdgeLines() {
+  edgeLines = static_cast<uint8_t>(~(plantLow | injectedLow));
+  if (pio.setInputs(edgeLines)) vm_.request(vm::Irq::Pio, pio.vector());
+}
+
+void Robot::inject(Tick t, const Injection& injection) {
+  match.trace().add(t, {{"type", "injection"},
+                        {"robot", spec.name},
+                        {"what", injection.text},
+                        {"line", vm_.line()}});
+  switch (injection.source) {
+    case InjectSource::EdgeFore:
+    case InjectSource::EdgeAft: {
+      const uint8_t bit = injection.source == InjectSource::EdgeFore ? 0x02 : 0x01;
+      injectedLow |= bit;
+      updateEdgeLines();
+      match.queue().schedule(t + kInjectedEdgePulse, EventClass::Injection,
+                             {QueuedEvent::Kind::ReleaseEdge, index, bit});
+      return;
+    }
+    case InjectSource::BumperFront:
+    case InjectSource::BumperBack:
+      match.reflexes().push_back({t, index,
+                                  injection.source == InjectSource::BumperFront
+                                      ? plant::Bumper::Front
+                                      : plant::Bumper::Back});
+      return;
+  }
 }
 
 void Robot::console(Tick t, std::string_view line) {
@@ -316,10 +385,11 @@ void Match::handlePlantEvents(Tick t, const plant::EventList& events) {
         Robot& r = *robots_[static_cast<size_t>(e.robot)];
         // Fore detector on port A bit 1, aft on bit 0; low within range.
         const uint8_t bit = e.detector == plant::Detector::Fore ? 0x02 : 0x01;
-        const uint8_t lines = e.kind == plant::EventKind::EdgeEnter
-                                  ? static_cast<uint8_t>(r.edgeLines & ~bit)
-                                  : static_cast<uint8_t>(r.edgeLines | bit);
-        r.setEdgeLines(t, lines);
+        if (e.kind == plant::EventKind::EdgeEnter)
+          r.plantLow |= bit;
+        else
+          r.plantLow &= static_cast<uint8_t>(~bit);
+        r.updateEdgeLines();
         rec["detector"] = e.detector == plant::Detector::Fore ? "fore" : "aft";
         break;
       }
@@ -396,6 +466,17 @@ MatchResult Match::run() {
           sampleUpTo(horizon);
           robots_[static_cast<size_t>(entry.payload.robot)]->byteDone(horizon);
           break;
+        case QueuedEvent::Kind::Inject: {
+          Robot& r = *robots_[static_cast<size_t>(entry.payload.robot)];
+          r.inject(horizon, config_.injections[static_cast<size_t>(entry.payload.index)]);
+          break;
+        }
+        case QueuedEvent::Kind::ReleaseEdge: {
+          Robot& r = *robots_[static_cast<size_t>(entry.payload.robot)];
+          r.injectedLow &= static_cast<uint8_t>(~entry.payload.index);
+          r.updateEdgeLines();
+          break;
+        }
         case QueuedEvent::Kind::EndOfRound:
           over = true;
           break;
@@ -441,6 +522,94 @@ void Match::finish(MatchResult& result) {
 }
 
 }  // namespace
+
+namespace {
+
+// A non-negative decimal number of `unit`s as an exact tick count: digits
+// are scaled as integers so that "12.5s" is exactly 115,200,000 ticks.
+Tick parseDuration(const std::string& digits, int64_t ticksPerUnit, const std::string& whole) {
+  const auto bad = [&] {
+    return std::invalid_argument("'" + whole +
+                                 "': WHEN must be a time (12.5s, 800ms), a tick (115200000t) "
+                                 "or a program point (line:N#K)");
+  };
+  if (digits.empty()) throw bad();
+  int64_t integer = 0, fraction = 0, scale = 1;
+  bool point = false;
+  for (char ch : digits) {
+    if (ch == '.' && !point) {
+      point = true;
+      continue;
+    }
+    if (ch < '0' || ch > '9') throw bad();
+    if (integer > 1'000'000'000 || scale > 1'000'000'000) throw bad();
+    if (point) {
+      fraction = fraction * 10 + (ch - '0');
+      scale *= 10;
+    } else {
+      integer = integer * 10 + (ch - '0');
+    }
+  }
+  const int64_t ticks = integer * ticksPerUnit + fraction * ticksPerUnit / scale;
+  if (fraction * ticksPerUnit % scale != 0)
+    throw std::invalid_argument("'" + whole + "' is not a whole number of ticks");
+  return ticks;
+}
+
+int parsePositive(const std::string& s, const std::string& whole, const char* what) {
+  if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos ||
+      std::stoi(s) <= 0)
+    throw std::invalid_argument("'" + whole + "': " + what + " must be a positive integer");
+  return std::stoi(s);
+}
+
+}  // namespace
+
+Injection parseInjection(const std::string& text, int robotCount) {
+  Injection in;
+  in.text = text;
+  const auto colon = text.find(':');
+  const auto at = text.find('@');
+  if (colon == std::string::npos || at == std::string::npos || at < colon)
+    throw std::invalid_argument("'" + text + "': expected ROBOT:SOURCE@WHEN");
+  const std::string robot = text.substr(0, colon);
+  const std::string source = text.substr(colon + 1, at - colon - 1);
+  const std::string when = text.substr(at + 1);
+  if (robot == "A")
+    in.robot = 0;
+  else if (robot == "B" && robotCount > 1)
+    in.robot = 1;
+  else
+    throw std::invalid_argument("'" + text + "': no robot '" + robot + "' in this run");
+  if (source == "edge_fore")
+    in.source = InjectSource::EdgeFore;
+  else if (source == "edge_aft")
+    in.source = InjectSource::EdgeAft;
+  else if (source == "bumper_front")
+    in.source = InjectSource::BumperFront;
+  else if (source == "bumper_back")
+    in.source = InjectSource::BumperBack;
+  else
+    throw std::invalid_argument("'" + text +
+                                "': SOURCE must be edge_fore, edge_aft, "
+                                "bumper_front or bumper_back");
+  if (when.rfind("line:", 0) == 0) {
+    const auto hash = when.find('#');
+    if (hash == std::string::npos)
+      throw std::invalid_argument("'" + text + "': a program point is line:N#K");
+    in.line = parsePositive(when.substr(5, hash - 5), text, "the line N");
+    in.count = parsePositive(when.substr(hash + 1), text, "the execution count K");
+  } else if (when.size() > 2 && when.compare(when.size() - 2, 2, "ms") == 0) {
+    in.tick = parseDuration(when.substr(0, when.size() - 2), kTicksPerSecond / 1000, text);
+  } else if (!when.empty() && when.back() == 's') {
+    in.tick = parseDuration(when.substr(0, when.size() - 1), kTicksPerSecond, text);
+  } else if (!when.empty() && when.back() == 't') {
+    in.tick = parseDuration(when.substr(0, when.size() - 1), 1, text);
+  } else {
+    parseDuration("", 1, text);  // throws the WHEN message
+  }
+  return in;
+}
 
 uint64_t streamSeed(uint64_t seed, const std::string& purpose) {
   // FNV-1a of the purpose, mixed with the master seed through SplitMix64.

@@ -45,6 +45,27 @@ struct RobotSpec {
   vm::Image image;
 };
 
+// An interrupt source injected by the user (DESIGN.md tool contract).
+enum class InjectSource : uint8_t { EdgeFore, EdgeAft, BumperFront, BumperBack };
+
+struct Injection {
+  int robot = 0;
+  InjectSource source = InjectSource::EdgeFore;
+  // When: at `tick`, or (line > 0) at the `count`-th execution of the first
+  // instruction the line table gives for `line`, at the boundary before it.
+  Tick tick = 0;
+  int line = 0;
+  int count = 1;
+  std::string text;  // as the user wrote it, for the trace
+};
+
+// An injected edge holds its detector low for this long (assumption, DESIGN).
+inline constexpr Tick kInjectedEdgePulse = kTicksPerSecond / 20;  // 50 ms
+
+// Parses ROBOT:SOURCE@WHEN (WHEN: 12.5s, 800ms, 115200000t, line:N#K).
+// Throws std::invalid_argument with a message naming what is wrong.
+Injection parseInjection(const std::string& text, int robotCount);
+
 struct MatchConfig {
   std::vector<RobotSpec> robots;  // 1 (solo) or 2
   plant::ArenaConfig arena;
@@ -52,6 +73,8 @@ struct MatchConfig {
   uint64_t seed = 1;
   bool stopWhenAllExited = false;  // solo: until main returns
   vm::CostKnobs knobs = vm::calibratedKnobs();
+  std::vector<Injection> injections;
+  std::vector<std::string> watches;  // variables added to trace records
   bool trace = false;
   Tick sampleInterval = kTicksPerSecond / 20;  // trace samples: 20 Hz
 };

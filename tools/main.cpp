@@ -64,6 +64,7 @@ struct RunOptions {
   std::string profile = "default";
   std::vector<std::string> hw;
   std::string trace;
+  std::vector<std::string> injections;
   bool json = false;
 };
 
@@ -99,12 +100,25 @@ scheduler::MatchResult play(const std::vector<std::string>& programs, const RunO
     auto& setup = config.arena.robots[static_cast<size_t>(robot)];
     setup.hardware = plant::loadHardware(file, setup.params);
   }
+  for (const auto& text : o.injections) {
+    try {
+      config.injections.push_back(
+          scheduler::parseInjection(text, static_cast<int>(programs.size())));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(fmt::format("simbot: --inject {}\n", e.what()));
+    }
+  }
   config.endTick = static_cast<scheduler::Tick>(o.seconds * scheduler::kTicksPerSecond);
   config.seed = o.seed;
   config.stopWhenAllExited = solo;
   config.trace = !o.trace.empty();
   const auto start = std::chrono::steady_clock::now();
-  auto result = scheduler::runMatch(config);
+  scheduler::MatchResult result;
+  try {
+    result = scheduler::runMatch(config);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("simbot: {}\n", e.what()));
+  }
   wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!o.trace.empty()) {
     std::ofstream out(o.trace);
@@ -195,6 +209,9 @@ void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
   cmd->add_option("--hw", o.hw,
                   solo ? "hardware file" : "hardware file for a robot: A=FILE or B=FILE");
   cmd->add_option("--trace", o.trace, "write the trace (JSONL) to this file");
+  cmd->add_option("--inject", o.injections,
+                  "ROBOT:SOURCE@WHEN, SOURCE edge_fore|edge_aft|bumper_front|bumper_back, "
+                  "WHEN 12.5s|800ms|115200000t|line:N#K (repeatable)");
   cmd->add_flag("--json", o.json, "print the summary as JSON");
 }
 

@@ -1,0 +1,129 @@
+// Interrupt injection through the match engine: at an exact tick and at a
+// program point (line:N#K), into a program sitting in a delay loop.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "plant/plant.h"
+#include "scheduler/match.h"
+#include "support/test_host.h"
+
+using namespace simbot;
+
+namespace {
+
+// Arms port A as ICEMAN does; the handler records where the loop was.
+const char* kDelay = R"(#INT_VEC PIOA_VEC edge
+int z, seen, hits;
+interrupt reti edge()
+{
+    seen = z;
+    hits++;
+}
+main()
+{
+    outport(PIOCA, 0xff);
+    outport(PIOCA, 0xff);
+    outport(PIOCA, PIOA_VEC);
+    outport(PIOCA, 0x97);
+    outport(PIOCA, 0xfc);
+    outport(PIOCA, 0x87);
+    for (z = 0; z < 20000; z++)
+        ;
+    printf("%d %d %d\n", z, seen, hits);
+}
+)";
+constexpr int kLoopBodyLine = 17;  // the lone ";"
+
+struct SoloRun {
+  scheduler::MatchResult result;
+  std::vector<nlohmann::json> trace;
+  const nlohmann::json* find(const std::string& type) const {
+    for (const auto& j : trace)
+      if (j.at("type") == type) return &j;
+    return nullptr;
+  }
+};
+
+SoloRun solo(const std::vector<std::string>& injections) {
+  scheduler::MatchConfig c;
+  c.arena =
+      plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml"), 1);
+  c.robots.push_back({"A", "delay.dc", testkit::compileOrDie(kDelay, "delay.dc")});
+  c.endTick = 10 * scheduler::kTicksPerSecond;
+  c.stopWhenAllExited = true;
+  c.trace = true;
+  for (const auto& text : injections) c.injections.push_back(scheduler::parseInjection(text, 1));
+  SoloRun run{scheduler::runMatch(c), {}};
+  for (const auto& line : run.result.trace) run.trace.push_back(nlohmann::json::parse(line));
+  return run;
+}
+
+TEST(Inject, EdgeAtATickInterruptsTheDelayLoopExactly) {
+  const SoloRun plain = solo({});
+  ASSERT_TRUE(plain.result.robots[0].exited);
+  ASSERT_EQ(plain.result.robots[0].console, std::vector<std::string>{"20000 0 0"});
+  const vm::Tick request = 1'000'003;  // well inside the loop
+  const SoloRun injected = solo({"A:edge_fore@" + std::to_string(request) + "t"});
+  const auto* accepted = injected.find("interrupt_accepted");
+  const auto* returned = injected.find("interrupt_returned");
+  ASSERT_NE(accepted, nullptr);
+  ASSERT_NE(returned, nullptr);
+  const vm::Tick acceptedAt = accepted->at("t").get<vm::Tick>();
+
+  // The same program on a bare VM: the first boundary at or after the
+  // request, and z there.
+  const auto img = testkit::compileOrDie(kDelay, "delay.dc");
+  testkit::TestHost host;
+  vm::Vm v(img, host, vm::makeCostTable(vm::calibratedKnobs()));
+  while (v.now() < request) v.run(request);
+  EXPECT_EQ(acceptedAt, v.now());
+  const uint16_t zAtBoundary = v.read16(static_cast<uint16_t>(testkit::symbol(img, "z").address));
+
+  // The loop resumed where it was and the run grew by the handler's time
+  // (and by the debug-port time of the longer line printf writes at the end).
+  const vm::Tick handlerTime = returned->at("t").get<vm::Tick>() - acceptedAt;
+  const std::string line = "20000 " + std::to_string(zAtBoundary) + " 1";
+  EXPECT_EQ(injected.result.robots[0].console, std::vector<std::string>{line});
+  const vm::Tick longerPrintf =
+      static_cast<vm::Tick>(line.size() - std::string("20000 0 0").size()) *
+      vm::calibratedKnobs().printfCharTstates;
+  EXPECT_EQ(injected.result.robots[0].exitTick,
+            plain.result.robots[0].exitTick + handlerTime + longerPrintf);
+  EXPECT_EQ(injected.result.robots[0].interrupts.at("pio_a"), 1u);
+}
+
+TEST(Inject, ProgramPointLandsOnTheKthPass) {
+  const SoloRun injected = solo({"A:edge_aft@line:" + std::to_string(kLoopBodyLine) + "#1234"});
+  // The 1234th execution of the loop body's first instruction is the pass
+  // with z == 1233; the handler is accepted before it runs.
+  EXPECT_EQ(injected.result.robots[0].console, std::vector<std::string>{"20000 1233 1"});
+  const auto* inj = injected.find("injection");
+  ASSERT_NE(inj, nullptr);
+  EXPECT_EQ(inj->at("line"), kLoopBodyLine);
+  const auto* accepted = injected.find("interrupt_accepted");
+  ASSERT_NE(accepted, nullptr);
+  EXPECT_EQ(accepted->at("t"), inj->at("t"));
+  EXPECT_EQ(accepted->at("line"), kLoopBodyLine);
+}
+
+TEST(Inject, InjectedEdgeIsAPulse) {
+  const SoloRun injected = solo({"A:edge_fore@100ms", "A:edge_fore@120ms", "A:edge_fore@200ms"});
+  // 120 ms falls inside the 50-ms pulse of the first: no new falling edge.
+  EXPECT_EQ(injected.result.robots[0].interrupts.at("pio_a"), 2u);
+}
+
+TEST(Inject, ParsesWhenForms) {
+  EXPECT_EQ(scheduler::parseInjection("A:edge_fore@12.5s", 1).tick, 115'200'000);
+  EXPECT_EQ(scheduler::parseInjection("A:edge_aft@800ms", 1).tick, 7'372'800);
+  EXPECT_EQ(scheduler::parseInjection("B:bumper_back@115200000t", 2).tick, 115'200'000);
+  const auto p = scheduler::parseInjection("A:edge_fore@line:42#3", 1);
+  EXPECT_EQ(p.line, 42);
+  EXPECT_EQ(p.count, 3);
+  for (const char* bad :
+       {"A:edge_fore", "C:edge_fore@1s", "B:edge_fore@1s", "A:laser@1s", "A:edge_fore@soon",
+        "A:edge_fore@line:4", "A:edge_fore@line:0#1", "A:edge_fore@0.00000001s", "A:edge_fore@-1s"})
+    EXPECT_THROW(scheduler::parseInjection(bad, 1), std::invalid_argument) << bad;
+}
+
+}  // namespace
