@@ -122,6 +122,8 @@ class Match {
     for (size_t i = 0; i < config.robots.size(); ++i)
       robots_.push_back(std::make_unique<Robot>(*this, static_cast<int>(i), config.robots[i],
                                                 costs_, config.seed));
+    if (config.profile)
+      for (auto& r : robots_) r->vm_.enableProfile();
     queue_.schedule(config.endTick, EventClass::EndOfRound, {QueuedEvent::Kind::EndOfRound, 0, 0});
     for (size_t k = 0; k < config.injections.size(); ++k) {
       const Injection& in = config.injections[k];
@@ -504,6 +506,10 @@ void Match::finish(MatchResult& result) {
     rr.hits = arena_.hits(r->index);
     rr.shots = arena_.shots(r->index);
     rr.cycles = static_cast<uint64_t>(r->vm_.now());
+    if (config_.profile) {
+      rr.profile = r->vm_.profile();
+      rr.serialIsrCycles = r->vm_.serialIsrCycles();
+    }
     for (vm::Irq irq : {vm::Irq::Pio, vm::Irq::SerialTx})
       rr.interrupts.emplace(std::string(vm::irqName(irq)), 0);
     rr.finalPose = arena_.pose(r->index, std::min(result.endTick, arena_.now()));

@@ -75,6 +75,7 @@ struct MatchConfig {
   vm::CostKnobs knobs = vm::calibratedKnobs();
   std::vector<Injection> injections;
   std::vector<std::string> watches;  // variables added to trace records
+  bool profile = false;              // per-instruction cycle counts (simbot profile)
   bool trace = false;
   Tick sampleInterval = kTicksPerSecond / 20;  // trace samples: 20 Hz
 };
@@ -96,6 +97,11 @@ struct RobotResult {
   std::vector<std::string> console;
   bool exited = false;
   Tick exitTick = 0;
+  // With MatchConfig::profile: T-states charged at each code address
+  // (interrupt acceptance to the handler's first instruction), and those
+  // of the serial library's transmit interrupts.
+  std::vector<uint64_t> profile;
+  uint64_t serialIsrCycles = 0;
 };
 
 struct MatchResult {

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -202,6 +203,112 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
   return 0;
 }
 
+// Cycles per source line and per function of a solo run, largest first.
+int profileCommand(const std::string& program, RunOptions o, int top) {
+  o.trace.clear();
+  const vm::Image image = compileOrThrow(program);
+  scheduler::MatchConfig config;
+  config.arena = plant::makeArenaConfig(loadProfile(o.profile), 1);
+  config.robots.push_back({"A", program, image});
+  config.endTick = static_cast<scheduler::Tick>(o.seconds * scheduler::kTicksPerSecond);
+  config.seed = o.seed;
+  config.stopWhenAllExited = true;
+  config.profile = true;
+  for (const auto& text : o.injections) {
+    try {
+      config.injections.push_back(scheduler::parseInjection(text, 1));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(fmt::format("simbot: --inject {}\n", e.what()));
+    }
+  }
+  scheduler::MatchResult r;
+  try {
+    r = scheduler::runMatch(config);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("simbot: {}\n", e.what()));
+  }
+  const auto& robot = r.robots[0];
+  std::map<int, uint64_t> byLine;
+  std::map<std::string, uint64_t> byFunction;
+  uint64_t busy = robot.serialIsrCycles;
+  for (uint32_t at = 0; at < robot.profile.size(); ++at) {
+    const uint64_t cycles = robot.profile[at];
+    if (cycles == 0) continue;
+    busy += cycles;
+    byLine[image.lineAt(at)] += cycles;
+    const vm::Symbol* fn = image.functionAt(at);
+    byFunction[fn ? fn->name : "(start-up)"] += cycles;
+  }
+  const uint64_t total = robot.cycles;
+  const uint64_t idle = total > busy ? total - busy : 0;
+  auto functionOf = [&](int line) {
+    for (uint32_t at = 0; at < image.lines.size(); ++at)
+      if (image.lines[at] == line)
+        if (const vm::Symbol* fn = image.functionAt(at)) return fn->name;
+    return std::string();
+  };
+  auto sorted = [](const auto& m) {
+    std::vector<std::pair<typename std::decay_t<decltype(m)>::key_type, uint64_t>> v(m.begin(),
+                                                                                     m.end());
+    std::stable_sort(v.begin(), v.end(),
+                     [](const auto& a, const auto& b) { return a.second > b.second; });
+    return v;
+  };
+  const auto functions = sorted(byFunction);
+  const auto lines = sorted(byLine);
+  const double tps = static_cast<double>(scheduler::kTicksPerSecond);
+  auto pct = [&](uint64_t c) { return total ? 100.0 * static_cast<double>(c) / total : 0.0; };
+  if (o.json) {
+    json j = {{"program", program},    {"sim_seconds", static_cast<double>(total) / tps},
+              {"cycles", total},       {"serial_isr_cycles", robot.serialIsrCycles},
+              {"idle_cycles", idle},   {"functions", json::array()},
+              {"lines", json::array()}};
+    for (const auto& [name, cycles] : functions)
+      j["functions"].push_back({{"function", name},
+                                {"cycles", cycles},
+                                {"seconds", static_cast<double>(cycles) / tps},
+                                {"percent", pct(cycles)}});
+    for (const auto& [line, cycles] : lines)
+      j["lines"].push_back(
+          {{"line", line},
+           {"function", functionOf(line)},
+           {"cycles", cycles},
+           {"seconds", static_cast<double>(cycles) / tps},
+           {"percent", pct(cycles)},
+           {"source", line > 0 && line <= static_cast<int>(image.sourceLines.size())
+                          ? image.sourceLines[static_cast<size_t>(line - 1)]
+                          : ""}});
+    std::cout << j.dump(2) << '\n';
+    return 0;
+  }
+  std::cout << fmt::format("{}: {:.3f} simulated seconds, {} T-states{}\n\n", program,
+                           static_cast<double>(total) / tps, total,
+                           robot.exited ? " (main returned)" : "");
+  std::cout << fmt::format("{:>12} {:>9} {:>6}  {}\n", "T-states", "seconds", "%", "function");
+  for (const auto& [name, cycles] : functions)
+    std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {}\n", cycles,
+                             static_cast<double>(cycles) / tps, pct(cycles), name);
+  if (robot.serialIsrCycles)
+    std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {}\n", robot.serialIsrCycles,
+                             static_cast<double>(robot.serialIsrCycles) / tps,
+                             pct(robot.serialIsrCycles), "(serial transmit interrupts)");
+  if (idle)
+    std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {}\n", idle,
+                             static_cast<double>(idle) / tps, pct(idle), "(halted)");
+  std::cout << fmt::format("\n{:>12} {:>9} {:>6}  {:>5}  {}\n", "T-states", "seconds", "%", "line",
+                           "source");
+  int shown = 0;
+  for (const auto& [line, cycles] : lines) {
+    if (shown++ == top) break;
+    std::string text = line > 0 && line <= static_cast<int>(image.sourceLines.size())
+                           ? image.sourceLines[static_cast<size_t>(line - 1)]
+                           : "";
+    std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {:>5}  {}\n", cycles,
+                             static_cast<double>(cycles) / tps, pct(cycles), line, text);
+  }
+  return 0;
+}
+
 void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
   cmd->add_option("--seconds", o.seconds, "simulated seconds (default 180)");
   cmd->add_option("--seed", o.seed, "master seed (default 1)");
@@ -240,6 +347,20 @@ int main(int argc, char** argv) {
   match->add_option("B", programB, "robot B's program")->required();
   addRunOptions(match, matchOptions, false);
 
+  RunOptions profileOptions;
+  profileOptions.seconds = 60;
+  std::string profileProgram;
+  int profileTop = 20;
+  auto* profile =
+      app.add_subcommand("profile", "cycles and time per source line and function of a solo run");
+  profile->add_option("FILE", profileProgram, "program (.dc)")->required();
+  profile->add_option("--seconds", profileOptions.seconds, "simulated seconds (default 60)");
+  profile->add_option("--seed", profileOptions.seed, "master seed (default 1)");
+  profile->add_option("--profile", profileOptions.profile, "physical profile (default: default)");
+  profile->add_option("--inject", profileOptions.injections, "as for solo (repeatable)");
+  profile->add_option("--top", profileTop, "source lines to list (default 20)");
+  profile->add_flag("--json", profileOptions.json, "print the profile as JSON");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -249,6 +370,7 @@ int main(int argc, char** argv) {
     if (*compile) return compileCommand(compileFile, disasm);
     if (*solo) return soloCommand(soloProgram, soloOptions);
     if (*match) return matchCommand(programA, programB, matchOptions);
+    if (*profile) return profileCommand(profileProgram, profileOptions, profileTop);
   } catch (const UsageError& e) {
     std::cerr << e.what();
     return 1;
