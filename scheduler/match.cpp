@@ -166,6 +166,7 @@ class Match {
   const std::string& name(int robot) const {
     return config_.robots[static_cast<size_t>(robot)].name;
   }
+  MatchObserver* observer() const { return config_.observer; }
 
  private:
   Tick earliestClock() const;
@@ -252,7 +253,9 @@ uint8_t Robot::in(Tick, uint16_t port) {
 
 int Robot::adSample(Tick t, int channel) {
   const plant::EyeReadings e = match.arena().eyeReadings(index, t, &noise);
-  return channel == 0 ? e.left : channel == 1 ? e.right : 0;
+  const int value = channel == 0 ? e.left : channel == 1 ? e.right : 0;
+  if (match.observer()) match.observer()->onEyeRead(index, t, channel, value);
+  return value;
 }
 
 void Robot::serialSend(Tick t, uint16_t buf, uint16_t cc) {
@@ -287,6 +290,7 @@ void Robot::updateSerialRequest() {
 void Robot::byteDone(Tick t) {
   serialEventAt = -1;
   if (auto frame = link.byteDone(t)) {
+    if (match.observer()) match.observer()->onFrame(index, t, frame->command.has_value());
     if (frame->command) {
       ++result.framesLatched;
       match.arena().setWheels(index, *frame->command, t);
@@ -338,6 +342,7 @@ void Robot::console(Tick t, std::string_view line) {
 
 void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
   ++result.interrupts[std::string(vm::irqName(irq))];
+  if (match.observer()) match.observer()->onInterruptAccepted(index, t, irq);
   if (irq == vm::Irq::Pio) pio.accepted();
   if (irq == vm::Irq::SerialTx || !match.trace().enabled()) return;
   const vm::Symbol* fn = spec.image.functionAt(pc);
@@ -370,16 +375,19 @@ void Match::applyPortB() {
   for (const auto& w : portBWrites_) {
     sampleUpTo(w.tick);
     const plant::EventList immediate = arena_.setPortB(w.robot, w.value, w.tick);
-    for (const auto& e : immediate)
+    for (const auto& e : immediate) {
+      if (config_.observer) config_.observer->onPlantEvent(w.tick, e);
       trace_.add(
           w.tick,
           {{"type", plant::eventKindName(e.kind)}, {"robot", name(e.robot)}, {"gun", e.gun}});
+    }
   }
   portBWrites_.clear();
 }
 
 void Match::handlePlantEvents(Tick t, const plant::EventList& events) {
   for (const auto& e : events) {
+    if (config_.observer) config_.observer->onPlantEvent(t, e);
     nlohmann::json rec = {{"type", plant::eventKindName(e.kind)}, {"robot", name(e.robot)}};
     switch (e.kind) {
       case plant::EventKind::EdgeEnter:

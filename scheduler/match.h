@@ -66,6 +66,18 @@ inline constexpr Tick kInjectedEdgePulse = kTicksPerSecond / 20;  // 50 ms
 // Throws std::invalid_argument with a message naming what is wrong.
 Injection parseInjection(const std::string& text, int robotCount);
 
+// Optional hooks for measurements (simbot bench). Called from the round loop
+// at the exact tick of each happening; an observer only reads, so a run with
+// one gives the same results as one without. Per robot, eye reads and frames
+// arrive in tick order; plant events may arrive after later eye reads.
+struct MatchObserver {
+  virtual ~MatchObserver() = default;
+  virtual void onEyeRead(int /*robot*/, Tick, int /*channel*/, int /*value*/) {}
+  virtual void onInterruptAccepted(int /*robot*/, Tick, vm::Irq) {}
+  virtual void onFrame(int /*robot*/, Tick, bool /*latched*/) {}
+  virtual void onPlantEvent(Tick, const plant::Event&) {}
+};
+
 struct MatchConfig {
   std::vector<RobotSpec> robots;  // 1 (solo) or 2
   plant::ArenaConfig arena;
@@ -78,6 +90,7 @@ struct MatchConfig {
   bool profile = false;              // per-instruction cycle counts (simbot profile)
   bool trace = false;
   Tick sampleInterval = kTicksPerSecond / 20;  // trace samples: 20 Hz
+  MatchObserver* observer = nullptr;           // not owned; may be null
 };
 
 struct FaultInfo {
