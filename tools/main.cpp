@@ -16,6 +16,7 @@
 #include "compiler/compiler.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
+#include "tools/commands.h"
 #include "vm/vm.h"
 
 namespace {
@@ -361,6 +362,9 @@ int main(int argc, char** argv) {
   profile->add_option("--top", profileTop, "source lines to list (default 20)");
   profile->add_flag("--json", profileOptions.json, "print the profile as JSON");
 
+  const auto bench = simbot::tools::addBenchCommand(app);
+  const auto tournament = simbot::tools::addTournamentCommand(app);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -371,6 +375,8 @@ int main(int argc, char** argv) {
     if (*solo) return soloCommand(soloProgram, soloOptions);
     if (*match) return matchCommand(programA, programB, matchOptions);
     if (*profile) return profileCommand(profileProgram, profileOptions, profileTop);
+    if (*bench.app) return bench.run();
+    if (*tournament.app) return tournament.run();
   } catch (const UsageError& e) {
     std::cerr << e.what();
     return 1;

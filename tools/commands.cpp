@@ -1,0 +1,93 @@
+#include "tools/commands.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <iostream>
+#include <memory>
+
+#include "tools/bench.h"
+#include "tools/runner.h"
+#include "tools/tournament.h"
+
+namespace simbot::tools {
+
+namespace {
+
+int guarded(const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const ToolError& e) {
+    std::cerr << e.what();
+    return 1;
+  } catch (const plant::ConfigError& e) {
+    std::cerr << e.what() << '\n';
+    return 1;
+  }
+}
+
+}  // namespace
+
+Subcommand addBenchCommand(CLI::App& app) {
+  struct Options {
+    BenchConfig config;
+    std::string out, profile = "default";
+  };
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("bench", "scenario families over many seeds, with statistics");
+  cmd->add_option("PROGRAM", o->config.programs, "programs under test (each is robot A)")
+      ->required();
+  cmd->add_option("--family", o->config.family, "stationary, circle, head-to-head or edge")
+      ->required();
+  cmd->add_option("--seeds", o->config.seeds, "runs per program")->required();
+  cmd->add_option("--seconds", o->config.seconds, "simulated seconds per run (default 60)");
+  cmd->add_option("--seed", o->config.masterSeed, "master seed (default 1)");
+  cmd->add_option("--threads", o->config.threads, "worker threads (default: all cores)");
+  cmd->add_option("--out", o->out, "output directory (default out/bench-FAMILY)");
+  cmd->add_option("--profile", o->profile, "profile name or file (default: default)");
+  cmd->add_option("--opponent", o->config.opponent, "robot B's program (head-to-head)");
+  return {cmd, [o] {
+            return guarded([&] {
+              const auto start = std::chrono::steady_clock::now();
+              const BenchResult r = runBench(o->config, loadNamedProfile(o->profile));
+              const std::string dir = o->out.empty() ? "out/bench-" + o->config.family : o->out;
+              writeBenchOutputs(r, dir);
+              std::cout << summaryMarkdown(r);
+              std::cerr << fmt::format(
+                  "simbot: {} runs in {:.1f} s wall; wrote {}/runs.csv, summary.json, summary.md\n",
+                  r.runs.size(),
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                  dir);
+              return 0;
+            });
+          }};
+}
+
+Subcommand addTournamentCommand(CLI::App& app) {
+  struct Options {
+    TournamentConfig config;
+    std::string profile = "default";
+    bool json = false;
+  };
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("tournament", "round robin after thesis Appendix A");
+  cmd->add_option("PROGRAM", o->config.programs, "the programs (two or more)")->required();
+  cmd->add_option("--rounds", o->config.rounds, "rounds per pair, sides swapped (default 2)");
+  cmd->add_option("--seconds", o->config.seconds, "round length (default 180)");
+  cmd->add_option("--seed", o->config.masterSeed, "master seed (default 1)");
+  cmd->add_option("--threads", o->config.threads, "worker threads (default: all cores)");
+  cmd->add_option("--profile", o->profile, "profile name or file (default: default)");
+  cmd->add_flag("--json", o->json, "print standings and games as JSON");
+  return {cmd, [o] {
+            return guarded([&] {
+              const TournamentResult r = runTournament(o->config, loadNamedProfile(o->profile));
+              if (o->json)
+                std::cout << tournamentJson(r).dump(2) << '\n';
+              else
+                std::cout << standingsTable(r);
+              return 0;
+            });
+          }};
+}
+
+}  // namespace simbot::tools

@@ -1,0 +1,16 @@
+// The bench and tournament subcommands, kept out of main.cpp.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace simbot::tools {
+
+struct Subcommand {
+  CLI::App* app = nullptr;
+  std::function<int()> run;  // prints its own errors; returns the exit status
+};
+
+Subcommand addBenchCommand(CLI::App& app);
+Subcommand addTournamentCommand(CLI::App& app);
+
+}  // namespace simbot::tools

@@ -1,0 +1,118 @@
+#include "tools/runner.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "compiler/compiler.h"
+
+namespace simbot::tools {
+
+namespace {
+
+vm::Image imageOrThrow(compiler::Result result) {
+  if (!result.image) {
+    std::string all;
+    for (const auto& d : result.errors) all += d.format();
+    throw ToolError(all);
+  }
+  return std::move(*result.image);
+}
+
+}  // namespace
+
+vm::Image compileProgramFile(const std::string& path) {
+  if (!std::filesystem::exists(path))
+    throw ToolError(fmt::format("simbot: no such program '{}'\n", path));
+  return imageOrThrow(compiler::compileFile(path));
+}
+
+vm::Image compileProgramText(const std::string& source, const std::string& name) {
+  return imageOrThrow(compiler::compile(source, name));
+}
+
+plant::Profile loadNamedProfile(const std::string& nameOrPath) {
+  namespace fs = std::filesystem;
+  fs::path p = nameOrPath;
+  if (!fs::exists(p)) p = fs::path(SIMBOT_PROFILES_DIR) / (nameOrPath + ".toml");
+  if (!fs::exists(p))
+    throw ToolError(
+        fmt::format("simbot: no profile '{}' (a file, or one of profiles/*.toml)\n", nameOrPath));
+  return plant::loadProfile(p.string());
+}
+
+int resolveThreads(int threads) {
+  if (threads > 0) return threads;
+  const unsigned hw = std::thread::hardware_concurrency();
+  return hw == 0 ? 1 : static_cast<int>(hw);
+}
+
+double uniform(plant::RandomBits& bits, double lo, double hi) {
+  const double u = static_cast<double>(bits.next() >> 11) * 0x1.0p-53;
+  return lo + (hi - lo) * u;
+}
+
+void parallelFor(size_t count, int threads, const std::function<void(size_t)>& job,
+                 const std::string& label, bool progress) {
+  const auto start = std::chrono::steady_clock::now();
+  const size_t workers =
+      std::min<size_t>(static_cast<size_t>(resolveThreads(threads)), std::max<size_t>(count, 1));
+  std::atomic<size_t> next{0}, done{0};
+  std::vector<std::exception_ptr> errors(count);
+  std::mutex mutex;
+  std::condition_variable finished;
+  auto work = [&] {
+    for (size_t i; (i = next.fetch_add(1)) < count;) {
+      try {
+        job(i);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+      done.fetch_add(1);
+      std::lock_guard lock(mutex);
+      finished.notify_all();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (size_t w = 0; w < workers; ++w) pool.emplace_back(work);
+  const bool tty = progress && isatty(STDERR_FILENO);
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  if (tty) {
+    std::unique_lock lock(mutex);
+    while (true) {
+      const size_t d = done.load();
+      constexpr size_t kWidth = 30;
+      const size_t filled = count ? d * kWidth / count : kWidth;
+      const double t = elapsed();
+      const std::string eta =
+          d > 0 && d < count
+              ? fmt::format(", ETA {:.0f} s", t / static_cast<double>(d) * (count - d))
+              : "";
+      std::cerr << fmt::format("\r{} [{}{}] {}/{}  {:.0f} s{}   ", label, std::string(filled, '#'),
+                               std::string(kWidth - filled, '.'), d, count, t, eta)
+                << std::flush;
+      if (d == count) break;
+      finished.wait_for(lock, std::chrono::milliseconds(250));
+    }
+    std::cerr << '\n';
+  }
+  for (auto& th : pool) th.join();
+  if (progress && !tty)
+    std::cerr << fmt::format("{}: {}/{} done in {:.1f} s on {} threads\n", label, done.load(),
+                             count, elapsed(), workers);
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+}  // namespace simbot::tools
