@@ -30,6 +30,23 @@
 // changes the plant. Hence an input can re-initialise at any tick between the
 // last re-initialisation and now().
 //
+// Stepping is independent of how the caller chops time. advance(stop) does
+// not stop CVODE at `stop`: it takes whole internal steps until CVODE has
+// returned a time at or past the stop (the last step may overshoot it; the
+// segments keep the overshoot for the next advance(), which steps only if
+// they do not reach its stop yet). CVODE is given a stop time only at a
+// discontinuity known when the segment starts: the next ball launch, set at
+// every re-initialisation (an input that schedules a launch re-initialises).
+// A root whose tick lies beyond the caller's stop is held, not reported: the
+// call returns at its stop, and a later advance() whose stop reaches the
+// root's tick reports it there, with the same events, exactly as a single
+// long advance() would have. A re-initialisation drops a held root (it lies
+// past the input's tick). Between re-initialisations the sequence of CVode
+// calls is therefore the same whatever the stops were, and so are the steps,
+// the segments, the roots and every query; the only CVode argument that is
+// not a state of the plant, tout, matters only on the first call after a
+// (re)initialisation (CVODE's initial step guess) and is a fixed horizon.
+//
 // Dense output. CVODE runs in CV_ONE_STEP mode; after every internal step
 // we store the step's Nordsieck data as Taylor coefficients c_k =
 // y^(k)(t_n) / k! from CVodeGetDky(t_n, k) for k = 0..q. On the step's
@@ -68,6 +85,10 @@ enum : int { X = 0, Y = 1, H = 2, VL = 3, VR = 4, S = 5, G1 = 6, G2 = 7 };
 constexpr int kMaxBalls = 64;
 constexpr int kMaxRoots = 2 * 6 + 1 + kMaxBalls * 4;
 constexpr int kRing = 16;
+// CVode's tout in CV_ONE_STEP mode only bounds the first step's guess after a
+// (re)initialisation; a fixed horizon keeps it independent of the caller.
+constexpr double kFirstStepHorizon = 1.0;  // s
+constexpr double kNoStopTime = 1e12;       // s, far beyond any match
 
 enum class RootKind : std::uint8_t {
   EdgeFore,
@@ -166,6 +187,17 @@ struct Arena::Impl {
   std::int64_t segTick = 0;  // tick of the last (re)initialisation
   double segT0 = 0;          // its time in seconds
 
+  // ---- the integrator's own position (see "Stepping" above)
+  double tOut = 0;               // tout for CVode: segT0 + kFirstStepHorizon
+  double tReturned = 0;          // time of CVode's last return: roots up to it are known
+  std::int64_t launchStop = -1;  // tick CVODE's stop time is set at (a launch), or -1
+  // A root found beyond the caller's stop, with events: reported by a later
+  // advance() whose stop reaches heldTick.
+  bool held = false;
+  std::int64_t heldTick = 0;
+  double heldTime = 0;
+  std::vector<int> heldFound;
+
   // ---- roots
   std::array<RootDesc, kMaxRoots> roots{};
   int nRoots = 0;
@@ -204,6 +236,7 @@ struct Arena::Impl {
     tmp.assign(static_cast<std::size_t>(n), 0.0);
     qtmp.assign(static_cast<std::size_t>(n), 0.0);
     rootsFound.assign(kMaxRoots, 0);
+    heldFound.assign(kMaxRoots, 0);
     recs.reserve(1024);
     coef.reserve(static_cast<std::size_t>(1024 * 13 * n));
 
@@ -455,6 +488,18 @@ struct Arena::Impl {
     }
   }
 
+  void clearStopTime() {
+#if SUNDIALS_VERSION_MAJOR > 6 || (SUNDIALS_VERSION_MAJOR == 6 && SUNDIALS_VERSION_MINOR >= 5)
+    cv::check(CVodeClearStopTime(mem.get()), "CVodeClearStopTime");
+#else
+    // No CVodeClearStopTime before SUNDIALS 6.5: a stop time no step ever
+    // comes near changes nothing (CVODE only shortens a step that would
+    // pass it, and uses it for the first step's guess only if it is closer
+    // than tout).
+    cv::check(CVodeSetStopTime(mem.get(), kNoStopTime), "CVodeSetStopTime");
+#endif
+  }
+
   void accumulateStats() {
     long v = 0;
     CVodeGetNumSteps(mem.get(), &v);
@@ -485,6 +530,20 @@ struct Arena::Impl {
     segTick = tick;
     segT0 = t0;
     now = tick;
+    tOut = t0 + kFirstStepHorizon;
+    tReturned = t0;
+    held = false;
+    // The only discontinuity known in advance: the next ball launch. CVODE
+    // must not step across it; any other stop time from the last segment
+    // (a launch this re-initialisation came before) is cleared.
+    const std::int64_t nl = nextLaunch();
+    if (nl > tick) {
+      cv::check(CVodeSetStopTime(mem.get(), secondsFromTick(nl)), "CVodeSetStopTime");
+      launchStop = nl;
+    } else {
+      clearStopTime();
+      launchStop = -1;
+    }
     recs.clear();
     coef.clear();
     recs.push_back(Rec{t0, t0, t0, 0, 0});
@@ -519,7 +578,8 @@ struct Arena::Impl {
 
   void evalAt(double t, std::vector<double>& out) const {
     // First record whose interval reaches t; past the end, the last one
-    // (extrapolation by less than one tick, see advance()).
+    // (advance() steps until CVODE has returned a time at or past now(), so
+    // at most a rounding of the tick's time).
     auto it = std::lower_bound(recs.begin(), recs.end(), t,
                                [](const Rec& r, double tt) { return r.thi < tt; });
     if (it == recs.end()) --it;
@@ -845,14 +905,21 @@ struct Arena::Impl {
     return best;
   }
 
-  // Computes the events at T (time te) from the current segment's state;
-  // if there are any, keeps them pending and returns true.
-  bool predict(std::int64_t T, double te, const int* found, EventList& ev) {
+  // Computes the events at T (time te) from the current segment's state
+  // into pendingD/pendingY and ev; true if there are any. Does not make
+  // them pending.
+  bool eventsAt(std::int64_t T, double te, const int* found, EventList& ev) {
     evalAt(te, pendingY);
     pendingD = D;
     ev.clear();
     process(T, te, pendingD, pendingY, found, ev);
-    if (ev.empty()) return false;
+    return !ev.empty();
+  }
+
+  // Computes the events at T (time te) from the current segment's state;
+  // if there are any, keeps them pending and returns true.
+  bool predict(std::int64_t T, double te, const int* found, EventList& ev) {
+    if (!eventsAt(T, te, found, ev)) return false;
     pending = true;
     pendingTick = T;
     pendingTime = te;
@@ -871,33 +938,55 @@ struct Arena::Impl {
     if (launchesDue(now) && predict(now, timeOfTick(now), nullptr, res.events)) return res;
     std::int64_t stop = stopTick;
     const std::int64_t nl = nextLaunch();
-    if (nl > now && nl < stop) stop = nl;
+    if (nl > now && nl < stop) stop = nl;  // CVODE's stop time is set there
     const double tStop = secondsFromTick(stop);
-    cv::check(CVodeSetStopTime(mem.get(), tStop), "CVodeSetStopTime");
     for (;;) {
+      if (held) {
+        if (heldTick > stop) break;  // still beyond: return at stop, keep it
+        held = false;
+        if (predict(heldTick, heldTime, heldFound.data(), res.events)) {
+          res.tick = heldTick;
+          return res;
+        }
+        continue;  // (cannot happen: it had events when found)
+      }
+      // Every root up to tReturned has been reported or held; all roots at
+      // ticks <= stop lie before the first time CVODE returns past tStop.
+      if (tReturned >= tStop) break;
       double tret = 0;
-      const int flag = CVode(mem.get(), tStop, yv.get(), &tret, CV_ONE_STEP);
+      const int flag = CVode(mem.get(), tOut, yv.get(), &tret, CV_ONE_STEP);
       cv::check(flag, "CVode");
       recordStep(tret);
-      if (flag == CV_ROOT_RETURN) {
-        ++acc.roots;
-        cv::check(CVodeGetRootInfo(mem.get(), rootsFound.data()), "CVodeGetRootInfo");
-        std::int64_t T = eventTickFromSeconds(tret);
-        T = std::clamp(T, now, stop);
-        const double te = std::max(timeOfTick(T), tret);
+      tReturned = tret;
+      if (flag == CV_TSTOP_RETURN) launchStop = -1;  // CVODE disarms a reached stop time
+      if (flag != CV_ROOT_RETURN) continue;
+      ++acc.roots;
+      cv::check(CVodeGetRootInfo(mem.get(), rootsFound.data()), "CVodeGetRootInfo");
+      std::int64_t T = std::max(eventTickFromSeconds(tret), now);
+      if (launchStop >= 0) T = std::min(T, launchStop);  // tret <= the stop time
+      const double te = std::max(timeOfTick(T), tret);
+      if (T <= stop) {
         if (predict(T, te, rootsFound.data(), res.events)) {
           res.tick = T;
           return res;
         }
         continue;  // nothing changed: integrate on without a reinit
       }
-      if (flag == CV_TSTOP_RETURN || tret >= tStop) {
-        now = stop;
-        res.tick = stop;
-        if (launchesDue(stop)) predict(stop, timeOfTick(stop), nullptr, res.events);
-        return res;
+      // Beyond the caller's stop. CVODE stays where the root left it (the
+      // next CVode call looks at the rest of that step, as when a root with
+      // no events is passed over); a later advance reports it at T.
+      if (eventsAt(T, te, rootsFound.data(), res.events)) {
+        held = true;
+        heldTick = T;
+        heldTime = te;
+        std::copy(rootsFound.begin(), rootsFound.end(), heldFound.begin());
+        res.events.clear();
       }
     }
+    now = stop;
+    res.tick = stop;
+    if (launchesDue(stop)) predict(stop, timeOfTick(stop), nullptr, res.events);
+    return res;
   }
 };
 

@@ -286,6 +286,13 @@ ArenaConfig makeArenaConfig(const Profile& profile, int robotCount);
 // prediction and re-initialises at c from dense output. Queries take any
 // tick from the last re-initialisation to now(); at a tick with events they
 // describe the state after the events.
+//
+// Where advance() stops does not change the results: the integrator takes
+// whole steps (the last may pass stop; the next advance() goes on from
+// there), is stopped only at a scheduled ball launch, and a root found past
+// stop is kept for the advance() whose stop reaches its tick. The same inputs
+// at the same ticks give bit-identical states, events and statistics however
+// the caller chops time into advance() calls.
 class Arena {
  public:
   explicit Arena(const ArenaConfig& config);

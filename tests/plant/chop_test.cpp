@@ -1,0 +1,177 @@
+// The plant's results must not depend on how the caller chops time into
+// advance() calls: the same inputs at the same ticks give bit-identical
+// states, the same events at the same ticks and the same integrator work,
+// whether advance() is called every 9,600 ticks (the scheduler's largest
+// round), only at the input ticks, or at irregular ticks.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <functional>
+#include <vector>
+
+#include "plant_support.h"
+
+namespace {
+
+using namespace plant_test;
+
+struct Input {
+  std::int64_t tick;
+  int robot;
+  bool wheels;  // setWheels(frame) or setPortB(portB)
+  const char* frame;
+  std::uint8_t portB;
+};
+
+struct Logged {
+  std::int64_t tick;
+  Event event;
+};
+
+struct ChopRun {
+  std::vector<double> samples;  // per sample tick and robot: pose, wheels, eyes
+  std::vector<Logged> events;
+  IntegratorStats stats;
+  int advances = 0;
+};
+
+constexpr std::int64_t kEnd = 30 * kTicksPerSecond + 4321;
+constexpr std::int64_t kSampleEvery = 23'456;
+
+std::vector<Input> script() {
+  // Robot A: gun motor 1 (bit 3), solenoid 1 (bit 4). Robot B: gun motor 2
+  // (bit 7), solenoid 2 (bit 5). Ticks deliberately off any 9,600 grid.
+  std::vector<Input> in = {
+      {0, 0, false, nullptr, 0x08},
+      {0, 1, false, nullptr, 0x80},
+      {0, 0, true, "ffg0cfg0", 0},
+      {3'337'771, 1, true, "8rg08fg0", 0},
+      {9'216'007, 0, false, nullptr, 0x18},  // A fires
+      {9'400'013, 0, false, nullptr, 0x08},
+      {12'000'001, 1, false, nullptr, 0xa0},  // B fires
+      {12'345'679, 1, false, nullptr, 0x80},
+      {14'000'003, 0, true, "ffg0ffg0", 0},
+      {23'456'789, 1, true, "ffg0ffg0", 0},
+      {41'000'017, 0, true, "3fg0frg0", 0},
+      {41'000'017, 1, true, "frg0ffg0", 0},
+      {55'555'553, 0, true, "ffg0ffg0", 0},
+      {61'234'567, 0, false, nullptr, 0x18},  // A fires again
+      {61'500'011, 0, false, nullptr, 0x08},
+      {77'777'777, 1, true, "cfg0ffg0", 0},
+      {99'999'989, 0, true, "frg0frg0", 0},
+      {130'000'027, 1, true, "ffg0ffs0", 0},
+      {150'000'001, 0, true, "afg0ffg0", 0},
+      {180'000'019, 1, true, "ffg0ffg0", 0},
+      {200'000'003, 1, false, nullptr, 0xa0},  // B fires again
+      {200'300'007, 1, false, nullptr, 0x80},
+      {230'000'011, 0, true, "ffg0ffg0", 0},
+  };
+  return in;
+}
+
+// Drives one arena through the script; `nextStop(now, target)` says where
+// the next advance() stops (at most target).
+ChopRun drive(const std::function<std::int64_t(std::int64_t, std::int64_t)>& nextStop) {
+  const Profile p = defaults();
+  Arena a(makeArenaConfig(p, 2));
+  ChopRun run;
+  std::int64_t nextSample = 0;
+  auto sample = [&] {
+    for (; nextSample <= a.now(); nextSample += kSampleEvery) {
+      // Nothing before the last re-initialisation was left unsampled.
+      EXPECT_GE(nextSample, a.lastReinitTick());
+      for (int r = 0; r < 2; ++r) {
+        const RobotState s = a.state(r, nextSample);
+        const EyeReadings e = a.eyeReadings(r, nextSample);
+        run.samples.insert(run.samples.end(),
+                           {s.pose.x_ft, s.pose.y_ft, s.pose.heading_deg, s.left_fps, s.right_fps,
+                            s.odometer_ft, s.gun_wheel[0], s.gun_wheel[1],
+                            static_cast<double>(e.left), static_cast<double>(e.right)});
+      }
+    }
+  };
+  auto advanceTo = [&](std::int64_t target) {
+    while (a.now() < target) {
+      const std::int64_t stop = nextStop(a.now(), target);
+      const AdvanceResult r = a.advance(stop);
+      ++run.advances;
+      EXPECT_LE(r.tick, stop);
+      EXPECT_EQ(r.tick, a.now());
+      for (const Event& e : r.events) run.events.push_back({r.tick, e});
+      sample();
+    }
+  };
+  sample();
+  for (const Input& in : script()) {
+    advanceTo(in.tick);
+    if (in.wheels) {
+      a.setWheels(in.robot, frame(in.frame), in.tick);
+    } else {
+      for (const Event& e : a.setPortB(in.robot, in.portB, in.tick))
+        run.events.push_back({in.tick, e});
+    }
+  }
+  advanceTo(kEnd);
+  run.stats = a.stats();
+  return run;
+}
+
+bool sameEvent(const Logged& x, const Logged& y) {
+  const Event& a = x.event;
+  const Event& b = y.event;
+  return x.tick == y.tick && a.kind == b.kind && a.robot == b.robot && a.other == b.other &&
+         a.detector == b.detector && a.bumper == b.bumper && a.with == b.with && a.miss == b.miss &&
+         a.gun == b.gun && a.ball == b.ball;
+}
+
+void expectSame(const ChopRun& x, const ChopRun& y, const char* what) {
+  SCOPED_TRACE(what);
+  ASSERT_EQ(x.samples.size(), y.samples.size());
+  EXPECT_EQ(std::memcmp(x.samples.data(), y.samples.data(), x.samples.size() * sizeof(double)), 0);
+  for (std::size_t i = 0; i < x.samples.size(); ++i)
+    if (std::memcmp(&x.samples[i], &y.samples[i], sizeof(double)) != 0) {
+      ADD_FAILURE() << "first differing sample value " << i << ": " << x.samples[i] << " vs "
+                    << y.samples[i];
+      break;
+    }
+  ASSERT_EQ(x.events.size(), y.events.size());
+  for (std::size_t i = 0; i < x.events.size(); ++i)
+    EXPECT_TRUE(sameEvent(x.events[i], y.events[i]))
+        << "event " << i << ": " << eventKindName(x.events[i].event.kind) << " at "
+        << x.events[i].tick << " vs " << eventKindName(y.events[i].event.kind) << " at "
+        << y.events[i].tick;
+  EXPECT_EQ(x.stats.steps, y.stats.steps);
+  EXPECT_EQ(x.stats.rhs_evals, y.stats.rhs_evals);
+  EXPECT_EQ(x.stats.reinits, y.stats.reinits);
+  EXPECT_EQ(x.stats.roots, y.stats.roots);
+}
+
+TEST(Chopping, ResultsDoNotDependOnWhereAdvanceStops) {
+  constexpr std::int64_t kRound = 9'600;
+  const ChopRun rounds = drive([](std::int64_t now, std::int64_t target) {
+    return std::min(target, (now / kRound + 1) * kRound);
+  });
+  const ChopRun atInputs = drive([](std::int64_t, std::int64_t target) { return target; });
+  SplitMix64 rng(12345);
+  const ChopRun irregular = drive([&rng](std::int64_t now, std::int64_t target) {
+    return std::min(target, now + 1 + static_cast<std::int64_t>(rng.next() % 300'000));
+  });
+
+  // The scenario exercises what chopping could disturb.
+  auto count = [&](EventKind k) {
+    return std::count_if(atInputs.events.begin(), atInputs.events.end(),
+                         [k](const Logged& l) { return l.event.kind == k; });
+  };
+  EXPECT_GT(count(EventKind::EdgeEnter), 0);
+  EXPECT_GT(count(EventKind::BallLaunch), 0);
+  EXPECT_GT(count(EventKind::BallHit) + count(EventKind::BallMiss), 0);
+  EXPECT_GT(count(EventKind::ReflexStart), 0);
+  EXPECT_GT(rounds.advances, 10 * atInputs.advances);
+  EXPECT_GT(atInputs.samples.size(), 20'000u);
+
+  expectSame(atInputs, rounds, "every 9,600 ticks vs only at inputs");
+  expectSame(atInputs, irregular, "irregular stops vs only at inputs");
+}
+
+}  // namespace
