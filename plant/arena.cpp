@@ -1079,6 +1079,16 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick) {
   return ev;
 }
 
+EventList Arena::triggerReflex(int robot, Bumper side, std::int64_t tick) {
+  Impl& m = *impl_;
+  EventList ev;
+  if (robot < 0 || robot >= m.nR) throw std::out_of_range("plant: robot index");
+  m.rewindTo(tick);
+  m.startReflex(m.D, m.tmp, robot, side, tick, ev);
+  m.reinit(tick, m.timeOfTick(tick), m.tmp);
+  return ev;
+}
+
 AdvanceResult Arena::advance(std::int64_t stopTick) { return impl_->advance(stopTick); }
 
 RobotState Arena::state(int robot, std::int64_t tick) const {

@@ -311,6 +311,11 @@ class Arena {
   // empty guns, disc shooter); launches come later from advance().
   EventList setPortB(int robot, std::uint8_t value, std::int64_t tick);
 
+  // The motor controller's bumper reflex, as if that bumper switch closed
+  // at `tick` (an injected bump). A reflex under way starts over. Returns
+  // the ReflexStart event.
+  EventList triggerReflex(int robot, Bumper side, std::int64_t tick);
+
   AdvanceResult advance(std::int64_t stopTick);
 
   Pose pose(int robot, std::int64_t tick) const;

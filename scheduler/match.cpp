@@ -58,10 +58,14 @@ class Trace {
   std::vector<Record> records_;
 };
 
-struct PortBWrite {
+// A plant input made by a robot during a round: a port B write, or a bump
+// injected at a program point. Applied after the round, in tick order.
+struct PlantInput {
   Tick tick;
   int robot;
-  uint8_t value;
+  enum class Kind : uint8_t { PortB, Reflex } kind;
+  uint8_t value;  // port B
+  plant::Bumper bumper;
 };
 
 class Match;
@@ -129,10 +133,6 @@ class Match {
       const Injection& in = config.injections[k];
       if (in.robot < 0 || in.robot >= static_cast<int>(robots_.size()))
         throw std::invalid_argument("injection for a robot that is not in this run: " + in.text);
-      if (in.source == InjectSource::BumperFront || in.source == InjectSource::BumperBack)
-        throw std::invalid_argument(in.text +
-                                    ": bumper injection is not built yet (the plant has no "
-                                    "entry point for an injected reflex)");
       Robot& r = *robots_[static_cast<size_t>(in.robot)];
       if (in.line > 0) {
         const auto& lines = r.spec.image.lines;
@@ -155,13 +155,9 @@ class Match {
   plant::Arena& arena() { return arena_; }
   Trace& trace() { return trace_; }
   EventQueue<QueuedEvent>& queue() { return queue_; }
-  std::vector<PortBWrite>& portB() { return portBWrites_; }
-  struct ReflexRequest {
-    Tick tick;
-    int robot;
-    plant::Bumper bumper;
-  };
-  std::vector<ReflexRequest>& reflexes() { return reflexRequests_; }
+  std::vector<PlantInput>& inputs() { return inputs_; }
+  bool betweenRounds() const { return betweenRounds_; }
+  void applyReflex(Tick t, int robot, plant::Bumper side);
   const Injection& injection(int k) const { return config_.injections[static_cast<size_t>(k)]; }
   const std::string& name(int robot) const {
     return config_.robots[static_cast<size_t>(robot)].name;
@@ -170,7 +166,7 @@ class Match {
 
  private:
   Tick earliestClock() const;
-  void applyPortB();
+  void applyInputs();
   void handlePlantEvents(Tick t, const plant::EventList& events);
   void sampleUpTo(Tick t);
   void finish(MatchResult& result);
@@ -182,8 +178,8 @@ class Match {
   plant::SplitMix64 coin_;
   EventQueue<QueuedEvent> queue_;
   std::vector<std::unique_ptr<Robot>> robots_;
-  std::vector<PortBWrite> portBWrites_;
-  std::vector<ReflexRequest> reflexRequests_;
+  std::vector<PlantInput> inputs_;
+  bool betweenRounds_ = false;
   Tick nextSample_ = 0;
   uint64_t rounds_ = 0;
 };
@@ -238,7 +234,7 @@ void Robot::out(Tick t, uint16_t port, uint8_t value) {
       pio.writeData(value);
       return;
     case vm::kPortPIODB:
-      match.portB().push_back({t, index, value});
+      match.inputs().push_back({t, index, PlantInput::Kind::PortB, value, plant::Bumper::Front});
       match.trace().add(t, {{"type", "port_b"}, {"robot", spec.name}, {"value", value}});
       return;
     default:
@@ -326,12 +322,18 @@ void Robot::inject(Tick t, const Injection& injection) {
       return;
     }
     case InjectSource::BumperFront:
-    case InjectSource::BumperBack:
-      match.reflexes().push_back({t, index,
-                                  injection.source == InjectSource::BumperFront
-                                      ? plant::Bumper::Front
-                                      : plant::Bumper::Back});
+    case InjectSource::BumperBack: {
+      const plant::Bumper side = injection.source == InjectSource::BumperFront
+                                     ? plant::Bumper::Front
+                                     : plant::Bumper::Back;
+      // Between rounds (a time or tick) the plant takes it at once; at a
+      // program point it waits for the end of the round with port B writes.
+      if (match.betweenRounds())
+        match.applyReflex(t, index, side);
+      else
+        match.inputs().push_back({t, index, PlantInput::Kind::Reflex, 0, side});
       return;
+    }
   }
 }
 
@@ -369,10 +371,19 @@ Tick Match::earliestClock() const {
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 
-void Match::applyPortB() {
-  std::stable_sort(portBWrites_.begin(), portBWrites_.end(),
-                   [](const PortBWrite& a, const PortBWrite& b) { return a.tick < b.tick; });
-  for (const auto& w : portBWrites_) {
+void Match::applyReflex(Tick t, int robot, plant::Bumper side) {
+  sampleUpTo(t);
+  handlePlantEvents(t, arena_.triggerReflex(robot, side, t));
+}
+
+void Match::applyInputs() {
+  std::stable_sort(inputs_.begin(), inputs_.end(),
+                   [](const PlantInput& a, const PlantInput& b) { return a.tick < b.tick; });
+  for (const auto& w : inputs_) {
+    if (w.kind == PlantInput::Kind::Reflex) {
+      applyReflex(w.tick, w.robot, w.bumper);
+      continue;
+    }
     sampleUpTo(w.tick);
     const plant::EventList immediate = arena_.setPortB(w.robot, w.value, w.tick);
     for (const auto& e : immediate) {
@@ -382,7 +393,7 @@ void Match::applyPortB() {
           {{"type", plant::eventKindName(e.kind)}, {"robot", name(e.robot)}, {"gun", e.gun}});
     }
   }
-  portBWrites_.clear();
+  inputs_.clear();
 }
 
 void Match::handlePlantEvents(Tick t, const plant::EventList& events) {
@@ -456,8 +467,8 @@ MatchResult Match::run() {
     plant::AdvanceResult step = arena_.advance(horizon);
     horizon = step.tick;
     for (auto& r : robots_) r->runTo(horizon);
-    if (!portBWrites_.empty()) {
-      applyPortB();
+    if (!inputs_.empty()) {
+      applyInputs();
       // A re-initialisation discarded the plant's prediction: find it again.
       while (arena_.now() < horizon) {
         step = arena_.advance(horizon);
@@ -468,6 +479,7 @@ MatchResult Match::run() {
       }
     }
     sampleUpTo(horizon);
+    betweenRounds_ = true;  // every VM is at the horizon
     handlePlantEvents(horizon, step.events);
     while (!queue_.empty() && queue_.nextTick() == horizon) {
       const auto entry = queue_.pop();
@@ -492,6 +504,7 @@ MatchResult Match::run() {
           break;
       }
     }
+    betweenRounds_ = false;
     if (config_.stopWhenAllExited && std::all_of(robots_.begin(), robots_.end(), [](const auto& r) {
           return r->result.exited || r->vm_.fault();
         })) {

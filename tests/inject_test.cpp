@@ -113,6 +113,29 @@ TEST(Inject, InjectedEdgeIsAPulse) {
   EXPECT_EQ(injected.result.robots[0].interrupts.at("pio_a"), 2u);
 }
 
+TEST(Inject, BumpTriggersTheReflexAtItsTick) {
+  scheduler::MatchConfig c;
+  const auto profile = plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/thesis-1997.toml");
+  c.arena = plant::makeArenaConfig(profile, 1);
+  c.arena.robots[0].start = {0, 0, 0};  // field centre, facing north
+  c.robots.push_back({"A", "idle.dc", testkit::compileOrDie("main()\n{\n    while (1);\n}\n")});
+  c.endTick = 5 * scheduler::kTicksPerSecond;
+  c.trace = true;
+  c.injections.push_back(scheduler::parseInjection("A:bumper_front@1s", 1));
+  const auto r = scheduler::runMatch(c);
+  vm::Tick start = -1, end = -1;
+  for (const auto& line : r.trace) {
+    const auto j = nlohmann::json::parse(line);
+    if (j.at("type") == "reflex_start") start = j.at("t").get<vm::Tick>();
+    if (j.at("type") == "reflex_end") end = j.at("t").get<vm::Tick>();
+  }
+  EXPECT_EQ(start, scheduler::kTicksPerSecond);
+  EXPECT_GT(end, start);
+  // Full reverse for the profile's reflex distance, straight back (south).
+  EXPECT_NEAR(r.robots[0].finalPose.x_ft, 0.0, 1e-9);
+  EXPECT_NEAR(r.robots[0].finalPose.y_ft, -profile.robot.reflex_distance_ft, 1e-6);
+}
+
 TEST(Inject, ParsesWhenForms) {
   EXPECT_EQ(scheduler::parseInjection("A:edge_fore@12.5s", 1).tick, 115'200'000);
   EXPECT_EQ(scheduler::parseInjection("A:edge_aft@800ms", 1).tick, 7'372'800);
