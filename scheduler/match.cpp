@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -31,8 +33,11 @@ class Trace {
  public:
   explicit Trace(bool enabled) : enabled_(enabled) {}
   bool enabled() const { return enabled_; }
+  // Adds watched variables to a robot's records (--watch).
+  std::function<void(nlohmann::json&)> decorate;
   void add(Tick t, nlohmann::json record) {
     if (!enabled_) return;
+    if (decorate) decorate(record);
     record["t"] = t;
     record["time_s"] = seconds(t);
     records_.push_back({t, seq_++, std::move(record)});
@@ -97,6 +102,13 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   uint8_t plantLow = 0, injectedLow = 0;
   std::map<uint32_t, std::vector<int>> lineInjections;  // code address -> injections
   std::map<uint32_t, int> lineHits;
+  struct Watch {
+    std::string name;
+    uint16_t address;
+    std::string type;
+  };
+  std::vector<Watch> watches;
+  nlohmann::json watchedValues() const;
   void scheduleSerial();
   void updateSerialRequest();
 
@@ -128,6 +140,7 @@ class Match {
                                                 costs_, config.seed));
     if (config.profile)
       for (auto& r : robots_) r->vm_.enableProfile();
+    resolveWatches();
     queue_.schedule(config.endTick, EventClass::EndOfRound, {QueuedEvent::Kind::EndOfRound, 0, 0});
     for (size_t k = 0; k < config.injections.size(); ++k) {
       const Injection& in = config.injections[k];
@@ -167,6 +180,7 @@ class Match {
  private:
   Tick earliestClock() const;
   void applyInputs();
+  void resolveWatches();
   void handlePlantEvents(Tick t, const plant::EventList& events);
   void sampleUpTo(Tick t);
   void finish(MatchResult& result);
@@ -301,6 +315,35 @@ void Robot::byteDone(Tick t) {
   updateSerialRequest();
 }
 
+// A watched variable's value as its C type reads it.
+nlohmann::json Robot::watchedValues() const {
+  nlohmann::json values = nlohmann::json::object();
+  for (const auto& w : watches) {
+    const bool isUnsigned = w.type.find("unsigned") != std::string::npos;
+    if (w.type.find('*') != std::string::npos) {
+      values[w.name] = vm_.read16(w.address);
+    } else if (w.type.find("float") != std::string::npos ||
+               w.type.find("double") != std::string::npos) {
+      values[w.name] = std::bit_cast<float>(vm_.read32(w.address));
+    } else if (w.type.find("long") != std::string::npos) {
+      const uint32_t v = vm_.read32(w.address);
+      if (isUnsigned)
+        values[w.name] = v;
+      else
+        values[w.name] = static_cast<int32_t>(v);
+    } else if (w.type.find("char") != std::string::npos) {
+      values[w.name] = vm_.read8(w.address);
+    } else {
+      const uint16_t v = vm_.read16(w.address);
+      if (isUnsigned)
+        values[w.name] = v;
+      else
+        values[w.name] = static_cast<int16_t>(v);
+    }
+  }
+  return values;
+}
+
 void Robot::updateEdgeLines() {
   edgeLines = static_cast<uint8_t>(~(plantLow | injectedLow));
   if (pio.setInputs(edgeLines)) vm_.request(vm::Irq::Pio, pio.vector());
@@ -369,6 +412,41 @@ Tick Match::earliestClock() const {
   for (const auto& r : robots_)
     if (!r->vm_.fault()) t = std::min(t, r->vm_.now());
   return t == INT64_MAX ? queue_.nextTick() : t;
+}
+
+// --watch VAR: a global, or a static local as FUNCTION.VAR, of any robot
+// whose program has it; scalars only. The value is read from the robot's
+// memory when the record is made (for samples: at the end of the round that
+// contains the sample tick, at most 9,600 ticks later).
+void Match::resolveWatches() {
+  for (const auto& name : config_.watches) {
+    bool found = false;
+    for (auto& r : robots_) {
+      for (const auto& s : r->spec.image.symbols) {
+        if (s.name != name) continue;
+        if (s.kind != vm::Symbol::Kind::Global && s.kind != vm::Symbol::Kind::Static &&
+            s.kind != vm::Symbol::Kind::Param)
+          throw std::invalid_argument("--watch " + name + ": only globals and static locals " +
+                                      "can be watched ('" + name + "' is an auto variable)");
+        if (s.size > 4 || s.type.find('[') != std::string::npos ||
+            s.type.find("struct") != std::string::npos || s.type.find("union") != std::string::npos)
+          throw std::invalid_argument("--watch " + name + ": only scalar variables can be watched");
+        r->watches.push_back({name, static_cast<uint16_t>(s.address), s.type});
+        found = true;
+      }
+    }
+    if (!found)
+      throw std::invalid_argument("--watch " + name + ": no such global or static variable " +
+                                  "(a static local is FUNCTION.NAME)");
+  }
+  if (config_.watches.empty()) return;
+  trace_.decorate = [this](nlohmann::json& record) {
+    const auto it = record.find("robot");
+    if (it == record.end() || !it->is_string()) return;
+    for (auto& r : robots_)
+      if (r->spec.name == it->get<std::string>() && !r->watches.empty())
+        record["watch"] = r->watchedValues();
+  };
 }
 
 void Match::applyReflex(Tick t, int robot, plant::Bumper side) {

@@ -136,6 +136,30 @@ TEST(Inject, BumpTriggersTheReflexAtItsTick) {
   EXPECT_NEAR(r.robots[0].finalPose.y_ft, -profile.robot.reflex_distance_ft, 1e-6);
 }
 
+TEST(Inject, WatchedVariableAppearsInTraceRecords) {
+  scheduler::MatchConfig c;
+  c.arena =
+      plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml"), 1);
+  c.robots.push_back({"A", "delay.dc", testkit::compileOrDie(kDelay, "delay.dc")});
+  c.endTick = 10 * scheduler::kTicksPerSecond;
+  c.stopWhenAllExited = true;
+  c.trace = true;
+  c.watches = {"z", "hits"};
+  c.injections.push_back(scheduler::parseInjection("A:edge_fore@line:17#500", 1));
+  const auto r = scheduler::runMatch(c);
+  bool sawAcceptance = false;
+  for (const auto& line : r.trace) {
+    const auto j = nlohmann::json::parse(line);
+    if (j.at("type") != "interrupt_accepted") continue;
+    sawAcceptance = true;
+    EXPECT_EQ(j.at("watch").at("z"), 499);  // the loop variable when it was interrupted
+    EXPECT_EQ(j.at("watch").at("hits"), 0);
+  }
+  EXPECT_TRUE(sawAcceptance);
+  c.watches = {"nosuch"};
+  EXPECT_THROW(scheduler::runMatch(c), std::invalid_argument);
+}
+
 TEST(Inject, ParsesWhenForms) {
   EXPECT_EQ(scheduler::parseInjection("A:edge_fore@12.5s", 1).tick, 115'200'000);
   EXPECT_EQ(scheduler::parseInjection("A:edge_aft@800ms", 1).tick, 7'372'800);

@@ -67,6 +67,7 @@ struct RunOptions {
   std::vector<std::string> hw;
   std::string trace;
   std::vector<std::string> injections;
+  std::vector<std::string> watches;
   bool json = false;
 };
 
@@ -113,6 +114,7 @@ scheduler::MatchResult play(const std::vector<std::string>& programs, const RunO
   config.endTick = static_cast<scheduler::Tick>(o.seconds * scheduler::kTicksPerSecond);
   config.seed = o.seed;
   config.stopWhenAllExited = solo;
+  config.watches = o.watches;
   config.trace = !o.trace.empty();
   const auto start = std::chrono::steady_clock::now();
   scheduler::MatchResult result;
@@ -320,6 +322,9 @@ void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
   cmd->add_option("--inject", o.injections,
                   "ROBOT:SOURCE@WHEN, SOURCE edge_fore|edge_aft|bumper_front|bumper_back, "
                   "WHEN 12.5s|800ms|115200000t|line:N#K (repeatable)");
+  cmd->add_option("--watch", o.watches,
+                  "add a global or static variable (FUNCTION.NAME) to every trace record "
+                  "(repeatable)");
   cmd->add_flag("--json", o.json, "print the summary as JSON");
 }
 
