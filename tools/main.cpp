@@ -6,7 +6,6 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -17,17 +16,13 @@
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "tools/commands.h"
+#include "tools/runner.h"
 #include "vm/vm.h"
 
 namespace {
 
 using namespace simbot;
 using nlohmann::json;
-
-// A user error: printed as is, exit status 1.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 int compileCommand(const std::string& file, bool disasm) {
   const auto result = compiler::compileFile(file);
@@ -37,27 +32,6 @@ int compileCommand(const std::string& file, bool disasm) {
   }
   if (disasm) std::cout << vm::disassemble(*result.image);
   return 0;
-}
-
-vm::Image compileOrThrow(const std::string& file) {
-  auto result = compiler::compileFile(file);
-  if (!result.image) {
-    std::string all;
-    for (const auto& d : result.errors) all += d.format();
-    throw UsageError(all);
-  }
-  return std::move(*result.image);
-}
-
-// A profile by name (profiles/NAME.toml) or by path.
-plant::Profile loadProfile(const std::string& nameOrPath) {
-  namespace fs = std::filesystem;
-  fs::path p = nameOrPath;
-  if (!fs::exists(p)) p = fs::path(SIMBOT_PROFILES_DIR) / (nameOrPath + ".toml");
-  if (!fs::exists(p))
-    throw UsageError(
-        fmt::format("simbot: no profile '{}' (a file, or one of profiles/*.toml)\n", nameOrPath));
-  return plant::loadProfile(p.string());
 }
 
 struct RunOptions {
@@ -83,20 +57,21 @@ json faultJson(const std::optional<scheduler::FaultInfo>& f) {
 scheduler::MatchResult play(const std::vector<std::string>& programs, const RunOptions& o,
                             bool solo, double& wallSeconds) {
   if (!(o.seconds > 0) || o.seconds > 1e6)
-    throw UsageError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", o.seconds));
-  const plant::Profile profile = loadProfile(o.profile);
+    throw tools::ToolError(
+        fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", o.seconds));
+  const plant::Profile profile = tools::loadNamedProfile(o.profile);
   scheduler::MatchConfig config;
   config.arena = plant::makeArenaConfig(profile, static_cast<int>(programs.size()));
   const char* names[] = {"A", "B"};
   for (size_t i = 0; i < programs.size(); ++i)
-    config.robots.push_back({names[i], programs[i], compileOrThrow(programs[i])});
+    config.robots.push_back({names[i], programs[i], tools::compileProgramFile(programs[i])});
   for (const auto& spec : o.hw) {
     int robot = 0;
     std::string file = spec;
     if (!solo) {
       const auto eq = spec.find('=');
       if (eq == std::string::npos || (spec.substr(0, eq) != "A" && spec.substr(0, eq) != "B"))
-        throw UsageError("simbot: --hw takes A=FILE or B=FILE\n");
+        throw tools::ToolError("simbot: --hw takes A=FILE or B=FILE\n");
       robot = spec[0] == 'A' ? 0 : 1;
       file = spec.substr(eq + 1);
     }
@@ -108,7 +83,7 @@ scheduler::MatchResult play(const std::vector<std::string>& programs, const RunO
       config.injections.push_back(
           scheduler::parseInjection(text, static_cast<int>(programs.size())));
     } catch (const std::invalid_argument& e) {
-      throw UsageError(fmt::format("simbot: --inject {}\n", e.what()));
+      throw tools::ToolError(fmt::format("simbot: --inject {}\n", e.what()));
     }
   }
   config.endTick = static_cast<scheduler::Tick>(o.seconds * scheduler::kTicksPerSecond);
@@ -121,12 +96,12 @@ scheduler::MatchResult play(const std::vector<std::string>& programs, const RunO
   try {
     result = scheduler::runMatch(config);
   } catch (const std::invalid_argument& e) {
-    throw UsageError(fmt::format("simbot: {}\n", e.what()));
+    throw tools::ToolError(fmt::format("simbot: {}\n", e.what()));
   }
   wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!o.trace.empty()) {
     std::ofstream out(o.trace);
-    if (!out) throw UsageError(fmt::format("simbot: cannot write trace '{}'\n", o.trace));
+    if (!out) throw tools::ToolError(fmt::format("simbot: cannot write trace '{}'\n", o.trace));
     for (const auto& line : result.trace) out << line << '\n';
   }
   return result;
@@ -209,9 +184,9 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
 // Cycles per source line and per function of a solo run, largest first.
 int profileCommand(const std::string& program, RunOptions o, int top) {
   o.trace.clear();
-  const vm::Image image = compileOrThrow(program);
+  const vm::Image image = tools::compileProgramFile(program);
   scheduler::MatchConfig config;
-  config.arena = plant::makeArenaConfig(loadProfile(o.profile), 1);
+  config.arena = plant::makeArenaConfig(tools::loadNamedProfile(o.profile), 1);
   config.robots.push_back({"A", program, image});
   config.endTick = static_cast<scheduler::Tick>(o.seconds * scheduler::kTicksPerSecond);
   config.seed = o.seed;
@@ -221,14 +196,14 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
     try {
       config.injections.push_back(scheduler::parseInjection(text, 1));
     } catch (const std::invalid_argument& e) {
-      throw UsageError(fmt::format("simbot: --inject {}\n", e.what()));
+      throw tools::ToolError(fmt::format("simbot: --inject {}\n", e.what()));
     }
   }
   scheduler::MatchResult r;
   try {
     r = scheduler::runMatch(config);
   } catch (const std::invalid_argument& e) {
-    throw UsageError(fmt::format("simbot: {}\n", e.what()));
+    throw tools::ToolError(fmt::format("simbot: {}\n", e.what()));
   }
   const auto& robot = r.robots[0];
   std::map<int, uint64_t> byLine;
@@ -382,7 +357,7 @@ int main(int argc, char** argv) {
     if (*profile) return profileCommand(profileProgram, profileOptions, profileTop);
     if (*bench.app) return bench.run();
     if (*tournament.app) return tournament.run();
-  } catch (const UsageError& e) {
+  } catch (const tools::ToolError& e) {
     std::cerr << e.what();
     return 1;
   } catch (const plant::ConfigError& e) {
