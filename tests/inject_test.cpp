@@ -45,7 +45,8 @@ struct SoloRun {
   }
 };
 
-SoloRun solo(const std::vector<std::string>& injections) {
+// The delay program alone, run until main returns, traced.
+scheduler::MatchConfig soloConfig(const std::vector<std::string>& injections) {
   scheduler::MatchConfig c;
   c.arena =
       plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml"), 1);
@@ -54,7 +55,11 @@ SoloRun solo(const std::vector<std::string>& injections) {
   c.stopWhenAllExited = true;
   c.trace = true;
   for (const auto& text : injections) c.injections.push_back(scheduler::parseInjection(text, 1));
-  SoloRun run{scheduler::runMatch(c), {}};
+  return c;
+}
+
+SoloRun solo(const std::vector<std::string>& injections) {
+  SoloRun run{scheduler::runMatch(soloConfig(injections)), {}};
   for (const auto& line : run.result.trace) run.trace.push_back(nlohmann::json::parse(line));
   return run;
 }
@@ -137,15 +142,8 @@ TEST(Inject, BumpTriggersTheReflexAtItsTick) {
 }
 
 TEST(Inject, WatchedVariableAppearsInTraceRecords) {
-  scheduler::MatchConfig c;
-  c.arena =
-      plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml"), 1);
-  c.robots.push_back({"A", "delay.dc", testkit::compileOrDie(kDelay, "delay.dc")});
-  c.endTick = 10 * scheduler::kTicksPerSecond;
-  c.stopWhenAllExited = true;
-  c.trace = true;
+  scheduler::MatchConfig c = soloConfig({"A:edge_fore@line:17#500"});
   c.watches = {"z", "hits"};
-  c.injections.push_back(scheduler::parseInjection("A:edge_fore@line:17#500", 1));
   const auto r = scheduler::runMatch(c);
   bool sawAcceptance = false;
   for (const auto& line : r.trace) {

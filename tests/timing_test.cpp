@@ -16,10 +16,7 @@ using vm::Tick;
 
 namespace {
 
-const vm::CostTable& costs() {
-  static const vm::CostTable t = vm::makeCostTable(vm::calibratedKnobs());
-  return t;
-}
+const vm::CostTable& costs() { return testkit::calibratedCosts(); }
 
 std::string readFile(const std::string& path) {
   std::ifstream f(path);

@@ -15,10 +15,7 @@ using vm::Stop;
 
 namespace {
 
-const vm::CostTable& costs() {
-  static const vm::CostTable t = vm::makeCostTable(vm::calibratedKnobs());
-  return t;
-}
+const vm::CostTable& costs() { return testkit::calibratedCosts(); }
 uint32_t cost(Op op) { return costs().op[static_cast<int>(op)]; }
 
 // A handler at label "handler" that counts into `counter` and returns.

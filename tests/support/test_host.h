@@ -101,6 +101,12 @@ class TestHost : public vm::Bus {
   uint32_t next_ = 1;
 };
 
+// The calibrated cycle table, built once for all tests of a binary.
+inline const vm::CostTable& calibratedCosts() {
+  static const vm::CostTable table = vm::makeCostTable(vm::calibratedKnobs());
+  return table;
+}
+
 // Compiles a program or fails the test with the diagnostic.
 inline vm::Image compileOrDie(const std::string& source, const std::string& name = "test.dc") {
   auto r = compiler::compile(source, name);
