@@ -136,6 +136,8 @@ struct Ring {
 
 struct RobotDisc {
   MotorFrame latched{};
+  bool driven = false;            // a scripted drive overrides the frame
+  std::array<double, 2> drive{};  // its wheel ground speeds, ft/s
   bool reflex = false;
   Bumper reflexSide = Bumper::Front;
   double reflexS0 = 0;
@@ -439,6 +441,8 @@ struct Arena::Impl {
         WheelCommand c{p.reflex_speed_step, r.reflexSide == Bumper::Back, true, '0'};
         wt[0] = wheelSpeedFps(c, p, true);
         wt[1] = wheelSpeedFps(c, p, false);
+      } else if (r.driven) {
+        wt = r.drive;
       } else {
         wt[0] = wheelSpeedFps(r.latched.left, p, true);
         wt[1] = wheelSpeedFps(r.latched.right, p, false);
@@ -1012,15 +1016,40 @@ bool Arena::setWheels(int robot, const MotorFrame& frame, std::int64_t tick) {
   const bool sameSpeeds =
       wheelSpeedFps(r.latched.left, p, true) == wheelSpeedFps(frame.left, p, true) &&
       wheelSpeedFps(r.latched.right, p, false) == wheelSpeedFps(frame.right, p, false);
-  if (r.reflex || sameSpeeds) {
-    // The reflex overrides motor strings; the frame takes effect when it
-    // ends. Either way the right-hand side is unchanged: no reinit.
+  if (r.reflex || r.driven || sameSpeeds) {
+    // The reflex overrides motor strings, and the frame takes effect when it
+    // ends; a scripted drive overrides them for good. Either way the
+    // right-hand side is unchanged: no reinit.
     m.D.r[static_cast<std::size_t>(robot)].latched = frame;
     if (m.pending) m.pendingD.r[static_cast<std::size_t>(robot)].latched = frame;
     return true;
   }
   m.rewindTo(tick);
   m.D.r[static_cast<std::size_t>(robot)].latched = frame;
+  m.reinit(tick, m.timeOfTick(tick), m.tmp);
+  return true;
+}
+
+bool Arena::setDrive(int robot, double leftFps, double rightFps, std::int64_t tick) {
+  Impl& m = *impl_;
+  if (robot < 0 || robot >= m.nR) throw std::out_of_range("plant: robot index");
+  if (tick < m.segTick || tick > m.now)
+    throw std::out_of_range("plant: input tick outside [last reinit, now]");
+  const bool committedAtTick = m.pending && tick == m.pendingTick;
+  const RobotDisc& r = (committedAtTick ? m.pendingD : m.D).r[static_cast<std::size_t>(robot)];
+  const std::array<double, 2> drive{leftFps, rightFps};
+  if (r.driven && r.drive == drive) return false;
+  if (r.reflex) {
+    // The reflex overrides the drive as it does motor strings.
+    for (Discrete* d : {&m.D, &m.pendingD}) {
+      d->r[static_cast<std::size_t>(robot)].driven = true;
+      d->r[static_cast<std::size_t>(robot)].drive = drive;
+    }
+    return true;
+  }
+  m.rewindTo(tick);
+  m.D.r[static_cast<std::size_t>(robot)].driven = true;
+  m.D.r[static_cast<std::size_t>(robot)].drive = drive;
   m.reinit(tick, m.timeOfTick(tick), m.tmp);
   return true;
 }

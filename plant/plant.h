@@ -307,6 +307,11 @@ class Arena {
   // A latched motor frame. Returns false (and does nothing, no reinit) if it
   // equals the frame already latched.
   bool setWheels(int robot, const MotorFrame& frame, std::int64_t tick);
+  // A scripted drive (a beacon on a path, no program): the wheels' target
+  // ground speeds in ft/s, bypassing the speed table and trims. From then on
+  // motor frames no longer move this robot; the bumper reflex still does.
+  // Returns false (no reinit) if the drive is already these speeds.
+  bool setDrive(int robot, double leftFps, double rightFps, std::int64_t tick);
   // A write to PIO port B. Returns the immediate events (solenoid strokes,
   // empty guns, disc shooter); launches come later from advance().
   EventList setPortB(int robot, std::uint8_t value, std::int64_t tick);

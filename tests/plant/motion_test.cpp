@@ -82,6 +82,31 @@ TEST(Motion, SpinInPlaceMatchesClosedForm) {
   }
 }
 
+// A scripted drive (a beacon on a path) follows its circle exactly:
+// centre, radius and speed from the commanded wheel speeds alone; motor
+// frames latched afterwards do not move it.
+TEST(Motion, ScriptedDriveFollowsItsCircle) {
+  Profile p = defaults();
+  p.robot.motor_lag_s = 0;
+  const double radius = 3, speed = 0.5, half = p.robot.track_ft / 2;
+  const double omega = speed / radius;     // rad/s, clockwise
+  Arena a(config(p, {Pose{0, -3, 270}}));  // on the circle about the origin, heading west
+  ASSERT_TRUE(a.setDrive(0, speed + omega * half, speed - omega * half, 0));
+  EXPECT_FALSE(a.setDrive(0, speed + omega * half, speed - omega * half, 0));
+  EXPECT_TRUE(a.setWheels(0, frame("ffg0ffg0"), 0));  // latched, but the drive rules
+  a.advance(ticks(40));
+  for (double t : {1.0, 7.5, 20.0, 37.7, 40.0}) {
+    const double tt = secondsFromTick(ticks(t));
+    const double phase = kPi + omega * tt;  // from +y, clockwise; starts at the south point
+    const Pose q = a.pose(0, ticks(t));
+    EXPECT_NEAR(q.x_ft, radius * std::sin(phase), 1e-5) << t;
+    EXPECT_NEAR(q.y_ft, radius * std::cos(phase), 1e-5) << t;
+    EXPECT_NEAR(std::hypot(q.x_ft, q.y_ft), radius, 1e-5) << t;
+  }
+  const RobotState s = a.state(0, ticks(40));
+  EXPECT_NEAR(s.odometer_ft, speed * secondsFromTick(ticks(40)), 1e-9);
+}
+
 TEST(Motion, WheelLagStepResponse) {
   Profile p = defaults();
   p.robot.motor_lag_s = 0.2;
