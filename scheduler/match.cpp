@@ -24,9 +24,9 @@ double seconds(Tick t) { return static_cast<double>(t) / kTicksPerSecond; }
 
 // Queued events; the plant's own events come from Arena::advance.
 struct QueuedEvent {
-  enum class Kind : uint8_t { SerialByte, Inject, ReleaseEdge, EndOfRound } kind;
+  enum class Kind : uint8_t { SerialByte, DriveLeg, Inject, ReleaseEdge, EndOfRound } kind;
   int robot = 0;
-  int index = 0;  // injection number, or the detector bit to release
+  int index = 0;  // injection number, path leg, or the detector bit to release
 };
 
 class Trace {
@@ -74,6 +74,14 @@ struct PlantInput {
 };
 
 class Match;
+
+// A robot on a scripted path follows it exactly: its wheels have no lag.
+plant::ArenaConfig arenaConfigFor(const MatchConfig& config) {
+  plant::ArenaConfig arena = config.arena;
+  for (size_t i = 0; i < config.robots.size() && i < arena.robots.size(); ++i)
+    if (!config.robots[i].path.empty()) arena.robots[i].params.motor_lag_s = 0;
+  return arena;
+}
 
 // One robot: its VM, the devices its program talks to, and its counters.
 class Robot : public vm::Bus, public plant::RobotMemory {
@@ -130,7 +138,7 @@ class Match {
   explicit Match(const MatchConfig& config)
       : config_(config),
         costs_(vm::makeCostTable(config.knobs)),
-        arena_(config.arena),
+        arena_(arenaConfigFor(config)),
         trace_(config.trace),
         coin_(streamSeed(config.seed, "coin")) {
     if (config.robots.empty() || config.robots.size() > 2)
@@ -142,6 +150,13 @@ class Match {
       for (auto& r : robots_) r->vm_.enableProfile();
     resolveWatches();
     queue_.schedule(config.endTick, EventClass::EndOfRound, {QueuedEvent::Kind::EndOfRound, 0, 0});
+    for (size_t i = 0; i < config.robots.size(); ++i) {
+      for (const DriveLeg& leg : config.robots[i].path)
+        if (leg.duration <= 0) throw std::invalid_argument("a path leg must last at least a tick");
+      if (!config.robots[i].path.empty())
+        queue_.schedule(0, EventClass::MotorLatch,
+                        {QueuedEvent::Kind::DriveLeg, static_cast<int>(i), 0});
+    }
     for (size_t k = 0; k < config.injections.size(); ++k) {
       const Injection& in = config.injections[k];
       if (in.robot < 0 || in.robot >= static_cast<int>(robots_.size()))
@@ -171,6 +186,7 @@ class Match {
   std::vector<PlantInput>& inputs() { return inputs_; }
   bool betweenRounds() const { return betweenRounds_; }
   void applyReflex(Tick t, int robot, plant::Bumper side);
+  void startLeg(Tick t, int robot, int leg);
   const Injection& injection(int k) const { return config_.injections[static_cast<size_t>(k)]; }
   const std::string& name(int robot) const {
     return config_.robots[static_cast<size_t>(robot)].name;
@@ -454,6 +470,26 @@ void Match::applyReflex(Tick t, int robot, plant::Bumper side) {
   handlePlantEvents(t, arena_.triggerReflex(robot, side, t));
 }
 
+// Leg `leg` of a robot's scripted path starts at t; leg == path size is
+// the stop after the last leg.
+void Match::startLeg(Tick t, int robot, int leg) {
+  const RobotSpec& spec = config_.robots[static_cast<size_t>(robot)];
+  const auto& path = spec.path;
+  if (leg == static_cast<int>(path.size()) && spec.repeatPath) leg = 0;
+  const bool stop = leg == static_cast<int>(path.size());
+  const DriveLeg drive = stop ? DriveLeg{} : path[static_cast<size_t>(leg)];
+  sampleUpTo(t);
+  arena_.setDrive(robot, drive.leftFps, drive.rightFps, t);
+  trace_.add(t, {{"type", "path_leg"},
+                 {"robot", name(robot)},
+                 {"leg", stop ? nlohmann::json(nullptr) : nlohmann::json(leg)},
+                 {"left_fps", drive.leftFps},
+                 {"right_fps", drive.rightFps}});
+  if (!stop)
+    queue_.schedule(t + drive.duration, EventClass::MotorLatch,
+                    {QueuedEvent::Kind::DriveLeg, robot, leg + 1});
+}
+
 void Match::applyInputs() {
   std::stable_sort(inputs_.begin(), inputs_.end(),
                    [](const PlantInput& a, const PlantInput& b) { return a.tick < b.tick; });
@@ -565,6 +601,9 @@ MatchResult Match::run() {
         case QueuedEvent::Kind::SerialByte:
           sampleUpTo(horizon);
           robots_[static_cast<size_t>(entry.payload.robot)]->byteDone(horizon);
+          break;
+        case QueuedEvent::Kind::DriveLeg:
+          startLeg(horizon, entry.payload.robot, entry.payload.index);
           break;
         case QueuedEvent::Kind::Inject: {
           Robot& r = *robots_[static_cast<size_t>(entry.payload.robot)];

@@ -27,6 +27,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "plant/plant.h"
@@ -39,10 +40,25 @@ namespace simbot::scheduler {
 using Tick = int64_t;
 inline constexpr Tick kTicksPerSecond = 9'216'000;
 
+// One leg of a scripted drive: the wheels' ground speeds for a duration.
+struct DriveLeg {
+  Tick duration = 0;  // > 0
+  double leftFps = 0, rightFps = 0;
+};
+
 struct RobotSpec {
+  RobotSpec() = default;
+  RobotSpec(std::string name_, std::string program_, vm::Image image_)
+      : name(std::move(name_)), program(std::move(program_)), image(std::move(image_)) {}
+
   std::string name;     // "A", "B"
   std::string program;  // path as given
   vm::Image image;
+  // A beacon on a scripted path (its program does nothing): the legs start
+  // at tick 0, each at the exact tick the previous one ends; after the last
+  // the robot stops, or the path starts over with `repeatPath`.
+  std::vector<DriveLeg> path;
+  bool repeatPath = false;
 };
 
 // An interrupt source injected by the user (DESIGN.md tool contract).
