@@ -91,13 +91,6 @@ TEST(Bench, ObserverDoesNotChangeTheMatch) {
   EXPECT_EQ(plain.rounds, watched.rounds);
 }
 
-TEST(Bench, CircleRadiusIsAboutThreeFeet) {
-  const auto profile = tools::loadNamedProfile(kSource + "/profiles/default.toml");
-  const double r = tools::circleRadiusFt(profile.robot);
-  EXPECT_GT(r, 2.5);
-  EXPECT_LT(r, 4.0);
-}
-
 TEST(Tournament, SameStandingsOnRerunAndThreadCounts) {
   tools::TournamentConfig c;
   c.programs = {kSource + "/programs/spiral.dc", kSource + "/programs/turret.dc",

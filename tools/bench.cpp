@@ -17,32 +17,6 @@ namespace {
 
 using scheduler::kTicksPerSecond;
 
-// The stationary beacon. Its main returns at once, so its VM halts and
-// costs nothing to simulate; to the arena it is the same as the issue's
-// `main(){ while(1); }` (only its pose is seen), which spent about 0.14 s
-// of wall time per 60-s run just interpreting the loop.
-constexpr const char* kBeaconSource = "main()\n{\n}\n";
-
-// The circling opponent: sends one constant motor frame, which the motor
-// controller keeps latched, and returns; the serial transmit interrupts
-// still run after main returns, so the frame goes out all the same.
-std::string circleSource() {
-  return fmt::format(
-      "#include \"serial.lib\"\n"
-      "char buf[9];\n"
-      "char cc;\n"
-      "main()\n"
-      "{{\n"
-      "    ser_init_z1(0, 9600/1200);\n"
-      "    hv_enb();\n"
-      "    strcpy(buf, \"{}\");\n"
-      "    cc = sizeof(buf);\n"
-      "    outport(ENB485, 1);\n"
-      "    ser_send_z1(buf, &cc);\n"
-      "}}\n",
-      kCircleFrame);
-}
-
 double radians(double deg) { return deg * std::numbers::pi / 180; }
 double normalizeHeading(double deg) {
   double h = std::fmod(deg, 360.0);
@@ -83,15 +57,15 @@ plant::Pose southernPose(plant::RandomBits& bits, const Geometry& g) {
   }
 }
 
-struct Scenario {
+struct Placement {
   plant::Pose a;
   std::optional<plant::Pose> b;
 };
 
-Scenario sampleScenario(const std::string& family, plant::RandomBits& bits,
-                        const plant::Profile& profile) {
+Placement samplePlacement(const std::string& family, plant::RandomBits& bits,
+                          const plant::Profile& profile) {
   const Geometry g = geometryOf(profile);
-  Scenario s;
+  Placement s;
   if (family == "stationary") {
     while (true) {
       s.a = southernPose(bits, g);
@@ -105,9 +79,9 @@ Scenario sampleScenario(const std::string& family, plant::RandomBits& bits,
     }
   }
   if (family == "circle") {
-    const double r = circleRadiusFt(profile.robot);
+    const double r = kCircleRadiusFt;
     const double phase = uniform(bits, 0, 360);
-    // Clockwise (left wheel faster): heading is the phase plus 90 degrees.
+    // Clockwise: heading is the phase plus 90 degrees.
     s.b = plant::Pose{r * std::sin(radians(phase)), r * std::cos(radians(phase)),
                       normalizeHeading(phase + 90)};
     while (true) {
@@ -153,16 +127,36 @@ const std::vector<std::string>& benchFamilies() {
   return f;
 }
 
-double circleRadiusFt(const plant::RobotParams& p) {
-  const auto frame = plant::parseMotorFrame(kCircleFrame);
-  const double vl = plant::wheelSpeedFps(frame->left, p, true);
-  const double vr = plant::wheelSpeedFps(frame->right, p, false);
-  return p.track_ft / 2 * (vl + vr) / (vl - vr);
+std::string benchLabel(const BenchConfig& config) {
+  if (!config.family.empty()) return config.family;
+  return "scenario " + std::filesystem::path(config.scenario->file).stem().string();
 }
+
+namespace {
+
+// The set-up every run of one program shares: its robots, arena and
+// injections; the runs differ in poses (a family's) and seeds.
+scheduler::MatchConfig baseConfig(const BenchConfig& config, const plant::Profile& profile,
+                                  const std::string& program, const vm::Image& image,
+                                  const std::optional<scheduler::RobotSpec>& opponent) {
+  scheduler::MatchConfig mc;
+  mc.arena = plant::makeArenaConfig(profile, opponent ? 2 : 1);
+  mc.robots.push_back({"A", program, image});
+  if (opponent) mc.robots.push_back(*opponent);
+  if (config.scenario)
+    applyScenario(*config.scenario,
+                  config.family.empty() ? ScenarioUse::BenchOwn : ScenarioUse::Bench, profile, mc);
+  return mc;
+}
+
+}  // namespace
 
 BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
   const auto& families = benchFamilies();
-  if (std::find(families.begin(), families.end(), config.family) == families.end())
+  if (config.family.empty() && !config.scenario)
+    throw ToolError("simbot: bench needs --family or --scenario\n");
+  if (!config.family.empty() &&
+      std::find(families.begin(), families.end(), config.family) == families.end())
     throw ToolError(fmt::format(
         "simbot: unknown family '{}' (stationary, circle, head-to-head, edge)\n", config.family));
   if (config.seeds <= 0) throw ToolError("simbot: --seeds must be positive\n");
@@ -172,15 +166,24 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
     throw ToolError("simbot: the head-to-head family needs --opponent FILE\n");
   if (config.programs.empty()) throw ToolError("simbot: bench needs at least one program\n");
 
-  std::vector<vm::Image> images;
-  for (const auto& p : config.programs) images.push_back(compileProgramFile(p));
   std::optional<scheduler::RobotSpec> opponent;
-  if (config.family == "stationary")
-    opponent = scheduler::RobotSpec{"B", "(beacon)", compileProgramText(kBeaconSource, "beacon")};
-  else if (config.family == "circle")
-    opponent = scheduler::RobotSpec{"B", "(circle)", compileProgramText(circleSource(), "circle")};
-  else if (config.family == "head-to-head")
+  if (config.family == "stationary") {
+    opponent = beaconSpec({}, false);
+  } else if (config.family == "circle") {
+    PathLeg lap;
+    lap.kind = PathLeg::Kind::Arc;
+    lap.radiusFt = kCircleRadiusFt;
+    lap.turnDeg = 360;
+    lap.speedFps = kCircleSpeedFps;
+    Scenario none;
+    none.file = "(circle family)";
+    opponent = beaconSpec(driveLegs(none, {lap}, profile.robot), true);
+  } else if (config.family == "head-to-head") {
     opponent = scheduler::RobotSpec{"B", config.opponent, compileProgramFile(config.opponent)};
+  }
+  std::vector<scheduler::MatchConfig> bases;
+  for (const auto& p : config.programs)
+    bases.push_back(baseConfig(config, profile, p, compileProgramFile(p), opponent));
 
   BenchResult result;
   result.config = config;
@@ -188,24 +191,22 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
   result.runs.resize(config.programs.size() * seeds);
   const scheduler::Tick endTick =
       static_cast<scheduler::Tick>(std::llround(config.seconds * kTicksPerSecond));
+  const std::string label = benchLabel(config);
   auto job = [&](size_t j) {
     const size_t p = j / seeds;
     BenchRun& run = result.runs[j];
     run.program = config.programs[p];
     run.index = static_cast<int>(j % seeds);
     run.seed = scheduler::streamSeed(
-        config.masterSeed,
-        fmt::format("{}/{}/{}", config.family, fileName(run.program), run.index));
-    plant::SplitMix64 bits(scheduler::streamSeed(run.seed, "scenario"));
-    const Scenario scenario = sampleScenario(config.family, bits, profile);
-    run.startA = scenario.a;
-    scheduler::MatchConfig mc;
-    const int robots = opponent ? 2 : 1;
-    mc.arena = plant::makeArenaConfig(profile, robots);
-    mc.arena.robots[0].start = scenario.a;
-    if (opponent) mc.arena.robots[1].start = *scenario.b;
-    mc.robots.push_back({"A", run.program, images[p]});
-    if (opponent) mc.robots.push_back(*opponent);
+        config.masterSeed, fmt::format("{}/{}/{}", label, fileName(run.program), run.index));
+    scheduler::MatchConfig mc = bases[p];
+    if (!config.family.empty()) {
+      plant::SplitMix64 bits(scheduler::streamSeed(run.seed, "scenario"));
+      const Placement placement = samplePlacement(config.family, bits, profile);
+      mc.arena.robots[0].start = placement.a;
+      if (placement.b) mc.arena.robots[1].start = *placement.b;
+    }
+    run.startA = mc.arena.robots[0].start;
     mc.endTick = endTick;
     mc.seed = run.seed;
     scheduler::MetricsObserver observer(0);
@@ -214,7 +215,8 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
     observer.finish(r.endTick);
     run.metrics = scheduler::collectMetrics(observer, r.robots[0]);
   };
-  parallelFor(result.runs.size(), config.threads, job, "bench " + config.family, config.progress);
+  parallelFor(result.runs.size(), config.threads, job, "bench " + benchLabel(config),
+              config.progress);
   return result;
 }
 
@@ -259,7 +261,8 @@ nlohmann::json optionalJson(const std::optional<double>& v) {
 nlohmann::json summaryJson(const BenchResult& result) {
   const auto& c = result.config;
   nlohmann::json j = {
-      {"family", c.family},
+      {"family", benchLabel(c)},
+      {"scenario", c.scenario ? nlohmann::json(c.scenario->file) : nlohmann::json(nullptr)},
       {"seeds", c.seeds},
       {"seconds", c.seconds},
       {"master_seed", c.masterSeed},
@@ -287,8 +290,8 @@ std::string summaryMarkdown(const BenchResult& result) {
   std::string out;
   const auto all = summaries(result);
   for (size_t p = 0; p < c.programs.size(); ++p) {
-    out += fmt::format("### {}: family {}, {} seeds x {} s\n\n", c.programs[p], c.family, c.seeds,
-                       c.seconds);
+    out += fmt::format("### {}: {}, {} seeds x {} s\n\n", c.programs[p],
+                       c.family.empty() ? benchLabel(c) : "family " + c.family, c.seeds, c.seconds);
     out += "| metric | n reached | mean | median | p90 | 95% CI of mean | censored |\n";
     out += "|---|---:|---:|---:|---:|---|---:|\n";
     for (const auto& s : all[p]) {

@@ -9,13 +9,17 @@
 
 #include "plant/plant.h"
 #include "scheduler/metrics.h"
+#include "tools/scenario.h"
 
 namespace simbot::tools {
 
 struct BenchConfig {
   std::vector<std::string> programs;  // each is robot A in its own runs
-  std::string family;                 // stationary, circle, head-to-head, edge
-  int seeds = 0;                      // runs per program
+  // stationary, circle, head-to-head, edge; empty with a scenario: every run
+  // is the scenario's own set-up (only the seeded streams differ).
+  std::string family;
+  std::optional<Scenario> scenario;  // profile, hardware, injections (and, alone, poses and B)
+  int seeds = 0;                     // runs per program
   double seconds = 60;
   uint64_t masterSeed = 1;
   int threads = 0;       // 0: hardware concurrency
@@ -37,10 +41,12 @@ struct BenchResult {
 };
 
 const std::vector<std::string>& benchFamilies();
-// The circle family's opponent: its motor string and the radius and speed
-// it gives with `params` (from the speed table, trims and track).
-inline constexpr const char* kCircleFrame = "5fgr4fgr";
-double circleRadiusFt(const plant::RobotParams& params);
+// The circle family's opponent: a beacon driving clockwise round the
+// field's centre on this circle, at this speed, for ever.
+inline constexpr double kCircleRadiusFt = 3.0;
+inline constexpr double kCircleSpeedFps = 0.5;
+// The family's name in outputs: the family, or "scenario NAME".
+std::string benchLabel(const BenchConfig& config);
 
 BenchResult runBench(const BenchConfig& config, const plant::Profile& profile);
 

@@ -2,12 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 #include <memory>
 
 #include "tools/bench.h"
 #include "tools/runner.h"
+#include "tools/scenario.h"
 #include "tools/tournament.h"
 
 namespace simbot::tools {
@@ -31,26 +33,48 @@ int guarded(const std::function<int()>& body) {
 Subcommand addBenchCommand(CLI::App& app) {
   struct Options {
     BenchConfig config;
-    std::string out, profile = "default";
+    std::string out, profile = "default", scenario;
+    CLI::Option *seconds = nullptr, *seed = nullptr, *profileOption = nullptr;
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("bench", "scenario families over many seeds, with statistics");
   cmd->add_option("PROGRAM", o->config.programs, "programs under test (each is robot A)")
       ->required();
-  cmd->add_option("--family", o->config.family, "stationary, circle, head-to-head or edge")
-      ->required();
+  auto* family =
+      cmd->add_option("--family", o->config.family, "stationary, circle, head-to-head or edge");
   cmd->add_option("--seeds", o->config.seeds, "runs per program")->required();
-  cmd->add_option("--seconds", o->config.seconds, "simulated seconds per run (default 60)");
-  cmd->add_option("--seed", o->config.masterSeed, "master seed (default 1)");
+  o->seconds =
+      cmd->add_option("--seconds", o->config.seconds, "simulated seconds per run (default 60)");
+  o->seed = cmd->add_option("--seed", o->config.masterSeed, "master seed (default 1)");
   cmd->add_option("--threads", o->config.threads, "worker threads (default: all cores)");
   cmd->add_option("--out", o->out, "output directory (default out/bench-FAMILY)");
-  cmd->add_option("--profile", o->profile, "profile name or file (default: default)");
+  o->profileOption =
+      cmd->add_option("--profile", o->profile, "profile name or file (default: default)");
   cmd->add_option("--opponent", o->config.opponent, "robot B's program (head-to-head)");
+  auto* scenario = cmd->add_option(
+      "--scenario", o->scenario,
+      "scenario file: profile, hardware and injections; without --family also the poses and B");
+  cmd->callback([family, scenario] {
+    if (family->count() == 0 && scenario->count() == 0)
+      throw CLI::RequiredError("--family or --scenario");
+  });
   return {cmd, [o] {
             return guarded([&] {
               const auto start = std::chrono::steady_clock::now();
-              const BenchResult r = runBench(o->config, loadNamedProfile(o->profile));
-              const std::string dir = o->out.empty() ? "out/bench-" + o->config.family : o->out;
+              BenchConfig& c = o->config;
+              std::string profile = o->profile;
+              if (!o->scenario.empty()) {
+                c.scenario = loadScenario(o->scenario);
+                if (c.scenario->profile && o->profileOption->count() == 0)
+                  profile = *c.scenario->profile;
+                if (c.scenario->seconds && o->seconds->count() == 0)
+                  c.seconds = *c.scenario->seconds;
+                if (c.scenario->seed && o->seed->count() == 0) c.masterSeed = *c.scenario->seed;
+              }
+              const BenchResult r = runBench(c, loadNamedProfile(profile));
+              std::string label = benchLabel(c);
+              std::replace(label.begin(), label.end(), ' ', '-');
+              const std::string dir = o->out.empty() ? "out/bench-" + label : o->out;
               writeBenchOutputs(r, dir);
               std::cout << summaryMarkdown(r);
               std::cerr << fmt::format(

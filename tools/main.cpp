@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include "scheduler/match.h"
 #include "tools/commands.h"
 #include "tools/runner.h"
+#include "tools/scenario.h"
 #include "vm/vm.h"
 
 namespace {
@@ -42,8 +44,13 @@ struct RunOptions {
   std::string trace;
   std::vector<std::string> injections;
   std::vector<std::string> watches;
+  std::string scenario;
   bool json = false;
+  // Options given explicitly win over the scenario's values.
+  CLI::Option *secondsOption = nullptr, *seedOption = nullptr, *profileOption = nullptr;
 };
+
+bool given(const CLI::Option* option) { return option && option->count() > 0; }
 
 json poseJson(const plant::Pose& p) {
   return {{"x_ft", p.x_ft}, {"y_ft", p.y_ft}, {"heading_deg", p.heading_deg}};
@@ -54,62 +61,93 @@ json faultJson(const std::optional<scheduler::FaultInfo>& f) {
   return {{"message", f->message}, {"time_s", f->timeS}, {"line", f->line}};
 }
 
-scheduler::MatchResult play(const std::vector<std::string>& programs, const RunOptions& o,
-                            bool solo, double& wallSeconds) {
-  if (!(o.seconds > 0) || o.seconds > 1e6)
-    throw tools::ToolError(
-        fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", o.seconds));
-  const plant::Profile profile = tools::loadNamedProfile(o.profile);
+// The run's configuration from the command line and the scenario: the
+// programs given (A, and B for match), then the scenario (start poses,
+// hardware, B for solo and profile, injections), then --hw and --inject.
+scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, const RunOptions& o,
+                                   tools::ScenarioUse use) {
+  std::optional<tools::Scenario> scenario;
+  if (!o.scenario.empty()) scenario = tools::loadScenario(o.scenario);
+  const bool fromScenario = scenario.has_value();
+  const double seconds =
+      fromScenario && scenario->seconds && !given(o.secondsOption) ? *scenario->seconds : o.seconds;
+  if (!(seconds > 0) || seconds > 1e6)
+    throw tools::ToolError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", seconds));
+  const plant::Profile profile = tools::loadNamedProfile(
+      fromScenario && scenario->profile && !given(o.profileOption) ? *scenario->profile
+                                                                   : o.profile);
   scheduler::MatchConfig config;
   config.arena = plant::makeArenaConfig(profile, static_cast<int>(programs.size()));
   const char* names[] = {"A", "B"};
   for (size_t i = 0; i < programs.size(); ++i)
     config.robots.push_back({names[i], programs[i], tools::compileProgramFile(programs[i])});
+  std::array<bool, 2> hwGiven{};
+  std::vector<std::pair<int, std::string>> hwFiles;
   for (const auto& spec : o.hw) {
     int robot = 0;
     std::string file = spec;
-    if (!solo) {
+    if (use == tools::ScenarioUse::Match) {
       const auto eq = spec.find('=');
       if (eq == std::string::npos || (spec.substr(0, eq) != "A" && spec.substr(0, eq) != "B"))
         throw tools::ToolError("simbot: --hw takes A=FILE or B=FILE\n");
       robot = spec[0] == 'A' ? 0 : 1;
       file = spec.substr(eq + 1);
     }
+    hwGiven[static_cast<size_t>(robot)] = true;
+    hwFiles.emplace_back(robot, file);
+  }
+  if (scenario) tools::applyScenario(*scenario, use, profile, config, hwGiven);
+  for (const auto& [robot, file] : hwFiles) {
     auto& setup = config.arena.robots[static_cast<size_t>(robot)];
     setup.hardware = plant::loadHardware(file, setup.params);
   }
   for (const auto& text : o.injections) {
     try {
       config.injections.push_back(
-          scheduler::parseInjection(text, static_cast<int>(programs.size())));
+          scheduler::parseInjection(text, static_cast<int>(config.robots.size())));
     } catch (const std::invalid_argument& e) {
       throw tools::ToolError(fmt::format("simbot: --inject {}\n", e.what()));
     }
   }
-  config.endTick = static_cast<scheduler::Tick>(o.seconds * scheduler::kTicksPerSecond);
-  config.seed = o.seed;
+  config.endTick = static_cast<scheduler::Tick>(seconds * scheduler::kTicksPerSecond);
+  config.seed = fromScenario && scenario->seed && !given(o.seedOption) ? *scenario->seed : o.seed;
+  return config;
+}
+
+struct Played {
+  scheduler::MatchResult result;
+  double wallSeconds = 0;
+  uint64_t seed = 0;  // the one used (--seed, the scenario's, or 1)
+};
+
+Played play(const std::vector<std::string>& programs, const RunOptions& o, bool solo) {
+  scheduler::MatchConfig config =
+      buildConfig(programs, o, solo ? tools::ScenarioUse::Solo : tools::ScenarioUse::Match);
   config.stopWhenAllExited = solo;
   config.watches = o.watches;
   config.trace = !o.trace.empty();
+  Played played;
+  played.seed = config.seed;
   const auto start = std::chrono::steady_clock::now();
-  scheduler::MatchResult result;
   try {
-    result = scheduler::runMatch(config);
+    played.result = scheduler::runMatch(config);
   } catch (const std::invalid_argument& e) {
     throw tools::ToolError(fmt::format("simbot: {}\n", e.what()));
   }
-  wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  played.wallSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!o.trace.empty()) {
     std::ofstream out(o.trace);
     if (!out) throw tools::ToolError(fmt::format("simbot: cannot write trace '{}'\n", o.trace));
-    for (const auto& line : result.trace) out << line << '\n';
+    for (const auto& line : played.result.trace) out << line << '\n';
   }
-  return result;
+  return played;
 }
 
 int soloCommand(const std::string& program, const RunOptions& o) {
-  double wall = 0;
-  const auto r = play({program}, o, true, wall);
+  const Played played = play({program}, o, true);
+  const auto& r = played.result;
+  const double wall = played.wallSeconds;
   const auto& a = r.robots[0];
   json j = {
       {"exited", a.exited},
@@ -141,8 +179,9 @@ int soloCommand(const std::string& program, const RunOptions& o) {
 }
 
 int matchCommand(const std::string& a, const std::string& b, const RunOptions& o) {
-  double wall = 0;
-  const auto r = play({a, b}, o, false, wall);
+  const Played played = play({a, b}, o, false);
+  const auto& r = played.result;
+  const double wall = played.wallSeconds;
   json robots = json::array();
   for (const auto& rr : r.robots)
     robots.push_back({{"name", rr.name},
@@ -158,7 +197,7 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
                       {"console_lines", rr.console.size()}});
   json j = {{"sim_seconds", static_cast<double>(r.endTick) / scheduler::kTicksPerSecond},
             {"wall_seconds", wall},
-            {"seed", o.seed},
+            {"seed", played.seed},
             {"winner", r.winner},
             {"tie_broken_by_coin", r.tieBrokenByCoin},
             {"integrator",
@@ -184,21 +223,10 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
 // Cycles per source line and per function of a solo run, largest first.
 int profileCommand(const std::string& program, RunOptions o, int top) {
   o.trace.clear();
-  const vm::Image image = tools::compileProgramFile(program);
-  scheduler::MatchConfig config;
-  config.arena = plant::makeArenaConfig(tools::loadNamedProfile(o.profile), 1);
-  config.robots.push_back({"A", program, image});
-  config.endTick = static_cast<scheduler::Tick>(o.seconds * scheduler::kTicksPerSecond);
-  config.seed = o.seed;
+  scheduler::MatchConfig config = buildConfig({program}, o, tools::ScenarioUse::Profile);
   config.stopWhenAllExited = true;
   config.profile = true;
-  for (const auto& text : o.injections) {
-    try {
-      config.injections.push_back(scheduler::parseInjection(text, 1));
-    } catch (const std::invalid_argument& e) {
-      throw tools::ToolError(fmt::format("simbot: --inject {}\n", e.what()));
-    }
-  }
+  const vm::Image& image = config.robots[0].image;
   scheduler::MatchResult r;
   try {
     r = scheduler::runMatch(config);
@@ -288,9 +316,12 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
 }
 
 void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
-  cmd->add_option("--seconds", o.seconds, "simulated seconds (default 180)");
-  cmd->add_option("--seed", o.seed, "master seed (default 1)");
-  cmd->add_option("--profile", o.profile, "profile name or file (default: default)");
+  o.secondsOption = cmd->add_option("--seconds", o.seconds, "simulated seconds (default 180)");
+  o.seedOption = cmd->add_option("--seed", o.seed, "master seed (default 1)");
+  o.profileOption =
+      cmd->add_option("--profile", o.profile, "profile name or file (default: default)");
+  cmd->add_option("--scenario", o.scenario,
+                  "scenario file (TOML): start poses, profile, hardware, injections, robot B");
   cmd->add_option("--hw", o.hw,
                   solo ? "hardware file" : "hardware file for a robot: A=FILE or B=FILE");
   cmd->add_option("--trace", o.trace, "write the trace (JSONL) to this file");
@@ -335,9 +366,14 @@ int main(int argc, char** argv) {
   auto* profile =
       app.add_subcommand("profile", "cycles and time per source line and function of a solo run");
   profile->add_option("FILE", profileProgram, "program (.dc)")->required();
-  profile->add_option("--seconds", profileOptions.seconds, "simulated seconds (default 60)");
-  profile->add_option("--seed", profileOptions.seed, "master seed (default 1)");
-  profile->add_option("--profile", profileOptions.profile, "physical profile (default: default)");
+  profileOptions.secondsOption =
+      profile->add_option("--seconds", profileOptions.seconds, "simulated seconds (default 60)");
+  profileOptions.seedOption =
+      profile->add_option("--seed", profileOptions.seed, "master seed (default 1)");
+  profileOptions.profileOption = profile->add_option("--profile", profileOptions.profile,
+                                                     "physical profile (default: default)");
+  profile->add_option("--scenario", profileOptions.scenario,
+                      "scenario file (TOML): start pose, profile, hardware, injections, robot B");
   profile->add_option("--inject", profileOptions.injections, "as for solo (repeatable)");
   profile->add_option("--top", profileTop, "source lines to list (default 20)");
   profile->add_flag("--json", profileOptions.json, "print the profile as JSON");

@@ -1,0 +1,260 @@
+// Scenario files: every key checked with FILE:LINE: error: messages, and
+// what a scenario does to a run (poses, a beacon on its path, injections).
+#include "tools/scenario.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "scheduler/match.h"
+#include "tools/bench.h"
+#include "tools/runner.h"
+
+namespace {
+
+using namespace simbot;
+
+const std::string kSource = SIMBOT_SOURCE_DIR;
+const std::string kShared = SIMBOT_SHARED_DIR;
+
+tools::Scenario parse(const std::string& text) {
+  return tools::parseScenario(text, "s.toml", kSource);
+}
+
+// The message a scenario's text gets, or "" if it loads.
+std::string errorOf(const std::string& text) {
+  try {
+    parse(text);
+  } catch (const plant::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Scenario, LoadsEveryKey) {
+  const auto s = parse(R"(profile = "thesis-1997"
+seconds = 45
+seed = 7
+[A]
+start = { x_ft = 1.5, y_ft = -6, heading_deg = -90 }
+hardware = "profiles/hardware/swapped-guns.toml"
+inject = ["edge_fore@12.5s", "bumper_front@line:220#3"]
+[B]
+beacon = true
+start = { x_ft = -2, y_ft = 0, heading_deg = 0 }
+path = [
+  { forward_ft = 4, speed_fps = 0.5 },
+  { arc_radius_ft = 3, turn_deg = -90, speed_fps = 0.5 },
+  { spin_deg = 90, speed_fps = 0.3 },
+  { wait_s = 1 },
+]
+repeat = true
+)");
+  EXPECT_EQ(*s.profile, "thesis-1997");
+  EXPECT_EQ(*s.seconds, 45);
+  EXPECT_EQ(*s.seed, 7u);
+  ASSERT_TRUE(s.a.start);
+  EXPECT_EQ(s.a.start->x_ft, 1.5);
+  EXPECT_EQ(s.a.start->heading_deg, 270);
+  EXPECT_EQ(s.a.startLine, 5);
+  EXPECT_EQ(s.a.hardware, kSource + "/profiles/hardware/swapped-guns.toml");
+  ASSERT_EQ(s.a.inject.size(), 2u);
+  EXPECT_EQ(s.a.inject[1].what, "bumper_front@line:220#3");
+  EXPECT_EQ(s.a.inject[1].line, 7);
+  EXPECT_EQ(s.opponent, tools::Scenario::Opponent::Beacon);
+  ASSERT_EQ(s.path.size(), 4u);
+  EXPECT_EQ(s.path[1].kind, tools::PathLeg::Kind::Arc);
+  EXPECT_EQ(s.path[1].turnDeg, -90);
+  EXPECT_EQ(s.path[3].line, 15);
+  EXPECT_TRUE(s.repeatPath);
+}
+
+struct Bad {
+  std::string text;
+  std::string message;
+};
+
+TEST(Scenario, EveryMistakeNamesItsLine) {
+  const Bad cases[] = {
+      {"speed = 3\n",
+       "s.toml:1: error: unknown key 'speed' in the scenario (expected one of: profile, seconds, "
+       "seed, A, B)"},
+      {"\nseconds = -1\n", "s.toml:2: error: 'seconds' must be greater than 0, got -1"},
+      {"seconds = \"ten\"\n", "s.toml:1: error: 'seconds' must be a number"},
+      {"seconds = 2e6\n", "s.toml:1: error: 'seconds' must be at most 1e6"},
+      {"seed = -3\n", "s.toml:1: error: 'seed' must be a non-negative integer"},
+      {"profile = \"nosuch\"\n",
+       "s.toml:1: error: 'profile': no profile 'nosuch' in profiles/ (or give a path to a .toml)"},
+      {"profile = \"nosuch.toml\"\n",
+       ("s.toml:1: error: 'profile': no file '" + kSource + "/nosuch.toml'")},
+      {"seconds = [1\n", "s.toml:1: error: "},  // toml++'s own description follows
+      {"A = 3\n", "s.toml:1: error: 'A' must be a table ([A])"},
+      {"[A]\nspeed = 1\n",
+       "s.toml:2: error: unknown key 'speed' in [A] (expected one of: start, hardware, inject)"},
+      {"[A]\nstart = { x_ft = 1, y_ft = 2 }\n", "s.toml:2: error: 'A.start' has no 'heading_deg'"},
+      {"[A]\nstart = { x_ft = 1, y_ft = 2, heading_deg = 0, z_ft = 1 }\n",
+       "s.toml:2: error: unknown key 'z_ft' in 'A.start' (expected one of: x_ft, y_ft, "
+       "heading_deg)"},
+      {"[A]\nstart = { x_ft = 1, y_ft = \"2\", heading_deg = 0 }\n",
+       "s.toml:2: error: 'A.start.y_ft' must be a number"},
+      {"[A]\nstart = [1, 2, 3]\n",
+       "s.toml:2: error: 'A.start' must be a table { x_ft = ..., y_ft = ..., heading_deg = ... }"},
+      {"[A]\nhardware = \"missing.toml\"\n",
+       ("s.toml:2: error: 'A.hardware': no file '" + kSource + "/missing.toml'")},
+      {"[A]\ninject = \"edge_fore@1s\"\n",
+       "s.toml:2: error: 'A.inject' must be an array of \"SOURCE@WHEN\" strings"},
+      {"[A]\ninject = [\n  \"edge_fore@1s\",\n  \"edge_side@1s\",\n]\n",
+       "s.toml:4: error: 'edge_side@1s': SOURCE must be edge_fore, edge_aft, bumper_front or "
+       "bumper_back"},
+      {"[A]\ninject = [\"edge_fore@soon\"]\n",
+       "s.toml:2: error: 'edge_fore@soon': WHEN must be a time (12.5s, 800ms), a tick "
+       "(115200000t) or a program point (line:N#K)"},
+      {"[B]\nprogram = \"nope.dc\"\n",
+       ("s.toml:2: error: 'B.program': no file '" + kSource + "/nope.dc'")},
+      {"[B]\nprogram = \"programs/spiral.dc\"\nbeacon = true\n",
+       "s.toml:3: error: [B] is either a program or a beacon, not both"},
+      {"[B]\nbeacon = false\n",
+       "s.toml:2: error: 'B.beacon' must be true (or leave it out and give B.program)"},
+      {"[B]\nprogram = \"programs/spiral.dc\"\npath = [{ wait_s = 1 }]\n",
+       "s.toml:3: error: only a beacon (B.beacon = true) drives a path"},
+      {"[B]\nrepeat = true\n", "s.toml:2: error: only a beacon (B.beacon = true) drives a path"},
+      {"[B]\nbeacon = true\ninject = [\"edge_fore@1s\"]\n",
+       "s.toml:3: error: a beacon has no program to interrupt; B.inject needs B.program"},
+      {"[B]\nbeacon = true\npath = []\n",
+       "s.toml:3: error: 'B.path' must be a non-empty array of legs"},
+      {"[B]\nbeacon = true\npath = [3]\n",
+       "s.toml:3: error: 'B.path[0]' must be a table (forward_ft, arc_radius_ft, spin_deg or "
+       "wait_s)"},
+      {"[B]\nbeacon = true\npath = [\n { wait_s = 1 },\n { forward_ft = 1, spin_deg = 9, "
+       "speed_fps = 1 },\n]\n",
+       "s.toml:5: error: 'B.path[1]' must have exactly one of forward_ft, arc_radius_ft, "
+       "spin_deg, wait_s"},
+      {"[B]\nbeacon = true\npath = [{ forward_ft = 1, turn_deg = 9, speed_fps = 1 }]\n",
+       "s.toml:3: error: 'B.path[0]': turn_deg belongs to an arc (arc_radius_ft)"},
+      {"[B]\nbeacon = true\npath = [{ arc_radius_ft = 3, speed_fps = 1 }]\n",
+       "s.toml:3: error: 'B.path[0]' has no 'turn_deg' (the arc's signed angle)"},
+      {"[B]\nbeacon = true\npath = [{ arc_radius_ft = -3, turn_deg = 9, speed_fps = 1 }]\n",
+       "s.toml:3: error: 'B.path[0].arc_radius_ft' must be greater than 0, got -3"},
+      {"[B]\nbeacon = true\npath = [{ wait_s = 1, speed_fps = 1 }]\n",
+       "s.toml:3: error: 'B.path[0]': a wait has no speed_fps"},
+      {"[B]\nbeacon = true\npath = [{ spin_deg = 90 }]\n",
+       "s.toml:3: error: 'B.path[0]' has no 'speed_fps'"},
+      {"[B]\nbeacon = true\npath = [{ forward_ft = 0, speed_fps = 1 }]\n",
+       "s.toml:3: error: 'B.path[0].forward_ft' must not be 0"},
+      {"[B]\nbeacon = true\npath = [{ forward_ft = 2, speed_fps = 1, fast = true }]\n",
+       "s.toml:3: error: unknown key 'fast' in 'B.path[0]' (expected one of: forward_ft, "
+       "arc_radius_ft, turn_deg, spin_deg, wait_s, speed_fps)"},
+      {"[B]\nbeacon = true\nrepeat = 1\n", "s.toml:3: error: 'B.repeat' must be true or false"},
+  };
+  for (const Bad& c : cases) {
+    const std::string got = errorOf(c.text);
+    EXPECT_EQ(got.substr(0, c.message.size()), c.message) << c.text;
+    EXPECT_EQ(got.find('\n'), std::string::npos) << got;
+  }
+}
+
+scheduler::MatchConfig soloConfig(const std::string& program, const plant::Profile& profile) {
+  scheduler::MatchConfig c;
+  c.arena = plant::makeArenaConfig(profile, 1);
+  c.robots.push_back({"A", program, tools::compileProgramFile(program)});
+  return c;
+}
+
+plant::Profile defaults() { return tools::loadNamedProfile("default"); }
+
+std::string applyError(const std::string& text, tools::ScenarioUse use, int programs = 1) {
+  const auto profile = defaults();
+  auto c = soloConfig(kSource + "/programs/spiral.dc", profile);
+  if (programs == 2) {
+    c.arena = plant::makeArenaConfig(profile, 2);
+    c.robots.push_back({"B", "turret", tools::compileProgramFile(kSource + "/programs/turret.dc")});
+  }
+  try {
+    tools::applyScenario(parse(text), use, profile, c);
+  } catch (const plant::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Scenario, WhatDoesNotFitTheRunNamesItsLine) {
+  EXPECT_EQ(applyError("\n[B]\nbeacon = true\n", tools::ScenarioUse::Match, 2),
+            "s.toml:3: error: match takes B's program from the command line; B.program and "
+            "B.beacon are for solo, profile and bench");
+  EXPECT_EQ(applyError("[B]\nstart = { x_ft = 0, y_ft = 0, heading_deg = 0 }\n",
+                       tools::ScenarioUse::Solo),
+            "s.toml:1: error: [B] sets up a robot B but names none: give B.program or B.beacon "
+            "= true");
+  EXPECT_EQ(applyError("[A]\nstart = { x_ft = 9, y_ft = 0, heading_deg = 0 }\n",
+                       tools::ScenarioUse::Solo),
+            "s.toml:2: error: start (9, 0) ft is outside the 16-ft field");
+  EXPECT_EQ(applyError("[A]\ninject = [\"edge_fore@line:1#1\"]\n", tools::ScenarioUse::Solo),
+            "s.toml:2: error: line 1 of " + kSource + "/programs/spiral.dc has no code");
+  EXPECT_EQ(applyError("[A]\nstart = { x_ft = 1, y_ft = 0, heading_deg = 0 }\n",
+                       tools::ScenarioUse::Bench),
+            "s.toml:2: error: a bench family places the robots and picks B; leave out --family "
+            "to run this scenario's own poses and opponent");
+  EXPECT_EQ(
+      applyError("[B]\nbeacon = true\npath = [{ wait_s = 1e-9 }]\n", tools::ScenarioUse::Solo),
+      "s.toml:3: error: this leg lasts 1e-09 s, which is not between one tick and 1e8 s");
+  // The same B set-up is fine for a match when it names no program.
+  EXPECT_EQ(applyError("[B]\nstart = { x_ft = 0, y_ft = 3, heading_deg = 0 }\n",
+                       tools::ScenarioUse::Match, 2),
+            "");
+}
+
+// A beacon on a scripted path, run by the scheduler: the poses the match
+// ends with are the path's closed form, legs starting at exact ticks.
+TEST(Scenario, BeaconFollowsItsPathInAMatch) {
+  const auto profile = defaults();
+  auto c = soloConfig(kSource + "/programs/spiral.dc", profile);
+  c.robots[0].image = tools::compileProgramText("main()\n{\n}\n", "still");  // out of the way
+  tools::applyScenario(parse(R"([B]
+beacon = true
+start = { x_ft = 0, y_ft = 3, heading_deg = 90 }
+path = [ { arc_radius_ft = 3, turn_deg = 90, speed_fps = 0.5 },
+         { forward_ft = -2, speed_fps = 0.25 },
+         { spin_deg = -90, speed_fps = 0.2 } ]
+)"),
+                       tools::ScenarioUse::Solo, profile, c);
+  ASSERT_EQ(c.robots.size(), 2u);
+  ASSERT_EQ(c.robots[1].path.size(), 3u);
+  const double quarter = 3 * std::numbers::pi / 2 / 0.5;  // seconds
+  EXPECT_EQ(c.robots[1].path[0].duration,
+            static_cast<scheduler::Tick>(std::round(quarter * scheduler::kTicksPerSecond)));
+  EXPECT_EQ(c.robots[1].path[1].duration, 8 * scheduler::kTicksPerSecond);
+  c.endTick = 40 * scheduler::kTicksPerSecond;  // path over at about 9.4 + 8 + 3.5 s
+  c.trace = true;
+  const auto r = scheduler::runMatch(c);
+  // A quarter circle clockwise from north to east (heading south), 2 ft
+  // backwards (north), a quarter turn to the left: at (3, 2) heading east.
+  const plant::Pose end = r.robots[1].finalPose;
+  EXPECT_NEAR(end.x_ft, 3.0, 1e-5);
+  EXPECT_NEAR(end.y_ft, 2.0, 1e-5);
+  EXPECT_NEAR(end.heading_deg, 90.0, 1e-4);
+  int legs = 0;
+  for (const auto& line : r.trace) legs += line.find("\"path_leg\"") != std::string::npos;
+  EXPECT_EQ(legs, 4);  // three legs and the stop
+}
+
+TEST(Scenario, BenchRunsItsOwnScenarioWhateverTheThreadCount) {
+  tools::BenchConfig c;
+  c.programs = {kShared + "/programs/iceman.dc"};
+  c.scenario = tools::loadScenario(kSource + "/scenarios/circle.toml");
+  c.seeds = 3;
+  c.seconds = 8;
+  c.progress = false;
+  auto profile = defaults();
+  profile.robot.noise_sigma = 3;  // the seeds differ only in the noise
+  c.threads = 1;
+  const auto one = tools::runBench(c, profile);
+  c.threads = 2;
+  const auto two = tools::runBench(c, profile);
+  EXPECT_EQ(tools::runsCsv(one), tools::runsCsv(two));
+  EXPECT_EQ(tools::summaryJson(one)["family"], "scenario circle");
+  for (const auto& run : one.runs) EXPECT_EQ(run.startA.x_ft, -5.0);
+}
+
+}  // namespace
