@@ -381,6 +381,28 @@ TEST(Determinism, SameCallsGiveBitIdenticalPosesWhetherQueriedOrNot) {
   EXPECT_GT(s1.reinits, 0);
 }
 
+// pose() evaluates only x, y and heading; it must give the very bits of
+// state().pose, inside a segment and at a tick with pending events.
+TEST(Queries, PoseIsTheStatesPoseBitForBit) {
+  const Profile p = defaults();
+  Arena a(config(p, {Pose{-6.5, -6.5, 30}, Pose{6, 6, 200}}));
+  a.setWheels(0, frame("cfg0afg0"), 0);
+  a.setWheels(1, frame("ffg0ffg0"), 0);
+  int checked = 0;
+  while (a.now() < ticks(12)) {
+    const std::int64_t from = a.lastReinitTick();
+    const AdvanceResult r = a.advance(ticks(12));
+    for (int robot = 0; robot < 2; ++robot)
+      for (std::int64_t t : {from, (from + r.tick) / 2, r.tick}) {
+        if (t < a.lastReinitTick()) continue;
+        const Pose q = a.pose(robot, t), s = a.state(robot, t).pose;
+        EXPECT_EQ(std::memcmp(&q, &s, sizeof q), 0) << robot << " " << t;
+        ++checked;
+      }
+  }
+  EXPECT_GT(checked, 10);
+}
+
 TEST(Queries, OutsideTheWindowThrow) {
   const Profile p = thesis();
   Arena a(config(p, {Pose{0, 0, 0}}));
