@@ -146,6 +146,7 @@ struct RobotDisc {
   Ring reflexTicks, eventTicks;
   std::uint8_t portB = 0;
   std::array<bool, 2> gunOn{};
+  std::array<bool, 2> gunJammed{};
   std::array<std::int64_t, 2> launchTick{-1, -1};
   std::array<int, 2> ballsLeft{};
   int shots = 0, hits = 0;
@@ -592,10 +593,10 @@ struct Arena::Impl {
   // Component i of the dense output polynomial of record r at time t.
   double component(const Rec& r, double t, int i) const {
     const double dt = t - r.tn;
-    double acc = coef[r.off + static_cast<std::size_t>(r.q * n + i)];
+    double sum = coef[r.off + static_cast<std::size_t>(r.q * n + i)];
     for (int k = r.q - 1; k >= 0; --k)
-      acc = acc * dt + coef[r.off + static_cast<std::size_t>(k * n + i)];
-    return acc;
+      sum = sum * dt + coef[r.off + static_cast<std::size_t>(k * n + i)];
+    return sum;
   }
   void evalAt(double t, std::vector<double>& out) const {
     const Rec& r = recordAt(t);
@@ -1072,7 +1073,7 @@ bool Arena::setDrive(int robot, double leftFps, double rightFps, std::int64_t ti
   return true;
 }
 
-EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick) {
+EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, RandomBits* gunLuck) {
   Impl& m = *impl_;
   EventList ev;
   if (robot < 0 || robot >= m.nR) throw std::out_of_range("plant: robot index");
@@ -1097,10 +1098,20 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick) {
       Event e{EventKind::SolenoidStroke};
       e.robot = static_cast<std::int8_t>(robot);
       e.gun = static_cast<std::int8_t>(g);
+      const double jam = p.jam_probability, misfire = p.misfire_probability;
       if (old.ballsLeft[static_cast<std::size_t>(g)] <= 0) {
         e.kind = EventKind::GunEmpty;
-      } else if (old.launchTick[static_cast<std::size_t>(g)] < 0) {
+      } else if (old.gunJammed[static_cast<std::size_t>(g)]) {
+        e.kind = EventKind::GunJammed;
+      } else if (old.launchTick[static_cast<std::size_t>(g)] >= 0) {
         // A stroke already under way ignores the new edge.
+      } else if (const double u = gunLuck && (jam > 0 || misfire > 0) ? unit53(gunLuck->next()) : 1;
+                 u < jam) {
+        e.kind = EventKind::GunJammed;
+        next.gunJammed[static_cast<std::size_t>(g)] = true;
+      } else if (u < jam + misfire) {
+        e.kind = EventKind::GunMisfire;
+      } else {
         next.launchTick[static_cast<std::size_t>(g)] =
             tick + static_cast<std::int64_t>(
                        std::llround(p.stroke_s * static_cast<double>(kTicksPerSecond)));
@@ -1115,9 +1126,11 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick) {
     ev.push(e);
   }
   if (!rhsChanges && !scheduleChanges) {
-    // Nothing physical changes: the prediction stays valid.
-    m.D.r[static_cast<std::size_t>(robot)].portB = value;
-    if (m.pending) m.pendingD.r[static_cast<std::size_t>(robot)].portB = value;
+    // Nothing that moves changes: the prediction stays valid.
+    for (Discrete* d : {&m.D, &m.pendingD}) {
+      d->r[static_cast<std::size_t>(robot)].portB = value;
+      d->r[static_cast<std::size_t>(robot)].gunJammed = next.gunJammed;
+    }
     return ev;
   }
   m.rewindTo(tick);
@@ -1253,6 +1266,10 @@ const char* eventKindName(EventKind k) {
       return "solenoid_stroke";
     case EventKind::GunEmpty:
       return "gun_empty";
+    case EventKind::GunMisfire:
+      return "gun_misfire";
+    case EventKind::GunJammed:
+      return "gun_jammed";
     case EventKind::DiscShooter:
       return "disc_shooter";
   }

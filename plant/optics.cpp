@@ -27,7 +27,6 @@ namespace simbot::plant {
 namespace {
 
 // [0, 1) from the top 53 bits.
-double unit53(std::uint64_t bits) { return static_cast<double>(bits >> 11) * 0x1.0p-53; }
 // (0, 1] from the top 53 bits (safe for log).
 double unit53Open0(std::uint64_t bits) { return static_cast<double>((bits >> 11) + 1) * 0x1.0p-53; }
 

@@ -69,6 +69,12 @@ struct RobotParams {
   double muzzle_speed_fps = 0;  // at full gun-wheel speed
   double launch_height_ft = 0;
   int balls_per_gun = 0;
+  // Per stroke that would launch: the gun jams (launches nothing, now or
+  // later, this match), or misfires (launches nothing; the ball stays
+  // chambered for the next stroke). DESIGN.md: an option.
+  double jam_probability = 0, misfire_probability = 0;
+  // controller
+  bool random_memory = false;  // power-on RAM from a seeded stream, not zeros
 };
 
 struct FieldParams {
@@ -152,6 +158,9 @@ class RandomBits {
   virtual ~RandomBits() = default;
   virtual std::uint64_t next() = 0;
 };
+// A uniform double in [0, 1) from the top 53 bits of a draw.
+inline double unit53(std::uint64_t bits) { return static_cast<double>(bits >> 11) * 0x1.0p-53; }
+
 // SplitMix64, a small reference generator for tests and callers.
 class SplitMix64 final : public RandomBits {
  public:
@@ -200,6 +209,8 @@ enum class EventKind : std::uint8_t {
   RefereeTurn,     // robot: too many reflexes/events, turned by turn_deg
   SolenoidStroke,  // (from setPortB) robot, gun: launch due after the stroke
   GunEmpty,        // (from setPortB) robot, gun: solenoid fired, magazine empty
+  GunMisfire,      // (from setPortB) robot, gun: the stroke launched nothing
+  GunJammed,       // (from setPortB) robot, gun: jammed now or before, launched nothing
   DiscShooter,     // (from setPortB) robot: disc shooter bit rose (logged only)
 };
 const char* eventKindName(EventKind k);
@@ -313,8 +324,12 @@ class Arena {
   // Returns false (no reinit) if the drive is already these speeds.
   bool setDrive(int robot, double leftFps, double rightFps, std::int64_t tick);
   // A write to PIO port B. Returns the immediate events (solenoid strokes,
-  // empty guns, disc shooter); launches come later from advance().
-  EventList setPortB(int robot, std::uint8_t value, std::int64_t tick);
+  // empty guns, misfires and jams, disc shooter); launches come later from
+  // advance(). `gunLuck` draws a stroke's jam or misfire (one draw per
+  // stroke that would launch, only if the robot's probabilities are not
+  // both 0); null: guns never jam or misfire.
+  EventList setPortB(int robot, std::uint8_t value, std::int64_t tick,
+                     RandomBits* gunLuck = nullptr);
 
   // The motor controller's bumper reflex, as if that bumper switch closed
   // at `tick` (an injected bump). A reflex under way starts over. Returns

@@ -13,7 +13,8 @@
 // angles, plain ratios and A/D readings.
 //
 // A hardware file has an optional [ports] section (port B bit numbers) and
-// may override the per-robot sections ([robot], [bumper], [eyes], [gun])
+// may override the per-robot sections ([robot], [bumper], [eyes], [gun],
+// [controller])
 // with the same key names and the same checks; every key there is optional.
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -136,6 +137,11 @@ const std::vector<KeyDef>& keyTable() {
       {"gun", "muzzle_speed", Kind::Speed, Range::Pos, true, D(p.robot.muzzle_speed_fps)},
       {"gun", "launch_height", Kind::Length, Range::Pos, true, D(p.robot.launch_height_ft)},
       {"gun", "balls_per_gun", Kind::Count, Range::Any, true, I(p.robot.balls_per_gun)},
+      {"gun", "jam_probability", Kind::Probability, Range::NonNeg, true,
+       D(p.robot.jam_probability)},
+      {"gun", "misfire_probability", Kind::Probability, Range::NonNeg, true,
+       D(p.robot.misfire_probability)},
+      {"controller", "random_memory", Kind::Bool, Range::Any, true, B(p.robot.random_memory)},
       {"projectile", "gravity", Kind::Accel, Range::Pos, false, D(p.field.gravity_fps2)},
       {"projectile", "count_floor_skips", Kind::Bool, Range::Any, false,
        B(p.field.count_floor_skips)},
@@ -416,6 +422,8 @@ void crossChecks(const Profile& p, const Checker& c, const toml::table& doc) {
   if (p.referee.reflex_limit > 15 || p.referee.event_limit > 15)
     c.fail(where("referee"), "reflex_limit and event_limit must be at most 15");
   if (p.robot.balls_per_gun > 16) c.fail(where("gun"), "balls_per_gun must be at most 16");
+  if (p.robot.jam_probability + p.robot.misfire_probability > 1)
+    c.fail(where("gun"), "jam_probability + misfire_probability must be at most 1");
   if (p.referee.putback_ft * 2 >= p.field.size_ft - 2 * p.field.wire_inset_ft)
     c.fail(where("referee"), "putback leaves no room inside the wire");
 }
@@ -470,6 +478,11 @@ Hardware parseHardware(std::string_view text, const std::string& sourceName, Rob
   if (p.robot.balls_per_gun > 16) {
     const toml::node* n = doc.get("gun");
     c.fail(n ? n->source() : doc.source(), "balls_per_gun must be at most 16");
+  }
+  if (p.robot.jam_probability + p.robot.misfire_probability > 1) {
+    const toml::node* n = doc.get("gun");
+    c.fail(n ? n->source() : doc.source(),
+           "jam_probability + misfire_probability must be at most 1");
   }
   params = p.robot;
   return h;

@@ -57,8 +57,7 @@ int resolveThreads(int threads) {
 }
 
 double uniform(plant::RandomBits& bits, double lo, double hi) {
-  const double u = static_cast<double>(bits.next() >> 11) * 0x1.0p-53;
-  return lo + (hi - lo) * u;
+  return lo + (hi - lo) * plant::unit53(bits.next());
 }
 
 void parallelFor(size_t count, int threads, const std::function<void(size_t)>& job,

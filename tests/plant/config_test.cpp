@@ -246,4 +246,47 @@ TEST(Hardware, GunBitsDriveTheArena) {
   EXPECT_EQ(r.tick, 0);
 }
 
+// Jams and misfires (DESIGN.md: an option): one draw per stroke that would
+// launch. A misfire keeps the ball chambered; a jam ends the gun's match.
+TEST(Hardware, GunsJamAndMisfireOnlyAsTheProfileSays) {
+  Profile p = thesis();
+  const auto strokes = [&](double jam, double misfire, RandomBits* luck) {
+    p.robot.jam_probability = jam;
+    p.robot.misfire_probability = misfire;
+    Arena a(makeArenaConfig(p, 1));
+    std::string kinds;
+    for (int k = 0; k < 3; ++k) {
+      for (const Event& e : a.setPortB(0, 0x18, a.now(), luck))
+        kinds += eventKindName(e.kind) + std::string(" ");
+      a.setPortB(0, 0x08, a.now());
+      a.advance(a.now() + 1000);
+    }
+    return kinds + std::to_string(a.shots(0)) + " " + std::to_string(a.ballsLeft(0, 0));
+  };
+  SplitMix64 luck(5);
+  EXPECT_EQ(strokes(0, 0, &luck), "solenoid_stroke solenoid_stroke solenoid_stroke 3 12");
+  EXPECT_EQ(strokes(0, 1, &luck), "gun_misfire gun_misfire gun_misfire 0 15");
+  EXPECT_EQ(strokes(1, 0, &luck), "gun_jammed gun_jammed gun_jammed 0 15");
+  EXPECT_EQ(strokes(1, 0, nullptr), "solenoid_stroke solenoid_stroke solenoid_stroke 3 12");
+  // Half and half: the same stream gives the same outcomes.
+  SplitMix64 l1(9), l2(9);
+  EXPECT_EQ(strokes(0.25, 0.25, &l1), strokes(0.25, 0.25, &l2));
+}
+
+TEST(Profile, JamAndMisfireTogetherAtMostOne) {
+  std::string text =
+      edit("jam_probability     = { value = 0.0", "jam_probability     = { value = 0.6");
+  const std::string mis = "misfire_probability = { value = 0.0";
+  ASSERT_NE(text.find(mis), std::string::npos);
+  text.replace(text.find(mis), mis.size(), "misfire_probability = { value = 0.6");
+  try {
+    parseProfile(text, "p.toml");
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("jam_probability + misfire_probability must be at most 1"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
