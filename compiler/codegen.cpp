@@ -86,6 +86,8 @@ class CodeGen {
   int stringAddress(const std::string& s, Pos pos);
   void writeData(int addr, uint64_t value, int size);
   void writeInit(const Init* init, int addr);
+  // A variable with an initialiser is given all its bytes at load.
+  void markInitialised(int addr, int size);
   bool staticPtr(Node* e, Loc& out);
   bool staticLoc(Node* e, Loc& out);
 
@@ -200,6 +202,7 @@ int CodeGen::allocData(int size, Pos pos, const std::string& what) {
   int a = dataTop_;
   dataTop_ += size;
   img_.data.resize(static_cast<size_t>(dataTop_ - vm::kDataBase), 0);
+  img_.initialised.resize(img_.data.size(), 0);
   return a;
 }
 
@@ -209,6 +212,7 @@ int CodeGen::stringAddress(const std::string& s, Pos pos) {
   if (it != strings_.end()) return it->second;
   int a = allocData(static_cast<int>(s.size()) + 1, pos, "a string literal");
   std::memcpy(img_.data.data() + (a - vm::kDataBase), s.data(), s.size());
+  markInitialised(a, static_cast<int>(s.size()) + 1);
   strings_[s] = a;
   return a;
 }
@@ -217,6 +221,10 @@ void CodeGen::writeData(int addr, uint64_t value, int size) {
   for (int i = 0; i < size; ++i)
     img_.data[static_cast<size_t>(addr - vm::kDataBase + i)] =
         static_cast<uint8_t>(value >> (8 * i));
+}
+
+void CodeGen::markInitialised(int addr, int size) {
+  std::fill_n(img_.initialised.begin() + (addr - vm::kDataBase), size, uint8_t{1});
 }
 
 // The initial bytes of a global or static (applied once, at load).
@@ -334,7 +342,10 @@ vm::Image CodeGen::run() {
 
   for (Obj* g : prog_.globals) g->address = allocData(g->type->size, g->pos, "'" + g->name + "'");
   for (Obj* g : prog_.globals)
-    if (g->init) writeInit(g->init, g->address);
+    if (g->init) {
+      writeInit(g->init, g->address);
+      markInitialised(g->address, g->type->size);
+    }
 
   for (Function* f : prog_.functions) function(f);
 
@@ -392,7 +403,10 @@ void CodeGen::function(Function* f) {
   for (Obj* p : f->params) place(p);
   for (Obj* l : f->locals) place(l);
   for (Obj* l : f->locals)
-    if (l->storage == Storage::Static && l->init) writeInit(l->init, l->address);
+    if (l->storage == Storage::Static && l->init) {
+      writeInit(l->init, l->address);
+      markInitialised(l->address, l->type->size);
+    }
   f->frameSize = frame;
 
   labels_.clear();

@@ -129,6 +129,7 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   uint8_t edgeLines = 0xFF;
   Tick serialEventAt = -1;
   plant::SplitMix64 noise;
+  plant::SplitMix64 gunLuck;  // jams and misfires
   RobotResult result;
   uint32_t mainReturn;
 };
@@ -192,6 +193,9 @@ class Match {
     return config_.robots[static_cast<size_t>(robot)].name;
   }
   MatchObserver* observer() const { return config_.observer; }
+  const plant::RobotParams& robotParams(int robot) const {
+    return config_.arena.robots[static_cast<size_t>(robot)].params;
+  }
 
  private:
   Tick earliestClock() const;
@@ -222,10 +226,15 @@ Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs, ui
       match(m),
       vm_(s.image, *this, costs),
       noise(streamSeed(seed, "eye-noise-" + s.name)),
+      gunLuck(streamSeed(seed, "gun-" + s.name)),
       mainReturn(s.image.entry + static_cast<uint32_t>(vm::instructionSize(vm::Op::CALL))) {
   result.name = s.name;
   result.program = s.program;
   vm_.setBreakpoint(mainReturn);
+  if (m.robotParams(i).random_memory) {
+    plant::SplitMix64 fill(streamSeed(seed, "memory-fill-" + s.name));
+    vm_.fillMemory([&fill] { return fill.next(); });
+  }
 }
 
 void Robot::runTo(Tick horizon) {
@@ -499,7 +508,8 @@ void Match::applyInputs() {
       continue;
     }
     sampleUpTo(w.tick);
-    const plant::EventList immediate = arena_.setPortB(w.robot, w.value, w.tick);
+    const plant::EventList immediate =
+        arena_.setPortB(w.robot, w.value, w.tick, &robots_[static_cast<size_t>(w.robot)]->gunLuck);
     for (const auto& e : immediate) {
       if (config_.observer) config_.observer->onPlantEvent(w.tick, e);
       trace_.add(

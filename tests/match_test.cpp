@@ -235,3 +235,40 @@ TEST(Match, SendStallsWhileInterruptsAreDisabledAndResumesOnEi) {
 }
 
 }  // namespace
+
+namespace {
+
+// Power-on memory (DESIGN.md): zero by default; with the profile's
+// random_memory, uninitialised globals, statics and the stack hold bytes
+// from the robot's seeded stream, while initialised ones (and string
+// literals) keep their values.
+TEST(Match, RandomPowerOnMemoryLeavesInitialisedDataAlone) {
+  const char* kProgram =
+      "int set = 1234;\n"
+      "int unset;\n"
+      "long lunset;\n"
+      "char text[] = \"ok\";\n"
+      "main()\n"
+      "{\n"
+      "    int a;\n"
+      "    printf(\"%d %d %ld %s\\n\", set, unset, lunset, text);\n"
+      "}\n";
+  auto run = [&](bool random, uint64_t seed) {
+    auto c = matchConfig({{"A", "mem.dc", compileSource(kProgram)}}, 1);
+    c.arena.robots[0].params.random_memory = random;
+    c.stopWhenAllExited = true;
+    c.seed = seed;
+    const auto r = scheduler::runMatch(c);
+    EXPECT_TRUE(r.robots[0].exited);
+    return r.robots[0].console.at(0);
+  };
+  EXPECT_EQ(run(false, 1), "1234 0 0 ok");
+  const std::string one = run(true, 1);
+  EXPECT_EQ(one, run(true, 1));
+  EXPECT_NE(one, run(true, 2));
+  EXPECT_EQ(one.rfind("1234 ", 0), 0u) << one;
+  EXPECT_EQ(one.substr(one.size() - 3), " ok") << one;
+  EXPECT_NE(one, "1234 0 0 ok");
+}
+
+}  // namespace

@@ -51,6 +51,10 @@ struct Image {
   // Initial memory: bytes [kDataBase, kDataBase + data.size()) hold the
   // globals' and statics' initial values (zeros where not initialised).
   std::vector<uint8_t> data;
+  // Parallel to data: 1 where the program gives the byte a value at load
+  // (globals and statics with an initialiser, string literals). The others
+  // hold whatever the RAM held at power-on (Vm::fillMemory).
+  std::vector<uint8_t> initialised;
   std::vector<VectorBinding> vectors;
   std::vector<Symbol> symbols;
   // First code address of each function, for profiles and fault messages.

@@ -1067,6 +1067,24 @@ Vm::Vm(const Image& image, Bus& bus, const CostTable& costs)
 
 Vm::~Vm() = default;
 
+void Vm::fillMemory(const std::function<uint64_t()>& next) {
+  State& s = *s_;
+  const auto& init = s.image.initialised;
+  uint64_t bits = 0;
+  int left = 0;
+  for (uint32_t a = kDataBase; a < kMemorySize; ++a) {
+    if (left == 0) {
+      bits = next();
+      left = 8;
+    }
+    const auto byte = static_cast<uint8_t>(bits);
+    bits >>= 8;
+    --left;
+    const uint32_t i = a - kDataBase;
+    if (i >= init.size() || !init[i]) s.mem[a] = byte;
+  }
+}
+
 Stop Vm::run(Tick until) { return s_->profiling ? s_->run<true>(until) : s_->run<false>(until); }
 
 void Vm::request(Irq irq, uint8_t vector) {

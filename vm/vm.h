@@ -17,6 +17,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -101,6 +102,11 @@ class Vm {
   bool interruptsEnabled() const;
   uint32_t pc() const;
   int line() const;  // source line of the next instruction
+
+  // Power-on RAM from a random stream (a profile option, DESIGN.md): every
+  // byte from kDataBase up that the image does not initialise is replaced,
+  // eight bytes per call of `next`, in address order. Before the first run().
+  void fillMemory(const std::function<uint64_t()>& next);
 
   // Robot memory, for the host (serial ISR, tests, watches).
   uint8_t read8(uint16_t address) const;
