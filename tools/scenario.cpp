@@ -122,7 +122,8 @@ class Walker {
         fail(*n, fmt::format("'{}.inject' must be an array of \"SOURCE@WHEN\" strings", section));
       for (const toml::node& e : *arr) {
         const std::string what = string(e, std::string(section) + ".inject");
-        // Checked now, with the robot the section implies.
+        // Checked now; the robot is the section's, so the message quotes
+        // the text without the "A:" put in front of it here.
         try {
           scheduler::parseInjection(std::string("A:") + what, 1);
         } catch (const std::invalid_argument& err) {
@@ -253,8 +254,6 @@ class Walker {
         if (!repeat->is_boolean()) fail(*repeat, "'B.repeat' must be true or false");
         s.repeatPath = *repeat->value<bool>();
       }
-      if (s.opponent == Scenario::Opponent::None && (s.b.start || !s.b.hardware.empty()))
-        s.opponentLine = static_cast<int>(n->source().begin.line);
     }
     return s;
   }
