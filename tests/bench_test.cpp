@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include "scheduler/metrics.h"
@@ -73,6 +74,29 @@ TEST(Bench, EdgeFamilyIsDeterministic) { EXPECT_EQ(benchJson("edge", 1), benchJs
 TEST(Bench, CircleAndHeadToHeadFamiliesRun) {
   EXPECT_EQ(benchJson("circle", 1), benchJson("circle", 2));
   EXPECT_EQ(benchJson("head-to-head", 1), benchJson("head-to-head", 2));
+}
+
+TEST(Bench, HeadToHeadPutsTheRobotsDownByHand) {
+  tools::BenchConfig c;
+  c.programs = {kShared + "/programs/iceman.dc"};
+  c.family = "head-to-head";
+  c.opponent = kShared + "/programs/fig92.dc";
+  c.seeds = 6;
+  c.seconds = 0.5;
+  c.progress = false;
+  const auto profile = tools::loadNamedProfile(kSource + "/profiles/default.toml");
+  const auto r = tools::runBench(c, profile);
+  const plant::Pose mark = profile.field.start[0];
+  for (size_t i = 0; i < r.runs.size(); ++i) {
+    const plant::Pose& p = r.runs[i].startA;
+    EXPECT_LE(std::fabs(p.x_ft - mark.x_ft), 0.5);
+    EXPECT_LE(std::fabs(p.y_ft - mark.y_ft), 0.5);
+    const double turn = std::fabs(std::remainder(p.heading_deg - mark.heading_deg, 360.0));
+    EXPECT_LE(turn, 15.0);
+    if (i > 0) {
+      EXPECT_NE(p.x_ft, r.runs[i - 1].startA.x_ft);
+    }
+  }
 }
 
 TEST(Bench, ObserverDoesNotChangeTheMatch) {

@@ -90,8 +90,17 @@ Placement samplePlacement(const std::string& family, plant::RandomBits& bits,
     }
   }
   if (family == "head-to-head") {
-    s.a = profile.field.start[0];
-    s.b = profile.field.start[1];
+    // The profile's start poses as a hand puts the robots down: within
+    // 0.5 ft of the mark and 15 degrees of the heading. Without it every
+    // seed of a noise-free profile would play the very same match.
+    auto placed = [&](plant::Pose p) {
+      p.x_ft += uniform(bits, -0.5, 0.5);
+      p.y_ft += uniform(bits, -0.5, 0.5);
+      p.heading_deg = normalizeHeading(p.heading_deg + uniform(bits, -15, 15));
+      return p;
+    };
+    s.a = placed(profile.field.start[0]);
+    s.b = placed(profile.field.start[1]);
     return s;
   }
   // edge: 3 ft inside the wire on a random side, heading for that side's
