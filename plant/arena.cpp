@@ -314,7 +314,7 @@ struct Arena::Impl {
   double wallG(const double* y, int i) const { return outG(y, i) - radius(i); }
   double dividerG(const double* y, int i) const {
     const Vec2 c = centre(y, i);
-    return (c - geom::closestPointOnRect(c, geom::dividerRect(cfg.field))).norm() - radius(i);
+    return dividerClearance(c.x(), c.y(), radius(i), cfg.field);
   }
   double robotG(const double* y) const {
     return (centre(y, 0) - centre(y, 1)).norm() - radius(0) - radius(1);

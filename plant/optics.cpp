@@ -67,6 +67,11 @@ bool dividerBlocks(double ax, double ay, double bx, double by, const FieldParams
   return geom::segmentHitsRect(geom::Vec2(ax, ay), geom::Vec2(bx, by), geom::dividerRect(field));
 }
 
+double dividerClearance(double x, double y, double radius, const FieldParams& field) {
+  const geom::Vec2 c(x, y);
+  return (c - geom::closestPointOnRect(c, geom::dividerRect(field))).norm() - radius;
+}
+
 EyeGeometry eyeGeometry(const Pose& self, const Pose& opp, const RobotParams& p,
                         const FieldParams& field) {
   EyeGeometry g;

@@ -188,6 +188,9 @@ EyeGeometry eyeGeometry(const Pose& self, const Pose& opponent, const RobotParam
                         const FieldParams& field);
 // True if the segment between the two centres passes through the divider.
 bool dividerBlocks(double ax, double ay, double bx, double by, const FieldParams& field);
+// Gap between a round body (centre x, y; radius) and the divider, in ft;
+// negative when they overlap.
+double dividerClearance(double x, double y, double radius, const FieldParams& field);
 
 // ---------------------------------------------------------------- events
 enum class Detector : std::uint8_t { Fore = 0, Aft = 1 };

@@ -189,7 +189,14 @@ TEST(Scenario, WhatDoesNotFitTheRunNamesItsLine) {
             "= true");
   EXPECT_EQ(applyError("[A]\nstart = { x_ft = 9, y_ft = 0, heading_deg = 0 }\n",
                        tools::ScenarioUse::Solo),
-            "s.toml:2: error: start (9, 0) ft is outside the 16-ft field");
+            "s.toml:2: error: start (9, 0) ft puts the body outside the 16-ft field");
+  EXPECT_EQ(applyError("[A]\nstart = { x_ft = 0.2, y_ft = -6, heading_deg = 0 }\n",
+                       tools::ScenarioUse::Solo),
+            "s.toml:2: error: start (0.2, -6) ft puts the body on the divider");
+  EXPECT_EQ(applyError("[A]\nstart = { x_ft = 1, y_ft = 1, heading_deg = 0 }\n[B]\nstart = "
+                       "{ x_ft = 1.5, y_ft = 1, heading_deg = 0 }\n",
+                       tools::ScenarioUse::Match, 2),
+            "s.toml:4: error: the two robots' start poses overlap");
   EXPECT_EQ(applyError("[A]\ninject = [\"edge_fore@line:1#1\"]\n", tools::ScenarioUse::Solo),
             "s.toml:2: error: line 1 of " + kSource + "/programs/spiral.dc has no code");
   EXPECT_EQ(applyError("[A]\nstart = { x_ft = 1, y_ft = 0, heading_deg = 0 }\n",

@@ -29,10 +29,9 @@ struct Geometry {
   double inside;  // centres at least 1.5 ft inside the wire
   double radius;  // body radius
   const plant::FieldParams* field;
-  // A body centred here would overlap the divider.
+  // A body centred here would touch the divider.
   bool nearDivider(double x, double y) const {
-    return std::fabs(x - field->divider_x_ft) < field->divider_thickness_ft / 2 + radius &&
-           y > field->divider_south_ft - radius && y < field->divider_north_ft + radius;
+    return plant::dividerClearance(x, y, radius, *field) <= 0;
   }
   bool inBounds(double x, double y) const {
     return std::fabs(x) <= inside && std::fabs(y) <= inside;

@@ -378,10 +378,13 @@ void applyScenario(const Scenario& s, ScenarioUse use, const plant::Profile& pro
     const ScenarioRobot& r = *each[i];
     plant::RobotSetup& setup = config.arena.robots[i];
     if (r.start) {
-      const double half = profile.field.size_ft / 2;
-      if (std::fabs(r.start->x_ft) >= half || std::fabs(r.start->y_ft) >= half)
-        fail(r.startLine, fmt::format("start ({}, {}) ft is outside the {}-ft field", r.start->x_ft,
-                                      r.start->y_ft, profile.field.size_ft));
+      const double half = profile.field.size_ft / 2, radius = setup.params.body_diameter_ft / 2;
+      const double x = r.start->x_ft, y = r.start->y_ft;
+      if (std::fabs(x) + radius > half || std::fabs(y) + radius > half)
+        fail(r.startLine, fmt::format("start ({}, {}) ft puts the body outside the {}-ft field", x,
+                                      y, profile.field.size_ft));
+      if (plant::dividerClearance(x, y, radius, profile.field) <= 0)
+        fail(r.startLine, fmt::format("start ({}, {}) ft puts the body on the divider", x, y));
       setup.start = *r.start;
     }
     if (!r.hardware.empty() && !keepHardware[i])
@@ -397,6 +400,15 @@ void applyScenario(const Scenario& s, ScenarioUse use, const plant::Profile& pro
       }
       config.injections.push_back(std::move(injection));
     }
+  }
+  if (robots == 2) {
+    const plant::Pose& a = config.arena.robots[0].start;
+    const plant::Pose& b = config.arena.robots[1].start;
+    const double touch = (config.arena.robots[0].params.body_diameter_ft +
+                          config.arena.robots[1].params.body_diameter_ft) /
+                         2;
+    if (std::hypot(a.x_ft - b.x_ft, a.y_ft - b.y_ft) <= touch)
+      fail(s.b.start ? s.b.startLine : s.a.startLine, "the two robots' start poses overlap");
   }
   if (robots == 2 && s.opponent == Scenario::Opponent::Beacon && !s.path.empty()) {
     config.robots[1].path = driveLegs(s, s.path, config.arena.robots[1].params);
