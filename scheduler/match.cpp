@@ -503,6 +503,14 @@ void Match::applyInputs() {
   std::stable_sort(inputs_.begin(), inputs_.end(),
                    [](const PlantInput& a, const PlantInput& b) { return a.tick < b.tick; });
   for (const auto& w : inputs_) {
+    // An earlier input of this round may have re-initialised the plant at
+    // its tick: integrate up to this one (its events at their ticks; those
+    // at this tick come first, as plant events do).
+    while (arena_.now() < w.tick) {
+      const plant::AdvanceResult step = arena_.advance(w.tick);
+      sampleUpTo(step.tick);
+      handlePlantEvents(step.tick, step.events);
+    }
     if (w.kind == PlantInput::Kind::Reflex) {
       applyReflex(w.tick, w.robot, w.bumper);
       continue;

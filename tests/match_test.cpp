@@ -272,3 +272,35 @@ TEST(Match, RandomPowerOnMemoryLeavesInitialisedDataAlone) {
 }
 
 }  // namespace
+
+namespace {
+
+// Two port B writes in one round that both change the plant (a gun motor,
+// then a solenoid stroke): the first re-initialises the integrator at its
+// tick, and the plant must be brought up to the second before it applies.
+TEST(Match, TwoPlantChangingPortBWritesInOneRound) {
+  const char* kProgram =
+      "main()\n"
+      "{\n"
+      "    outport(PIODB, 0x08);\n"
+      "    outport(PIODB, 0x88);\n"
+      "    outport(PIODB, 0x98);\n"
+      "    while (1);\n"
+      "}\n";
+  for (const char* profile : {"default", "thesis-1997"}) {
+    auto c = matchConfig({{"A", "guns.dc", compileSource(kProgram)}}, 1, profile);
+    c.trace = true;
+    scheduler::MatchResult r;
+    ASSERT_NO_THROW(r = scheduler::runMatch(c)) << profile;
+    int writes = 0, strokes = 0;
+    for (const auto& line : r.trace) {
+      writes += line.find("\"port_b\"") != std::string::npos;
+      strokes += line.find("\"solenoid_stroke\"") != std::string::npos;
+    }
+    EXPECT_EQ(writes, 3) << profile;
+    EXPECT_EQ(strokes, 1) << profile;
+    EXPECT_EQ(r.robots[0].shots, 1) << profile;
+  }
+}
+
+}  // namespace
