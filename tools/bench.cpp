@@ -219,9 +219,20 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
     mc.seed = run.seed;
     scheduler::MetricsObserver observer(0);
     mc.observer = &observer;
-    const scheduler::MatchResult r = scheduler::runMatch(mc);
-    observer.finish(r.endTick);
-    run.metrics = scheduler::collectMetrics(observer, r.robots[0]);
+    try {
+      const scheduler::MatchResult r = scheduler::runMatch(mc);
+      observer.finish(r.endTick);
+      run.metrics = scheduler::collectMetrics(observer, r.robots[0]);
+    } catch (const std::exception& e) {
+      // Name the run, so that it can be replayed as a match with a scenario.
+      std::string poses;
+      for (const auto& robot : mc.arena.robots)
+        poses += fmt::format(" ({}, {}, {} deg)", robot.start.x_ft, robot.start.y_ft,
+                             robot.start.heading_deg);
+      throw ToolError(
+          fmt::format("simbot: internal error in run {} of {} (seed {}, starts{}): {}\n", run.index,
+                      run.program, run.seed, poses, e.what()));
+    }
   };
   parallelFor(result.runs.size(), config.threads, job, "bench " + benchLabel(config),
               config.progress);
