@@ -183,9 +183,7 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
     lap.radiusFt = kCircleRadiusFt;
     lap.turnDeg = 360;
     lap.speedFps = kCircleSpeedFps;
-    Scenario none;
-    none.file = "(circle family)";
-    opponent = beaconSpec(driveLegs(none, {lap}, profile.robot), true);
+    opponent = beaconSpec(driveLegs("(circle family)", {lap}, profile.robot), true);
   } else if (config.family == "head-to-head") {
     opponent = scheduler::RobotSpec{"B", config.opponent, compileProgramFile(config.opponent)};
   }

@@ -283,7 +283,8 @@ Scenario loadScenario(const std::string& path) {
   return parseScenario(text, path, dir.empty() ? "." : dir.string());
 }
 
-std::vector<scheduler::DriveLeg> driveLegs(const Scenario& s, const std::vector<PathLeg>& legs,
+std::vector<scheduler::DriveLeg> driveLegs(const std::string& sourceName,
+                                           const std::vector<PathLeg>& legs,
                                            const plant::RobotParams& params) {
   std::vector<scheduler::DriveLeg> out;
   const double half = params.track_ft / 2;
@@ -317,7 +318,7 @@ std::vector<scheduler::DriveLeg> driveLegs(const Scenario& s, const std::vector<
     if (!(ticks >= 1) || ticks > 1e15)
       throw plant::ConfigError(
           fmt::format("{}:{}: error: this leg lasts {} s, which is not between one tick and 1e8 s",
-                      s.file, leg.line, seconds));
+                      sourceName, leg.line, seconds));
     out.push_back({static_cast<scheduler::Tick>(ticks), left, right});
   }
   return out;
@@ -411,7 +412,7 @@ void applyScenario(const Scenario& s, ScenarioUse use, const plant::Profile& pro
       fail(s.b.start ? s.b.startLine : s.a.startLine, "the two robots' start poses overlap");
   }
   if (robots == 2 && s.opponent == Scenario::Opponent::Beacon && !s.path.empty()) {
-    config.robots[1].path = driveLegs(s, s.path, config.arena.robots[1].params);
+    config.robots[1].path = driveLegs(s.file, s.path, config.arena.robots[1].params);
     config.robots[1].repeatPath = s.repeatPath;
     config.robots[1].program = "(beacon on a path)";
   }

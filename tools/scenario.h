@@ -64,7 +64,8 @@ Scenario parseScenario(std::string_view text, const std::string& sourceName,
 // A beacon's path as wheel speeds and exact tick durations, with the
 // beacon's own track (the scheduler follows a path exactly: no motor lag). Throws
 // plant::ConfigError naming the leg's line if a leg is shorter than a tick.
-std::vector<scheduler::DriveLeg> driveLegs(const Scenario& s, const std::vector<PathLeg>& legs,
+std::vector<scheduler::DriveLeg> driveLegs(const std::string& sourceName,
+                                           const std::vector<PathLeg>& legs,
                                            const plant::RobotParams& params);
 
 // B as a beacon: a program whose main returns at once (so its VM halts and
