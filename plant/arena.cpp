@@ -449,8 +449,8 @@ struct Arena::Impl {
         wt[1] = wheelSpeedFps(r.latched.right, p, false);
       }
       auto& gt = gunTarget[static_cast<std::size_t>(i)];
-      gt[0] = r.gunOn[0] ? 1.0 : 0.0;
-      gt[1] = r.gunOn[1] ? 1.0 : 0.0;
+      gt[0] = r.gunOn[0] || p.gun_motors_always_on ? 1.0 : 0.0;
+      gt[1] = r.gunOn[1] || p.gun_motors_always_on ? 1.0 : 0.0;
     }
   }
   // Zero time constants: the state jumps to its target.
@@ -1091,7 +1091,7 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
   bool rhsChanges = false, scheduleChanges = false;
   for (int g = 0; g < 2; ++g) {
     const bool on = bit(value, hw.gun_motor_bit[static_cast<std::size_t>(g)]);
-    if (on != old.gunOn[static_cast<std::size_t>(g)]) rhsChanges = true;
+    if (on != old.gunOn[static_cast<std::size_t>(g)] && !p.gun_motors_always_on) rhsChanges = true;
     next.gunOn[static_cast<std::size_t>(g)] = on;
     const int sb = hw.gun_solenoid_bit[static_cast<std::size_t>(g)];
     if (bit(value, sb) && !bit(old.portB, sb)) {

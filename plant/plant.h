@@ -65,6 +65,7 @@ struct RobotParams {
   bool thesis_swapped_eyes = false;    // Appendix C: far eye gets the full value
   // guns
   double gun_wheel_lag_s = 0;   // first-order spin-up/down; 0 = instant
+  bool gun_motors_always_on = false;  // thesis Appendix E: port B motor bits ignored
   double stroke_s = 0;          // solenoid rising edge -> launch
   double muzzle_speed_fps = 0;  // at full gun-wheel speed
   double launch_height_ft = 0;

@@ -133,6 +133,7 @@ const std::vector<KeyDef>& keyTable() {
        D(p.robot.bad_reading_probability)},
       {"eyes", "thesis_swapped_eyes", Kind::Bool, Range::Any, true, B(p.robot.thesis_swapped_eyes)},
       {"gun", "wheel_lag", Kind::Time, Range::NonNeg, true, D(p.robot.gun_wheel_lag_s)},
+      {"gun", "motors_always_on", Kind::Bool, Range::Any, true, B(p.robot.gun_motors_always_on)},
       {"gun", "stroke_time", Kind::Time, Range::NonNeg, true, D(p.robot.stroke_s)},
       {"gun", "muzzle_speed", Kind::Speed, Range::Pos, true, D(p.robot.muzzle_speed_fps)},
       {"gun", "launch_height", Kind::Length, Range::Pos, true, D(p.robot.launch_height_ft)},

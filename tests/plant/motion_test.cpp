@@ -178,6 +178,35 @@ TEST(Motion, ProjectileFlightTimeAndRange) {
   EXPECT_EQ(a.ballsLeft(0, 0), 14);
 }
 
+// thesis-1997 follows Appendix E: gun motors on at all times. ICEMAN's
+// fire() strokes with 0x30, the motor bits already off again: the ball must
+// still leave at full muzzle speed there, and fall at the muzzle when the
+// motor bits rule and the wheel has no spin-down (lag 0).
+TEST(Motion, GunMotorsAlwaysOnIgnoresTheMotorBits) {
+  for (bool alwaysOn : {true, false}) {
+    Profile p = thesis();
+    ASSERT_TRUE(p.robot.gun_motors_always_on);
+    p.robot.gun_motors_always_on = alwaysOn;
+    Arena a(config(p, {Pose{-2, 0, 90}}));
+    a.setPortB(0, 0x88, 0);
+    const auto fire = ticks(0.5);
+    a.advance(fire);
+    a.setPortB(0, 0x30, fire);  // solenoids on, motors off
+    ASSERT_TRUE(runUntil(a, EventKind::BallLaunch, ticks(1)).has_value());
+    const auto later = fire + ticks(0.01);
+    a.advance(later);
+    const auto balls = a.balls(later);
+    ASSERT_EQ(balls.size(), 2u);
+    const double muzzleX = -2 + p.robot.body_diameter_ft / 2;
+    const double flown = balls[0].x_ft - muzzleX;
+    if (alwaysOn)
+      expectRel(flown, p.robot.muzzle_speed_fps * (secondsFromTick(later) - secondsFromTick(fire)),
+                1e-9, "full muzzle speed");
+    else
+      EXPECT_NEAR(flown, 0.0, 1e-12);
+  }
+}
+
 TEST(Motion, HitTickMatchesClosedForm) {
   const Profile p = thesis();
   Arena a(config(p, {Pose{-3, 0, 90}, Pose{3, 0, 270}}));
