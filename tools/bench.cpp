@@ -213,6 +213,7 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
       if (placement.b) mc.arena.robots[1].start = *placement.b;
     }
     run.startA = mc.arena.robots[0].start;
+    if (mc.arena.robots.size() > 1) run.startB = mc.arena.robots[1].start;
     mc.endTick = endTick;
     mc.seed = run.seed;
     scheduler::MetricsObserver observer(0);
@@ -238,12 +239,18 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
 }
 
 std::string runsCsv(const BenchResult& result) {
-  std::string out = "program,run,seed,start_x_ft,start_y_ft,start_heading_deg";
+  std::string out =
+      "program,run,seed,start_x_ft,start_y_ft,start_heading_deg,b_start_x_ft,b_start_y_ft,"
+      "b_start_heading_deg";
   for (const auto& name : scheduler::metricNames()) out += "," + name;
   out += '\n';
   for (const auto& run : result.runs) {
     out += fmt::format("{},{},{},{},{},{}", run.program, run.index, run.seed, run.startA.x_ft,
                        run.startA.y_ft, run.startA.heading_deg);
+    if (run.startB)
+      out += fmt::format(",{},{},{}", run.startB->x_ft, run.startB->y_ft, run.startB->heading_deg);
+    else
+      out += ",,,";
     for (const auto& v : run.metrics.values) out += "," + (v ? fmt::format("{}", *v) : "");
     out += '\n';
   }

@@ -32,6 +32,7 @@ struct BenchRun {
   int index = 0;
   uint64_t seed = 0;  // streamSeed(master, "<family>/<program file name>/<index>")
   plant::Pose startA;
+  std::optional<plant::Pose> startB;  // absent in solo families
   scheduler::RunMetrics metrics;
 };
 
