@@ -616,6 +616,13 @@ struct Arena::Impl {
     return {component(r, t, base + X), component(r, t, base + Y), component(r, t, base + H)};
   }
 
+  void checkRobot(int robot) const {
+    if (robot < 0 || robot >= nR) throw std::out_of_range("plant: robot index");
+  }
+  void checkInputTick(std::int64_t tick) const {
+    if (tick < segTick || tick > now)
+      throw std::out_of_range("plant: input tick outside [last reinit, now]");
+  }
   void checkQueryTick(std::int64_t tick) const {
     if (tick < segTick || tick > now)
       throw std::out_of_range("plant: query tick outside [last reinit, now]");
@@ -842,36 +849,30 @@ struct Arena::Impl {
       }
       d.robotContact = c;
     }
+    // A robot against a fixed obstacle: contact starts (the bumper on the
+    // side facing `towards`, and its reflex) or ends where g changes sign.
+    auto obstacle = [&](int i, RootKind k, double g, bool& touching, ContactWith with,
+                        const Vec2& towards) {
+      const int rep = reported(found, k, i);
+      const bool c = rep != 0 ? rep < 0 : g < 0;
+      if (c && !touching) {
+        const Bumper side = sideOf(heading(ys, i), towards);
+        contactEvent(EventKind::Contact, i, side, with, -1);
+        startReflex(d, y, i, side, T, ev);
+      } else if (!c && touching) {
+        contactEvent(EventKind::ContactEnd, i, Bumper::Front, with, -1);
+      }
+      touching = c;
+    };
     for (int i = 0; i < nR; ++i) {
       RobotDisc& r = d.r[static_cast<std::size_t>(i)];
-      {
-        const int rep = reported(found, RootKind::Divider, i);
-        const bool c = rep != 0 ? rep < 0 : dividerG(ys, i) < 0;
-        if (c && !r.dividerContact) {
-          const Vec2 cc = centre(ys, i);
-          const Vec2 towards = geom::closestPointOnRect(cc, geom::dividerRect(cfg.field)) - cc;
-          const Bumper side = sideOf(heading(ys, i), towards);
-          contactEvent(EventKind::Contact, i, side, ContactWith::Divider, -1);
-          startReflex(d, y, i, side, T, ev);
-        } else if (!c && r.dividerContact) {
-          contactEvent(EventKind::ContactEnd, i, Bumper::Front, ContactWith::Divider, -1);
-        }
-        r.dividerContact = c;
-      }
+      const Vec2 cc = centre(ys, i);
+      obstacle(i, RootKind::Divider, dividerG(ys, i), r.dividerContact, ContactWith::Divider,
+               geom::closestPointOnRect(cc, geom::dividerRect(cfg.field)) - cc);
       if (cfg.field.field_walls) {
-        const int rep = reported(found, RootKind::Wall, i);
-        const bool c = rep != 0 ? rep < 0 : wallG(ys, i) < 0;
-        if (c && !r.wallContact) {
-          const Vec2 cc = centre(ys, i);
-          const Vec2 normal = std::abs(cc.x()) >= std::abs(cc.y()) ? Vec2(cc.x() >= 0 ? 1 : -1, 0)
-                                                                   : Vec2(0, cc.y() >= 0 ? 1 : -1);
-          const Bumper side = sideOf(heading(ys, i), normal);
-          contactEvent(EventKind::Contact, i, side, ContactWith::Wall, -1);
-          startReflex(d, y, i, side, T, ev);
-        } else if (!c && r.wallContact) {
-          contactEvent(EventKind::ContactEnd, i, Bumper::Front, ContactWith::Wall, -1);
-        }
-        r.wallContact = c;
+        const Vec2 normal = std::abs(cc.x()) >= std::abs(cc.y()) ? Vec2(cc.x() >= 0 ? 1 : -1, 0)
+                                                                 : Vec2(0, cc.y() >= 0 ? 1 : -1);
+        obstacle(i, RootKind::Wall, wallG(ys, i), r.wallContact, ContactWith::Wall, normal);
       }
     }
   }
@@ -907,8 +908,7 @@ struct Arena::Impl {
     if (pending && c == pendingTick) {
       commit();
     } else {
-      if (c < segTick || c > now)
-        throw std::out_of_range("plant: input tick outside [last reinit, now]");
+      checkInputTick(c);
       pending = false;
     }
     evalAt(timeOfTick(c), tmp);
@@ -1024,9 +1024,8 @@ std::int64_t Arena::lastReinitTick() const { return impl_->segTick; }
 
 bool Arena::setWheels(int robot, const MotorFrame& frame, std::int64_t tick) {
   Impl& m = *impl_;
-  if (robot < 0 || robot >= m.nR) throw std::out_of_range("plant: robot index");
-  if (tick < m.segTick || tick > m.now)
-    throw std::out_of_range("plant: input tick outside [last reinit, now]");
+  m.checkRobot(robot);
+  m.checkInputTick(tick);
   const bool committedAtTick = m.pending && tick == m.pendingTick;
   const Discrete& cur = committedAtTick ? m.pendingD : m.D;
   const RobotDisc& r = cur.r[static_cast<std::size_t>(robot)];
@@ -1051,9 +1050,8 @@ bool Arena::setWheels(int robot, const MotorFrame& frame, std::int64_t tick) {
 
 bool Arena::setDrive(int robot, double leftFps, double rightFps, std::int64_t tick) {
   Impl& m = *impl_;
-  if (robot < 0 || robot >= m.nR) throw std::out_of_range("plant: robot index");
-  if (tick < m.segTick || tick > m.now)
-    throw std::out_of_range("plant: input tick outside [last reinit, now]");
+  m.checkRobot(robot);
+  m.checkInputTick(tick);
   const bool committedAtTick = m.pending && tick == m.pendingTick;
   const RobotDisc& r = (committedAtTick ? m.pendingD : m.D).r[static_cast<std::size_t>(robot)];
   const std::array<double, 2> drive{leftFps, rightFps};
@@ -1076,9 +1074,8 @@ bool Arena::setDrive(int robot, double leftFps, double rightFps, std::int64_t ti
 EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, RandomBits* gunLuck) {
   Impl& m = *impl_;
   EventList ev;
-  if (robot < 0 || robot >= m.nR) throw std::out_of_range("plant: robot index");
-  if (tick < m.segTick || tick > m.now)
-    throw std::out_of_range("plant: input tick outside [last reinit, now]");
+  m.checkRobot(robot);
+  m.checkInputTick(tick);
   if (m.pending && tick == m.pendingTick) m.commit();
   const RobotDisc& old = m.D.r[static_cast<std::size_t>(robot)];
   if (old.portB == value) return ev;
@@ -1142,7 +1139,7 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
 EventList Arena::triggerReflex(int robot, Bumper side, std::int64_t tick) {
   Impl& m = *impl_;
   EventList ev;
-  if (robot < 0 || robot >= m.nR) throw std::out_of_range("plant: robot index");
+  m.checkRobot(robot);
   m.rewindTo(tick);
   m.startReflex(m.D, m.tmp, robot, side, tick, ev);
   m.reinit(tick, m.timeOfTick(tick), m.tmp);
@@ -1153,7 +1150,7 @@ AdvanceResult Arena::advance(std::int64_t stopTick) { return impl_->advance(stop
 
 RobotState Arena::state(int robot, std::int64_t tick) const {
   const Impl& m = *impl_;
-  if (robot < 0 || robot >= m.nR) throw std::out_of_range("plant: robot index");
+  m.checkRobot(robot);
   std::vector<double>& y = m.qtmp;
   m.stateAt(tick, y);
   const double* r = y.data() + robot * kPerRobot;
@@ -1168,7 +1165,7 @@ RobotState Arena::state(int robot, std::int64_t tick) const {
 
 Pose Arena::pose(int robot, std::int64_t tick) const {
   const Impl& m = *impl_;
-  if (robot < 0 || robot >= m.nR) throw std::out_of_range("plant: robot index");
+  m.checkRobot(robot);
   const auto [x, y, h] = m.poseAt(robot, tick);
   return Pose{x, y, geom::wrap360(geom::radToDeg(h))};
 }
