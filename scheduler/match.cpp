@@ -200,6 +200,7 @@ class Match {
  private:
   Tick earliestClock() const;
   void applyInputs();
+  bool advancePlantTo(Tick t, plant::AdvanceResult& step);
   void resolveWatches();
   void handlePlantEvents(Tick t, const plant::EventList& events);
   void sampleUpTo(Tick t);
@@ -499,17 +500,33 @@ void Match::startLeg(Tick t, int robot, int leg) {
                     {QueuedEvent::Kind::DriveLeg, robot, leg + 1});
 }
 
+// Integrates the plant from its clock up to t (after an input re-initialised
+// it earlier), handling the plant events before t at their ticks. Returns
+// true if it advanced; then `step` is the last advance, and its events at
+// t are the caller's.
+bool Match::advancePlantTo(Tick t, plant::AdvanceResult& step) {
+  if (arena_.now() >= t) return false;
+  while (arena_.now() < t) {
+    step = arena_.advance(t);
+    if (step.tick < t) {
+      sampleUpTo(step.tick);
+      handlePlantEvents(step.tick, step.events);
+    }
+  }
+  return true;
+}
+
 void Match::applyInputs() {
   std::stable_sort(inputs_.begin(), inputs_.end(),
                    [](const PlantInput& a, const PlantInput& b) { return a.tick < b.tick; });
   for (const auto& w : inputs_) {
     // An earlier input of this round may have re-initialised the plant at
-    // its tick: integrate up to this one (its events at their ticks; those
-    // at this tick come first, as plant events do).
-    while (arena_.now() < w.tick) {
-      const plant::AdvanceResult step = arena_.advance(w.tick);
-      sampleUpTo(step.tick);
-      handlePlantEvents(step.tick, step.events);
+    // its tick: integrate up to this one. Plant events at this tick come
+    // before the input, as plant events do.
+    plant::AdvanceResult step;
+    if (advancePlantTo(w.tick, step)) {
+      sampleUpTo(w.tick);
+      handlePlantEvents(w.tick, step.events);
     }
     if (w.kind == PlantInput::Kind::Reflex) {
       applyReflex(w.tick, w.robot, w.bumper);
@@ -602,13 +619,7 @@ MatchResult Match::run() {
     if (!inputs_.empty()) {
       applyInputs();
       // A re-initialisation discarded the plant's prediction: find it again.
-      while (arena_.now() < horizon) {
-        step = arena_.advance(horizon);
-        if (step.tick < horizon) {
-          sampleUpTo(step.tick);
-          handlePlantEvents(step.tick, step.events);
-        }
-      }
+      advancePlantTo(horizon, step);
     }
     sampleUpTo(horizon);
     betweenRounds_ = true;  // every VM is at the horizon
