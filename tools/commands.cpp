@@ -58,33 +58,32 @@ Subcommand addBenchCommand(CLI::App& app) {
     if (family->count() == 0 && scenario->count() == 0)
       throw CLI::RequiredError("--family or --scenario");
   });
-  return {cmd, [o] {
-            return guarded([&] {
-              const auto start = std::chrono::steady_clock::now();
-              BenchConfig& c = o->config;
-              std::string profile = o->profile;
-              if (!o->scenario.empty()) {
-                c.scenario = loadScenario(o->scenario);
-                if (c.scenario->profile && o->profileOption->count() == 0)
-                  profile = *c.scenario->profile;
-                if (c.scenario->seconds && o->seconds->count() == 0)
-                  c.seconds = *c.scenario->seconds;
-                if (c.scenario->seed && o->seed->count() == 0) c.masterSeed = *c.scenario->seed;
-              }
-              const BenchResult r = runBench(c, loadNamedProfile(profile));
-              std::string label = benchLabel(c);
-              std::replace(label.begin(), label.end(), ' ', '-');
-              const std::string dir = o->out.empty() ? "out/bench-" + label : o->out;
-              writeBenchOutputs(r, dir);
-              std::cout << summaryMarkdown(r);
-              std::cerr << fmt::format(
-                  "simbot: {} runs in {:.1f} s wall; wrote {}/runs.csv, summary.json, summary.md\n",
-                  r.runs.size(),
-                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-                  dir);
-              return 0;
-            });
-          }};
+  return {
+      cmd, [o] {
+        return guarded([&] {
+          const auto start = std::chrono::steady_clock::now();
+          BenchConfig& c = o->config;
+          std::string profile = o->profile;
+          if (!o->scenario.empty()) {
+            c.scenario = loadScenario(o->scenario);
+            profile =
+                preferCommandLine(o->profileOption->count() > 0, c.scenario->profile, profile);
+            c.seconds = preferCommandLine(o->seconds->count() > 0, c.scenario->seconds, c.seconds);
+            c.masterSeed = preferCommandLine(o->seed->count() > 0, c.scenario->seed, c.masterSeed);
+          }
+          const BenchResult r = runBench(c, loadNamedProfile(profile));
+          std::string label = benchLabel(c);
+          std::replace(label.begin(), label.end(), ' ', '-');
+          const std::string dir = o->out.empty() ? "out/bench-" + label : o->out;
+          writeBenchOutputs(r, dir);
+          std::cout << summaryMarkdown(r);
+          std::cerr << fmt::format(
+              "simbot: {} runs in {:.1f} s wall; wrote {}/runs.csv, summary.json, summary.md\n",
+              r.runs.size(),
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), dir);
+          return 0;
+        });
+      }};
 }
 
 Subcommand addTournamentCommand(CLI::App& app) {

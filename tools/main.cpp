@@ -68,14 +68,12 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
                                    tools::ScenarioUse use) {
   std::optional<tools::Scenario> scenario;
   if (!o.scenario.empty()) scenario = tools::loadScenario(o.scenario);
-  const bool fromScenario = scenario.has_value();
-  const double seconds =
-      fromScenario && scenario->seconds && !given(o.secondsOption) ? *scenario->seconds : o.seconds;
+  const double seconds = tools::preferCommandLine(
+      given(o.secondsOption), scenario ? scenario->seconds : std::nullopt, o.seconds);
   if (!(seconds > 0) || seconds > 1e6)
     throw tools::ToolError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", seconds));
-  const plant::Profile profile = tools::loadNamedProfile(
-      fromScenario && scenario->profile && !given(o.profileOption) ? *scenario->profile
-                                                                   : o.profile);
+  const plant::Profile profile = tools::loadNamedProfile(tools::preferCommandLine(
+      given(o.profileOption), scenario ? scenario->profile : std::nullopt, o.profile));
   scheduler::MatchConfig config;
   config.arena = plant::makeArenaConfig(profile, static_cast<int>(programs.size()));
   const char* names[] = {"A", "B"};
@@ -110,7 +108,8 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
     }
   }
   config.endTick = static_cast<scheduler::Tick>(seconds * scheduler::kTicksPerSecond);
-  config.seed = fromScenario && scenario->seed && !given(o.seedOption) ? *scenario->seed : o.seed;
+  config.seed = tools::preferCommandLine(given(o.seedOption),
+                                         scenario ? scenario->seed : std::nullopt, o.seed);
   return config;
 }
 

@@ -40,14 +40,20 @@ vm::Image compileProgramText(const std::string& source, const std::string& name)
   return imageOrThrow(compiler::compile(source, name));
 }
 
+std::optional<std::string> shippedProfilePath(const std::string& name) {
+  const std::filesystem::path p = std::filesystem::path(SIMBOT_PROFILES_DIR) / (name + ".toml");
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(p, ec)) return std::nullopt;
+  return p.string();
+}
+
 plant::Profile loadNamedProfile(const std::string& nameOrPath) {
-  namespace fs = std::filesystem;
-  fs::path p = nameOrPath;
-  if (!fs::exists(p)) p = fs::path(SIMBOT_PROFILES_DIR) / (nameOrPath + ".toml");
-  if (!fs::exists(p))
+  if (std::filesystem::exists(nameOrPath)) return plant::loadProfile(nameOrPath);
+  const auto shipped = shippedProfilePath(nameOrPath);
+  if (!shipped)
     throw ToolError(
         fmt::format("simbot: no profile '{}' (a file, or one of profiles/*.toml)\n", nameOrPath));
-  return plant::loadProfile(p.string());
+  return plant::loadProfile(*shipped);
 }
 
 int resolveThreads(int threads) {

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -21,6 +22,8 @@ vm::Image compileProgramFile(const std::string& path);
 vm::Image compileProgramText(const std::string& source, const std::string& name);
 // A profile by name (profiles/NAME.toml) or by path.
 plant::Profile loadNamedProfile(const std::string& nameOrPath);
+// The file of the shipped profile NAME (profiles/NAME.toml), if there is one.
+std::optional<std::string> shippedProfilePath(const std::string& name);
 // threads <= 0: the hardware concurrency (at least 1).
 int resolveThreads(int threads);
 

@@ -197,8 +197,7 @@ class Walker {
       if (isPath) {
         s.profile = file(*n, "profile");
       } else {
-        std::error_code ec;
-        if (!fs::is_regular_file(fs::path(SIMBOT_PROFILES_DIR) / (v + ".toml"), ec))
+        if (!shippedProfilePath(v))
           fail(*n, fmt::format(
                        "'profile': no profile '{}' in profiles/ (or give a path to a .toml)", v));
         s.profile = v;

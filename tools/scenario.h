@@ -55,6 +55,14 @@ struct Scenario {
   bool repeatPath = false;
 };
 
+// A run's setting: the command line's value if the option was given there,
+// else the scenario's if it sets one, else the command's default.
+template <typename T>
+T preferCommandLine(bool givenOnCommandLine, const std::optional<T>& fromScenario,
+                    const T& fromCommand) {
+  return !givenOnCommandLine && fromScenario ? *fromScenario : fromCommand;
+}
+
 // Throws plant::ConfigError ("FILE:LINE: error: ..."). Relative paths in the
 // file (profile, hardware, program) are taken from the file's directory.
 Scenario loadScenario(const std::string& path);
