@@ -262,6 +262,7 @@ void Vm::State::accept() {
   halted = false;
   iff1 = iff2 = false;
   bus.interruptAccepted(now, irq, interruptedPc);
+  bus.iffChanged(now, false);
   now += costs.interruptAccept;
   if (profiling) profile[handler] += costs.interruptAccept;
   pc = static_cast<uint32_t>(handler);
@@ -409,6 +410,7 @@ void Vm::State::libBegin() {
       return;
     case Lib::SER_INIT_Z1:
       bus.serialInit(now, asInt16(a[0]), asInt16(a[1]));
+      if (!iff1) bus.iffChanged(now, true);
       iff1 = iff2 = true;  // the routine ends with EI
       busTouched = true;
       return;
@@ -1008,8 +1010,10 @@ Stop Vm::State::run(Tick until) {
         lib = std::move(f.lib);
         const Irq irq = f.irq;
         ints.pop_back();
-        if (costs.knobs.epilogueEi) iff1 = iff2 = true;
         bus.interruptReturned(now, irq);
+        // The epilogue's EI: IFF1 is set when the RETI after it ends.
+        if (costs.knobs.epilogueEi && !iff1) bus.iffChanged(now, true);
+        if (costs.knobs.epilogueEi) iff1 = iff2 = true;
         busTouched = true;
       }
       NEXT;
@@ -1029,10 +1033,16 @@ Stop Vm::State::run(Tick until) {
         libCall(static_cast<Lib>(id), argc, opPc);
       }
       NEXT;
-      CASE(EI) iff1 = iff2 = true;
-      eiShadow = true;
+      CASE(EI) {
+        if (!iff1) bus.iffChanged(now, true);
+        iff1 = iff2 = true;
+        eiShadow = true;
+      }
       NEXT;
-      CASE(DI) iff1 = iff2 = false;
+      CASE(DI) {
+        if (iff1) bus.iffChanged(now, false);
+        iff1 = iff2 = false;
+      }
       NEXT;
       CASE(DBG) NEXT;
 #if !SIMBOT_COMPUTED_GOTO
@@ -1106,6 +1116,7 @@ const Fault* Vm::fault() const { return s_->fault ? &*s_->fault : nullptr; }
 bool Vm::interruptsEnabled() const { return s_->iff1; }
 uint32_t Vm::pc() const { return s_->lib.active ? s_->lib.pc : s_->burn ? s_->burnPc : s_->pc; }
 int Vm::line() const { return s_->image.lineAt(pc()); }
+int Vm::interruptDepth() const { return static_cast<int>(s_->ints.size()); }
 uint8_t Vm::read8(uint16_t a) const { return s_->rd8(a); }
 void Vm::write8(uint16_t a, uint8_t v) { s_->wr8(a, v); }
 uint16_t Vm::read16(uint16_t a) const { return s_->rd16(a); }

@@ -58,6 +58,9 @@ class Bus {
   // Notifications for traces and device logic (PIO "under service").
   virtual void interruptAccepted(Tick, Irq, uint32_t /*interruptedPc*/) {}
   virtual void interruptReturned(Tick, Irq) {}
+  // IFF1 changed at t: EI, DI, a handler's acceptance or its RETI (the
+  // serial library's own interrupt leaves IFF1 as it was).
+  virtual void iffChanged(Tick, bool /*iff1*/) {}
 };
 
 struct Fault {
@@ -100,8 +103,11 @@ class Vm {
   bool halted() const;
   const Fault* fault() const;  // null unless faulted
   bool interruptsEnabled() const;
+  // The instruction, library call or interrupt acceptance under way at the
+  // current boundary: a long library call's own address while it runs.
   uint32_t pc() const;
-  int line() const;  // source line of the next instruction
+  int line() const;            // source line of pc()
+  int interruptDepth() const;  // handlers in service (nested ones count)
 
   // Power-on RAM from a random stream (a profile option, DESIGN.md): every
   // byte from kDataBase up that the image does not initialise is replaced,
