@@ -21,7 +21,8 @@
 // from its sign at T, which also catches a second crossing inside the same
 // tick. A root that changes nothing (a ball passing the divider's plane
 // beside the wall, the closest approach of a ball that misses) lets
-// integration go on without a re-initialisation.
+// integration go on without a re-initialisation; it only updates the
+// ball's closest distance to its target, which its ball_miss reports.
 //
 // The events at T are a prediction (DESIGN.md "co-simulation"): advance()
 // returns them and keeps the post-event state aside; they are applied (and
@@ -115,6 +116,9 @@ struct Ball {
   int shooter = 0, gun = 0;
   double t0 = 0;
   double x0 = 0, y0 = 0, z0 = 0, vx = 0, vy = 0;
+  // Smallest distance to the other robot's body seen at an event tick or
+  // at the closest-approach root of the hit function (for ball_miss).
+  double closest = HUGE_VAL;
 };
 
 struct Ring {
@@ -349,6 +353,16 @@ struct Arena::Impl {
     const double a = rel.dot(u);
     perp2 = std::max(dist2 - a * a, 0.0);
     return a + std::sqrt(std::max(R * R - perp2, 0.0));
+  }
+  // Distance from the ball to the other robot's body, a cylinder of the
+  // target height (0 when inside it).
+  double ballGap(const Ball& b, double t, const double* y) const {
+    double x, yy, z;
+    ballAt(b, t, x, yy, z);
+    const int tgt = 1 - b.shooter;
+    const double across = std::max((Vec2(x, yy) - centre(y, tgt)).norm() - radius(tgt), 0.0);
+    const double above = std::max(z - P(tgt).target_height_ft, 0.0);
+    return std::hypot(across, above);
   }
   double ballOutG(const Ball& b, double t) const {
     double x, yy, z;
@@ -713,6 +727,11 @@ struct Arena::Impl {
         e.robot = static_cast<std::int8_t>(i);
         e.gun = static_cast<std::int8_t>(g);
         e.ball = static_cast<std::int8_t>(slot);
+        e.x = b.x0;
+        e.y = b.y0;
+        e.z = b.z0;
+        e.vx = b.vx;
+        e.vy = b.vy;
         ev.push(e);
       }
     }
@@ -722,10 +741,15 @@ struct Arena::Impl {
       if (!b.active) continue;
       double x, yy, z;
       ballAt(b, te, x, yy, z);
+      if (nR == 2) b.closest = std::min(b.closest, ballGap(b, te, ys));
       Event e{EventKind::BallMiss};
       e.robot = static_cast<std::int8_t>(b.shooter);
       e.gun = static_cast<std::int8_t>(b.gun);
       e.ball = static_cast<std::int8_t>(s);
+      e.x = x;
+      e.y = yy;
+      e.z = z;
+      e.closest_ft = nR == 2 ? b.closest : -1;
       if (!b.rolling && (reported(found, RootKind::BallFloor, s) < 0 || z <= 0)) {
         if (cfg.field.count_floor_skips) {
           // Appendix A counts skips: the ball goes on along the floor
@@ -736,6 +760,12 @@ struct Arena::Impl {
           b.t0 += dt;
           b.rolling = true;
           z = 0;
+          Event skip = e;
+          skip.kind = EventKind::BallSkip;
+          skip.x = b.x0;
+          skip.y = b.y0;
+          skip.z = 0;
+          ev.push(skip);
         } else {
           e.miss = MissReason::Floor;
           ev.push(e);
@@ -936,6 +966,10 @@ struct Arena::Impl {
     pendingD = D;
     ev.clear();
     process(T, te, pendingD, pendingY, found, ev);
+    if (ev.empty())  // nothing happens here, but a ball may pass closest to its target
+      for (int s = 0; s < kMaxBalls; ++s)
+        D.balls[static_cast<std::size_t>(s)].closest =
+            pendingD.balls[static_cast<std::size_t>(s)].closest;
     return !ev.empty();
   }
 
@@ -1255,6 +1289,8 @@ const char* eventKindName(EventKind k) {
       return "ball_hit";
     case EventKind::BallMiss:
       return "ball_miss";
+    case EventKind::BallSkip:
+      return "ball_skip";
     case EventKind::RefereePutBack:
       return "referee_put_back";
     case EventKind::RefereeTurn:

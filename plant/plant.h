@@ -13,6 +13,7 @@
 // robot's own values.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -64,10 +65,10 @@ struct RobotParams {
   double bad_reading_probability = 0;  // reading replaced by a random A/D value
   bool thesis_swapped_eyes = false;    // Appendix C: far eye gets the full value
   // guns
-  double gun_wheel_lag_s = 0;   // first-order spin-up/down; 0 = instant
+  double gun_wheel_lag_s = 0;         // first-order spin-up/down; 0 = instant
   bool gun_motors_always_on = false;  // thesis Appendix E: port B motor bits ignored
-  double stroke_s = 0;          // solenoid rising edge -> launch
-  double muzzle_speed_fps = 0;  // at full gun-wheel speed
+  double stroke_s = 0;                // solenoid rising edge -> launch
+  double muzzle_speed_fps = 0;        // at full gun-wheel speed
   double launch_height_ft = 0;
   int balls_per_gun = 0;
   // Per stroke that would launch: the gun jams (launches nothing, now or
@@ -206,9 +207,10 @@ enum class EventKind : std::uint8_t {
   ContactEnd,      // robot, with
   ReflexStart,     // robot, bumper
   ReflexEnd,       // robot, bumper
-  BallLaunch,      // robot = shooter, gun, ball (slot)
-  BallHit,         // robot = shooter, gun, ball, other = target
-  BallMiss,        // robot = shooter, gun, ball, miss
+  BallLaunch,      // robot = shooter, gun, ball (slot); x, y, z, vx, vy: the flight
+  BallHit,         // robot = shooter, gun, ball, other = target; x, y, z: where
+  BallMiss,        // robot = shooter, gun, ball, miss; x, y, z: where; closest_ft
+  BallSkip,        // robot = shooter, gun, ball; x, y: on the floor, rolling on
   RefereePutBack,  // robot: centre left the field, put back inside the wire
   RefereeTurn,     // robot: too many reflexes/events, turned by turn_deg
   SolenoidStroke,  // (from setPortB) robot, gun: launch due after the stroke
@@ -229,12 +231,27 @@ struct Event {
   MissReason miss = MissReason::None;
   std::int8_t gun = -1;
   std::int8_t ball = -1;
+  // Balls: position (ft) at the event, and at a launch the velocity (ft/s):
+  // the flight is x + vx s, y + vy s, z - g s^2 / 2 after the launch tick.
+  double x = 0, y = 0, z = 0, vx = 0, vy = 0;
+  // A miss: the ball's closest distance to the other robot's body (ft), the
+  // smaller of that when it passed abreast of the body's centre and at the
+  // end of its flight; negative when there is no other robot.
+  double closest_ft = -1;
 };
 
-// Fixed-capacity list: nothing allocated while advancing.
+// Fixed-capacity list: nothing allocated while advancing. Copies copy only
+// the events it holds.
 class EventList {
  public:
   static constexpr std::size_t kCapacity = 128;
+  EventList() = default;
+  EventList(const EventList& o) : n_(o.n_) { std::copy(o.begin(), o.end(), items_.begin()); }
+  EventList& operator=(const EventList& o) {
+    n_ = o.n_;
+    std::copy(o.begin(), o.end(), items_.begin());
+    return *this;
+  }
   void push(const Event& e) {
     if (n_ < kCapacity) items_[n_++] = e;
   }

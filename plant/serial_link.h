@@ -63,6 +63,8 @@ class SerialLink {
     return tsrBusy_ ? std::optional<Tick>(tsrDoneAt_) : std::nullopt;
   }
   bool idle() const { return !tsrBusy_ && !tdrFull_; }
+  // The byte in the TSR (on the wire until nextByteDone()).
+  uint8_t shifting() const { return tsr_; }
   uint64_t bytesSent() const { return bytesSent_; }
   // Bytes received since the previous NUL (for traces).
   const std::string& pending() const { return received_; }
