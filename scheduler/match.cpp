@@ -5,9 +5,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
-#include <functional>
-#include <nlohmann/json.hpp>
+#include <cmath>
+#include <deque>
 #include <stdexcept>
 
 #include "plant/pio.h"
@@ -27,40 +28,6 @@ struct QueuedEvent {
   enum class Kind : uint8_t { SerialByte, DriveLeg, Inject, ReleaseEdge, EndOfRound } kind;
   int robot = 0;
   int index = 0;  // injection number, path leg, or the detector bit to release
-};
-
-class Trace {
- public:
-  explicit Trace(bool enabled) : enabled_(enabled) {}
-  bool enabled() const { return enabled_; }
-  // Adds watched variables to a robot's records (--watch).
-  std::function<void(nlohmann::json&)> decorate;
-  void add(Tick t, nlohmann::json record) {
-    if (!enabled_) return;
-    if (decorate) decorate(record);
-    record["t"] = t;
-    record["time_s"] = seconds(t);
-    records_.push_back({t, seq_++, std::move(record)});
-  }
-  std::vector<std::string> lines() {
-    std::stable_sort(records_.begin(), records_.end(), [](const Record& a, const Record& b) {
-      return a.tick != b.tick ? a.tick < b.tick : a.seq < b.seq;
-    });
-    std::vector<std::string> out;
-    out.reserve(records_.size());
-    for (const auto& r : records_) out.push_back(r.json.dump());
-    return out;
-  }
-
- private:
-  struct Record {
-    Tick tick;
-    uint64_t seq;
-    nlohmann::json json;
-  };
-  bool enabled_;
-  uint64_t seq_ = 0;
-  std::vector<Record> records_;
 };
 
 // A plant input made by a robot during a round: a port B write, or a bump
@@ -97,6 +64,7 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   void console(Tick t, std::string_view line) override;
   void interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) override;
   void interruptReturned(Tick t, vm::Irq irq) override;
+  void iffChanged(Tick t, bool iff1) override;
   // plant::RobotMemory
   uint8_t read8(uint16_t a) const override { return vm_.read8(a); }
   void write8(uint16_t a, uint8_t v) override { vm_.write8(a, v); }
@@ -105,7 +73,7 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   void runTo(Tick horizon);
   void byteDone(Tick t);
   // Port A's edge lines: low while the plant says so or an injection holds.
-  void updateEdgeLines();
+  void updateEdgeLines(Tick t);
   void inject(Tick t, const Injection& injection);
   uint8_t plantLow = 0, injectedLow = 0;
   std::map<uint32_t, std::vector<int>> lineInjections;  // code address -> injections
@@ -116,9 +84,24 @@ class Robot : public vm::Bus, public plant::RobotMemory {
     std::string type;
   };
   std::vector<Watch> watches;
-  nlohmann::json watchedValues() const;
-  void scheduleSerial();
+  trace::Watch watchedValues() const;
+  void scheduleSerial(Tick t);
   void updateSerialRequest();
+
+  // Where the program was at each sample tick (traced runs): taken at the
+  // VM's first instruction boundary at or after the tick.
+  struct Snapshot {
+    Tick tick;
+    int line;
+    const vm::Symbol* function;
+    bool inHandler;
+    trace::Watch watch;
+  };
+  std::deque<Snapshot> snapshots;
+  Tick nextSnapshot = 0;
+  void takeSnapshots();
+  Snapshot snapshotFor(Tick t);
+  std::string handlerName() const;
 
   const RobotSpec& spec;
   int index;
@@ -127,7 +110,11 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   plant::SerialLink link;
   plant::PioPortA pio;
   uint8_t edgeLines = 0xFF;
+  int enb485 = -1;  // never written
+  std::array<int64_t, 2> adReads{};
+  std::array<int, 2> lastAdValue{-1, -1};
   Tick serialEventAt = -1;
+  Tick serialIsrAccepted = 0;
   plant::SplitMix64 noise;
   plant::SplitMix64 gunLuck;  // jams and misfires
   RobotResult result;
@@ -140,8 +127,8 @@ class Match {
       : config_(config),
         costs_(vm::makeCostTable(config.knobs)),
         arena_(arenaConfigFor(config)),
-        trace_(config.trace),
         coin_(streamSeed(config.seed, "coin")) {
+    for (trace::Sink* sink : config.sinks) trace_.attach(sink);
     if (config.robots.empty() || config.robots.size() > 2)
       throw std::invalid_argument("a match needs one or two robots");
     for (size_t i = 0; i < config.robots.size(); ++i)
@@ -182,7 +169,14 @@ class Match {
   MatchResult run();
 
   plant::Arena& arena() { return arena_; }
-  Trace& trace() { return trace_; }
+  bool tracing() const { return trace_.on(); }
+  Tick sampleInterval() const { return config_.sampleInterval; }
+  // A record at tick t, with the watched variables of its robot as they are
+  // now in that robot's memory.
+  void emit(Tick t, trace::Record record);
+  void emit(Tick t, trace::Record record, trace::Watch watch) {
+    trace_.emit(t, std::move(record), std::move(watch));
+  }
   EventQueue<QueuedEvent>& queue() { return queue_; }
   std::vector<PlantInput>& inputs() { return inputs_; }
   bool betweenRounds() const { return betweenRounds_; }
@@ -202,6 +196,8 @@ class Match {
   void applyInputs();
   bool advancePlantTo(Tick t, plant::AdvanceResult& step);
   void resolveWatches();
+  void emitSetup();
+  trace::Record plantRecord(const plant::Event& e) const;
   void handlePlantEvents(Tick t, const plant::EventList& events);
   void sampleUpTo(Tick t);
   void finish(MatchResult& result);
@@ -209,7 +205,7 @@ class Match {
   const MatchConfig& config_;
   vm::CostTable costs_;
   plant::Arena arena_;
-  Trace trace_;
+  trace::Tracer trace_;
   plant::SplitMix64 coin_;
   EventQueue<QueuedEvent> queue_;
   std::vector<std::unique_ptr<Robot>> robots_;
@@ -239,15 +235,16 @@ Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs, ui
 }
 
 void Robot::runTo(Tick horizon) {
-  while (vm_.now() < horizon) {
-    const vm::Stop stop = vm_.run(horizon);
+  const bool tracing = match.tracing();
+  for (;;) {
+    if (tracing) takeSnapshots();
+    if (vm_.now() >= horizon) return;
+    const vm::Stop stop = vm_.run(tracing ? std::min(horizon, nextSnapshot) : horizon);
     if (stop == vm::Stop::Fault) {
       if (!result.fault) {
         const vm::Fault* f = vm_.fault();
         result.fault = FaultInfo{f->message, seconds(f->tick), f->line};
-        match.trace().add(
-            f->tick,
-            {{"type", "fault"}, {"robot", spec.name}, {"message", f->message}, {"line", f->line}});
+        if (tracing) match.emit(f->tick, trace::rec::Fault{index, f->message, f->line});
       }
       return;
     }
@@ -255,7 +252,7 @@ void Robot::runTo(Tick horizon) {
     if (vm_.pc() == mainReturn) {
       result.exited = true;
       result.exitTick = vm_.now();
-      match.trace().add(vm_.now(), {{"type", "exit"}, {"robot", spec.name}});
+      if (tracing) match.emit(vm_.now(), trace::rec::Exit{index});
     }
     if (auto it = lineInjections.find(vm_.pc()); it != lineInjections.end()) {
       const int hit = ++lineHits[vm_.pc()];
@@ -263,6 +260,25 @@ void Robot::runTo(Tick horizon) {
         if (match.injection(k).count == hit) inject(vm_.now(), match.injection(k));
     }
   }
+}
+
+// The VM's state at its first boundary at or after each sample tick it has
+// reached: it was stopped there (runTo), or it idled there (halted).
+void Robot::takeSnapshots() {
+  while (nextSnapshot <= vm_.now()) {
+    snapshots.push_back(Snapshot{nextSnapshot, vm_.line(), spec.image.functionAt(vm_.pc()),
+                                 vm_.interruptDepth() > 0, watchedValues()});
+    nextSnapshot += match.sampleInterval();
+  }
+}
+
+// The snapshot of sample tick t; a faulted robot stays where it faulted.
+Robot::Snapshot Robot::snapshotFor(Tick t) {
+  while (!snapshots.empty() && snapshots.front().tick < t) snapshots.pop_front();
+  if (!snapshots.empty() && snapshots.front().tick == t) return snapshots.front();
+  const uint32_t pc = vm_.pc();
+  return Snapshot{t, vm_.fault() ? vm_.fault()->line : spec.image.lineAt(pc),
+                  spec.image.functionAt(pc), false, watchedValues()};
 }
 
 void Robot::out(Tick t, uint16_t port, uint8_t value) {
@@ -275,10 +291,14 @@ void Robot::out(Tick t, uint16_t port, uint8_t value) {
       return;
     case vm::kPortPIODB:
       match.inputs().push_back({t, index, PlantInput::Kind::PortB, value, plant::Bumper::Front});
-      match.trace().add(t, {{"type", "port_b"}, {"robot", spec.name}, {"value", value}});
+      if (match.tracing()) match.emit(t, trace::rec::PortB{index, value});
+      return;
+    case vm::kPortENB485:
+      if (match.tracing() && value != enb485) match.emit(t, trace::rec::Rs485{index, value});
+      enb485 = value;
       return;
     default:
-      return;  // PIOCB set-up, ENB485 and unknown ports have no effect here
+      return;  // PIOCB set-up and unknown ports have no effect here
   }
 }
 
@@ -291,26 +311,38 @@ int Robot::adSample(Tick t, int channel) {
   const plant::EyeReadings e = match.arena().eyeReadings(index, t, &noise);
   const int value = channel == 0 ? e.left : channel == 1 ? e.right : 0;
   if (match.observer()) match.observer()->onEyeRead(index, t, channel, value);
+  if (channel == 0 || channel == 1) {
+    // Traced as a step when it differs: a search loop reads thousands a second.
+    const auto c = static_cast<size_t>(channel);
+    ++adReads[c];
+    if (match.tracing() && value != lastAdValue[c])
+      match.emit(t, trace::rec::AdRead{index, channel, value, adReads[c]});
+    lastAdValue[c] = value;
+  }
   return value;
 }
 
 void Robot::serialSend(Tick t, uint16_t buf, uint16_t cc) {
-  match.trace().add(t, {{"type", "serial_send"}, {"robot", spec.name}, {"count", vm_.read8(cc)}});
+  if (match.tracing()) match.emit(t, trace::rec::SerialSend{index, vm_.read8(cc)});
   link.send(t, buf, cc, *this);
-  scheduleSerial();
+  scheduleSerial(t);
   updateSerialRequest();
 }
 
 void Robot::serialTxService(Tick t, vm::Vm&) {
   link.service(t, *this);
-  scheduleSerial();
+  scheduleSerial(t);
   updateSerialRequest();
 }
 
-void Robot::scheduleSerial() {
+// A byte that entered the shift register is on the wire for one character
+// time, ending at nextByteDone().
+void Robot::scheduleSerial(Tick) {
   const auto done = link.nextByteDone();
   if (done && *done != serialEventAt) {
     serialEventAt = *done;
+    if (match.tracing())
+      match.emit(*done - plant::kTicksPerChar, trace::rec::SerialByte{index, link.shifting()});
     match.queue().schedule(*done, EventClass::SerialByte,
                            {QueuedEvent::Kind::SerialByte, index, 0});
   }
@@ -333,59 +365,57 @@ void Robot::byteDone(Tick t) {
     } else {
       ++result.framesRejected;
     }
-    match.trace().add(t, {{"type", frame->command ? "frame_latched" : "frame_rejected"},
-                          {"robot", spec.name},
-                          {"bytes", frame->bytes}});
+    if (match.tracing()) {
+      if (frame->command)
+        match.emit(t, trace::rec::FrameLatched{index, frame->bytes});
+      else
+        match.emit(t, trace::rec::FrameRejected{index, frame->bytes});
+    }
   }
-  scheduleSerial();
+  scheduleSerial(t);
   updateSerialRequest();
 }
 
-// A watched variable's value as its C type reads it.
-nlohmann::json Robot::watchedValues() const {
-  nlohmann::json values = nlohmann::json::object();
+// Each watched variable's value as its C type reads it.
+trace::Watch Robot::watchedValues() const {
+  trace::Watch values;
   for (const auto& w : watches) {
     const bool isUnsigned = w.type.find("unsigned") != std::string::npos;
+    trace::WatchValue v;
     if (w.type.find('*') != std::string::npos) {
-      values[w.name] = vm_.read16(w.address);
+      v = std::int64_t{vm_.read16(w.address)};
     } else if (w.type.find("float") != std::string::npos ||
                w.type.find("double") != std::string::npos) {
-      values[w.name] = std::bit_cast<float>(vm_.read32(w.address));
+      v = static_cast<double>(std::bit_cast<float>(vm_.read32(w.address)));
     } else if (w.type.find("long") != std::string::npos) {
-      const uint32_t v = vm_.read32(w.address);
-      if (isUnsigned)
-        values[w.name] = v;
-      else
-        values[w.name] = static_cast<int32_t>(v);
+      const uint32_t raw = vm_.read32(w.address);
+      v = isUnsigned ? std::int64_t{raw} : std::int64_t{static_cast<int32_t>(raw)};
     } else if (w.type.find("char") != std::string::npos) {
-      values[w.name] = vm_.read8(w.address);
+      v = std::int64_t{vm_.read8(w.address)};
     } else {
-      const uint16_t v = vm_.read16(w.address);
-      if (isUnsigned)
-        values[w.name] = v;
-      else
-        values[w.name] = static_cast<int16_t>(v);
+      const uint16_t raw = vm_.read16(w.address);
+      v = isUnsigned ? std::int64_t{raw} : std::int64_t{static_cast<int16_t>(raw)};
     }
+    values.emplace_back(w.name, v);
   }
   return values;
 }
 
-void Robot::updateEdgeLines() {
-  edgeLines = static_cast<uint8_t>(~(plantLow | injectedLow));
+void Robot::updateEdgeLines(Tick t) {
+  const auto lines = static_cast<uint8_t>(~(plantLow | injectedLow));
+  if (lines != edgeLines && match.tracing()) match.emit(t, trace::rec::PortA{index, lines});
+  edgeLines = lines;
   if (pio.setInputs(edgeLines)) vm_.request(vm::Irq::Pio, pio.vector());
 }
 
 void Robot::inject(Tick t, const Injection& injection) {
-  match.trace().add(t, {{"type", "injection"},
-                        {"robot", spec.name},
-                        {"what", injection.text},
-                        {"line", vm_.line()}});
+  if (match.tracing()) match.emit(t, trace::rec::Injection{index, injection.text, vm_.line()});
   switch (injection.source) {
     case InjectSource::EdgeFore:
     case InjectSource::EdgeAft: {
       const uint8_t bit = injection.source == InjectSource::EdgeFore ? 0x02 : 0x01;
       injectedLow |= bit;
-      updateEdgeLines();
+      updateEdgeLines(t);
       match.queue().schedule(t + kInjectedEdgePulse, EventClass::Injection,
                              {QueuedEvent::Kind::ReleaseEdge, index, bit});
       return;
@@ -408,27 +438,44 @@ void Robot::inject(Tick t, const Injection& injection) {
 
 void Robot::console(Tick t, std::string_view line) {
   result.console.emplace_back(line);
-  match.trace().add(t, {{"type", "console"}, {"robot", spec.name}, {"text", std::string(line)}});
+  if (match.tracing()) match.emit(t, trace::rec::Console{index, std::string(line)});
+}
+
+// The #INT_VEC handler the PIO's vector selects.
+std::string Robot::handlerName() const {
+  for (const auto& v : spec.image.vectors)
+    if (v.vector == pio.vector()) return v.handlerName;
+  return "";
 }
 
 void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
   ++result.interrupts[std::string(vm::irqName(irq))];
   if (match.observer()) match.observer()->onInterruptAccepted(index, t, irq);
   if (irq == vm::Irq::Pio) pio.accepted();
-  if (irq == vm::Irq::SerialTx || !match.trace().enabled()) return;
+  if (!match.tracing()) return;
+  if (irq == vm::Irq::SerialTx) {
+    serialIsrAccepted = t;  // traced as one span when it returns
+    return;
+  }
   const vm::Symbol* fn = spec.image.functionAt(pc);
-  match.trace().add(t, {{"type", "interrupt_accepted"},
-                        {"robot", spec.name},
-                        {"source", vm::irqName(irq)},
-                        {"line", spec.image.lineAt(pc)},
-                        {"function", fn ? fn->name : ""}});
+  match.emit(t, trace::rec::InterruptAccepted{index, std::string(vm::irqName(irq)),
+                                              spec.image.lineAt(pc), fn ? fn->name : "",
+                                              irq == vm::Irq::Pio ? handlerName() : ""});
 }
 
 void Robot::interruptReturned(Tick t, vm::Irq irq) {
+  if (irq == vm::Irq::SerialTx) {
+    if (match.tracing()) match.emit(serialIsrAccepted, trace::rec::SerialIsr{index, t});
+    return;
+  }
   if (irq != vm::Irq::Pio) return;
-  match.trace().add(
-      t, {{"type", "interrupt_returned"}, {"robot", spec.name}, {"source", vm::irqName(irq)}});
+  if (match.tracing())
+    match.emit(t, trace::rec::InterruptReturned{index, std::string(vm::irqName(irq))});
   if (pio.returned()) vm_.request(vm::Irq::Pio, pio.vector());
+}
+
+void Robot::iffChanged(Tick t, bool iff1) {
+  if (match.tracing()) match.emit(t, trace::rec::Iff1{index, iff1});
 }
 
 // ---- match ------------------------------------------------------------------
@@ -465,14 +512,61 @@ void Match::resolveWatches() {
       throw std::invalid_argument("--watch " + name + ": no such global or static variable " +
                                   "(a static local is FUNCTION.NAME)");
   }
-  if (config_.watches.empty()) return;
-  trace_.decorate = [this](nlohmann::json& record) {
-    const auto it = record.find("robot");
-    if (it == record.end() || !it->is_string()) return;
-    for (auto& r : robots_)
-      if (r->spec.name == it->get<std::string>() && !r->watches.empty())
-        record["watch"] = r->watchedValues();
-  };
+}
+
+void Match::emit(Tick t, trace::Record record) {
+  const int robot = trace::robotOf(record);
+  trace::Watch watch;
+  if (robot >= 0 && robot < static_cast<int>(robots_.size()))
+    watch = robots_[static_cast<size_t>(robot)]->watchedValues();
+  trace_.emit(t, std::move(record), std::move(watch));
+}
+
+// The run's set-up: the first records of every trace.
+void Match::emitSetup() {
+  const plant::FieldParams& f = config_.arena.field;
+  emit(0,
+       trace::rec::Run{"simbot-trace/1", static_cast<int64_t>(config_.seed), config_.profileName,
+                       static_cast<int64_t>(robots_.size()), config_.endTick, kTicksPerSecond,
+                       config_.sampleInterval, f.size_ft, f.wire_inset_ft, f.wire_sensitivity_ft,
+                       f.field_walls, f.divider_x_ft, f.divider_south_ft, f.divider_north_ft,
+                       f.divider_thickness_ft, f.divider_height_ft, f.gravity_fps2},
+       {});
+  for (const auto& r : robots_) {
+    const plant::RobotSetup& setup = config_.arena.robots[static_cast<size_t>(r->index)];
+    const plant::RobotParams& p = setup.params;
+    std::string source;
+    for (const auto& line : r->spec.image.sourceLines) source += line + "\n";
+    const auto limit = [&p](double width) {
+      return std::atan(width / p.eye_nose) * 180.0 / 3.14159265358979323846;
+    };
+    emit(0,
+         trace::rec::RobotSetup{r->index,
+                                r->spec.program,
+                                std::move(source),
+                                !r->spec.path.empty(),
+                                setup.start.x_ft,
+                                setup.start.y_ft,
+                                setup.start.heading_deg,
+                                p.body_diameter_ft,
+                                p.target_height_ft,
+                                p.track_ft,
+                                p.edge_detector_inset_ft,
+                                limit(p.left_eye_width),
+                                limit(p.right_eye_width),
+                                p.eye_max,
+                                p.eye_background,
+                                p.eye_saturation_ft,
+                                p.launch_height_ft,
+                                p.muzzle_speed_fps,
+                                p.balls_per_gun,
+                                setup.hardware.gun_motor_bit[0],
+                                setup.hardware.gun_solenoid_bit[0],
+                                setup.hardware.gun_motor_bit[1],
+                                setup.hardware.gun_solenoid_bit[1],
+                                setup.hardware.disc_shooter_bit},
+         {});
+  }
 }
 
 void Match::applyReflex(Tick t, int robot, plant::Bumper side) {
@@ -490,11 +584,9 @@ void Match::startLeg(Tick t, int robot, int leg) {
   const DriveLeg drive = stop ? DriveLeg{} : path[static_cast<size_t>(leg)];
   sampleUpTo(t);
   arena_.setDrive(robot, drive.leftFps, drive.rightFps, t);
-  trace_.add(t, {{"type", "path_leg"},
-                 {"robot", name(robot)},
-                 {"leg", stop ? nlohmann::json(nullptr) : nlohmann::json(leg)},
-                 {"left_fps", drive.leftFps},
-                 {"right_fps", drive.rightFps}});
+  if (trace_.on())
+    emit(t, trace::rec::PathLeg{robot, stop ? std::nullopt : std::optional<int64_t>(leg),
+                                drive.leftFps, drive.rightFps});
   if (!stop)
     queue_.schedule(t + drive.duration, EventClass::MotorLatch,
                     {QueuedEvent::Kind::DriveLeg, robot, leg + 1});
@@ -537,69 +629,106 @@ void Match::applyInputs() {
         arena_.setPortB(w.robot, w.value, w.tick, &robots_[static_cast<size_t>(w.robot)]->gunLuck);
     for (const auto& e : immediate) {
       if (config_.observer) config_.observer->onPlantEvent(w.tick, e);
-      trace_.add(
-          w.tick,
-          {{"type", plant::eventKindName(e.kind)}, {"robot", name(e.robot)}, {"gun", e.gun}});
+      if (trace_.on()) emit(w.tick, plantRecord(e));
     }
   }
   inputs_.clear();
 }
 
+// The trace record of a plant event.
+trace::Record Match::plantRecord(const plant::Event& e) const {
+  namespace rec = trace::rec;
+  const int r = e.robot;
+  const auto side = [](plant::Bumper b) { return b == plant::Bumper::Front ? "front" : "back"; };
+  const auto with = [](plant::ContactWith w) {
+    return w == plant::ContactWith::Robot     ? "robot"
+           : w == plant::ContactWith::Divider ? "divider"
+                                              : "wall";
+  };
+  const auto missed = [](plant::MissReason m) {
+    return m == plant::MissReason::Floor     ? "floor"
+           : m == plant::MissReason::Divider ? "divider"
+                                             : "wall";
+  };
+  switch (e.kind) {
+    case plant::EventKind::EdgeEnter:
+      return rec::EdgeEnter{r, e.detector == plant::Detector::Fore ? "fore" : "aft"};
+    case plant::EventKind::EdgeLeave:
+      return rec::EdgeLeave{r, e.detector == plant::Detector::Fore ? "fore" : "aft"};
+    case plant::EventKind::Contact:
+      return rec::Contact{r, side(e.bumper), with(e.with)};
+    case plant::EventKind::ContactEnd:
+      return rec::ContactEnd{r, with(e.with)};
+    case plant::EventKind::ReflexStart:
+      return rec::ReflexStart{r, side(e.bumper)};
+    case plant::EventKind::ReflexEnd:
+      return rec::ReflexEnd{r, side(e.bumper)};
+    case plant::EventKind::BallLaunch:
+      return rec::BallLaunch{r, e.gun, e.ball, e.x, e.y, e.z, e.vx, e.vy};
+    case plant::EventKind::BallSkip:
+      return rec::BallSkip{r, e.gun, e.ball, e.x, e.y};
+    case plant::EventKind::BallHit:
+      return rec::BallHit{r, e.gun, e.other, e.ball, "robot", e.x, e.y, e.z};
+    case plant::EventKind::BallMiss:
+      return rec::BallMiss{
+          r,      e.gun,
+          e.ball, missed(e.miss),
+          e.x,    e.y,
+          e.z,    e.closest_ft >= 0 ? std::optional<double>(e.closest_ft) : std::nullopt};
+    case plant::EventKind::RefereePutBack:
+      return rec::RefereePutBack{r};
+    case plant::EventKind::RefereeTurn:
+      return rec::RefereeTurn{r};
+    case plant::EventKind::SolenoidStroke:
+      return rec::SolenoidStroke{r, e.gun};
+    case plant::EventKind::GunEmpty:
+      return rec::GunEmpty{r, e.gun};
+    case plant::EventKind::GunMisfire:
+      return rec::GunMisfire{r, e.gun};
+    case plant::EventKind::GunJammed:
+      return rec::GunJammed{r, e.gun};
+    case plant::EventKind::DiscShooter:
+      return rec::DiscShooter{r, -1};
+  }
+  throw std::logic_error("plant event without a trace record");
+}
+
 void Match::handlePlantEvents(Tick t, const plant::EventList& events) {
   for (const auto& e : events) {
     if (config_.observer) config_.observer->onPlantEvent(t, e);
-    nlohmann::json rec = {{"type", plant::eventKindName(e.kind)}, {"robot", name(e.robot)}};
-    switch (e.kind) {
-      case plant::EventKind::EdgeEnter:
-      case plant::EventKind::EdgeLeave: {
-        Robot& r = *robots_[static_cast<size_t>(e.robot)];
-        // Fore detector on port A bit 1, aft on bit 0; low within range.
-        const uint8_t bit = e.detector == plant::Detector::Fore ? 0x02 : 0x01;
-        if (e.kind == plant::EventKind::EdgeEnter)
-          r.plantLow |= bit;
-        else
-          r.plantLow &= static_cast<uint8_t>(~bit);
-        r.updateEdgeLines();
-        rec["detector"] = e.detector == plant::Detector::Fore ? "fore" : "aft";
-        break;
-      }
-      case plant::EventKind::BallLaunch:
-      case plant::EventKind::BallHit:
-      case plant::EventKind::BallMiss:
-        rec["gun"] = e.gun;
-        if (e.other >= 0) rec["target"] = name(e.other);
-        break;
-      case plant::EventKind::Contact:
-      case plant::EventKind::ReflexStart:
-      case plant::EventKind::ReflexEnd:
-        rec["bumper"] = e.bumper == plant::Bumper::Front ? "front" : "back";
-        break;
-      default:
-        break;
+    if (e.kind == plant::EventKind::EdgeEnter || e.kind == plant::EventKind::EdgeLeave) {
+      Robot& r = *robots_[static_cast<size_t>(e.robot)];
+      // Fore detector on port A bit 1, aft on bit 0; low within range.
+      const uint8_t bit = e.detector == plant::Detector::Fore ? 0x02 : 0x01;
+      if (e.kind == plant::EventKind::EdgeEnter)
+        r.plantLow |= bit;
+      else
+        r.plantLow &= static_cast<uint8_t>(~bit);
+      // The plant's record first, then the port's (in emission order).
+      if (trace_.on()) emit(t, plantRecord(e));
+      r.updateEdgeLines(t);
+      continue;
     }
-    trace_.add(t, std::move(rec));
+    if (trace_.on()) emit(t, plantRecord(e));
   }
 }
 
 // Trace samples at fixed ticks, read from dense output once the plant has
 // passed them and before any input discards that part of the trajectory.
 void Match::sampleUpTo(Tick t) {
-  if (!trace_.enabled()) return;
+  if (!trace_.on()) return;
   const Tick limit = std::min(t, arena_.now());
   while (nextSample_ <= limit) {
     if (nextSample_ >= arena_.lastReinitTick()) {
       for (int i = 0; i < arena_.robotCount(); ++i) {
         const plant::RobotState s = arena_.state(i, nextSample_);
         const plant::EyeReadings eyes = arena_.eyeReadings(i, nextSample_);
-        trace_.add(nextSample_, {{"type", "sample"},
-                                 {"robot", name(i)},
-                                 {"x_ft", s.pose.x_ft},
-                                 {"y_ft", s.pose.y_ft},
-                                 {"heading_deg", s.pose.heading_deg},
-                                 {"left_fps", s.left_fps},
-                                 {"right_fps", s.right_fps},
-                                 {"eye_left", eyes.left},
-                                 {"eye_right", eyes.right}});
+        Robot::Snapshot at = robots_[static_cast<size_t>(i)]->snapshotFor(nextSample_);
+        emit(nextSample_,
+             trace::rec::Sample{i, s.pose.x_ft, s.pose.y_ft, s.pose.heading_deg, s.left_fps,
+                                s.right_fps, eyes.left, eyes.right, at.line,
+                                at.function ? at.function->name : "", at.inHandler},
+             std::move(at.watch));
       }
     }
     nextSample_ += config_.sampleInterval;
@@ -608,10 +737,12 @@ void Match::sampleUpTo(Tick t) {
 
 MatchResult Match::run() {
   MatchResult result;
+  if (trace_.on()) emitSetup();
   bool over = false;
   while (!over) {
     ++rounds_;
     const Tick t = earliestClock();
+    if (trace_.on()) trace_.flushBefore(std::min(t, arena_.now()));
     Tick horizon = std::min(queue_.nextTick(), t + kLookahead);
     plant::AdvanceResult step = arena_.advance(horizon);
     horizon = step.tick;
@@ -642,7 +773,7 @@ MatchResult Match::run() {
         case QueuedEvent::Kind::ReleaseEdge: {
           Robot& r = *robots_[static_cast<size_t>(entry.payload.robot)];
           r.injectedLow &= static_cast<uint8_t>(~entry.payload.index);
-          r.updateEdgeLines();
+          r.updateEdgeLines(horizon);
           break;
         }
         case QueuedEvent::Kind::EndOfRound:
@@ -691,7 +822,18 @@ void Match::finish(MatchResult& result) {
       result.winner = (coin_.next() >> 63) ? "B" : "A";
     }
   }
-  result.trace = trace_.lines();
+  if (trace_.on()) {
+    for (const auto& rr : result.robots) {
+      const int i = &rr - result.robots.data();
+      emit(
+          result.endTick,
+          trace::rec::RobotResult{i, rr.hits, rr.shots, rr.framesLatched, rr.framesRejected,
+                                  static_cast<int64_t>(rr.cycles), rr.fault.has_value(), rr.exited},
+          {});
+    }
+    emit(result.endTick, trace::rec::End{result.winner, result.tieBrokenByCoin}, {});
+  }
+  trace_.close();
 }
 
 }  // namespace

@@ -21,6 +21,16 @@
 //      each is accepted at the first boundary at or after h.
 // Trace samples never move a horizon: they are read from dense output after
 // the fact, so a run with --trace gives the same results as one without.
+// A traced VM stops at each sample tick (run(until) executes the same
+// instructions whether it is stopped there or not) so that the sample can
+// say where the program was.
+//
+// The trace (trace/trace.h): records are emitted as the round loop learns of
+// them and handed to the sinks in tick order. At the start of a round no
+// record can come before min(earliest VM clock, the plant's clock): every VM
+// event is at or after its VM's clock, every plant event after the plant's,
+// and samples up to the plant's clock were taken at the end of the last
+// round. Records before that bound are written then.
 #pragma once
 #include <cstdint>
 #include <map>
@@ -31,6 +41,7 @@
 #include <vector>
 
 #include "plant/plant.h"
+#include "trace/trace.h"
 #include "vm/cost.h"
 #include "vm/image.h"
 #include "vm/vm.h"
@@ -104,7 +115,10 @@ struct MatchConfig {
   std::vector<Injection> injections;
   std::vector<std::string> watches;  // variables added to trace records
   bool profile = false;              // per-instruction cycle counts (simbot profile)
-  bool trace = false;
+  // The trace goes to each sink (not owned), in tick order; none: no trace
+  // is built at all.
+  std::vector<trace::Sink*> sinks;
+  std::string profileName;                     // for the trace's run record
   Tick sampleInterval = kTicksPerSecond / 20;  // trace samples: 20 Hz
   MatchObserver* observer = nullptr;           // not owned; may be null
 };
@@ -140,7 +154,6 @@ struct MatchResult {
   std::string winner;  // "A"/"B"; empty for solo
   bool tieBrokenByCoin = false;
   uint64_t rounds = 0;
-  std::vector<std::string> trace;  // JSONL lines in tick order (if enabled)
 };
 
 MatchResult runMatch(const MatchConfig& config);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "scheduler/metrics.h"
+#include "support/traced.h"
 #include "tools/runner.h"
 #include "tools/tournament.h"
 
@@ -105,11 +106,10 @@ TEST(Bench, ObserverDoesNotChangeTheMatch) {
   c.robots.push_back({"A", "iceman", tools::compileProgramFile(kShared + "/programs/iceman.dc")});
   c.robots.push_back({"B", "fig92", tools::compileProgramFile(kShared + "/programs/fig92.dc")});
   c.endTick = 10 * scheduler::kTicksPerSecond;
-  c.trace = true;
-  const auto plain = scheduler::runMatch(c);
+  const auto plain = testkit::runTraced(c);
   scheduler::MetricsObserver observer;
   c.observer = &observer;
-  const auto watched = scheduler::runMatch(c);
+  const auto watched = testkit::runTraced(c);
   EXPECT_EQ(plain.trace, watched.trace);
   EXPECT_EQ(plain.robots[0].cycles, watched.robots[0].cycles);
   EXPECT_EQ(plain.rounds, watched.rounds);

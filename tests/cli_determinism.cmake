@@ -1,17 +1,24 @@
-# Runs a match twice through the command line; the traces must be
-# byte-identical and the JSON identical once wall_seconds is removed.
-foreach(run 1 2)
+# Runs a match through the command line: twice with --trace, which must give
+# byte-identical traces; once with no trace at all and once with every other
+# sink (--vcd, --replay). The JSON must be identical in all four once
+# wall_seconds is removed: no sink changes the result.
+set(runs traced1 traced2 plain sinks)
+set(args_traced1 --trace ${OUT}/trace1.jsonl)
+set(args_traced2 --trace ${OUT}/trace2.jsonl)
+set(args_plain)
+set(args_sinks --vcd ${OUT}/match.vcd ${REPLAY_ARGS})
+foreach(run ${runs})
   execute_process(
-    COMMAND ${SIMBOT} match ${A} ${B} --seconds ${SECONDS} --seed 1 --json --trace ${OUT}/trace${run}.jsonl
-    OUTPUT_VARIABLE json${run} RESULT_VARIABLE rc)
+    COMMAND ${SIMBOT} match ${A} ${B} --seconds ${SECONDS} --seed 1 --json ${args_${run}}
+    OUTPUT_VARIABLE json_${run} RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "simbot match failed (${rc})")
+    message(FATAL_ERROR "simbot match (${run}) failed (${rc})")
   endif()
-  string(REGEX REPLACE "\"wall_seconds\": [0-9.e+-]+" "" json${run} "${json${run}}")
+  string(REGEX REPLACE "\"wall_seconds\": [0-9.e+-]+" "" json_${run} "${json_${run}}")
+  if(NOT json_${run} STREQUAL json_traced1)
+    message(FATAL_ERROR "JSON differs between runs (${run}):\n${json_traced1}\n${json_${run}}")
+  endif()
 endforeach()
-if(NOT json1 STREQUAL json2)
-  message(FATAL_ERROR "JSON differs between runs:\n${json1}\n${json2}")
-endif()
 execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${OUT}/trace1.jsonl ${OUT}/trace2.jsonl
                 RESULT_VARIABLE same)
 if(NOT same EQUAL 0)

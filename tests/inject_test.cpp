@@ -7,6 +7,7 @@
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "support/test_host.h"
+#include "support/traced.h"
 
 using namespace simbot;
 
@@ -53,14 +54,14 @@ scheduler::MatchConfig soloConfig(const std::vector<std::string>& injections) {
   c.robots.push_back({"A", "delay.dc", testkit::compileOrDie(kDelay, "delay.dc")});
   c.endTick = 10 * scheduler::kTicksPerSecond;
   c.stopWhenAllExited = true;
-  c.trace = true;
   for (const auto& text : injections) c.injections.push_back(scheduler::parseInjection(text, 1));
   return c;
 }
 
 SoloRun solo(const std::vector<std::string>& injections) {
-  SoloRun run{scheduler::runMatch(soloConfig(injections)), {}};
-  for (const auto& line : run.result.trace) run.trace.push_back(nlohmann::json::parse(line));
+  const testkit::TracedRun traced = testkit::runTraced(soloConfig(injections));
+  SoloRun run{traced, {}};
+  for (const auto& line : traced.trace) run.trace.push_back(nlohmann::json::parse(line));
   return run;
 }
 
@@ -125,9 +126,8 @@ TEST(Inject, BumpTriggersTheReflexAtItsTick) {
   c.arena.robots[0].start = {0, 0, 0};  // field centre, facing north
   c.robots.push_back({"A", "idle.dc", testkit::compileOrDie("main()\n{\n    while (1);\n}\n")});
   c.endTick = 5 * scheduler::kTicksPerSecond;
-  c.trace = true;
   c.injections.push_back(scheduler::parseInjection("A:bumper_front@1s", 1));
-  const auto r = scheduler::runMatch(c);
+  const auto r = testkit::runTraced(c);
   vm::Tick start = -1, end = -1;
   for (const auto& line : r.trace) {
     const auto j = nlohmann::json::parse(line);
@@ -144,7 +144,7 @@ TEST(Inject, BumpTriggersTheReflexAtItsTick) {
 TEST(Inject, WatchedVariableAppearsInTraceRecords) {
   scheduler::MatchConfig c = soloConfig({"A:edge_fore@line:17#500"});
   c.watches = {"z", "hits"};
-  const auto r = scheduler::runMatch(c);
+  const auto r = testkit::runTraced(c);
   bool sawAcceptance = false;
   for (const auto& line : r.trace) {
     const auto j = nlohmann::json::parse(line);
@@ -155,7 +155,7 @@ TEST(Inject, WatchedVariableAppearsInTraceRecords) {
   }
   EXPECT_TRUE(sawAcceptance);
   c.watches = {"nosuch"};
-  EXPECT_THROW(scheduler::runMatch(c), std::invalid_argument);
+  EXPECT_THROW(testkit::runTraced(c), std::invalid_argument);
 }
 
 TEST(Inject, ParsesWhenForms) {

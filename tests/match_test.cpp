@@ -11,6 +11,7 @@
 
 #include "compiler/compiler.h"
 #include "plant/plant.h"
+#include "support/traced.h"
 
 using namespace simbot;
 
@@ -63,10 +64,9 @@ TEST(Match, IcemanAgainstFig92IsDeterministicAndTraceDoesNotChangeIt) {
   };
   auto plain = make();
   auto traced = make();
-  traced.trace = true;
   const auto r1 = scheduler::runMatch(plain);
-  const auto r2 = scheduler::runMatch(traced);
-  const auto r3 = scheduler::runMatch(traced);
+  const auto r2 = testkit::runTraced(traced);
+  const auto r3 = testkit::runTraced(traced);
   EXPECT_EQ(summary(r1), summary(r2));
   EXPECT_EQ(r2.trace, r3.trace);
   EXPECT_FALSE(r2.trace.empty());
@@ -100,8 +100,7 @@ std::vector<TraceRecord> parse(const std::vector<std::string>& lines) {
 
 TEST(Match, IcemanAloneTakesEdgeInterruptsAtTheWire) {
   auto config = matchConfig({{"A", kIceman, compileFile(kIceman)}}, 12);
-  config.trace = true;
-  const auto r = scheduler::runMatch(config);
+  const auto r = testkit::runTraced(config);
   EXPECT_GE(r.robots[0].interrupts.at("pio_a"), 1u);
   const auto trace = parse(r.trace);
   auto find = [&](const std::string& type, long long after) {
@@ -146,8 +145,7 @@ main()
 
 TEST(Match, SecondPlatformBeforeTheFirstFinishesWins) {
   auto config = matchConfig({{"A", "two.dc", compileSource(kTwoSends)}}, 1);
-  config.trace = true;
-  const auto r = scheduler::runMatch(config);
+  const auto r = testkit::runTraced(config);
   const auto trace = parse(r.trace);
   std::vector<TraceRecord> sends, frames;
   for (const auto& rec : trace) {
@@ -178,8 +176,7 @@ TEST(Match, IcemanSendsNothingWhileOnlyOneEyeSeesTheOpponent) {
     const double range = 4, rad = bearingDeg * 3.14159265358979323846 / 180;
     config.arena.robots[0].start = {0, 1, 0};
     config.arena.robots[1].start = {range * std::sin(rad), 1 + range * std::cos(rad), 0};
-    config.trace = true;
-    return scheduler::runMatch(config);
+    return testkit::runTraced(config);
   };
   const auto oneEye = run(-50);  // left of ICEMAN, beyond the far eye's cone
   int sends = 0;
@@ -219,8 +216,7 @@ main()
 
 TEST(Match, SendStallsWhileInterruptsAreDisabledAndResumesOnEi) {
   auto config = matchConfig({{"A", "stall.dc", compileSource(kStall)}}, 1);
-  config.trace = true;
-  const auto r = scheduler::runMatch(config);
+  const auto r = testkit::runTraced(config);
   const auto trace = parse(r.trace);
   long long send = -1, latched = -1;
   for (const auto& rec : trace) {
@@ -289,9 +285,8 @@ TEST(Match, TwoPlantChangingPortBWritesInOneRound) {
       "}\n";
   for (const char* profile : {"default", "thesis-1997"}) {
     auto c = matchConfig({{"A", "guns.dc", compileSource(kProgram)}}, 1, profile);
-    c.trace = true;
-    scheduler::MatchResult r;
-    ASSERT_NO_THROW(r = scheduler::runMatch(c)) << profile;
+    testkit::TracedRun r;
+    ASSERT_NO_THROW(r = testkit::runTraced(c)) << profile;
     int writes = 0, strokes = 0;
     for (const auto& line : r.trace) {
       writes += line.find("\"port_b\"") != std::string::npos;

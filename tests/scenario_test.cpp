@@ -9,6 +9,7 @@
 #include <string>
 
 #include "scheduler/match.h"
+#include "support/traced.h"
 #include "tools/bench.h"
 #include "tools/runner.h"
 
@@ -233,8 +234,7 @@ path = [ { arc_radius_ft = 3, turn_deg = 90, speed_fps = 0.5 },
             static_cast<scheduler::Tick>(std::round(quarter * scheduler::kTicksPerSecond)));
   EXPECT_EQ(c.robots[1].path[1].duration, 8 * scheduler::kTicksPerSecond);
   c.endTick = 40 * scheduler::kTicksPerSecond;  // path over at about 9.4 + 8 + 3.5 s
-  c.trace = true;
-  const auto r = scheduler::runMatch(c);
+  const auto r = testkit::runTraced(c);
   // A quarter circle clockwise from north to east (heading south), 2 ft
   // backwards (north), a quarter turn to the left: at (3, 2) heading east.
   const plant::Pose end = r.robots[1].finalPose;

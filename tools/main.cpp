@@ -19,6 +19,8 @@
 #include "tools/commands.h"
 #include "tools/runner.h"
 #include "tools/scenario.h"
+#include "tools/trace_jsonl.h"
+#include "tools/vcd.h"
 #include "vm/vm.h"
 
 namespace {
@@ -42,6 +44,7 @@ struct RunOptions {
   std::string profile = "default";
   std::vector<std::string> hw;
   std::string trace;
+  std::string vcd;
   std::vector<std::string> injections;
   std::vector<std::string> watches;
   std::string scenario;
@@ -76,6 +79,7 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
       given(o.profileOption), scenario ? scenario->profile : std::nullopt, o.profile));
   scheduler::MatchConfig config;
   config.arena = plant::makeArenaConfig(profile, static_cast<int>(programs.size()));
+  config.profileName = profile.name;
   const char* names[] = {"A", "B"};
   for (size_t i = 0; i < programs.size(); ++i)
     config.robots.push_back({names[i], programs[i], tools::compileProgramFile(programs[i])});
@@ -124,7 +128,11 @@ Played play(const std::vector<std::string>& programs, const RunOptions& o, bool 
       buildConfig(programs, o, solo ? tools::ScenarioUse::Solo : tools::ScenarioUse::Match);
   config.stopWhenAllExited = solo;
   config.watches = o.watches;
-  config.trace = !o.trace.empty();
+  // Sinks open their files before the run: a bad path costs nothing.
+  std::optional<tools::JsonlSink> jsonl;
+  std::optional<tools::VcdSink> vcd;
+  if (!o.trace.empty()) config.sinks.push_back(&jsonl.emplace(o.trace));
+  if (!o.vcd.empty()) config.sinks.push_back(&vcd.emplace(o.vcd));
   Played played;
   played.seed = config.seed;
   const auto start = std::chrono::steady_clock::now();
@@ -135,11 +143,6 @@ Played play(const std::vector<std::string>& programs, const RunOptions& o, bool 
   }
   played.wallSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!o.trace.empty()) {
-    std::ofstream out(o.trace);
-    if (!out) throw tools::ToolError(fmt::format("simbot: cannot write trace '{}'\n", o.trace));
-    for (const auto& line : played.result.trace) out << line << '\n';
-  }
   return played;
 }
 
@@ -324,6 +327,9 @@ void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
   cmd->add_option("--hw", o.hw,
                   solo ? "hardware file" : "hardware file for a robot: A=FILE or B=FILE");
   cmd->add_option("--trace", o.trace, "write the trace (JSONL) to this file");
+  cmd->add_option("--vcd", o.vcd,
+                  "write the digital signals (serial TXD, ports, IFF1, handlers, motor commands, "
+                  "eye readings) as a value change dump for GTKWave and sigrok");
   cmd->add_option("--inject", o.injections,
                   "ROBOT:SOURCE@WHEN, SOURCE edge_fore|edge_aft|bumper_front|bumper_back, "
                   "WHEN 12.5s|800ms|115200000t|line:N#K (repeatable)");

@@ -1,0 +1,321 @@
+// The typed trace (trace/records.def): what the new records and fields say,
+// checked against closed forms and hand computations, and the order and
+// encoding every sink relies on.
+#include "trace/trace.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "plant/plant.h"
+#include "scheduler/match.h"
+#include "support/test_host.h"
+#include "tools/trace_jsonl.h"
+
+using namespace simbot;
+
+namespace {
+
+namespace rec = trace::rec;
+
+plant::Profile profile(const std::string& name) {
+  return plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/" + name + ".toml");
+}
+
+// A run with the typed trace collected.
+struct Traced {
+  scheduler::MatchResult result;
+  std::vector<trace::Entry> entries;
+  template <class R>
+  std::vector<std::pair<trace::Tick, R>> all(int robot = -1) const {
+    std::vector<std::pair<trace::Tick, R>> out;
+    for (const auto& e : entries)
+      if (const R* r = std::get_if<R>(&e.record))
+        if (robot < 0 || trace::robotOf(e.record) == robot) out.emplace_back(e.t, *r);
+    return out;
+  }
+};
+
+Traced run(scheduler::MatchConfig c) {
+  trace::Collector collector;
+  c.sinks.push_back(&collector);
+  Traced t{scheduler::runMatch(c), {}};
+  t.entries = std::move(collector.entries);
+  return t;
+}
+
+scheduler::MatchConfig solo(const std::string& source, double seconds,
+                            const std::string& profileName = "thesis-1997") {
+  scheduler::MatchConfig c;
+  c.arena = plant::makeArenaConfig(profile(profileName), 1);
+  c.robots.push_back({"A", "test.dc", testkit::compileOrDie(source)});
+  c.endTick = static_cast<scheduler::Tick>(seconds * scheduler::kTicksPerSecond);
+  return c;
+}
+
+// A shooter and a beacon (a program that returns at once).
+scheduler::MatchConfig duel(const std::string& shooter, plant::Pose a, plant::Pose b,
+                            double seconds) {
+  scheduler::MatchConfig c;
+  c.arena = plant::makeArenaConfig(profile("thesis-1997"), 2);
+  c.arena.robots[0].start = a;
+  c.arena.robots[1].start = b;
+  c.robots.push_back({"A", "shooter.dc", testkit::compileOrDie(shooter)});
+  c.robots.push_back({"B", "beacon.dc", testkit::compileOrDie("main()\n{\n}\n")});
+  c.endTick = static_cast<scheduler::Tick>(seconds * scheduler::kTicksPerSecond);
+  return c;
+}
+
+constexpr scheduler::Tick kSample = scheduler::kTicksPerSecond / 20;  // 460,800
+
+// Two delay loops, 30,000 passes each. A pass of `for(z=0;z<N;z++);` costs
+// 255 T-states in a debug build (README, "The cycle model"), so the first
+// loop runs about 30,000 x 255 = 7,650,000 ticks and the second as long
+// again; start-up and loop set-up add tens of ticks. Samples every 460,800
+// ticks: samples 1..16 (up to 7,372,800) fall in line 4, samples 17..33
+// (7,833,600 .. 15,206,400) in line 5, and from sample 34 (15,667,200) main
+// has returned.
+const char* kTwoLoops =
+    "int z;\n"
+    "main()\n"
+    "{\n"
+    "    for (z = 0; z < 30000; z++);\n"
+    "    for (z = 0; z < 30000; z++);\n"
+    "}\n";
+
+TEST(Trace, SamplesSayWhichLineTheProgramIsAt) {
+  const Traced t = run(solo(kTwoLoops, 2));
+  const auto samples = t.all<rec::Sample>();
+  ASSERT_EQ(samples.size(), 41u);  // 0, 0.05, ..., 2.0 s
+  for (size_t k = 1; k < samples.size(); ++k) {
+    const auto& [tick, s] = samples[k];
+    EXPECT_EQ(tick, static_cast<scheduler::Tick>(k) * kSample);
+    const int want = k <= 16 ? 4 : k <= 33 ? 5 : -1;
+    if (want > 0) {
+      EXPECT_EQ(s.line, want) << "sample " << k;
+      EXPECT_EQ(s.function, "main") << "sample " << k;
+    } else {
+      EXPECT_EQ(s.function, "") << "sample " << k << ": main has returned";
+    }
+    EXPECT_FALSE(s.in_handler);
+  }
+  EXPECT_TRUE(t.result.robots[0].exited);
+  const double exit = static_cast<double>(t.result.robots[0].exitTick);
+  EXPECT_NEAR(exit, 2 * 30000 * 255.0, 1000);  // the closed form, plus set-up
+}
+
+// An edge handler that runs 20,000 passes (20,000 x 255 = 5,100,000 ticks)
+// injected at 0.2 s = 1,843,200 ticks, which is sample 4's tick: that sample
+// is taken before the request (raised when the round ends there), samples
+// 5..15 (2,304,000 .. 6,912,000) fall inside the handler, which ends near
+// 1,843,200 + 5,100,000 = 6,943,200, and sample 16 (7,372,800) is back in
+// main's loop, which has 30,000 x 255 - 1,843,200 ticks of its own left.
+const char* kHandler =
+    "#INT_VEC PIOA_VEC edge\n"
+    "int z, w;\n"
+    "interrupt reti edge()\n"
+    "{\n"
+    "    for (w = 0; w < 20000; w++);\n"
+    "}\n"
+    "main()\n"
+    "{\n"
+    "    outport(PIOCA, 0xff);\n"
+    "    outport(PIOCA, 0xff);\n"
+    "    outport(PIOCA, PIOA_VEC);\n"
+    "    outport(PIOCA, 0x97);\n"
+    "    outport(PIOCA, 0xfc);\n"
+    "    outport(PIOCA, 0x87);\n"
+    "    for (z = 0; z < 30000; z++);\n"
+    "}\n";
+
+TEST(Trace, SamplesSayWhenAHandlerIsInService) {
+  auto c = solo(kHandler, 1);
+  c.injections.push_back(scheduler::parseInjection("A:edge_fore@0.2s", 1));
+  const Traced t = run(c);
+  const auto samples = t.all<rec::Sample>();
+  ASSERT_GE(samples.size(), 17u);
+  for (size_t k = 1; k <= 16; ++k) {
+    const rec::Sample& s = samples[k].second;
+    const bool inside = k >= 5 && k <= 15;
+    EXPECT_EQ(s.in_handler, inside) << "sample " << k;
+    EXPECT_EQ(s.function, inside ? "edge" : "main") << "sample " << k;
+    EXPECT_EQ(s.line, inside ? 5 : 15) << "sample " << k;
+  }
+  // The acceptance names the handler; IFF1 falls with it and rises when its
+  // RETI ends (the epilogue's EI), and port A shows the injected pulse.
+  const auto accepted = t.all<rec::InterruptAccepted>();
+  ASSERT_EQ(accepted.size(), 1u);
+  EXPECT_EQ(accepted[0].second.handler, "edge");
+  EXPECT_EQ(accepted[0].second.function, "main");
+  EXPECT_EQ(accepted[0].second.line, 15);
+  const auto returned = t.all<rec::InterruptReturned>();
+  ASSERT_EQ(returned.size(), 1u);
+  EXPECT_NEAR(static_cast<double>(returned[0].first - accepted[0].first), 20000 * 255.0, 1000);
+  const auto iff = t.all<rec::Iff1>();
+  ASSERT_EQ(iff.size(), 2u);
+  EXPECT_EQ(iff[0].first, accepted[0].first);
+  EXPECT_FALSE(iff[0].second.enabled);
+  EXPECT_EQ(iff[1].first, returned[0].first);
+  EXPECT_TRUE(iff[1].second.enabled);
+  const auto portA = t.all<rec::PortA>();
+  ASSERT_EQ(portA.size(), 2u);
+  EXPECT_EQ(portA[0].first, 1'843'200);
+  EXPECT_EQ(portA[0].second.value, 0xFD);                      // fore (bit 1) low
+  EXPECT_EQ(portA[1].first, 1'843'200 + scheduler::kTicksPerSecond / 20);  // 50 ms later
+  EXPECT_EQ(portA[1].second.value, 0xFF);
+}
+
+// Fires gun 1 once (thesis-1997: gun wheels always at full speed, no
+// stroke time, 105 ft/s, launched 1.5 ft up from the body's edge).
+const char* kShootOnce =
+    "main()\n"
+    "{\n"
+    "    outport(PIOCB, 0xff);\n"
+    "    outport(PIOCB, 0x00);\n"
+    "    outport(PIODB, 0x18);\n"
+    "    outport(PIODB, 0x00);\n"
+    "}\n";
+
+// A at the centre facing north, the beacon 5 ft ahead. Body radius
+// 12.75 / 24 = 0.53125 ft: the ball leaves from y = 0.53125 and meets the
+// beacon's body at y = 5 - 0.53125 = 4.46875 after 3.9375 ft, which at
+// 105 ft/s is 0.0375 s = 345,600 ticks exactly; its height then is
+// 1.5 - 32.174 / 2 x 0.0375^2 = 1.477378... ft, below the 2.5-ft target.
+TEST(Trace, BallRecordsDrawTheFlightAndSayWhatItHit) {
+  const Traced t = run(duel(kShootOnce, {0, 0, 0}, {0, 5, 0}, 1));
+  const auto launches = t.all<rec::BallLaunch>();
+  ASSERT_EQ(launches.size(), 1u);
+  const auto& [t0, launch] = launches[0];
+  EXPECT_EQ(launch.gun, 0);
+  EXPECT_NEAR(launch.x_ft, 0.0, 1e-12);
+  EXPECT_NEAR(launch.y_ft, 0.53125, 1e-12);
+  EXPECT_DOUBLE_EQ(launch.z_ft, 1.5);
+  EXPECT_NEAR(launch.vx_fps, 0.0, 1e-12);
+  EXPECT_NEAR(launch.vy_fps, 105.0, 1e-12);
+  const auto hits = t.all<rec::BallHit>();
+  ASSERT_EQ(hits.size(), 1u);
+  const auto& [t1, hit] = hits[0];
+  EXPECT_EQ(hit.ball, launch.ball);
+  EXPECT_EQ(hit.target, 1);
+  EXPECT_EQ(hit.hit, "robot");
+  EXPECT_GE(t1 - t0, 345'600);
+  EXPECT_LE(t1 - t0, 345'601);
+  EXPECT_NEAR(hit.y_ft, 4.46875, 2e-5);  // within one tick of travel (1.1e-5 ft)
+  EXPECT_NEAR(hit.z_ft, 1.5 - 32.174 / 2 * 0.0375 * 0.0375, 1e-6);
+  EXPECT_TRUE(t.all<rec::BallMiss>().empty());
+}
+
+// The beacon 1.5 ft to the side of the line of fire, 5 ft up the field: the
+// ball passes it at a horizontal distance 1.5 - 0.53125 = 0.96875 ft from
+// its body (at a height of about 1.47 ft, within the body's 2.5 ft), then
+// flies on out of the field over the north wall.
+TEST(Trace, AMissSaysWhereAndHowCloseItCame) {
+  const Traced t = run(duel(kShootOnce, {0, 0, 0}, {1.5, 5, 0}, 1));
+  const auto misses = t.all<rec::BallMiss>();
+  ASSERT_EQ(misses.size(), 1u);
+  const rec::BallMiss& miss = misses[0].second;
+  EXPECT_EQ(miss.hit, "wall");
+  ASSERT_TRUE(miss.closest_ft.has_value());
+  EXPECT_NEAR(*miss.closest_ft, 0.96875, 1e-6);
+  EXPECT_GE(miss.y_ft, 8.0);
+  // Solo: there is no target, so no closest distance.
+  const Traced alone = run(solo(kShootOnce, 1));
+  const auto lone = alone.all<rec::BallMiss>();
+  ASSERT_EQ(lone.size(), 1u);
+  EXPECT_FALSE(lone[0].second.closest_ft.has_value());
+}
+
+// Drives forward at speed 8 (0.8 ft/s, thesis-1997) until something stops it.
+const char* kDriveForward =
+    "char buf[9];\n"
+    "char cc;\n"
+    "main()\n"
+    "{\n"
+    "    ser_init_z1(0, 9600/1200);\n"
+    "    strcpy(buf, \"8fgr8fgr\");\n"
+    "    cc = sizeof(buf);\n"
+    "    ser_send_z1(buf, &cc);\n"
+    "    while (1);\n"
+    "}\n";
+
+TEST(Trace, ContactsSayWhatTheBodyTouched) {
+  struct Case {
+    plant::Pose start;
+    const char* with;
+  } cases[] = {
+      {{0, 6.5, 0}, "wall"},         // north, 1.5 ft from the wall
+      {{-1.5, -6, 90}, "divider"},   // east, towards the divider at x = 0
+  };
+  for (const auto& k : cases) {
+    auto c = solo(kDriveForward, 4);
+    c.arena.robots[0].start = k.start;
+    const Traced t = run(c);
+    const auto contacts = t.all<rec::Contact>();
+    ASSERT_FALSE(contacts.empty()) << k.with;
+    EXPECT_EQ(contacts[0].second.with, k.with);
+    EXPECT_EQ(contacts[0].second.bumper, "front");
+    const auto ends = t.all<rec::ContactEnd>();
+    ASSERT_FALSE(ends.empty()) << k.with;
+    EXPECT_EQ(ends[0].second.with, k.with);
+  }
+  // Into a beacon 2 ft ahead: both robots touch the other robot; the
+  // beacon (facing the same way) is hit from behind.
+  const Traced t = run(duel(kDriveForward, {0, 0, 0}, {0, 2, 0}, 4));
+  const auto a = t.all<rec::Contact>(0), b = t.all<rec::Contact>(1);
+  ASSERT_FALSE(a.empty());
+  ASSERT_FALSE(b.empty());
+  EXPECT_EQ(a[0].second.with, "robot");
+  EXPECT_EQ(a[0].second.bumper, "front");
+  EXPECT_EQ(b[0].second.with, "robot");
+  EXPECT_EQ(b[0].second.bumper, "back");
+}
+
+// Records reach the sinks in tick order, begin with the set-up and end
+// with the result; the JSONL form reads back to the same JSON.
+TEST(Trace, RecordsAreInTickOrderAndReadBack) {
+  scheduler::MatchConfig c;
+  c.arena = plant::makeArenaConfig(profile("default"), 2);
+  const std::string iceman = SIMBOT_SHARED_DIR "/programs/iceman.dc";
+  const std::string fig92 = SIMBOT_SHARED_DIR "/programs/fig92.dc";
+  auto read = [](const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  c.robots.push_back({"A", iceman, testkit::compileOrDie(read(iceman), iceman)});
+  c.robots.push_back({"B", fig92, testkit::compileOrDie(read(fig92), fig92)});
+  c.endTick = 10 * scheduler::kTicksPerSecond;
+  c.watches = {"count"};
+  const Traced t = run(c);
+  ASSERT_GT(t.entries.size(), 1000u);
+  EXPECT_TRUE(std::holds_alternative<rec::Run>(t.entries[0].record));
+  EXPECT_TRUE(std::holds_alternative<rec::RobotSetup>(t.entries[1].record));
+  EXPECT_TRUE(std::holds_alternative<rec::RobotSetup>(t.entries[2].record));
+  EXPECT_TRUE(std::holds_alternative<rec::End>(t.entries.back().record));
+  EXPECT_EQ(std::get<rec::RobotSetup>(t.entries[1].record).source.substr(0, 2), "/*");
+  for (size_t i = 1; i < t.entries.size(); ++i)
+    ASSERT_LE(t.entries[i - 1].t, t.entries[i].t) << i;
+  bool watched = false;
+  for (const auto& e : t.entries) {
+    const nlohmann::json j = tools::traceJson(e);
+    EXPECT_EQ(tools::traceJson(tools::traceEntry(j)), j);
+    watched = watched || (trace::robotOf(e.record) == 0 && j.contains("watch"));
+  }
+  EXPECT_TRUE(watched);  // ICEMAN has a global `count`
+}
+
+TEST(Trace, BytesReadBackExactly) {
+  trace::Entry e{7, rec::Console{0, std::string("\xff\x01 ok\x80", 6)}, {}};
+  const std::string line = tools::traceLine(e);
+  EXPECT_NE(line.find("\"text\":\"\xc3\xbf\\u0001 ok\xc2\x80\""), std::string::npos) << line;
+  const trace::Entry back = tools::traceEntry(nlohmann::json::parse(line));
+  EXPECT_EQ(std::get<rec::Console>(back.record).text, std::string("\xff\x01 ok\x80", 6));
+  // A file name that is not UTF-8 is written as Latin-1 instead of failing.
+  trace::Entry f{0, rec::Fault{0, std::string("bad \xff name"), 3}, {}};
+  EXPECT_NO_THROW(tools::traceLine(f));
+}
+
+}  // namespace
