@@ -162,7 +162,7 @@ TEST(Trace, SamplesSayWhenAHandlerIsInService) {
   const auto portA = t.all<rec::PortA>();
   ASSERT_EQ(portA.size(), 2u);
   EXPECT_EQ(portA[0].first, 1'843'200);
-  EXPECT_EQ(portA[0].second.value, 0xFD);                      // fore (bit 1) low
+  EXPECT_EQ(portA[0].second.value, 0xFD);                                  // fore (bit 1) low
   EXPECT_EQ(portA[1].first, 1'843'200 + scheduler::kTicksPerSecond / 20);  // 50 ms later
   EXPECT_EQ(portA[1].second.value, 0xFF);
 }
@@ -245,8 +245,8 @@ TEST(Trace, ContactsSayWhatTheBodyTouched) {
     plant::Pose start;
     const char* with;
   } cases[] = {
-      {{0, 6.5, 0}, "wall"},         // north, 1.5 ft from the wall
-      {{-1.5, -6, 90}, "divider"},   // east, towards the divider at x = 0
+      {{0, 6.5, 0}, "wall"},        // north, 1.5 ft from the wall
+      {{-1.5, -6, 90}, "divider"},  // east, towards the divider at x = 0
   };
   for (const auto& k : cases) {
     auto c = solo(kDriveForward, 4);
@@ -296,8 +296,7 @@ TEST(Trace, RecordsAreInTickOrderAndReadBack) {
   EXPECT_TRUE(std::holds_alternative<rec::RobotSetup>(t.entries[2].record));
   EXPECT_TRUE(std::holds_alternative<rec::End>(t.entries.back().record));
   EXPECT_EQ(std::get<rec::RobotSetup>(t.entries[1].record).source.substr(0, 2), "/*");
-  for (size_t i = 1; i < t.entries.size(); ++i)
-    ASSERT_LE(t.entries[i - 1].t, t.entries[i].t) << i;
+  for (size_t i = 1; i < t.entries.size(); ++i) ASSERT_LE(t.entries[i - 1].t, t.entries[i].t) << i;
   bool watched = false;
   for (const auto& e : t.entries) {
     const nlohmann::json j = tools::traceJson(e);
@@ -316,6 +315,21 @@ TEST(Trace, BytesReadBackExactly) {
   // A file name that is not UTF-8 is written as Latin-1 instead of failing.
   trace::Entry f{0, rec::Fault{0, std::string("bad \xff name"), 3}, {}};
   EXPECT_NO_THROW(tools::traceLine(f));
+}
+
+// The README lists the record kinds as trace/records.def defines them.
+TEST(Trace, ReadmeListsTheRecordKindsOfTheDefinition) {
+  std::ifstream in(SIMBOT_SOURCE_DIR "/README.md");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string readme = text.str();
+  const std::string begin = "<!-- trace-records:begin -->\n", end = "<!-- trace-records:end -->";
+  const auto from = readme.find(begin), to = readme.find(end);
+  ASSERT_NE(from, std::string::npos) << "README.md has no " << begin;
+  ASSERT_NE(to, std::string::npos) << "README.md has no " << end;
+  EXPECT_EQ(readme.substr(from + begin.size(), to - from - begin.size()), trace::recordsMarkdown())
+      << "README.md's record list differs from trace/records.def; it should read:\n"
+      << trace::recordsMarkdown();
 }
 
 }  // namespace

@@ -51,6 +51,25 @@ int robotOf(const Record& record) {
   return robot;
 }
 
+std::string recordsMarkdown() {
+  std::string out = "| record | what it records | fields |\n|---|---|---|\n";
+  for (const KindInfo& k : kKinds) {
+    out += "| `";
+    out += k.name;
+    out += "` | ";
+    out += k.doc;
+    out += " | ";
+    for (size_t i = 0; i < k.fields.size(); ++i) {
+      if (i) out += ", ";
+      out += "`";
+      out += k.fields[i].name;
+      out += "`";
+    }
+    out += " |\n";
+  }
+  return out;
+}
+
 void Tracer::emit(Tick t, Record record, Watch watch) {
   if (t < flushed_)
     throw std::logic_error("trace: a record at tick " + std::to_string(t) +

@@ -133,6 +133,10 @@ void forEachField(R& record, F&& f) {
 // The robot a record belongs to (its `robot` field), or -1.
 int robotOf(const Record& record);
 
+// The README's table of record kinds and their fields, made from the
+// definition (tests/trace_test.cpp checks that the README holds it).
+std::string recordsMarkdown();
+
 // Values of --watch variables, read from the robot's memory when the
 // record was made: integers, or float for float variables.
 using WatchValue = std::variant<std::int64_t, double>;
