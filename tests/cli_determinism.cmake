@@ -6,7 +6,7 @@ set(runs traced1 traced2 plain sinks)
 set(args_traced1 --trace ${OUT}/trace1.jsonl)
 set(args_traced2 --trace ${OUT}/trace2.jsonl)
 set(args_plain)
-set(args_sinks --vcd ${OUT}/match.vcd ${REPLAY_ARGS})
+set(args_sinks --vcd ${OUT}/match.vcd --replay ${REPLAY})
 foreach(run ${runs})
   execute_process(
     COMMAND ${SIMBOT} match ${A} ${B} --seconds ${SECONDS} --seed 1 --json ${args_${run}}

@@ -21,6 +21,7 @@
 #include "tools/scenario.h"
 #include "tools/trace_jsonl.h"
 #include "tools/vcd.h"
+#include "tools/viewer.h"
 #include "vm/vm.h"
 
 namespace {
@@ -38,6 +39,14 @@ int compileCommand(const std::string& file, bool disasm) {
   return 0;
 }
 
+// simbot view TRACE.jsonl -o FILE.html: the replay page of a recorded run.
+int viewCommand(const std::string& tracePath, const std::string& out) {
+  tools::ReplaySink page(out);
+  tools::readTrace(tracePath, [&](const trace::Entry& e) { page.write(e); });
+  page.close();
+  return 0;
+}
+
 struct RunOptions {
   double seconds = 180;
   uint64_t seed = 1;
@@ -45,6 +54,7 @@ struct RunOptions {
   std::vector<std::string> hw;
   std::string trace;
   std::string vcd;
+  std::string replay;
   std::vector<std::string> injections;
   std::vector<std::string> watches;
   std::string scenario;
@@ -131,8 +141,10 @@ Played play(const std::vector<std::string>& programs, const RunOptions& o, bool 
   // Sinks open their files before the run: a bad path costs nothing.
   std::optional<tools::JsonlSink> jsonl;
   std::optional<tools::VcdSink> vcd;
+  std::optional<tools::ReplaySink> replay;
   if (!o.trace.empty()) config.sinks.push_back(&jsonl.emplace(o.trace));
   if (!o.vcd.empty()) config.sinks.push_back(&vcd.emplace(o.vcd));
+  if (!o.replay.empty()) config.sinks.push_back(&replay.emplace(o.replay));
   Played played;
   played.seed = config.seed;
   const auto start = std::chrono::steady_clock::now();
@@ -327,6 +339,8 @@ void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
   cmd->add_option("--hw", o.hw,
                   solo ? "hardware file" : "hardware file for a robot: A=FILE or B=FILE");
   cmd->add_option("--trace", o.trace, "write the trace (JSONL) to this file");
+  cmd->add_option("--replay", o.replay,
+                  "write a replay page (one self-contained HTML file) to this file");
   cmd->add_option("--vcd", o.vcd,
                   "write the digital signals (serial TXD, ports, IFF1, handlers, motor commands, "
                   "eye readings) as a value change dump for GTKWave and sigrok");
@@ -383,6 +397,11 @@ int main(int argc, char** argv) {
   profile->add_option("--top", profileTop, "source lines to list (default 20)");
   profile->add_flag("--json", profileOptions.json, "print the profile as JSON");
 
+  std::string viewTrace, viewOut;
+  auto* view = app.add_subcommand("view", "write the replay page (HTML) of a recorded trace");
+  view->add_option("TRACE", viewTrace, "trace file (.jsonl) written with --trace")->required();
+  view->add_option("-o,--output", viewOut, "the page to write (.html)")->required();
+
   const auto bench = simbot::tools::addBenchCommand(app);
   const auto tournament = simbot::tools::addTournamentCommand(app);
 
@@ -396,6 +415,7 @@ int main(int argc, char** argv) {
     if (*solo) return soloCommand(soloProgram, soloOptions);
     if (*match) return matchCommand(programA, programB, matchOptions);
     if (*profile) return profileCommand(profileProgram, profileOptions, profileTop);
+    if (*view) return viewCommand(viewTrace, viewOut);
     if (*bench.app) return bench.run();
     if (*tournament.app) return tournament.run();
   } catch (const tools::ToolError& e) {

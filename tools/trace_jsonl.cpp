@@ -90,6 +90,10 @@ std::string bytesFromUtf8(const std::string& s) {
 
 }  // namespace
 
+std::string jsonString(const std::string& value, trace::FieldKind kind) {
+  return kind == FieldKind::Bytes || !validUtf8(value) ? latin1(value) : value;
+}
+
 json traceJson(const trace::Entry& e) {
   json j = json::object();
   j["type"] = trace::kindOf(e.record).name;
@@ -101,7 +105,7 @@ json traceJson(const trace::Entry& e) {
       else
         j[f.name] = v;
     } else if constexpr (std::is_same_v<V, std::string>) {
-      j[f.name] = f.kind == FieldKind::Bytes || !validUtf8(v) ? latin1(v) : v;
+      j[f.name] = jsonString(v, f.kind);
     } else if constexpr (std::is_same_v<V, std::optional<std::int64_t>> ||
                          std::is_same_v<V, std::optional<double>>) {
       j[f.name] = v ? json(*v) : json(nullptr);

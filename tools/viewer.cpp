@@ -1,0 +1,126 @@
+// The replay page: the run's records as columns per kind, inlined in the
+// viewer's template with its script, style and three.js (see viewer.h).
+#include "tools/viewer.h"
+
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+#include <type_traits>
+
+#include "tools/runner.h"
+#include "tools/trace_jsonl.h"
+#include "tools/viewer_assets.h"
+
+namespace simbot::tools {
+
+namespace {
+
+using nlohmann::json;
+
+// Replaces the one occurrence of `marker` in `page` by `text`.
+void fill(std::string& page, std::string_view marker, std::string_view text) {
+  const auto at = page.find(marker);
+  if (at == std::string::npos || page.find(marker, at + 1) != std::string::npos)
+    throw std::logic_error(fmt::format("viewer template: marker {} must occur once", marker));
+  page.replace(at, marker.size(), text);
+}
+
+// Script text inlined in a <script> element must not close it early.
+std::string_view script(std::string_view text, const char* what) {
+  if (text.find("</script") != std::string_view::npos ||
+      text.find("<!--") != std::string_view::npos)
+    throw std::logic_error(fmt::format("viewer: {} cannot be inlined in a <script>", what));
+  return text;
+}
+
+constexpr const char* kRobotNames[] = {"A", "B"};
+
+}  // namespace
+
+// Columns per record kind: {"t": [...], field: [...], ...}; robot fields as
+// 0/1. Watched variables from the samples, per robot and variable, as the
+// ticks where the value changed and the values.
+struct ReplaySink::Columns {
+  json kinds = json::object();
+  json watch = json::object();
+};
+
+ReplaySink::ReplaySink(const std::string& path) : path_(path), columns_(new Columns) {
+  file_ = std::fopen(path.c_str(), "wb");
+  if (!file_) {
+    delete columns_;
+    throw ToolError(
+        fmt::format("simbot: cannot write replay '{}': {}\n", path, std::strerror(errno)));
+  }
+}
+
+ReplaySink::~ReplaySink() {
+  if (file_) std::fclose(file_);
+  delete columns_;
+}
+
+void ReplaySink::write(const trace::Entry& e) {
+  json& cols = columns_->kinds[trace::kindOf(e.record).name];
+  cols["t"].push_back(e.t);
+  trace::forEachField(e.record, [&](const trace::FieldInfo& f, const auto& v) {
+    using V = std::remove_cvref_t<decltype(v)>;
+    json& col = cols[f.name];
+    if constexpr (std::is_same_v<V, std::string>)
+      col.push_back(jsonString(v, f.kind));
+    else if constexpr (std::is_same_v<V, std::optional<std::int64_t>> ||
+                       std::is_same_v<V, std::optional<double>>)
+      col.push_back(v ? json(*v) : json(nullptr));
+    else
+      col.push_back(v);
+  });
+  if (!e.watch.empty() && std::holds_alternative<trace::rec::Sample>(e.record)) {
+    const int robot = trace::robotOf(e.record);
+    json& vars = columns_->watch[kRobotNames[robot & 1]];
+    for (const auto& [name, value] : e.watch) {
+      json& series = vars[name];
+      const json v = std::visit([](const auto& x) { return json(x); }, value);
+      if (series.contains("v") && !series["v"].empty() && series["v"].back() == v) continue;
+      series["t"].push_back(e.t);
+      series["v"].push_back(v);
+    }
+  }
+}
+
+json ReplaySink::data() const {
+  return {{"format", "simbot-replay/1"}, {"kinds", columns_->kinds}, {"watch", columns_->watch}};
+}
+
+void ReplaySink::close() {
+  if (!file_) return;
+  const std::string page = replayPage(data());
+  const bool written = std::fwrite(page.data(), 1, page.size(), file_) == page.size();
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!written || !closed)
+    throw ToolError(fmt::format("simbot: writing replay '{}': {}\n", path_, std::strerror(errno)));
+}
+
+std::string replayPage(const json& data) {
+  std::string text = data.dump();
+  // '<' only occurs inside JSON strings, where \u003c means the same: the
+  // data can then never end its <script> element.
+  std::string safe;
+  safe.reserve(text.size() + text.size() / 64);
+  for (char c : text) {
+    if (c == '<')
+      safe += "\\u003c";
+    else
+      safe.push_back(c);
+  }
+  std::string page(assets::viewerHtml());
+  fill(page, "/*simbot:css*/", assets::viewerCss());
+  fill(page, "/*simbot:three*/", script(assets::threeJs(), "three.js"));
+  fill(page, "/*simbot:orbit*/", script(assets::orbitControlsJs(), "OrbitControls.js"));
+  fill(page, "/*simbot:viewer*/", script(assets::viewerJs(), "viewer.js"));
+  fill(page, "/*simbot:data*/", safe);
+  return page;
+}
+
+}  // namespace simbot::tools

@@ -1,0 +1,45 @@
+// Embeds the viewer's files with the assembler's .incbin, so that simbot
+// needs no file at run time to write a page. The paths (string literals)
+// come from CMake (tools/CMakeLists.txt), which also rebuilds this file
+// when one of them changes.
+#include "tools/viewer_assets.h"
+
+#define SIMBOT_INCBIN(name, path)                                                       \
+  __asm__(                                                                              \
+      ".section .rodata\n"                                                              \
+      ".global simbot_asset_" #name                                                     \
+      "\n"                                                                              \
+      ".balign 16\n"                                                                    \
+      "simbot_asset_" #name                                                             \
+      ":\n"                                                                             \
+      ".incbin \"" path                                                                 \
+      "\"\n"                                                                            \
+      ".global simbot_asset_" #name                                                     \
+      "_end\n"                                                                          \
+      "simbot_asset_" #name                                                             \
+      "_end:\n"                                                                         \
+      ".byte 0\n"                                                                       \
+      ".previous\n");                                                                   \
+  extern "C" const char simbot_asset_##name[];                                          \
+  extern "C" const char simbot_asset_##name##_end[];                                    \
+  std::string_view asset_##name() {                                                     \
+    return {simbot_asset_##name,                                                        \
+            static_cast<std::size_t>(simbot_asset_##name##_end - simbot_asset_##name)}; \
+  }
+
+namespace simbot::tools::assets {
+namespace {
+SIMBOT_INCBIN(html, SIMBOT_VIEWER_HTML)
+SIMBOT_INCBIN(css, SIMBOT_VIEWER_CSS)
+SIMBOT_INCBIN(js, SIMBOT_VIEWER_JS)
+SIMBOT_INCBIN(three, SIMBOT_THREE_JS)
+SIMBOT_INCBIN(orbit, SIMBOT_ORBIT_JS)
+}  // namespace
+
+std::string_view viewerHtml() { return asset_html(); }
+std::string_view viewerCss() { return asset_css(); }
+std::string_view viewerJs() { return asset_js(); }
+std::string_view threeJs() { return asset_three(); }
+std::string_view orbitControlsJs() { return asset_orbit(); }
+
+}  // namespace simbot::tools::assets
