@@ -1,21 +1,37 @@
 #!/usr/bin/env bash
-# Installs simbot's build and test dependencies from Debian 12's packages.
-# Idempotent: packages already present are skipped by apt. Run as root.
+# Installs simbot's build and test dependencies: Debian 12's packages, then
+# the browser test driver (playwright-core, pinned by tests/browser's
+# package-lock.json) with npm. Idempotent: packages already present are
+# skipped, and npm ci runs only when the lock file changed. Run as root.
 set -euo pipefail
+cd "$(dirname "$0")/.."
 packages=(
-  build-essential cmake ninja-build pkg-config
+  build-essential cmake ninja-build pkg-config clang-format
   libsundials-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev
-  lua5.4
+  lua5.4 python3
+  libjs-three                  # three.js r111, inlined in replay pages
+  sigrok-cli gtkwave xvfb      # tests read --vcd output with sigrok's decoder and GTKWave
+  chromium                     # the browser test (headless, software WebGL)
 )
+# Node.js and npm drive the browser test; a machine that has them (from
+# Debian or elsewhere) keeps its own.
+command -v npm > /dev/null || packages+=(nodejs npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
 if ((${#missing[@]})); then
-  SUDO=""
-  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+# playwright-core only: it drives Debian's Chromium and downloads no browser.
+lock=tests/browser/package-lock.json
+stamp=tests/browser/node_modules/.simbot-lock
+if ! cmp -s "$lock" "$stamp" 2>/dev/null; then
+  (cd tests/browser && npm ci --no-audit --no-fund --loglevel=error)
+  cp "$lock" "$stamp"
 fi

@@ -12,7 +12,8 @@ Usage: vcd_test.py SIMBOT ICEMAN FIG92 OUTDIR
   RETI, and IFF1 is low from acceptance until ICEMAN's EI() at the top of
   its handler.
 - GTKWave's vcd2fst accepts every VCD this test writes, and fst2vcd gives
-  back the same value changes.
+  back the same value changes; GTKWave itself, under Xvfb, opens the
+  match's VCD with every signal and the run's end as its last time.
 """
 import json
 import subprocess
@@ -168,6 +169,18 @@ check({"A_txd", "B_txd", "A_iff1", "B_left_cmd", "A_gun1_solenoid"} <= set(names
       f"signals of both robots: {sorted(names.values())[:8]}...")
 for vcd in (solo_vcd, inj_vcd, match_vcd):
     fst_round_trip(vcd)
+
+# ---- 5. GTKWave itself (under Xvfb) opens the match's VCD: every signal,
+# and the run's 30 s exactly as its last time.
+script = OUT / "gtkwave.tcl"
+script.write_text("set n [gtkwave::getNumFacs]\nputs \"facs: $n\"\n"
+                  "puts \"max: [gtkwave::getMaxTime]\"\ngtkwave::/File/Quit\n")
+gw = subprocess.run(["xvfb-run", "-a", "gtkwave", "-S", str(script), str(match_vcd)],
+                    capture_output=True, text=True, timeout=300)
+report = gw.stdout + gw.stderr
+check(f"facs: {len(names)}" in report, f"GTKWave lists {len(names)} signals: {report[-500:]}")
+check(f"max: {picoseconds(30 * TICKS_PER_SECOND)}" in report,
+      f"GTKWave's last time is the run's end (30 s): {report[-500:]}")
 
 if failures:
     sys.exit(f"{len(failures)} check(s) failed")

@@ -99,6 +99,8 @@ struct VcdSink::State {
   trace::Tick tick = 0;  // the tick whose changes are being gathered
   std::vector<int> touched;
   trace::Tick lastTick = 0;
+  trace::Tick endTick = -1;  // the run's end, from its end record
+  trace::Tick stamped = 0;   // the last time written to the file
 
   Signal& sig(int robotIndex, int wire) {
     return signals[static_cast<size_t>(robotIndex * kSignalsPerRobot + wire)];
@@ -116,13 +118,14 @@ struct VcdSink::State {
   }
   // Writes the changes gathered at the current tick.
   void flushTick() {
-    bool stamped = false;
+    bool stampedNow = false;
     for (int index : touched) {
       Signal& s = signals[static_cast<size_t>(index)];
       if (s.now == s.written) continue;
-      if (!stamped) {
+      if (!stampedNow) {
         std::fprintf(file, "#%lld\n", static_cast<long long>(vcdPicoseconds(tick)));
-        stamped = true;
+        stampedNow = true;
+        stamped = tick;
       }
       s.written = s.now;
       if (s.real)
@@ -206,6 +209,7 @@ void VcdSink::State::header() {
 
 void VcdSink::State::record(const trace::Entry& e) {
   namespace rec = trace::rec;
+  if (std::holds_alternative<rec::End>(e.record)) endTick = e.t;
   const auto* run = std::get_if<rec::Run>(&e.record);
   if (run) {
     robots = static_cast<int>(std::clamp<std::int64_t>(run->robots, 1, 2));
@@ -337,9 +341,10 @@ void VcdSink::write(const trace::Entry& entry) {
 void VcdSink::close() {
   if (!file_) return;
   State& s = *s_;
-  // The changes still queued (the last byte's bits, an interrupt's end),
-  // then the run's last tick, so that viewers show the whole run.
-  while (!s.later.empty()) {
+  // The changes still queued (the last byte's bits, an interrupt's end)
+  // up to the run's end, then its last tick, so that viewers show the
+  // whole run and nothing after it.
+  while (!s.later.empty() && (s.endTick < 0 || s.later.top().tick <= s.endTick)) {
     const Later l = s.later.top();
     s.later.pop();
     s.at(l.tick);
@@ -347,7 +352,7 @@ void VcdSink::close() {
     s.lastTick = std::max(s.lastTick, l.tick);
   }
   s.flushTick();
-  if (s.headerDone && vcdPicoseconds(s.lastTick) > vcdPicoseconds(s.tick))
+  if (s.headerDone && s.lastTick > s.stamped)
     std::fprintf(file_, "#%lld\n", static_cast<long long>(vcdPicoseconds(s.lastTick)));
   const bool ok = !std::ferror(file_) && std::fflush(file_) == 0;
   const bool closed = std::fclose(file_) == 0;
