@@ -172,9 +172,46 @@ struct VcdSink::State {
     later.push(Later{t, seq++, kind, r, signal, value});
   }
 
+  void declareSignals();
   void header();
   void record(const trace::Entry& e);
 };
+
+// Names of the signals other than port B's bits.
+constexpr std::pair<int, const char*> kWireNames[] = {{kTxd, "txd"},
+                                                      {kRs485, "rs485_enable"},
+                                                      {kEdgeFore, "edge_fore"},
+                                                      {kEdgeAft, "edge_aft"},
+                                                      {kIff1, "iff1"},
+                                                      {kInPio, "in_pio_a"},
+                                                      {kInSerial, "in_serial_tx"},
+                                                      {kLeftCmd, "left_cmd"},
+                                                      {kRightCmd, "right_cmd"},
+                                                      {kEyeLeft, "eye_left"},
+                                                      {kEyeRight, "eye_right"},
+                                                      {kConsole, "console_lines"}};
+
+// Every robot's signals, with their power-on values, then the header.
+void VcdSink::State::declareSignals() {
+  if (robots == 0) throw ToolError("simbot: --vcd: the trace has no run record\n");
+  signals.resize(static_cast<size_t>(robots * kSignalsPerRobot));
+  int n = 0;
+  for (int r = 0; r < robots; ++r) {
+    for (const auto& [w, name] : kWireNames) sig(r, w).name = name;
+    for (int bit = 0; bit < 8; ++bit) {
+      const std::string& bound = portBNames[static_cast<size_t>(r)][static_cast<size_t>(bit)];
+      sig(r, kPortB0 + bit).name = bound.empty() ? fmt::format("portb{}", bit) : bound;
+    }
+    for (int w = 0; w < kSignalsPerRobot; ++w) {
+      Signal& s = sig(r, w);
+      s.real = w >= kLeftCmd;
+      s.id = idFor(n++);
+      const bool high = w == kTxd || w == kEdgeFore || w == kEdgeAft || w == kIff1;
+      s.written = s.now = s.real ? "r0" : high ? "1" : "0";
+    }
+  }
+  header();
+}
 
 void VcdSink::State::header() {
   headerDone = true;
@@ -228,40 +265,7 @@ void VcdSink::State::record(const trace::Entry& e) {
         names[static_cast<size_t>(bit)] = name;
     return;
   }
-  if (!headerDone) {
-    if (robots == 0) throw ToolError("simbot: --vcd: the trace has no run record\n");
-    int n = 0;
-    const char* wires[kSignalsPerRobot] = {};
-    wires[kTxd] = "txd";
-    wires[kRs485] = "rs485_enable";
-    wires[kEdgeFore] = "edge_fore";
-    wires[kEdgeAft] = "edge_aft";
-    wires[kIff1] = "iff1";
-    wires[kInPio] = "in_pio_a";
-    wires[kInSerial] = "in_serial_tx";
-    wires[kLeftCmd] = "left_cmd";
-    wires[kRightCmd] = "right_cmd";
-    wires[kEyeLeft] = "eye_left";
-    wires[kEyeRight] = "eye_right";
-    wires[kConsole] = "console_lines";
-    signals.resize(static_cast<size_t>(robots * kSignalsPerRobot));
-    for (int r = 0; r < robots; ++r)
-      for (int w = 0; w < kSignalsPerRobot; ++w) {
-        Signal& s = sig(r, w);
-        if (w >= kPortB0 && w < kPortB0 + 8) {
-          const std::string& bound =
-              portBNames[static_cast<size_t>(r)][static_cast<size_t>(w - kPortB0)];
-          s.name = bound.empty() ? fmt::format("portb{}", w - kPortB0) : bound;
-        } else {
-          s.name = wires[w];
-        }
-        s.real = w >= kLeftCmd;
-        s.id = idFor(n++);
-        const bool high = w == kTxd || w == kEdgeFore || w == kEdgeAft || w == kIff1;
-        s.written = s.now = s.real ? "r0" : high ? "1" : "0";
-      }
-    header();
-  }
+  if (!headerDone) declareSignals();
   advanceTo(e.t);
   applyDue(e.t);
   lastTick = std::max(lastTick, e.t);
