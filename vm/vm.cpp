@@ -40,9 +40,12 @@ namespace simbot::vm {
 namespace {
 
 constexpr int kEvalSlots = 8192;
-// No function's own expressions and arguments need more than this many slots
-// (the compiler caps nesting), so a check per call is enough.
+// A call needs this many free slots (its own expressions, in practice).
 constexpr int kEvalHeadroom = 1024;
+// No instruction or library step pushes more than two slots, so checking
+// this much room at every boundary keeps any program (8,200 arguments, a
+// deep nest of calls) from writing past the expression stack.
+constexpr int kEvalGuard = 4;
 constexpr int kMaxInterruptNesting = 16;
 constexpr uint32_t kMaxStepTstates = 100;  // long library calls: boundary spacing
 constexpr int kMaxLibArgs = 32;
@@ -578,6 +581,10 @@ Stop Vm::State::run(Tick until) {
   for (;;) {
   boundary:
     if (fault) return Stop::Fault;
+    if (sp > kEvalSlots - kEvalGuard) {
+      raiseFault("expression stack overflow (too many arguments or values pending)", pc);
+      continue;
+    }
     if (busTouched) {
       busTouched = false;
       return Stop::Io;
