@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # Sets everything up and runs simbot's main job on the programs it ships: a
 # full 3-minute match between programs/spiral.dc and programs/turret.dc,
-# writing the trace and the JSON summary to out/.
+# writing the trace, the replay page, the waveforms and the JSON summary to
+# out/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
 ./scripts/build.sh build
 mkdir -p out
 build/bin/simbot match programs/spiral.dc programs/turret.dc --seconds 180 --seed 1 \
-  --trace out/match.jsonl --json > out/match.json
+  --trace out/match.jsonl --replay out/match.html --vcd out/match.vcd --json > out/match.json
 build/bin/simbot match programs/spiral.dc programs/turret.dc --seconds 180 --seed 1
 echo "trace: out/match.jsonl ($(wc -l < out/match.jsonl) records); summary: out/match.json"
+echo "replay: open out/match.html in a browser; waveforms: gtkwave out/match.vcd"

@@ -49,6 +49,9 @@ constexpr int kEvalGuard = 4;
 constexpr int kMaxInterruptNesting = 16;
 constexpr uint32_t kMaxStepTstates = 100;  // long library calls: boundary spacing
 constexpr int kMaxLibArgs = 32;
+// printf's largest field width and precision (assumption: Dynamic C's
+// printf formatted each field into a buffer of this size).
+constexpr long kMaxPrintfField = 127;
 // Robot stack bytes: CALL pushes the return address and IX; acceptance
 // pushes PC, AF, BC, DE, HL, IX, IY.
 constexpr uint32_t kCallFrameBytes = 4;
@@ -296,18 +299,24 @@ std::string Vm::State::formatPrintf(uint32_t instructionPc) {
       out.push_back(c);
       continue;
     }
-    // %[flags][width][.precision][l]conv
+    // %[flags][width][.precision][l]conv; width and precision are read as
+    // numbers and clamped to kMaxPrintfField, as the era's library, which
+    // formatted into a small buffer, could not print more.
     std::string spec = "%";
     size_t j = i + 1;
-    while (j < format.size() && std::strchr("-0+ #", format[j])) spec.push_back(format[j++]);
-    while (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j])) &&
-           spec.size() < 8)
+    while (j < format.size() && format[j] != '\0' && std::strchr("-0+ #", format[j]))
       spec.push_back(format[j++]);
+    const auto number = [&]() {
+      long n = 0;
+      while (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j])))
+        n = std::min<long>(n * 10 + (format[j++] - '0'), kMaxPrintfField);
+      return n;
+    };
+    if (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j])))
+      spec += std::to_string(number());
     if (j < format.size() && format[j] == '.') {
-      spec.push_back(format[j++]);
-      while (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j])) &&
-             spec.size() < 12)
-        spec.push_back(format[j++]);
+      ++j;
+      spec += "." + std::to_string(number());
     }
     bool isLong = false;
     if (j < format.size() && format[j] == 'l') {
