@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "scheduler/match.h"
+#include "tools/json_text.h"
 #include "tools/runner.h"
 
 namespace simbot::tools {
@@ -338,7 +339,7 @@ void writeBenchOutputs(const BenchResult& result, const std::string& dir) {
     out << text;
   };
   write("runs.csv", runsCsv(result));
-  write("summary.json", summaryJson(result).dump(2) + "\n");
+  write("summary.json", dumpJson(summaryJson(result), 2) + "\n");
   write("summary.md", summaryMarkdown(result));
 }
 

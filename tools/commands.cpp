@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "tools/bench.h"
+#include "tools/json_text.h"
 #include "tools/runner.h"
 #include "tools/scenario.h"
 #include "tools/tournament.h"
@@ -105,7 +106,7 @@ Subcommand addTournamentCommand(CLI::App& app) {
             return guarded([&] {
               const TournamentResult r = runTournament(o->config, loadNamedProfile(o->profile));
               if (o->json)
-                std::cout << tournamentJson(r).dump(2) << '\n';
+                std::cout << dumpJson(tournamentJson(r), 2) << '\n';
               else
                 std::cout << standingsTable(r);
               return 0;

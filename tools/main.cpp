@@ -17,6 +17,7 @@
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "tools/commands.h"
+#include "tools/json_text.h"
 #include "tools/runner.h"
 #include "tools/scenario.h"
 #include "tools/trace_jsonl.h"
@@ -67,6 +68,13 @@ bool given(const CLI::Option* option) { return option && option->count() > 0; }
 
 json poseJson(const plant::Pose& p) {
   return {{"x_ft", p.x_ft}, {"y_ft", p.y_ft}, {"heading_deg", p.heading_deg}};
+}
+
+// Console lines are bytes the robot printed: one character per byte.
+json consoleJson(const std::vector<std::string>& lines) {
+  json out = json::array();
+  for (const auto& line : lines) out.push_back(tools::jsonString(line, true));
+  return out;
 }
 
 json faultJson(const std::optional<scheduler::FaultInfo>& f) {
@@ -170,14 +178,14 @@ int soloCommand(const std::string& program, const RunOptions& o) {
       {"cycles", a.cycles},
       {"sim_seconds", static_cast<double>(r.endTick) / scheduler::kTicksPerSecond},
       {"wall_seconds", wall},
-      {"console", a.console},
+      {"console", consoleJson(a.console)},
       {"fault", faultJson(a.fault)},
       {"motor_frames_latched", a.framesLatched},
       {"motor_frames_rejected", a.framesRejected},
       {"interrupts", a.interrupts},
       {"final_pose", poseJson(a.finalPose)}};
   if (o.json) {
-    std::cout << j.dump(2) << '\n';
+    std::cout << tools::dumpJson(j, 2) << '\n';
   } else {
     for (const auto& line : a.console) std::cout << line << '\n';
     std::cerr << fmt::format("simbot: {} {} at {:.3f} s; {} frames latched, {} rejected\n", program,
@@ -221,7 +229,7 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
               {"roots", r.integrator.roots}}},
             {"robots", robots}};
   if (o.json) {
-    std::cout << j.dump(2) << '\n';
+    std::cout << tools::dumpJson(j, 2) << '\n';
   } else {
     for (const auto& rr : r.robots)
       std::cout << fmt::format("{} {:<24} hits {:>2}  shots {:>2}  frames {:>5} (+{} rejected)\n",
@@ -298,7 +306,7 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
            {"source", line > 0 && line <= static_cast<int>(image.sourceLines.size())
                           ? image.sourceLines[static_cast<size_t>(line - 1)]
                           : ""}});
-    std::cout << j.dump(2) << '\n';
+    std::cout << tools::dumpJson(j, 2) << '\n';
     return 0;
   }
   std::cout << fmt::format("{}: {:.3f} simulated seconds, {} T-states{}\n\n", program,

@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "scheduler/match.h"
+#include "tools/json_text.h"
 #include "tools/runner.h"
 
 namespace simbot::tools {
@@ -20,79 +21,7 @@ using trace::FieldKind;
 
 constexpr const char* kRobotNames[] = {"A", "B"};
 
-void appendUtf8(std::string& out, unsigned codePoint) {
-  if (codePoint < 0x80) {
-    out.push_back(static_cast<char>(codePoint));
-  } else {
-    out.push_back(static_cast<char>(0xC0 | (codePoint >> 6)));
-    out.push_back(static_cast<char>(0x80 | (codePoint & 0x3F)));
-  }
-}
-
-std::string latin1(const std::string& bytes) {
-  std::string out;
-  out.reserve(bytes.size());
-  for (unsigned char c : bytes) appendUtf8(out, c);
-  return out;
-}
-
-// Well-formed UTF-8 (RFC 3629: no overlong forms, no surrogates).
-bool validUtf8(const std::string& s) {
-  const auto byte = [&s](size_t i) { return static_cast<unsigned char>(s[i]); };
-  size_t i = 0;
-  while (i < s.size()) {
-    const unsigned c = byte(i);
-    if (c < 0x80) {
-      ++i;
-      continue;
-    }
-    size_t more = 0;
-    unsigned lo = 0x80, hi = 0xBF;  // the range of the second byte
-    if (c >= 0xC2 && c <= 0xDF) {
-      more = 1;
-    } else if (c >= 0xE0 && c <= 0xEF) {
-      more = 2;
-      if (c == 0xE0) lo = 0xA0;
-      if (c == 0xED) hi = 0x9F;
-    } else if (c >= 0xF0 && c <= 0xF4) {
-      more = 3;
-      if (c == 0xF0) lo = 0x90;
-      if (c == 0xF4) hi = 0x8F;
-    } else {
-      return false;
-    }
-    if (s.size() - i <= more) return false;
-    if (byte(i + 1) < lo || byte(i + 1) > hi) return false;
-    for (size_t k = 2; k <= more; ++k)
-      if ((byte(i + k) & 0xC0) != 0x80) return false;
-    i += more + 1;
-  }
-  return true;
-}
-
-// The bytes a Bytes field was written from (code points U+0000..U+00FF).
-std::string bytesFromUtf8(const std::string& s) {
-  std::string out;
-  for (size_t i = 0; i < s.size(); ++i) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    if (c < 0x80) {
-      out.push_back(static_cast<char>(c));
-    } else if ((c >> 5) == 6 && i + 1 < s.size()) {
-      const unsigned cp = ((c & 0x1Fu) << 6) | (static_cast<unsigned char>(s[++i]) & 0x3Fu);
-      if (cp > 0xFF) throw std::invalid_argument("a byte string holds a character above U+00FF");
-      out.push_back(static_cast<char>(cp));
-    } else {
-      throw std::invalid_argument("a byte string holds a character above U+00FF");
-    }
-  }
-  return out;
-}
-
 }  // namespace
-
-std::string jsonString(const std::string& value, trace::FieldKind kind) {
-  return kind == FieldKind::Bytes || !validUtf8(value) ? latin1(value) : value;
-}
 
 json traceJson(const trace::Entry& e) {
   json j = json::object();
@@ -105,7 +34,7 @@ json traceJson(const trace::Entry& e) {
       else
         j[f.name] = v;
     } else if constexpr (std::is_same_v<V, std::string>) {
-      j[f.name] = jsonString(v, f.kind);
+      j[f.name] = jsonString(v, f.kind == FieldKind::Bytes);
     } else if constexpr (std::is_same_v<V, std::optional<std::int64_t>> ||
                          std::is_same_v<V, std::optional<double>>) {
       j[f.name] = v ? json(*v) : json(nullptr);
@@ -173,7 +102,7 @@ trace::Entry traceEntry(const json& j) {
       v = it->get<bool>();
     } else if constexpr (std::is_same_v<V, std::string>) {
       if (!it->is_string()) throw bad("a string");
-      v = f.kind == FieldKind::Bytes ? bytesFromUtf8(it->get<std::string>())
+      v = f.kind == FieldKind::Bytes ? bytesFromJsonString(it->get<std::string>())
                                      : it->get<std::string>();
     } else if constexpr (std::is_same_v<V, std::optional<std::int64_t>>) {
       if (it->is_null())

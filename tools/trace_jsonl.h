@@ -17,8 +17,6 @@
 namespace simbot::tools {
 
 nlohmann::json traceJson(const trace::Entry& entry);
-// A Text or Bytes field's value as the UTF-8 the JSONL holds.
-std::string jsonString(const std::string& value, trace::FieldKind kind);
 std::string traceLine(const trace::Entry& entry);
 
 // Reads one record; throws std::invalid_argument naming what is wrong.

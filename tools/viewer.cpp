@@ -9,8 +9,8 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "tools/json_text.h"
 #include "tools/runner.h"
-#include "tools/trace_jsonl.h"
 #include "tools/viewer_assets.h"
 
 namespace simbot::tools {
@@ -68,7 +68,7 @@ void ReplaySink::write(const trace::Entry& e) {
     using V = std::remove_cvref_t<decltype(v)>;
     json& col = cols[f.name];
     if constexpr (std::is_same_v<V, std::string>)
-      col.push_back(jsonString(v, f.kind));
+      col.push_back(jsonString(v, f.kind == trace::FieldKind::Bytes));
     else if constexpr (std::is_same_v<V, std::optional<std::int64_t>> ||
                        std::is_same_v<V, std::optional<double>>)
       col.push_back(v ? json(*v) : json(nullptr));
@@ -103,7 +103,7 @@ void ReplaySink::close() {
 }
 
 std::string replayPage(const json& data) {
-  std::string text = data.dump();
+  std::string text = dumpJson(data);
   // '<' only occurs inside JSON strings, where \u003c means the same: the
   // data can then never end its <script> element.
   std::string safe;
