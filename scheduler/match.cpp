@@ -815,8 +815,12 @@ void Match::finish(MatchResult& result) {
   }
   if (result.robots.size() == 2) {
     const int a = result.robots[0].hits, b = result.robots[1].hits;
+    const bool faultA = result.robots[0].fault.has_value();
+    const bool faultB = result.robots[1].fault.has_value();
     if (a != b) {
       result.winner = a > b ? "A" : "B";
+    } else if (faultA != faultB) {
+      result.winner = faultA ? "B" : "A";  // a robot that faulted loses a tied round
     } else {
       result.tieBrokenByCoin = true;
       result.winner = (coin_.next() >> 63) ? "B" : "A";

@@ -298,4 +298,21 @@ TEST(Match, TwoPlantChangingPortBWritesInOneRound) {
   }
 }
 
+// DESIGN.md's rules: a robot that faulted loses a tied round; the coin is
+// for ties between robots that both ran (or both faulted).
+TEST(Match, AFaultedRobotLosesATiedRound) {
+  const char* kFaults = "int *p;\nmain()\n{\n    *p = 1;\n}\n";  // null pointer at once
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    auto c = matchConfig(
+        {{"A", "faults.dc", compileSource(kFaults)}, {"B", "beacon.dc", compileSource(kBeacon)}},
+        1);
+    c.seed = seed;
+    const auto r = scheduler::runMatch(c);
+    ASSERT_TRUE(r.robots[0].fault.has_value());
+    EXPECT_EQ(r.robots[0].hits, r.robots[1].hits);
+    EXPECT_EQ(r.winner, "B") << "seed " << seed;
+    EXPECT_FALSE(r.tieBrokenByCoin);
+  }
+}
+
 }  // namespace
