@@ -4,6 +4,9 @@
 // back as a Diagnostic.
 #include "compiler/compiler.h"
 
+#include <fmt/format.h>
+
+#include <filesystem>
 #include <fstream>
 #include <new>
 #include <sstream>
@@ -47,6 +50,13 @@ Diagnostic makeDiagnostic(const std::string& fileName, const std::vector<std::st
 
 Result compile(const std::string& source, const std::string& fileName, const Options& options) {
   Result result;
+  if (source.size() > kMaxSourceBytes) {
+    result.errors.push_back(
+        makeDiagnostic(fileName, {}, Pos{1, 1},
+                       fmt::format("the program is {} bytes, more than a program may have ({})",
+                                   source.size(), kMaxSourceBytes)));
+    return result;
+  }
   std::vector<std::string> lines = splitLines(source);
   try {
     Preprocessor pp(source, fileName);
@@ -70,19 +80,30 @@ Result compile(const std::string& source, const std::string& fileName, const Opt
 }
 
 Result compileFile(const std::string& path, const Options& options) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  if (in) text << in.rdbuf();
-  if (!in || in.bad()) {
+  const auto cannot = [&path](const std::string& why) {
     Result r;
     Diagnostic d;
     d.file = path;
     d.line = 1;
     d.column = 1;
-    d.message = "cannot read file";
+    d.message = "cannot read file: " + why;
     r.errors.push_back(d);
     return r;
-  }
+  };
+  // Looked at before it is opened: opening a FIFO would wait for a writer.
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) return cannot("no such file");
+  if (std::filesystem::is_directory(status)) return cannot("it is a directory");
+  if (!std::filesystem::is_regular_file(status)) return cannot("not a regular file");
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxSourceBytes)
+    return cannot(
+        fmt::format("{} bytes is more than a program may have ({})", size, kMaxSourceBytes));
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  if (in) text << in.rdbuf();
+  if (!in || in.bad()) return cannot("read error");
   return compile(text.str(), path, options);
 }
 

@@ -2,6 +2,7 @@
 // Stages (one file each): preprocess.cpp, lexer.cpp, parser.cpp (builds the
 // AST and checks types), codegen.cpp (emits bytecode), disasm lives in vm/.
 #pragma once
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +31,10 @@ struct Result {
   std::optional<vm::Image> image;
   std::vector<Diagnostic> errors;  // empty iff image is set
 };
+
+// The largest program the compiler reads (ICEMAN is 10 KB): a bound, so
+// that a file nobody meant as a program costs nothing.
+inline constexpr std::size_t kMaxSourceBytes = 1 << 20;
 
 // Compile `source` whose name (for messages and #include) is `fileName`.
 Result compile(const std::string& source, const std::string& fileName, const Options& options = {});

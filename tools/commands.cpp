@@ -31,6 +31,19 @@ int guarded(const std::function<int()>& body) {
 
 }  // namespace
 
+CLI::Validator seedValidator() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        constexpr std::string_view kMax = "18446744073709551615";  // 2^64 - 1
+        const bool digits = !text.empty() && text.size() <= kMax.size() &&
+                            text.find_first_not_of("0123456789") == std::string::npos;
+        if (!digits || (text.size() == kMax.size() && text > kMax))
+          return "a seed is an integer from 0 to 18446744073709551615, got '" + text + "'";
+        return "";
+      },
+      "SEED");
+}
+
 Subcommand addBenchCommand(CLI::App& app) {
   struct Options {
     BenchConfig config;
@@ -43,11 +56,15 @@ Subcommand addBenchCommand(CLI::App& app) {
       ->required();
   auto* family =
       cmd->add_option("--family", o->config.family, "stationary, circle, head-to-head or edge");
-  cmd->add_option("--seeds", o->config.seeds, "runs per program")->required();
+  cmd->add_option("--seeds", o->config.seeds, "runs per program")
+      ->required()
+      ->check(CLI::Range(1, 1'000'000));
   o->seconds =
       cmd->add_option("--seconds", o->config.seconds, "simulated seconds per run (default 60)");
-  o->seed = cmd->add_option("--seed", o->config.masterSeed, "master seed (default 1)");
-  cmd->add_option("--threads", o->config.threads, "worker threads (default: all cores)");
+  o->seed = cmd->add_option("--seed", o->config.masterSeed, "master seed (default 1)")
+                ->check(seedValidator());
+  cmd->add_option("--threads", o->config.threads, "worker threads (default: all cores)")
+      ->check(CLI::Range(1, 1024));
   cmd->add_option("--out", o->out, "output directory (default out/bench-FAMILY)");
   o->profileOption =
       cmd->add_option("--profile", o->profile, "profile name or file (default: default)");
@@ -96,10 +113,13 @@ Subcommand addTournamentCommand(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("tournament", "round robin after thesis Appendix A");
   cmd->add_option("PROGRAM", o->config.programs, "the programs (two or more)")->required();
-  cmd->add_option("--rounds", o->config.rounds, "rounds per pair, sides swapped (default 2)");
+  cmd->add_option("--rounds", o->config.rounds, "rounds per pair, sides swapped (default 2)")
+      ->check(CLI::Range(1, 10'000));
   cmd->add_option("--seconds", o->config.seconds, "round length (default 180)");
-  cmd->add_option("--seed", o->config.masterSeed, "master seed (default 1)");
-  cmd->add_option("--threads", o->config.threads, "worker threads (default: all cores)");
+  cmd->add_option("--seed", o->config.masterSeed, "master seed (default 1)")
+      ->check(seedValidator());
+  cmd->add_option("--threads", o->config.threads, "worker threads (default: all cores)")
+      ->check(CLI::Range(1, 1024));
   cmd->add_option("--profile", o->profile, "profile name or file (default: default)");
   cmd->add_flag("--json", o->json, "print standings and games as JSON");
   return {cmd, [o] {

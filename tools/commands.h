@@ -10,6 +10,9 @@ struct Subcommand {
   std::function<int()> run;  // prints its own errors; returns the exit status
 };
 
+// A seed: a decimal integer from 0 to 2^64 - 1 (not wrapped, not signed).
+CLI::Validator seedValidator();
+
 Subcommand addBenchCommand(CLI::App& app);
 Subcommand addTournamentCommand(CLI::App& app);
 

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -75,6 +76,23 @@ json consoleJson(const std::vector<std::string>& lines) {
   json out = json::array();
   for (const auto& line : lines) out.push_back(tools::jsonString(line, true));
   return out;
+}
+
+// Exit statuses (README, "Exit statuses").
+constexpr int kExitBadInput = 1;
+constexpr int kExitInternalError = 2;
+constexpr int kExitRobotFault = 3;
+
+// One loud line per faulted robot, on stderr; true if any robot faulted.
+bool reportFaults(const scheduler::MatchResult& r) {
+  bool any = false;
+  for (const auto& rr : r.robots) {
+    if (!rr.fault) continue;
+    any = true;
+    std::cerr << fmt::format("{}:{}: fault: robot {} at {:.6f} s: {}\n", rr.program, rr.fault->line,
+                             rr.name, rr.fault->timeS, rr.fault->message);
+  }
+  return any;
 }
 
 json faultJson(const std::optional<scheduler::FaultInfo>& f) {
@@ -194,10 +212,8 @@ int soloCommand(const std::string& program, const RunOptions& o) {
                                         : "ran",
                              static_cast<double>(r.endTick) / scheduler::kTicksPerSecond,
                              a.framesLatched, a.framesRejected);
-    if (a.fault)
-      std::cerr << fmt::format("{}:{}: fault: {}\n", program, a.fault->line, a.fault->message);
   }
-  return 0;
+  return reportFaults(r) ? kExitRobotFault : 0;
 }
 
 int matchCommand(const std::string& a, const std::string& b, const RunOptions& o) {
@@ -239,7 +255,7 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
                              r.tieBrokenByCoin ? " (coin flip)" : "",
                              static_cast<double>(r.endTick) / scheduler::kTicksPerSecond, wall);
   }
-  return 0;
+  return reportFaults(r) ? kExitRobotFault : 0;
 }
 
 // Cycles per source line and per function of a solo run, largest first.
@@ -339,7 +355,8 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
 
 void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
   o.secondsOption = cmd->add_option("--seconds", o.seconds, "simulated seconds (default 180)");
-  o.seedOption = cmd->add_option("--seed", o.seed, "master seed (default 1)");
+  o.seedOption =
+      cmd->add_option("--seed", o.seed, "master seed (default 1)")->check(tools::seedValidator());
   o.profileOption =
       cmd->add_option("--profile", o.profile, "profile name or file (default: default)");
   cmd->add_option("--scenario", o.scenario,
@@ -396,13 +413,15 @@ int main(int argc, char** argv) {
   profileOptions.secondsOption =
       profile->add_option("--seconds", profileOptions.seconds, "simulated seconds (default 60)");
   profileOptions.seedOption =
-      profile->add_option("--seed", profileOptions.seed, "master seed (default 1)");
+      profile->add_option("--seed", profileOptions.seed, "master seed (default 1)")
+          ->check(tools::seedValidator());
   profileOptions.profileOption = profile->add_option("--profile", profileOptions.profile,
                                                      "physical profile (default: default)");
   profile->add_option("--scenario", profileOptions.scenario,
                       "scenario file (TOML): start pose, profile, hardware, injections, robot B");
   profile->add_option("--inject", profileOptions.injections, "as for solo (repeatable)");
-  profile->add_option("--top", profileTop, "source lines to list (default 20)");
+  profile->add_option("--top", profileTop, "source lines to list (default 20)")
+      ->check(CLI::Range(1, 1'000'000));
   profile->add_flag("--json", profileOptions.json, "print the profile as JSON");
 
   std::string viewTrace, viewOut;
@@ -415,8 +434,16 @@ int main(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // A usage error: one line, exit status 1.
+    std::string message = e.what();
+    std::replace(message.begin(), message.end(), '\n', ' ');
+    std::cerr << "simbot: " << message << " (simbot --help lists the options)\n";
+    return kExitBadInput;
   }
   try {
     if (*compile) return compileCommand(compileFile, disasm);
@@ -428,13 +455,13 @@ int main(int argc, char** argv) {
     if (*tournament.app) return tournament.run();
   } catch (const tools::ToolError& e) {
     std::cerr << e.what();
-    return 1;
+    return kExitBadInput;
   } catch (const plant::ConfigError& e) {
     std::cerr << e.what() << '\n';
-    return 1;
+    return kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << "simbot: internal error: " << e.what() << "\n";
-    return 2;
+    return kExitInternalError;
   }
   return 0;
 }
