@@ -1,7 +1,8 @@
 # Runs a match through the command line: twice with --trace, which must give
 # byte-identical traces; once with no trace at all and once with every other
 # sink (--vcd, --replay). The JSON must be identical in all four once
-# wall_seconds is removed: no sink changes the result.
+# wall_seconds is removed: no sink changes the result. Then simbot view of
+# the trace must write the very page --replay wrote.
 set(runs traced1 traced2 plain sinks)
 set(args_traced1 --trace ${OUT}/trace1.jsonl)
 set(args_traced2 --trace ${OUT}/trace2.jsonl)
@@ -23,4 +24,14 @@ execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${OUT}/trace1.jsonl ${
                 RESULT_VARIABLE same)
 if(NOT same EQUAL 0)
   message(FATAL_ERROR "traces differ between runs")
+endif()
+# The replay page from the recorded trace is the page --replay wrote.
+execute_process(COMMAND ${SIMBOT} view ${OUT}/trace1.jsonl -o ${OUT}/view.html RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "simbot view failed (${rc})")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${OUT}/view.html ${REPLAY}
+                RESULT_VARIABLE same)
+if(NOT same EQUAL 0)
+  message(FATAL_ERROR "simbot view of the trace differs from the page --replay wrote")
 endif()

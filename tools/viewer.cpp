@@ -118,7 +118,15 @@ std::string replayPage(const json& data) {
   fill(page, "/*simbot:css*/", assets::viewerCss());
   fill(page, "/*simbot:three*/", script(assets::threeJs(), "three.js"));
   fill(page, "/*simbot:orbit*/", script(assets::orbitControlsJs(), "OrbitControls.js"));
-  fill(page, "/*simbot:viewer*/", script(assets::viewerJs(), "viewer.js"));
+  // The script's parts share one function scope, in strict mode.
+  std::string viewer = "(function () {\n'use strict';\n";
+  for (const auto& [name, part] : assets::viewerScripts()) {
+    viewer += fmt::format("// ---- {}\n", name);
+    viewer += script(part, "the viewer's script");
+    viewer += "\n";
+  }
+  viewer += "})();\n";
+  fill(page, "/*simbot:viewer*/", viewer);
   fill(page, "/*simbot:data*/", safe);
   return page;
 }

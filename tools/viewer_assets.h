@@ -1,14 +1,18 @@
 // The viewer's files, compiled into simbot (tools/viewer_assets.cpp): the
-// page template, its script and style, and three.js with its orbit
-// controls from Debian's libjs-three.
+// page template and style (tools/viewer/page.*), its script in parts
+// (tools/viewer/js/*.js, in the order they must run), and three.js with its
+// orbit controls from Debian's libjs-three.
 #pragma once
 #include <string_view>
+#include <utility>
+#include <vector>
 
 namespace simbot::tools::assets {
 
 std::string_view viewerHtml();
 std::string_view viewerCss();
-std::string_view viewerJs();
+// (file name, text) of each part of the viewer's script, in order.
+std::vector<std::pair<std::string_view, std::string_view>> viewerScripts();
 std::string_view threeJs();
 std::string_view orbitControlsJs();
 

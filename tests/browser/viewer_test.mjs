@@ -1,0 +1,155 @@
+// The replay viewer in real Chromium (Debian's /usr/bin/chromium, driven by
+// playwright-core): the page of a 180-s ICEMAN vs fig92 match must open
+// without console errors, draw the robots where the trace puts them at
+// three seek positions, advance time when playing, highlight the source
+// line the trace gives, and render every camera preset. It writes
+// screenshots of the 2-D view, the 3-D view and the timeline.
+//
+// Usage: node viewer_test.mjs SIMBOT ICEMAN FIG92 OUTDIR
+import { execFileSync } from 'node:child_process';
+import { mkdirSync, readFileSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+import { pathToFileURL } from 'node:url';
+
+let chromium;
+try {
+  ({ chromium } = await import('playwright-core'));
+} catch {
+  console.error('playwright-core is not installed: run scripts/setup.sh (npm ci in tests/browser)');
+  process.exit(1);
+}
+
+const [simbot, iceman, fig92, outArg] = process.argv.slice(2);
+const out = resolve(outArg);
+mkdirSync(out, { recursive: true });
+const failures = [];
+function check(ok, message) {
+  if (!ok) {
+    failures.push(message);
+    console.log('FAIL: ' + message);
+  }
+}
+
+// ---- the match, its trace and its page
+const tracePath = join(out, 'm180.jsonl');
+const pagePath = join(out, 'm180.html');
+execFileSync(simbot, ['match', iceman, fig92, '--seconds', '180', '--seed', '1', '--trace', tracePath,
+  '--replay', pagePath], { stdio: ['ignore', 'ignore', 'inherit'] });
+const samples = { A: [], B: [] };
+for (const line of readFileSync(tracePath, 'utf8').split('\n')) {
+  if (!line.includes('"type":"sample"')) continue;
+  const r = JSON.parse(line);
+  samples[r.robot].push(r);
+}
+check(samples.A.length === 3601 && samples.B.length === 3601, 'a sample every 50 ms for 180 s');
+// The latest sample of a robot at or before tick t.
+function sampleAt(robot, t) {
+  let lo = 0, hi = samples[robot].length - 1;
+  while (lo < hi) {
+    const mid = (lo + hi + 1) >> 1;
+    if (samples[robot][mid].t <= t) lo = mid; else hi = mid - 1;
+  }
+  return samples[robot][lo];
+}
+
+// ---- the browser: no network, software WebGL
+const browser = await chromium.launch({
+  executablePath: '/usr/bin/chromium',
+  headless: true,
+  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+    '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
+});
+const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
+const consoleProblems = [];
+// Chromium's software GL reports a "GPU stall due to ReadPixels" when the
+// test reads the 3-D canvas back (view3dStats): the test's doing, not the page's.
+const readPixelsNote = /GL Driver Message \(OpenGL, Performance.*ReadPixels/;
+page.on('console', (m) => {
+  if (m.type() === 'error' || (m.type() === 'warning' && !readPixelsNote.test(m.text())))
+    consoleProblems.push(`${m.type()}: ${m.text()}`);
+});
+page.on('pageerror', (e) => consoleProblems.push(`pageerror: ${e.message}`));
+const requests = [];
+page.on('request', (r) => { if (!r.url().startsWith('file:') && !r.url().startsWith('data:')) requests.push(r.url()); });
+
+const started = Date.now();
+await page.goto(pathToFileURL(pagePath).href);
+await page.waitForFunction(() => window.simbotViewer && window.simbotViewer.ready === true, null,
+  { timeout: 60000 });
+const openMs = Date.now() - started;
+console.log(`viewer: the 180-s page (${(readFileSync(pagePath).length / 1e6).toFixed(1)} MB) ` +
+  `was ready ${openMs} ms after navigation`);
+
+// ---- robots where the trace puts them, at three seek positions (sample ticks)
+const TPS = 9216000;
+for (const seconds of [30, 95.05, 170]) {
+  const tick = Math.round(seconds * TPS);
+  await page.evaluate((t) => window.simbotViewer.seek(t), tick);
+  check(await page.evaluate(() => window.simbotViewer.time()) === tick, `seek to ${seconds} s`);
+  for (const robot of ['A', 'B']) {
+    const want = sampleAt(robot, tick);
+    check(want.t === tick, `a sample of ${robot} at ${seconds} s`);
+    const drawn = await page.evaluate((r) => window.simbotViewer.pose(r), robot);
+    const close = (a, b) => Math.abs(a - b) <= 1e-9;
+    check(close(drawn.x_ft, want.x_ft) && close(drawn.y_ft, want.y_ft) &&
+          close(drawn.heading_deg, want.heading_deg),
+    `${robot} at ${seconds} s drawn at ${JSON.stringify(drawn)}, the trace says ` +
+          `(${want.x_ft}, ${want.y_ft}, ${want.heading_deg})`);
+  }
+}
+
+// ---- the highlighted source line of A is the line the trace gives
+for (const seconds of [1.234, 42.5, 97.07, 150.01]) {
+  const tick = Math.round(seconds * TPS);
+  await page.evaluate((t) => window.simbotViewer.seek(t), tick);
+  const want = sampleAt('A', tick).line;
+  const shown = await page.evaluate(() => {
+    const el = document.querySelector('#source-A .current');
+    return el ? Number(el.getAttribute('data-line')) : null;
+  });
+  check(shown === want, `A's highlighted line at ${seconds} s is ${shown}, the trace says ${want}`);
+  check(await page.evaluate(() => window.simbotViewer.currentLine('A')) === want,
+    `currentLine('A') at ${seconds} s`);
+}
+
+// ---- play advances time
+await page.evaluate((t) => window.simbotViewer.seek(t), 10 * TPS);
+await page.evaluate(() => { window.simbotViewer.setSpeed(1); window.simbotViewer.play(); });
+await page.waitForTimeout(700);
+const played = await page.evaluate(() => {
+  const v = window.simbotViewer;
+  const playing = v.playing();
+  v.pause();
+  return { playing, t: v.time() };
+});
+check(played.playing, 'playing after play()');
+check(played.t > 10 * TPS + 0.2 * TPS && played.t < 10 * TPS + 5 * TPS,
+  `0.7 s of playback at 1x moved the cursor from 10 s to ${played.t / TPS} s`);
+
+// ---- every camera preset renders something; screenshots
+await page.evaluate((t) => window.simbotViewer.seek(t), 95 * TPS);
+const cameras = await page.evaluate(() => window.simbotViewer.cameras());
+for (const name of ['overhead', 'corner SW', 'corner SE', 'corner NE', 'corner NW', 'A eye', 'B eye'])
+  check(cameras.includes(name), `camera preset "${name}"`);
+for (const name of cameras) {
+  const stats = await page.evaluate((n) => { window.simbotViewer.setCamera(n); return window.simbotViewer.view3dStats(); }, name);
+  check(stats.nonBackground > 0.01 * stats.width * stats.height,
+    `camera "${name}" renders a non-empty view (${stats.nonBackground} of ${stats.width}x${stats.height} pixels)`);
+  if (name === 'corner SW') await page.locator('#view3d').screenshot({ path: join(out, 'viewer-3d.png') });
+}
+await page.locator('#field2d').screenshot({ path: join(out, 'viewer-2d.png') });
+await page.locator('#timeline').screenshot({ path: join(out, 'viewer-timeline.png') });
+await page.screenshot({ path: join(out, 'viewer.png'), fullPage: true });
+
+check(consoleProblems.length === 0, `console: ${consoleProblems.join(' | ')}`);
+const caught = await page.evaluate(() => window.simbotViewer.errors);
+check(caught.length === 0, `the viewer caught errors: ${caught.join(' | ')}`);
+check(requests.length === 0, `the page made network requests: ${requests.join(' ')}`);
+await browser.close();
+
+console.log(`screenshots: ${join(out, 'viewer-2d.png')}, viewer-3d.png, viewer-timeline.png, viewer.png`);
+if (failures.length) {
+  console.log(`${failures.length} check(s) failed`);
+  process.exit(1);
+}
+console.log('viewer_test: all checks passed');
