@@ -129,7 +129,7 @@ function createField2d(canvas, model) {
   }
 
   // Ball outcomes and referee actions: shown for a while after they happen.
-  function drawMarks(t, poses) {
+  function drawMarks(t) {
     const keep = 4 * model.tps;
     const from = firstAtOrAfter(model.markTicks, t - keep);
     ctx.font = `${Math.max(11, Math.round(0.32 * scale))}px sans-serif`;
@@ -139,7 +139,7 @@ function createField2d(canvas, model) {
       const m = model.marks[i];
       const alpha = 1 - (t - m.t) / keep;
       let x = m.x, y = m.y;
-      if (x === null) ({ x_ft: x, y_ft: y } = poses[m.robot]);
+      if (x === null) ({ x_ft: x, y_ft: y } = poseAt(model.robots[m.robot], m.t));
       ctx.globalAlpha = Math.max(0.15, alpha);
       ctx.strokeStyle = m.kind === 'hit' ? '#ff3030' : m.kind === 'miss' ? '#b0b0b0' : '#ffffff';
       ctx.lineWidth = 2;
@@ -166,7 +166,7 @@ function createField2d(canvas, model) {
     model.robots.forEach((robot, i) => drawEyes(robot, poses[i]));
     drawBalls(t);
     model.robots.forEach((robot, i) => drawRobot(robot, poses[i], states[i]));
-    drawMarks(t, poses);
+    drawMarks(t);
   }
 
   resize();
