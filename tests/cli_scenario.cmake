@@ -33,7 +33,7 @@ expect_json(sim_seconds 2.0)
 
 # match: B comes from the command line, so a scenario's beacon is an error.
 run(1 match ${ICEMAN} ${FIG92} --scenario ${SCENARIOS}/beacon-ahead.toml)
-expect_match("${err}" "beacon-ahead.toml:11: error: match takes B's program from the command line")
+expect_match("${err}" "beacon-ahead.toml:11:10: error: match takes B's program from the command line")
 run(0 match ${ICEMAN} ${FIG92} --scenario ${SCENARIOS}/start-corners.toml --seconds 0.001 --json)
 expect_json("robots;0;final_pose;x_ft" -5.0)
 expect_json("robots;1;final_pose;heading_deg" 225.0)

@@ -1,4 +1,4 @@
-// Scenario files: every key checked with FILE:LINE: error: messages, and
+// Scenario files: every key checked with FILE:LINE:COL: error: messages, and
 // what a scenario does to a run (poses, a beacon on its path, injections).
 #include "tools/scenario.h"
 
@@ -59,16 +59,16 @@ repeat = true
   ASSERT_TRUE(s.a.start);
   EXPECT_EQ(s.a.start->x_ft, 1.5);
   EXPECT_EQ(s.a.start->heading_deg, 270);
-  EXPECT_EQ(s.a.startLine, 5);
+  EXPECT_EQ(s.a.startPos.line, 5);
   EXPECT_EQ(s.a.hardware, kSource + "/profiles/hardware/swapped-guns.toml");
   ASSERT_EQ(s.a.inject.size(), 2u);
   EXPECT_EQ(s.a.inject[1].what, "bumper_front@line:220#3");
-  EXPECT_EQ(s.a.inject[1].line, 7);
+  EXPECT_EQ(s.a.inject[1].pos.line, 7);
   EXPECT_EQ(s.opponent, tools::Scenario::Opponent::Beacon);
   ASSERT_EQ(s.path.size(), 4u);
   EXPECT_EQ(s.path[1].kind, tools::PathLeg::Kind::Arc);
   EXPECT_EQ(s.path[1].turnDeg, -90);
-  EXPECT_EQ(s.path[3].line, 15);
+  EXPECT_EQ(s.path[3].pos.line, 15);
   EXPECT_TRUE(s.repeatPath);
 }
 
@@ -80,74 +80,77 @@ struct Bad {
 TEST(Scenario, EveryMistakeNamesItsLine) {
   const Bad cases[] = {
       {"speed = 3\n",
-       "s.toml:1: error: unknown key 'speed' in the scenario (expected one of: profile, seconds, "
+       "s.toml:1:1: error: unknown key 'speed' in the scenario (expected one of: profile, seconds, "
        "seed, A, B)"},
-      {"\nseconds = -1\n", "s.toml:2: error: 'seconds' must be greater than 0, got -1"},
-      {"seconds = \"ten\"\n", "s.toml:1: error: 'seconds' must be a number"},
-      {"seconds = 2e6\n", "s.toml:1: error: 'seconds' must be at most 1e6"},
-      {"seed = -3\n", "s.toml:1: error: 'seed' must be a non-negative integer"},
+      {"\nseconds = -1\n", "s.toml:2:11: error: 'seconds' must be greater than 0, got -1"},
+      {"seconds = \"ten\"\n", "s.toml:1:11: error: 'seconds' must be a number"},
+      {"seconds = 2e6\n", "s.toml:1:11: error: 'seconds' must be at most 1e6"},
+      {"seed = -3\n", "s.toml:1:8: error: 'seed' must be a non-negative integer"},
       {"profile = \"nosuch\"\n",
-       "s.toml:1: error: 'profile': no profile 'nosuch' in profiles/ (or give a path to a .toml)"},
+       "s.toml:1:11: error: 'profile': no profile 'nosuch' in profiles/ (or give a path to a "
+       ".toml)"},
       {"profile = \"nosuch.toml\"\n",
-       ("s.toml:1: error: 'profile': no file '" + kSource + "/nosuch.toml'")},
-      {"seconds = [1\n", "s.toml:1: error: "},  // toml++'s own description follows
-      {"A = 3\n", "s.toml:1: error: 'A' must be a table ([A])"},
+       ("s.toml:1:11: error: 'profile': no file '" + kSource + "/nosuch.toml'")},
+      {"seconds = [1\n", "s.toml:1:14: error: "},  // toml++'s own description follows
+      {"A = 3\n", "s.toml:1:5: error: 'A' must be a table ([A])"},
       {"[A]\nspeed = 1\n",
-       "s.toml:2: error: unknown key 'speed' in [A] (expected one of: start, hardware, inject)"},
-      {"[A]\nstart = { x_ft = 1, y_ft = 2 }\n", "s.toml:2: error: 'A.start' has no 'heading_deg'"},
+       "s.toml:2:1: error: unknown key 'speed' in [A] (expected one of: start, hardware, inject)"},
+      {"[A]\nstart = { x_ft = 1, y_ft = 2 }\n",
+       "s.toml:2:9: error: 'A.start' has no 'heading_deg'"},
       {"[A]\nstart = { x_ft = 1, y_ft = 2, heading_deg = 0, z_ft = 1 }\n",
-       "s.toml:2: error: unknown key 'z_ft' in 'A.start' (expected one of: x_ft, y_ft, "
+       "s.toml:2:48: error: unknown key 'z_ft' in 'A.start' (expected one of: x_ft, y_ft, "
        "heading_deg)"},
       {"[A]\nstart = { x_ft = 1, y_ft = \"2\", heading_deg = 0 }\n",
-       "s.toml:2: error: 'A.start.y_ft' must be a number"},
+       "s.toml:2:28: error: 'A.start.y_ft' must be a number"},
       {"[A]\nstart = [1, 2, 3]\n",
-       "s.toml:2: error: 'A.start' must be a table { x_ft = ..., y_ft = ..., heading_deg = ... }"},
+       "s.toml:2:9: error: 'A.start' must be a table { x_ft = ..., y_ft = ..., heading_deg = ... "
+       "}"},
       {"[A]\nhardware = \"missing.toml\"\n",
-       ("s.toml:2: error: 'A.hardware': no file '" + kSource + "/missing.toml'")},
+       ("s.toml:2:12: error: 'A.hardware': no file '" + kSource + "/missing.toml'")},
       {"[A]\ninject = \"edge_fore@1s\"\n",
-       "s.toml:2: error: 'A.inject' must be an array of \"SOURCE@WHEN\" strings"},
+       "s.toml:2:10: error: 'A.inject' must be an array of \"SOURCE@WHEN\" strings"},
       {"[A]\ninject = [\n  \"edge_fore@1s\",\n  \"edge_side@1s\",\n]\n",
-       "s.toml:4: error: 'edge_side@1s': SOURCE must be edge_fore, edge_aft, bumper_front or "
+       "s.toml:4:3: error: 'edge_side@1s': SOURCE must be edge_fore, edge_aft, bumper_front or "
        "bumper_back"},
       {"[A]\ninject = [\"edge_fore@soon\"]\n",
-       "s.toml:2: error: 'edge_fore@soon': WHEN must be a time (12.5s, 800ms), a tick "
+       "s.toml:2:11: error: 'edge_fore@soon': WHEN must be a time (12.5s, 800ms), a tick "
        "(115200000t) or a program point (line:N#K)"},
       {"[B]\nprogram = \"nope.dc\"\n",
-       ("s.toml:2: error: 'B.program': no file '" + kSource + "/nope.dc'")},
+       ("s.toml:2:11: error: 'B.program': no file '" + kSource + "/nope.dc'")},
       {"[B]\nprogram = \"programs/spiral.dc\"\nbeacon = true\n",
-       "s.toml:3: error: [B] is either a program or a beacon, not both"},
+       "s.toml:3:10: error: [B] is either a program or a beacon, not both"},
       {"[B]\nbeacon = false\n",
-       "s.toml:2: error: 'B.beacon' must be true (or leave it out and give B.program)"},
+       "s.toml:2:10: error: 'B.beacon' must be true (or leave it out and give B.program)"},
       {"[B]\nprogram = \"programs/spiral.dc\"\npath = [{ wait_s = 1 }]\n",
-       "s.toml:3: error: only a beacon (B.beacon = true) drives a path"},
-      {"[B]\nrepeat = true\n", "s.toml:2: error: only a beacon (B.beacon = true) drives a path"},
+       "s.toml:3:8: error: only a beacon (B.beacon = true) drives a path"},
+      {"[B]\nrepeat = true\n", "s.toml:2:10: error: only a beacon (B.beacon = true) drives a path"},
       {"[B]\nbeacon = true\ninject = [\"edge_fore@1s\"]\n",
-       "s.toml:3: error: a beacon has no program to interrupt; B.inject needs B.program"},
+       "s.toml:3:10: error: a beacon has no program to interrupt; B.inject needs B.program"},
       {"[B]\nbeacon = true\npath = []\n",
-       "s.toml:3: error: 'B.path' must be a non-empty array of legs"},
+       "s.toml:3:8: error: 'B.path' must be a non-empty array of legs"},
       {"[B]\nbeacon = true\npath = [3]\n",
-       "s.toml:3: error: 'B.path[0]' must be a table (forward_ft, arc_radius_ft, spin_deg or "
+       "s.toml:3:9: error: 'B.path[0]' must be a table (forward_ft, arc_radius_ft, spin_deg or "
        "wait_s)"},
       {"[B]\nbeacon = true\npath = [\n { wait_s = 1 },\n { forward_ft = 1, spin_deg = 9, "
        "speed_fps = 1 },\n]\n",
-       "s.toml:5: error: 'B.path[1]' must have exactly one of forward_ft, arc_radius_ft, "
+       "s.toml:5:2: error: 'B.path[1]' must have exactly one of forward_ft, arc_radius_ft, "
        "spin_deg, wait_s"},
       {"[B]\nbeacon = true\npath = [{ forward_ft = 1, turn_deg = 9, speed_fps = 1 }]\n",
-       "s.toml:3: error: 'B.path[0]': turn_deg belongs to an arc (arc_radius_ft)"},
+       "s.toml:3:38: error: 'B.path[0]': turn_deg belongs to an arc (arc_radius_ft)"},
       {"[B]\nbeacon = true\npath = [{ arc_radius_ft = 3, speed_fps = 1 }]\n",
-       "s.toml:3: error: 'B.path[0]' has no 'turn_deg' (the arc's signed angle)"},
+       "s.toml:3:9: error: 'B.path[0]' has no 'turn_deg' (the arc's signed angle)"},
       {"[B]\nbeacon = true\npath = [{ arc_radius_ft = -3, turn_deg = 9, speed_fps = 1 }]\n",
-       "s.toml:3: error: 'B.path[0].arc_radius_ft' must be greater than 0, got -3"},
+       "s.toml:3:27: error: 'B.path[0].arc_radius_ft' must be greater than 0, got -3"},
       {"[B]\nbeacon = true\npath = [{ wait_s = 1, speed_fps = 1 }]\n",
-       "s.toml:3: error: 'B.path[0]': a wait has no speed_fps"},
+       "s.toml:3:35: error: 'B.path[0]': a wait has no speed_fps"},
       {"[B]\nbeacon = true\npath = [{ spin_deg = 90 }]\n",
-       "s.toml:3: error: 'B.path[0]' has no 'speed_fps'"},
+       "s.toml:3:9: error: 'B.path[0]' has no 'speed_fps'"},
       {"[B]\nbeacon = true\npath = [{ forward_ft = 0, speed_fps = 1 }]\n",
-       "s.toml:3: error: 'B.path[0].forward_ft' must not be 0"},
+       "s.toml:3:24: error: 'B.path[0].forward_ft' must not be 0"},
       {"[B]\nbeacon = true\npath = [{ forward_ft = 2, speed_fps = 1, fast = true }]\n",
-       "s.toml:3: error: unknown key 'fast' in 'B.path[0]' (expected one of: forward_ft, "
+       "s.toml:3:42: error: unknown key 'fast' in 'B.path[0]' (expected one of: forward_ft, "
        "arc_radius_ft, turn_deg, spin_deg, wait_s, speed_fps)"},
-      {"[B]\nbeacon = true\nrepeat = 1\n", "s.toml:3: error: 'B.repeat' must be true or false"},
+      {"[B]\nbeacon = true\nrepeat = 1\n", "s.toml:3:10: error: 'B.repeat' must be true or false"},
   };
   for (const Bad& c : cases) {
     const std::string got = errorOf(c.text);
@@ -182,31 +185,31 @@ std::string applyError(const std::string& text, tools::ScenarioUse use, int prog
 
 TEST(Scenario, WhatDoesNotFitTheRunNamesItsLine) {
   EXPECT_EQ(applyError("\n[B]\nbeacon = true\n", tools::ScenarioUse::Match, 2),
-            "s.toml:3: error: match takes B's program from the command line; B.program and "
+            "s.toml:3:10: error: match takes B's program from the command line; B.program and "
             "B.beacon are for solo, profile and bench");
   EXPECT_EQ(applyError("[B]\nstart = { x_ft = 0, y_ft = 0, heading_deg = 0 }\n",
                        tools::ScenarioUse::Solo),
-            "s.toml:1: error: [B] sets up a robot B but names none: give B.program or B.beacon "
+            "s.toml:1:1: error: [B] sets up a robot B but names none: give B.program or B.beacon "
             "= true");
   EXPECT_EQ(applyError("[A]\nstart = { x_ft = 9, y_ft = 0, heading_deg = 0 }\n",
                        tools::ScenarioUse::Solo),
-            "s.toml:2: error: start (9, 0) ft puts the body outside the 16-ft field");
+            "s.toml:2:9: error: start (9, 0) ft puts the body outside the 16-ft field");
   EXPECT_EQ(applyError("[A]\nstart = { x_ft = 0.2, y_ft = -6, heading_deg = 0 }\n",
                        tools::ScenarioUse::Solo),
-            "s.toml:2: error: start (0.2, -6) ft puts the body on the divider");
+            "s.toml:2:9: error: start (0.2, -6) ft puts the body on the divider");
   EXPECT_EQ(applyError("[A]\nstart = { x_ft = 1, y_ft = 1, heading_deg = 0 }\n[B]\nstart = "
                        "{ x_ft = 1.5, y_ft = 1, heading_deg = 0 }\n",
                        tools::ScenarioUse::Match, 2),
-            "s.toml:4: error: the two robots' start poses overlap");
+            "s.toml:4:9: error: the two robots' start poses overlap");
   EXPECT_EQ(applyError("[A]\ninject = [\"edge_fore@line:1#1\"]\n", tools::ScenarioUse::Solo),
-            "s.toml:2: error: line 1 of " + kSource + "/programs/spiral.dc has no code");
+            "s.toml:2:11: error: line 1 of " + kSource + "/programs/spiral.dc has no code");
   EXPECT_EQ(applyError("[A]\nstart = { x_ft = 1, y_ft = 0, heading_deg = 0 }\n",
                        tools::ScenarioUse::Bench),
-            "s.toml:2: error: a bench family places the robots and picks B; leave out --family "
+            "s.toml:2:9: error: a bench family places the robots and picks B; leave out --family "
             "to run this scenario's own poses and opponent");
   EXPECT_EQ(
       applyError("[B]\nbeacon = true\npath = [{ wait_s = 1e-9 }]\n", tools::ScenarioUse::Solo),
-      "s.toml:3: error: this leg lasts 1e-09 s, which is not between one tick and 1e8 s");
+      "s.toml:3:9: error: this leg lasts 1e-09 s, which is not between one tick and 1e8 s");
   // The same B set-up is fine for a match when it names no program.
   EXPECT_EQ(applyError("[B]\nstart = { x_ft = 0, y_ft = 3, heading_deg = 0 }\n",
                        tools::ScenarioUse::Match, 2),

@@ -27,23 +27,32 @@ namespace {
 
 namespace fs = std::filesystem;
 
+SourcePos posOf(const toml::source_region& where) {
+  return {static_cast<int>(where.begin.line), static_cast<int>(where.begin.column)};
+}
+
+std::string scenarioError(const std::string& file, SourcePos at, const std::string& msg) {
+  return fmt::format("{}:{}:{}: error: {}", file, at.line < 1 ? 1 : at.line,
+                     at.column < 1 ? 1 : at.column, msg);
+}
+
 class Walker {
  public:
   Walker(std::string file, std::string baseDir)
       : file_(std::move(file)), base_(std::move(baseDir)) {}
 
-  [[noreturn]] void fail(int line, const std::string& msg) const {
-    throw plant::ConfigError(fmt::format("{}:{}: error: {}", file_, line < 1 ? 1 : line, msg));
+  [[noreturn]] void fail(SourcePos at, const std::string& msg) const {
+    throw plant::ConfigError(scenarioError(file_, at, msg));
   }
   [[noreturn]] void fail(const toml::node& n, const std::string& msg) const {
-    fail(static_cast<int>(n.source().begin.line), msg);
+    fail(posOf(n.source()), msg);
   }
 
   toml::table parse(std::string_view text) const {
     try {
       return toml::parse(text, file_);
     } catch (const toml::parse_error& e) {
-      fail(static_cast<int>(e.source().begin.line), std::string(e.description()));
+      fail(posOf(e.source()), std::string(e.description()));
     }
   }
 
@@ -58,7 +67,7 @@ class Walker {
         list += list.empty() ? a : std::string(", ") + a;
       }
       if (!known)
-        fail(static_cast<int>(key.source().begin.line),
+        fail(posOf(key.source()),
              fmt::format("unknown key '{}' in {} (expected one of: {})", key.str(), where, list));
     }
   }
@@ -112,7 +121,7 @@ class Walker {
   void robot(const toml::table& t, const char* section, ScenarioRobot& r) const {
     if (const toml::node* n = t.get("start")) {
       r.start = pose(*n, std::string(section) + ".start");
-      r.startLine = static_cast<int>(n->source().begin.line);
+      r.startPos = posOf(n->source());
     }
     if (const toml::node* n = t.get("hardware"))
       r.hardware = file(*n, std::string(section) + ".hardware");
@@ -131,7 +140,7 @@ class Walker {
           if (const auto at = msg.find("'A:"); at != std::string::npos) msg.erase(at + 1, 2);
           fail(e, msg);
         }
-        r.inject.push_back({what, static_cast<int>(e.source().begin.line)});
+        r.inject.push_back({what, posOf(e.source())});
       }
     }
   }
@@ -149,7 +158,7 @@ class Walker {
     onlyKeys(*t, ("'" + name + "'").c_str(),
              {"forward_ft", "arc_radius_ft", "turn_deg", "spin_deg", "wait_s", "speed_fps"});
     PathLeg leg;
-    leg.line = static_cast<int>(n.source().begin.line);
+    leg.pos = posOf(n.source());
     const int kinds = (t->contains("forward_ft") ? 1 : 0) + (t->contains("arc_radius_ft") ? 1 : 0) +
                       (t->contains("spin_deg") ? 1 : 0) + (t->contains("wait_s") ? 1 : 0);
     if (kinds != 1)
@@ -223,19 +232,19 @@ class Walker {
       if (!t) fail(*n, "'B' must be a table ([B])");
       onlyKeys(*t, "[B]", {"program", "beacon", "start", "hardware", "inject", "path", "repeat"});
       robot(*t, "B", s.b);
-      s.opponentLine = static_cast<int>(n->source().begin.line);
+      s.opponentPos = posOf(n->source());
       const toml::node* program = t->get("program");
       const toml::node* beacon = t->get("beacon");
       if (program && beacon) fail(*beacon, "[B] is either a program or a beacon, not both");
       if (program) {
         s.opponent = Scenario::Opponent::Program;
-        s.opponentLine = static_cast<int>(program->source().begin.line);
+        s.opponentPos = posOf(program->source());
         s.program = file(*program, "B.program");
       } else if (beacon) {
         if (!beacon->is_boolean() || !*beacon->value<bool>())
           fail(*beacon, "'B.beacon' must be true (or leave it out and give B.program)");
         s.opponent = Scenario::Opponent::Beacon;
-        s.opponentLine = static_cast<int>(beacon->source().begin.line);
+        s.opponentPos = posOf(beacon->source());
       }
       const toml::node* path = t->get("path");
       const toml::node* repeat = t->get("repeat");
@@ -315,9 +324,9 @@ std::vector<scheduler::DriveLeg> driveLegs(const std::string& sourceName,
     }
     const double ticks = std::round(seconds * static_cast<double>(scheduler::kTicksPerSecond));
     if (!(ticks >= 1) || ticks > 1e15)
-      throw plant::ConfigError(
-          fmt::format("{}:{}: error: this leg lasts {} s, which is not between one tick and 1e8 s",
-                      sourceName, leg.line, seconds));
+      throw plant::ConfigError(scenarioError(
+          sourceName, leg.pos,
+          fmt::format("this leg lasts {} s, which is not between one tick and 1e8 s", seconds)));
     out.push_back({static_cast<scheduler::Tick>(ticks), left, right});
   }
   return out;
@@ -333,22 +342,22 @@ scheduler::RobotSpec beaconSpec(std::vector<scheduler::DriveLeg> legs, bool repe
 
 void applyScenario(const Scenario& s, ScenarioUse use, const plant::Profile& profile,
                    scheduler::MatchConfig& config, std::array<bool, 2> keepHardware) {
-  auto fail = [&](int line, const std::string& msg) {
-    throw plant::ConfigError(fmt::format("{}:{}: error: {}", s.file, line < 1 ? 1 : line, msg));
+  auto fail = [&](SourcePos at, const std::string& msg) {
+    throw plant::ConfigError(scenarioError(s.file, at, msg));
   };
   const bool bFromScenario = s.opponent != Scenario::Opponent::None;
   switch (use) {
     case ScenarioUse::Match:
       if (bFromScenario)
-        fail(s.opponentLine,
+        fail(s.opponentPos,
              "match takes B's program from the command line; "
              "B.program and B.beacon are for solo, profile and bench");
       break;
     case ScenarioUse::Bench:
       if (bFromScenario || s.a.start || s.b.start)
-        fail(bFromScenario ? s.opponentLine
-             : s.a.start   ? s.a.startLine
-                           : s.b.startLine,
+        fail(bFromScenario ? s.opponentPos
+             : s.a.start   ? s.a.startPos
+                           : s.b.startPos,
              "a bench family places the robots and picks B; leave out --family to run "
              "this scenario's own poses and opponent");
       break;
@@ -356,7 +365,7 @@ void applyScenario(const Scenario& s, ScenarioUse use, const plant::Profile& pro
     case ScenarioUse::Profile:
     case ScenarioUse::BenchOwn:
       if (!bFromScenario && (s.b.start || !s.b.hardware.empty() || !s.b.inject.empty()))
-        fail(s.opponentLine,
+        fail(s.opponentPos,
              "[B] sets up a robot B but names none: give B.program or B.beacon = true");
       break;
   }
@@ -381,10 +390,10 @@ void applyScenario(const Scenario& s, ScenarioUse use, const plant::Profile& pro
       const double half = profile.field.size_ft / 2, radius = setup.params.body_diameter_ft / 2;
       const double x = r.start->x_ft, y = r.start->y_ft;
       if (std::fabs(x) + radius > half || std::fabs(y) + radius > half)
-        fail(r.startLine, fmt::format("start ({}, {}) ft puts the body outside the {}-ft field", x,
-                                      y, profile.field.size_ft));
+        fail(r.startPos, fmt::format("start ({}, {}) ft puts the body outside the {}-ft field", x,
+                                     y, profile.field.size_ft));
       if (plant::dividerClearance(x, y, radius, profile.field) <= 0)
-        fail(r.startLine, fmt::format("start ({}, {}) ft puts the body on the divider", x, y));
+        fail(r.startPos, fmt::format("start ({}, {}) ft puts the body on the divider", x, y));
       setup.start = *r.start;
     }
     if (!r.hardware.empty() && !keepHardware[i])
@@ -395,7 +404,7 @@ void applyScenario(const Scenario& s, ScenarioUse use, const plant::Profile& pro
       if (injection.line > 0) {
         const auto& lines = config.robots[i].image.lines;
         if (std::find(lines.begin(), lines.end(), injection.line) == lines.end())
-          fail(in.line,
+          fail(in.pos,
                fmt::format("line {} of {} has no code", injection.line, config.robots[i].program));
       }
       config.injections.push_back(std::move(injection));
@@ -408,7 +417,7 @@ void applyScenario(const Scenario& s, ScenarioUse use, const plant::Profile& pro
                           config.arena.robots[1].params.body_diameter_ft) /
                          2;
     if (std::hypot(a.x_ft - b.x_ft, a.y_ft - b.y_ft) <= touch)
-      fail(s.b.start ? s.b.startLine : s.a.startLine, "the two robots' start poses overlap");
+      fail(s.b.start ? s.b.startPos : s.a.startPos, "the two robots' start poses overlap");
   }
   if (robots == 2 && s.opponent == Scenario::Opponent::Beacon && !s.path.empty()) {
     config.robots[1].path = driveLegs(s.file, s.path, config.arena.robots[1].params);

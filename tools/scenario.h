@@ -4,7 +4,7 @@
 // file and injections, and robot B: another program, or a beacon that
 // stands still or drives a scripted path. The schema is in the README
 // ("Scenarios"); every key is checked, and every error is reported as
-// FILE:LINE: error: MESSAGE.
+// FILE:LINE:COL: error: MESSAGE.
 //
 // What the command line says explicitly wins over the scenario (--profile,
 // --seconds, --seed, --hw); --inject adds to the scenario's injections.
@@ -20,6 +20,13 @@
 
 namespace simbot::tools {
 
+// Where something is in the scenario file, for the errors found when the
+// run is set up.
+struct SourcePos {
+  int line = 0;
+  int column = 0;
+};
+
 // One leg of a beacon's path, as the scenario file states it.
 struct PathLeg {
   enum class Kind : uint8_t { Forward, Arc, Spin, Wait } kind = Kind::Wait;
@@ -28,16 +35,16 @@ struct PathLeg {
   double turnDeg = 0;    // Arc, Spin: signed turn, + clockwise (to the right)
   double speedFps = 0;   // Forward, Arc: centre speed; Spin: wheel speed
   double waitS = 0;      // Wait
-  int line = 0;
+  SourcePos pos;
 };
 
 struct ScenarioRobot {
   std::optional<plant::Pose> start;
-  int startLine = 0;
+  SourcePos startPos;
   std::string hardware;  // resolved path; empty: the default bindings
   struct Inject {
     std::string what;  // SOURCE@WHEN as written
-    int line = 0;
+    SourcePos pos;
   };
   std::vector<Inject> inject;
 };
@@ -49,8 +56,8 @@ struct Scenario {
   std::optional<uint64_t> seed;
   ScenarioRobot a, b;
   enum class Opponent : uint8_t { None, Program, Beacon } opponent = Opponent::None;
-  int opponentLine = 0;  // the line of [B]'s program or beacon key
-  std::string program;   // B's program (resolved path)
+  SourcePos opponentPos;  // [B]'s program or beacon key
+  std::string program;    // B's program (resolved path)
   std::vector<PathLeg> path;
   bool repeatPath = false;
 };
@@ -63,7 +70,7 @@ T preferCommandLine(bool givenOnCommandLine, const std::optional<T>& fromScenari
   return !givenOnCommandLine && fromScenario ? *fromScenario : fromCommand;
 }
 
-// Throws plant::ConfigError ("FILE:LINE: error: ..."). Relative paths in the
+// Throws plant::ConfigError ("FILE:LINE:COL: error: ..."). Relative paths in the
 // file (profile, hardware, program) are taken from the file's directory.
 Scenario loadScenario(const std::string& path);
 Scenario parseScenario(std::string_view text, const std::string& sourceName,
@@ -71,7 +78,7 @@ Scenario parseScenario(std::string_view text, const std::string& sourceName,
 
 // A beacon's path as wheel speeds and exact tick durations, with the
 // beacon's own track (the scheduler follows a path exactly: no motor lag). Throws
-// plant::ConfigError naming the leg's line if a leg is shorter than a tick.
+// plant::ConfigError naming the leg's place if a leg is shorter than a tick.
 std::vector<scheduler::DriveLeg> driveLegs(const std::string& sourceName,
                                            const std::vector<PathLeg>& legs,
                                            const plant::RobotParams& params);
@@ -93,7 +100,8 @@ enum class ScenarioUse : uint8_t {
 // `config` and whose arena was made from `profile` for those robots: start
 // poses, hardware (unless `keepHardware[i]`: given on the command line),
 // B when the scenario adds one, and injections (appended). Throws
-// plant::ConfigError naming the scenario line of anything that does not fit.
+// plant::ConfigError naming the place in the scenario of anything that does
+// not fit.
 void applyScenario(const Scenario& s, ScenarioUse use, const plant::Profile& profile,
                    scheduler::MatchConfig& config, std::array<bool, 2> keepHardware = {});
 
