@@ -44,9 +44,9 @@ SIMBOT_INCBIN(orbit, SIMBOT_ORBIT_JS)
 std::string_view viewerHtml() { return asset_html(); }
 std::string_view viewerCss() { return asset_css(); }
 std::vector<std::pair<std::string_view, std::string_view>> viewerScripts() {
-  return {{"model.js", asset_model()},       {"field2d.js", asset_field2d()},
-          {"scene3d.js", asset_scene3d()},   {"timeline.js", asset_timeline()},
-          {"source.js", asset_source()},     {"app.js", asset_app()}};
+  return {{"model.js", asset_model()},     {"field2d.js", asset_field2d()},
+          {"scene3d.js", asset_scene3d()}, {"timeline.js", asset_timeline()},
+          {"source.js", asset_source()},   {"app.js", asset_app()}};
 }
 std::string_view threeJs() { return asset_three(); }
 std::string_view orbitControlsJs() { return asset_orbit(); }
