@@ -21,6 +21,7 @@
 
 #include <cmath>
 #include <functional>
+#include <optional>
 
 #include "plant/plant.h"
 
@@ -43,7 +44,15 @@ enum class Kind {
   SpeedTable,   // array of 16 speeds
 };
 
-enum class Range { Any, NonNeg, Pos };
+// The physically sensible values of a key, in internal units (ft, s,
+// ft/s, ft/s^2, deg, readings, counts): wide enough for any real robot of
+// the kind, narrow enough that the integrator never meets a value that
+// breaks it. `orZero`: 0 is allowed too (an instant motor or gun wheel),
+// else the value must be at least `lo`.
+struct Bounds {
+  double lo, hi;
+  bool orZero = false;
+};
 
 struct Target {
   double* d = nullptr;
@@ -56,7 +65,7 @@ struct KeyDef {
   const char* section;
   const char* key;
   Kind kind;
-  Range range;
+  Bounds bounds;
   bool perRobot;
   std::function<Target(Profile&, Hardware&)> target;
 };
@@ -88,81 +97,93 @@ struct KeyDef {
 
 const std::vector<KeyDef>& keyTable() {
   static const std::vector<KeyDef> keys = {
-      {"field", "size", Kind::Length, Range::Pos, false, D(p.field.size_ft)},
-      {"field", "wire_inset", Kind::Length, Range::NonNeg, false, D(p.field.wire_inset_ft)},
-      {"field", "wire_sensitivity", Kind::Length, Range::Pos, false,
-       D(p.field.wire_sensitivity_ft)},
-      {"field", "field_walls", Kind::Bool, Range::Any, false, B(p.field.field_walls)},
-      {"field", "divider_x", Kind::Length, Range::Any, false, D(p.field.divider_x_ft)},
-      {"field", "divider_south", Kind::Length, Range::Any, false, D(p.field.divider_south_ft)},
-      {"field", "divider_north", Kind::Length, Range::Any, false, D(p.field.divider_north_ft)},
-      {"field", "divider_thickness", Kind::Length, Range::NonNeg, false,
-       D(p.field.divider_thickness_ft)},
-      {"field", "divider_height", Kind::Length, Range::NonNeg, false, D(p.field.divider_height_ft)},
-      {"start", "a_x", Kind::Length, Range::Any, false, D(p.field.start[0].x_ft)},
-      {"start", "a_y", Kind::Length, Range::Any, false, D(p.field.start[0].y_ft)},
-      {"start", "a_heading", Kind::Angle, Range::Any, false, D(p.field.start[0].heading_deg)},
-      {"start", "b_x", Kind::Length, Range::Any, false, D(p.field.start[1].x_ft)},
-      {"start", "b_y", Kind::Length, Range::Any, false, D(p.field.start[1].y_ft)},
-      {"start", "b_heading", Kind::Angle, Range::Any, false, D(p.field.start[1].heading_deg)},
-      {"robot", "body_diameter", Kind::Length, Range::Pos, true, D(p.robot.body_diameter_ft)},
-      {"robot", "target_height", Kind::Length, Range::Pos, true, D(p.robot.target_height_ft)},
-      {"robot", "edge_detector_inset", Kind::Length, Range::NonNeg, true,
+      {"field", "size", Kind::Length, {1, 100}, false, D(p.field.size_ft)},
+      {"field", "wire_inset", Kind::Length, {0, 10}, false, D(p.field.wire_inset_ft)},
+      {"field", "wire_sensitivity", Kind::Length, {0.01, 1}, false, D(p.field.wire_sensitivity_ft)},
+      {"field", "field_walls", Kind::Bool, {0, 0}, false, B(p.field.field_walls)},
+      {"field", "divider_x", Kind::Length, {-50, 50}, false, D(p.field.divider_x_ft)},
+      {"field", "divider_south", Kind::Length, {-50, 50}, false, D(p.field.divider_south_ft)},
+      {"field", "divider_north", Kind::Length, {-50, 50}, false, D(p.field.divider_north_ft)},
+      {"field", "divider_thickness", Kind::Length, {0, 2}, false, D(p.field.divider_thickness_ft)},
+      {"field", "divider_height", Kind::Length, {0, 20}, false, D(p.field.divider_height_ft)},
+      {"start", "a_x", Kind::Length, {-50, 50}, false, D(p.field.start[0].x_ft)},
+      {"start", "a_y", Kind::Length, {-50, 50}, false, D(p.field.start[0].y_ft)},
+      {"start", "a_heading", Kind::Angle, {-360, 360}, false, D(p.field.start[0].heading_deg)},
+      {"start", "b_x", Kind::Length, {-50, 50}, false, D(p.field.start[1].x_ft)},
+      {"start", "b_y", Kind::Length, {-50, 50}, false, D(p.field.start[1].y_ft)},
+      {"start", "b_heading", Kind::Angle, {-360, 360}, false, D(p.field.start[1].heading_deg)},
+      {"robot", "body_diameter", Kind::Length, {0.1, 5}, true, D(p.robot.body_diameter_ft)},
+      {"robot", "target_height", Kind::Length, {0.1, 10}, true, D(p.robot.target_height_ft)},
+      {"robot",
+       "edge_detector_inset",
+       Kind::Length,
+       {0, 2.5},
+       true,
        D(p.robot.edge_detector_inset_ft)},
-      {"robot", "wheel_diameter", Kind::Length, Range::Pos, true, D(p.robot.wheel_diameter_ft)},
-      {"robot", "track", Kind::Length, Range::Pos, true, D(p.robot.track_ft)},
-      {"robot", "speed_table", Kind::SpeedTable, Range::NonNeg, true,
+      {"robot", "wheel_diameter", Kind::Length, {0.05, 2}, true, D(p.robot.wheel_diameter_ft)},
+      {"robot", "track", Kind::Length, {0.05, 5}, true, D(p.robot.track_ft)},
+      {"robot",
+       "speed_table",
+       Kind::SpeedTable,
+       {0, 20},
+       true,
        [](Profile& p, Hardware&) {
          Target t;
          t.table = &p.robot.speed_table_fps;
          return t;
        }},
-      {"robot", "left_trim", Kind::Ratio, Range::Pos, true, D(p.robot.left_trim)},
-      {"robot", "right_trim", Kind::Ratio, Range::Pos, true, D(p.robot.right_trim)},
-      {"robot", "motor_lag", Kind::Time, Range::NonNeg, true, D(p.robot.motor_lag_s)},
-      {"bumper", "reflex_distance", Kind::Length, Range::Pos, true, D(p.robot.reflex_distance_ft)},
-      {"bumper", "reflex_speed_step", Kind::Step, Range::Any, true, I(p.robot.reflex_speed_step)},
-      {"eyes", "max", Kind::Reading, Range::Pos, true, D(p.robot.eye_max)},
-      {"eyes", "background", Kind::Reading, Range::NonNeg, true, D(p.robot.eye_background)},
-      {"eyes", "saturation_distance", Kind::Length, Range::Pos, true, D(p.robot.eye_saturation_ft)},
-      {"eyes", "left_width", Kind::Length, Range::Pos, true, D(p.robot.left_eye_width)},
-      {"eyes", "right_width", Kind::Length, Range::Pos, true, D(p.robot.right_eye_width)},
-      {"eyes", "nose", Kind::Length, Range::Pos, true, D(p.robot.eye_nose)},
-      {"eyes", "noise_sigma", Kind::Reading, Range::NonNeg, true, D(p.robot.noise_sigma)},
-      {"eyes", "bad_reading_probability", Kind::Probability, Range::NonNeg, true,
+      {"robot", "left_trim", Kind::Ratio, {0.5, 2}, true, D(p.robot.left_trim)},
+      {"robot", "right_trim", Kind::Ratio, {0.5, 2}, true, D(p.robot.right_trim)},
+      {"robot", "motor_lag", Kind::Time, {0.001, 10, true}, true, D(p.robot.motor_lag_s)},
+      {"bumper", "reflex_distance", Kind::Length, {0.05, 20}, true, D(p.robot.reflex_distance_ft)},
+      {"bumper", "reflex_speed_step", Kind::Step, {0, 15}, true, I(p.robot.reflex_speed_step)},
+      {"eyes", "max", Kind::Reading, {16, 65535}, true, D(p.robot.eye_max)},
+      {"eyes", "background", Kind::Reading, {0, 65535}, true, D(p.robot.eye_background)},
+      {"eyes", "saturation_distance", Kind::Length, {0.1, 50}, true, D(p.robot.eye_saturation_ft)},
+      {"eyes", "left_width", Kind::Length, {0.001, 1}, true, D(p.robot.left_eye_width)},
+      {"eyes", "right_width", Kind::Length, {0.001, 1}, true, D(p.robot.right_eye_width)},
+      {"eyes", "nose", Kind::Length, {0.001, 1}, true, D(p.robot.eye_nose)},
+      {"eyes", "noise_sigma", Kind::Reading, {0, 4096}, true, D(p.robot.noise_sigma)},
+      {"eyes",
+       "bad_reading_probability",
+       Kind::Probability,
+       {0, 1},
+       true,
        D(p.robot.bad_reading_probability)},
-      {"eyes", "thesis_swapped_eyes", Kind::Bool, Range::Any, true, B(p.robot.thesis_swapped_eyes)},
-      {"gun", "wheel_lag", Kind::Time, Range::NonNeg, true, D(p.robot.gun_wheel_lag_s)},
-      {"gun", "motors_always_on", Kind::Bool, Range::Any, true, B(p.robot.gun_motors_always_on)},
-      {"gun", "stroke_time", Kind::Time, Range::NonNeg, true, D(p.robot.stroke_s)},
-      {"gun", "muzzle_speed", Kind::Speed, Range::Pos, true, D(p.robot.muzzle_speed_fps)},
-      {"gun", "launch_height", Kind::Length, Range::Pos, true, D(p.robot.launch_height_ft)},
-      {"gun", "balls_per_gun", Kind::Count, Range::Any, true, I(p.robot.balls_per_gun)},
-      {"gun", "jam_probability", Kind::Probability, Range::NonNeg, true,
-       D(p.robot.jam_probability)},
-      {"gun", "misfire_probability", Kind::Probability, Range::NonNeg, true,
+      {"eyes", "thesis_swapped_eyes", Kind::Bool, {0, 0}, true, B(p.robot.thesis_swapped_eyes)},
+      {"gun", "wheel_lag", Kind::Time, {0.001, 10, true}, true, D(p.robot.gun_wheel_lag_s)},
+      {"gun", "motors_always_on", Kind::Bool, {0, 0}, true, B(p.robot.gun_motors_always_on)},
+      {"gun", "stroke_time", Kind::Time, {0, 2}, true, D(p.robot.stroke_s)},
+      {"gun", "muzzle_speed", Kind::Speed, {1, 1000}, true, D(p.robot.muzzle_speed_fps)},
+      {"gun", "launch_height", Kind::Length, {0.05, 10}, true, D(p.robot.launch_height_ft)},
+      {"gun", "balls_per_gun", Kind::Count, {0, 16}, true, I(p.robot.balls_per_gun)},
+      {"gun", "jam_probability", Kind::Probability, {0, 1}, true, D(p.robot.jam_probability)},
+      {"gun",
+       "misfire_probability",
+       Kind::Probability,
+       {0, 1},
+       true,
        D(p.robot.misfire_probability)},
-      {"controller", "random_memory", Kind::Bool, Range::Any, true, B(p.robot.random_memory)},
-      {"projectile", "gravity", Kind::Accel, Range::Pos, false, D(p.field.gravity_fps2)},
-      {"projectile", "count_floor_skips", Kind::Bool, Range::Any, false,
-       B(p.field.count_floor_skips)},
-      {"referee", "reflex_limit", Kind::Count, Range::Any, false, I(p.referee.reflex_limit)},
-      {"referee", "event_limit", Kind::Count, Range::Any, false, I(p.referee.event_limit)},
-      {"referee", "window", Kind::Time, Range::Pos, false, D(p.referee.window_s)},
-      {"referee", "putback", Kind::Length, Range::NonNeg, false, D(p.referee.putback_ft)},
-      {"referee", "turn", Kind::Angle, Range::Any, false, D(p.referee.turn_deg)},
-      {"match", "round_length", Kind::Time, Range::Pos, false, D(p.round_length_s)},
+      {"controller", "random_memory", Kind::Bool, {0, 0}, true, B(p.robot.random_memory)},
+      {"projectile", "gravity", Kind::Accel, {1, 1000}, false, D(p.field.gravity_fps2)},
+      {"projectile", "count_floor_skips", Kind::Bool, {0, 0}, false, B(p.field.count_floor_skips)},
+      {"referee", "reflex_limit", Kind::Count, {0, 15}, false, I(p.referee.reflex_limit)},
+      {"referee", "event_limit", Kind::Count, {0, 15}, false, I(p.referee.event_limit)},
+      {"referee", "window", Kind::Time, {0.1, 3600}, false, D(p.referee.window_s)},
+      {"referee", "putback", Kind::Length, {0, 10}, false, D(p.referee.putback_ft)},
+      {"referee", "turn", Kind::Angle, {-360, 360}, false, D(p.referee.turn_deg)},
+      {"match", "round_length", Kind::Time, {1, 1e6}, false, D(p.round_length_s)},
   };
   return keys;
 }
 
 const std::vector<KeyDef>& portTable() {
   static const std::vector<KeyDef> keys = {
-      {"ports", "gun1_motor", Kind::Bit, Range::Any, true, I(h.gun_motor_bit[0])},
-      {"ports", "gun1_solenoid", Kind::Bit, Range::Any, true, I(h.gun_solenoid_bit[0])},
-      {"ports", "gun2_motor", Kind::Bit, Range::Any, true, I(h.gun_motor_bit[1])},
-      {"ports", "gun2_solenoid", Kind::Bit, Range::Any, true, I(h.gun_solenoid_bit[1])},
-      {"ports", "disc_shooter", Kind::Bit, Range::Any, true, I(h.disc_shooter_bit)},
+      {"ports", "gun1_motor", Kind::Bit, {0, 7}, true, I(h.gun_motor_bit[0])},
+      {"ports", "gun1_solenoid", Kind::Bit, {0, 7}, true, I(h.gun_solenoid_bit[0])},
+      {"ports", "gun2_motor", Kind::Bit, {0, 7}, true, I(h.gun_motor_bit[1])},
+      {"ports", "gun2_solenoid", Kind::Bit, {0, 7}, true, I(h.gun_solenoid_bit[1])},
+      {"ports", "disc_shooter", Kind::Bit, {0, 7}, true, I(h.disc_shooter_bit)},
   };
   return keys;
 }
@@ -251,6 +272,33 @@ const char* allowedUnits(Kind k) {
   return "";
 }
 
+// The internal unit of a kind, for messages about its range.
+const char* internalUnit(Kind k) {
+  switch (k) {
+    case Kind::Length:
+      return "ft";
+    case Kind::Speed:
+    case Kind::SpeedTable:
+      return "ft/s";
+    case Kind::Time:
+      return "s";
+    case Kind::Angle:
+      return "deg";
+    case Kind::Accel:
+      return "ft/s^2";
+    default:
+      return allowedUnits(k);
+  }
+}
+
+// A TOML number as a double. toml++ gives no double for an integer it
+// cannot represent exactly (beyond 2^53), so integers are converted here.
+std::optional<double> numberOf(const toml::node& n) {
+  if (const auto* i = n.as_integer()) return static_cast<double>(i->get());
+  if (const auto* f = n.as_floating_point()) return f->get();
+  return std::nullopt;
+}
+
 class Checker {
  public:
   explicit Checker(std::string file) : file_(std::move(file)) {}
@@ -267,6 +315,18 @@ class Checker {
     } catch (const toml::parse_error& e) {
       fail(e.source(), std::string(e.description()));
     }
+  }
+
+  // Fails unless v (internal units) is within the key's bounds.
+  void checkBounds(const KeyDef& def, const toml::node& at, const std::string& name,
+                   double v) const {
+    const Bounds& b = def.bounds;
+    if (!std::isfinite(v)) fail(at.source(), fmt::format("'{}' must be finite", name));
+    if (b.orZero && v == 0) return;
+    if (v >= b.lo && v <= b.hi) return;
+    fail(at.source(), fmt::format("'{}' must be {}between {} and {} {}, got {} {}", name,
+                                  b.orZero ? "0 or " : "", b.lo, b.hi, internalUnit(def.kind), v,
+                                  internalUnit(def.kind)));
   }
 
   // Applies one entry (an inline table) to its target.
@@ -317,11 +377,13 @@ class Checker {
       case Kind::Count:
       case Kind::Step:
       case Kind::Bit: {
-        if (!value->is_integer())
-          fail(value->source(), fmt::format("'{}' must be an integer", name));
-        const std::int64_t v = *value->value<std::int64_t>();
-        const std::int64_t hi = def.kind == Kind::Step ? 15 : def.kind == Kind::Bit ? 7 : 1000000;
-        if (v < 0 || v > hi) fail(value->source(), fmt::format("'{}' must be in 0..{}", name, hi));
+        const auto* integer = value->as_integer();
+        if (!integer) fail(value->source(), fmt::format("'{}' must be an integer", name));
+        const std::int64_t v = integer->get();
+        if (v < static_cast<std::int64_t>(def.bounds.lo) ||
+            v > static_cast<std::int64_t>(def.bounds.hi))
+          fail(value->source(),
+               fmt::format("'{}' must be in {}..{}", name, def.bounds.lo, def.bounds.hi));
         *t.i = static_cast<int>(v);
         return;
       }
@@ -333,23 +395,19 @@ class Checker {
                fmt::format("'{}' must have 16 entries (steps 0..f), has {}", name, arr->size()));
         for (std::size_t i = 0; i < 16; ++i) {
           const toml::node& e = *arr->get(i);
-          if (!e.is_number()) fail(e.source(), fmt::format("'{}[{}]' must be a number", name, i));
-          const double v = *e.value<double>() * factor;
-          if (v < 0) fail(e.source(), fmt::format("'{}[{}]' must not be negative", name, i));
+          const auto number = numberOf(e);
+          if (!number) fail(e.source(), fmt::format("'{}[{}]' must be a number", name, i));
+          const double v = *number * factor;
+          checkBounds(def, e, fmt::format("{}[{}]", name, i), v);
           (*t.table)[i] = v;
         }
         return;
       }
       default: {
-        if (!value->is_number()) fail(value->source(), fmt::format("'{}' must be a number", name));
-        const double v = *value->value<double>() * factor;
-        if (!std::isfinite(v)) fail(value->source(), fmt::format("'{}' must be finite", name));
-        if (def.range == Range::NonNeg && v < 0)
-          fail(value->source(), fmt::format("'{}' must not be negative", name));
-        if (def.range == Range::Pos && !(v > 0))
-          fail(value->source(), fmt::format("'{}' must be positive", name));
-        if (def.kind == Kind::Probability && v > 1)
-          fail(value->source(), fmt::format("'{}' must be at most 1", name));
+        const auto number = numberOf(*value);
+        if (!number) fail(value->source(), fmt::format("'{}' must be a number", name));
+        const double v = *number * factor;
+        checkBounds(def, *value, name, v);
         *t.d = v;
         return;
       }
@@ -414,8 +472,18 @@ void crossChecks(const Profile& p, const Checker& c, const toml::table& doc) {
     const toml::node* n = doc.get(section);
     return n ? n->source() : doc.source();
   };
+  const double half = p.field.size_ft / 2 + 1e-9;  // units converted to ft round a little
   if (p.field.wire_inset_ft * 2 >= p.field.size_ft)
     c.fail(where("field"), "wire_inset leaves no field inside the wire");
+  if (std::abs(p.field.divider_x_ft) > half || std::abs(p.field.divider_south_ft) > half ||
+      std::abs(p.field.divider_north_ft) > half)
+    c.fail(where("field"), "the divider must lie inside the field");
+  for (const Pose& start : p.field.start)
+    if (std::abs(start.x_ft) + p.robot.body_diameter_ft / 2 > half ||
+        std::abs(start.y_ft) + p.robot.body_diameter_ft / 2 > half)
+      c.fail(where("start"), "a start pose puts the body outside the field");
+  if (p.robot.eye_background >= p.robot.eye_max)
+    c.fail(where("eyes"), "background must be below max");
   if (p.field.divider_north_ft < p.field.divider_south_ft)
     c.fail(where("field"), "divider_north must not be south of divider_south");
   if (p.robot.edge_detector_inset_ft * 2 >= p.robot.body_diameter_ft)

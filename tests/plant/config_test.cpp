@@ -153,7 +153,9 @@ TEST(Profiles, MissingAndWrongTypeAndRange) {
 
   text = edit("value = 180.0, unit = \"s\"", "value = -1, unit = \"s\"");
   msg = errorOf(text);
-  EXPECT_NE(msg.find("must be positive"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("'match.round_length' must be between 1 and 1000000 s, got -1 s"),
+            std::string::npos)
+      << msg;
 
   text = edit("value = 0.0, unit = \"s\", source = \"thesis VI.C.1: acceleration ignored\"",
               "value = 0.0, unit = \"s\"");
@@ -164,6 +166,44 @@ TEST(Profiles, MissingAndWrongTypeAndRange) {
               "unit = \"ft\", source = \"thesis VI.C.1 linear");
   msg = errorOf(text);
   EXPECT_NE(msg.find("wrong unit 'ft'"), std::string::npos) << msg;
+}
+
+// Numbers that parse but mean nothing physical (issue 9's audit: each of
+// them once ended in a solver failure, a hang or gigabytes): every one is
+// rejected at its place, with the key's range in the message.
+TEST(Profiles, HostileNumbersAreRejectedWithTheirRange) {
+  struct Case {
+    const char* from;
+    const char* to;
+    const char* message;
+  } cases[] = {
+      {"value = [0.0, 0.1,", "value = [nan, 0.1,", "'robot.speed_table[0]' must be finite"},
+      {"value = [0.0, 0.1,", "value = [inf, 0.1,", "'robot.speed_table[0]' must be finite"},
+      {"value = [0.0, 0.1,", "value = [1e308, 0.1,",
+       "'robot.speed_table[0]' must be between 0 and 20 ft/s"},
+      {"left_trim  = { value = 1.0,", "left_trim  = { value = 1e300,",
+       "'robot.left_trim' must be between 0.5 and 2"},
+      {"left_trim  = { value = 1.0,", "left_trim  = { value = 1e6,",
+       "'robot.left_trim' must be between 0.5 and 2"},
+      {"motor_lag  = { value = 0.0,", "motor_lag  = { value = 1e-300,",
+       "'robot.motor_lag' must be 0 or between 0.001 and 10 s"},
+      {"body_diameter       = { value = 12.75,", "body_diameter       = { value = 1e300,",
+       "'robot.body_diameter' must be between 0.1 and 5 ft"},
+      // Integers beyond 2^53 have no exact double: read as integers, then checked.
+      {"body_diameter       = { value = 12.75,",
+       "body_diameter       = { value = 9223372036854775807,",
+       "'robot.body_diameter' must be between 0.1 and 5 ft"},
+      {"balls_per_gun = { value = 15,", "balls_per_gun = { value = 9223372036854775807,",
+       "'gun.balls_per_gun' must be in 0..16"},
+      {"balls_per_gun = { value = 15,", "balls_per_gun = { value = -1,",
+       "'gun.balls_per_gun' must be in 0..16"},
+  };
+  for (const Case& c : cases) {
+    const std::string text = edit(c.from, c.to);
+    const std::string msg = errorOf(text);
+    EXPECT_NE(msg.find(c.message), std::string::npos) << c.to << "\n" << msg;
+    EXPECT_GT(errLine(msg), 0) << msg;
+  }
 }
 
 TEST(Profiles, UnitsAreConverted) {
