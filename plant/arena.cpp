@@ -274,6 +274,9 @@ struct Arena::Impl {
     cv::check(CVodeSetLinearSolver(mem.get(), ls.get(), jac.get()), "CVodeSetLinearSolver");
     cv::check(CVodeSetMaxNumSteps(mem.get(), 100000), "CVodeSetMaxNumSteps");
     cv::check(CVodeSetNoInactiveRootWarn(mem.get()), "CVodeSetNoInactiveRootWarn");
+    // CVODE's own messages would go to stderr: a failure is reported as the
+    // run's plant fault instead (SolverError).
+    cv::check(CVodeSetErrFile(mem.get(), nullptr), "CVodeSetErrFile");
     cv::check(CVodeSetMaxStep(mem.get(), maxStep()), "CVodeSetMaxStep");
     std::copy(y, y + n, tmp.begin());
     reinit(0, 0.0, tmp, /*first=*/true);

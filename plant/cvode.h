@@ -5,8 +5,8 @@
 // context). Each wrapper owns one handle, is move-only, and frees it in its
 // destructor; Arena::Impl declares them in creation order so C++'s reverse
 // destruction order frees them correctly. A failing SUNDIALS call throws
-// std::runtime_error naming the call: these are programming errors, not
-// user input errors.
+// SolverError (plant.h) naming the call: the run ends with a fault of the
+// plant.
 #pragma once
 
 #include <cvode/cvode.h>
@@ -19,12 +19,13 @@
 #include <string>
 #include <utility>
 
+#include "plant/plant.h"
+
 namespace simbot::plant::cv {
 
 inline void check(int flag, const char* what) {
   if (flag < 0)
-    throw std::runtime_error(std::string("SUNDIALS: ") + what + " failed, flag " +
-                             std::to_string(flag));
+    throw SolverError(std::string("SUNDIALS: ") + what + " failed, flag " + std::to_string(flag));
 }
 
 class Context {

@@ -121,6 +121,14 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The integrator failed (a SUNDIALS call returned an error). The profile
+// checks keep it from happening; if it still does, the run ends there
+// with a fault of the plant, not an internal error.
+class SolverError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 Profile loadProfile(const std::string& path);
 Profile parseProfile(std::string_view text, const std::string& sourceName);
 // Reads a hardware file: port bindings, plus overrides of per-robot profile

@@ -167,6 +167,8 @@ class Match {
   }
 
   MatchResult run();
+  // The round loop; `roundStart` is the tick the current round began at.
+  void rounds(MatchResult& result, Tick& roundStart);
 
   plant::Arena& arena() { return arena_; }
   bool tracing() const { return trace_.on(); }
@@ -738,10 +740,26 @@ void Match::sampleUpTo(Tick t) {
 MatchResult Match::run() {
   MatchResult result;
   if (trace_.on()) emitSetup();
+  Tick roundStart = 0;
+  try {
+    rounds(result, roundStart);
+  } catch (const plant::SolverError& e) {
+    // The plant cannot go on: the run ends where the failing round began,
+    // with everything before it kept.
+    result.plantFault = FaultInfo{e.what(), seconds(roundStart), 0};
+    result.endTick = roundStart;
+    if (trace_.on()) emit(roundStart, trace::rec::PlantFault{e.what()}, {});
+  }
+  finish(result);
+  return result;
+}
+
+void Match::rounds(MatchResult& result, Tick& roundStart) {
   bool over = false;
   while (!over) {
     ++rounds_;
     const Tick t = earliestClock();
+    roundStart = t;
     if (trace_.on()) trace_.flushBefore(std::min(t, arena_.now()));
     Tick horizon = std::min(queue_.nextTick(), t + kLookahead);
     plant::AdvanceResult step = arena_.advance(horizon);
@@ -792,8 +810,6 @@ MatchResult Match::run() {
       sampleUpTo(horizon);
     }
   }
-  finish(result);
-  return result;
 }
 
 void Match::finish(MatchResult& result) {
@@ -810,7 +826,9 @@ void Match::finish(MatchResult& result) {
     }
     for (vm::Irq irq : {vm::Irq::Pio, vm::Irq::SerialTx})
       rr.interrupts.emplace(std::string(vm::irqName(irq)), 0);
-    rr.finalPose = arena_.pose(r->index, std::min(result.endTick, arena_.now()));
+    // After a plant fault the plant answers only from its last re-initialisation.
+    rr.finalPose =
+        arena_.pose(r->index, std::clamp(result.endTick, arena_.lastReinitTick(), arena_.now()));
     result.robots.push_back(std::move(rr));
   }
   if (result.robots.size() == 2) {

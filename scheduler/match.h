@@ -154,6 +154,9 @@ struct MatchResult {
   std::string winner;  // "A"/"B"; empty for solo
   bool tieBrokenByCoin = false;
   uint64_t rounds = 0;
+  // The integrator failed (plant::SolverError): the run ended at the start
+  // of the round that failed, and this says why (line is 0).
+  std::optional<FaultInfo> plantFault;
 };
 
 MatchResult runMatch(const MatchConfig& config);

@@ -315,4 +315,24 @@ TEST(Match, AFaultedRobotLosesATiedRound) {
   }
 }
 
+// A value the profile loader would refuse (a motor lag of 1e-300 s), put
+// straight into the arena: the integrator fails, and the run ends there
+// with a fault of the plant, its time, and the rest of the result intact.
+TEST(Match, AnIntegratorFailureEndsTheRunWithAPlantFault) {
+  const char* kDrive =
+      "char buf[9];\nchar cc;\nmain()\n{\n    ser_init_z1(0, 9600/1200);\n"
+      "    strcpy(buf, \"8fgr8fgr\");\n    cc = sizeof(buf);\n    ser_send_z1(buf, &cc);\n"
+      "    while (1);\n}\n";
+  auto c = matchConfig({{"A", "drive.dc", compileSource(kDrive)}}, 5);
+  c.arena.robots[0].params.motor_lag_s = 1e-300;
+  scheduler::MatchResult r;
+  ASSERT_NO_THROW(r = scheduler::runMatch(c));
+  ASSERT_TRUE(r.plantFault.has_value());
+  EXPECT_NE(r.plantFault->message.find("SUNDIALS"), std::string::npos) << r.plantFault->message;
+  EXPECT_LT(r.endTick, 5 * scheduler::kTicksPerSecond);
+  EXPECT_EQ(r.plantFault->timeS, static_cast<double>(r.endTick) / scheduler::kTicksPerSecond);
+  EXPECT_GT(r.robots[0].framesLatched, 0);  // the frame that made the plant fail
+  EXPECT_TRUE(std::isfinite(r.robots[0].finalPose.x_ft));
+}
+
 }  // namespace

@@ -86,6 +86,13 @@ constexpr int kExitRobotFault = 3;
 // One loud line per faulted robot, on stderr; true if any robot faulted.
 bool reportFaults(const scheduler::MatchResult& r) {
   bool any = false;
+  if (r.plantFault) {
+    any = true;
+    std::cerr << fmt::format(
+        "simbot: fault: the plant's integrator failed at {:.6f} s: {}; the "
+        "run ended there\n",
+        r.plantFault->timeS, r.plantFault->message);
+  }
   for (const auto& rr : r.robots) {
     if (!rr.fault) continue;
     any = true;
@@ -198,6 +205,7 @@ int soloCommand(const std::string& program, const RunOptions& o) {
       {"wall_seconds", wall},
       {"console", consoleJson(a.console)},
       {"fault", faultJson(a.fault)},
+      {"plant_fault", faultJson(r.plantFault)},
       {"motor_frames_latched", a.framesLatched},
       {"motor_frames_rejected", a.framesRejected},
       {"interrupts", a.interrupts},
@@ -238,6 +246,7 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
             {"seed", played.seed},
             {"winner", r.winner},
             {"tie_broken_by_coin", r.tieBrokenByCoin},
+            {"plant_fault", faultJson(r.plantFault)},
             {"integrator",
              {{"steps", r.integrator.steps},
               {"rhs_evals", r.integrator.rhs_evals},

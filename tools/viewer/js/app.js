@@ -45,6 +45,13 @@ function startViewer() {
     div.addEventListener('click', () => seek(f.t));
     $('faults').appendChild(div);
   }
+  for (const f of model.plantFaults) {
+    const div = document.createElement('div');
+    div.className = 'fault';
+    div.textContent = `PLANT FAULT at ${fmt(f.t)}: ${f.message}; the run ended there`;
+    div.addEventListener('click', () => seek(f.t));
+    $('faults').appendChild(div);
+  }
   function updateScore() {
     const parts = model.robots.map((r) => {
       const hits = lastAtOrBefore(r.hitTicks, cursor) + 1, shots = lastAtOrBefore(r.shotTicks, cursor) + 1;

@@ -85,6 +85,7 @@ function buildModel(data) {
     marks: fieldMarks(K),
     events: eventList(K),
     faults: rowsOf(K.fault),
+    plantFaults: rowsOf(K.plant_fault),
     injections: rowsOf(K.injection),
     consoleLines: rowsOf(K.console),
     winner: endRows ? K.end.winner[0] : '',
