@@ -18,6 +18,22 @@ namespace simbot::compiler {
 
 namespace {
 
+// CRLF and a lone CR (classic Mac OS files) end a line as LF does; the rest
+// of the compiler sees LF only, so line numbers are right in all three.
+std::string normalizeNewlines(const std::string& source) {
+  std::string out;
+  out.reserve(source.size());
+  for (size_t i = 0; i < source.size(); ++i) {
+    if (source[i] != '\r') {
+      out.push_back(source[i]);
+    } else {
+      out.push_back('\n');
+      if (i + 1 < source.size() && source[i + 1] == '\n') ++i;
+    }
+  }
+  return out;
+}
+
 std::vector<std::string> splitLines(const std::string& source) {
   std::vector<std::string> lines;
   size_t start = 0;
@@ -48,15 +64,16 @@ Diagnostic makeDiagnostic(const std::string& fileName, const std::vector<std::st
 
 }  // namespace
 
-Result compile(const std::string& source, const std::string& fileName, const Options& options) {
+Result compile(const std::string& rawSource, const std::string& fileName, const Options& options) {
   Result result;
-  if (source.size() > kMaxSourceBytes) {
+  if (rawSource.size() > kMaxSourceBytes) {
     result.errors.push_back(
         makeDiagnostic(fileName, {}, Pos{1, 1},
                        fmt::format("the program is {} bytes, more than a program may have ({})",
-                                   source.size(), kMaxSourceBytes)));
+                                   rawSource.size(), kMaxSourceBytes)));
     return result;
   }
+  const std::string source = normalizeNewlines(rawSource);
   std::vector<std::string> lines = splitLines(source);
   try {
     Preprocessor pp(source, fileName);

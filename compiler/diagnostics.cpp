@@ -1,21 +1,52 @@
 // Diagnostic::format: the one place that knows the tool contract's error
 // layout, "FILE:LINE:COL: error: MESSAGE", the source line, and a caret under
 // column COL. Tabs before the column are copied so the caret lines up in any
-// terminal whatever its tab width.
+// terminal whatever its tab width. Long lines are cut around the column.
 #include <fmt/format.h>
+
+#include <algorithm>
+#include <string_view>
 
 #include "compiler/compiler.h"
 
 namespace simbot::compiler {
 
+namespace {
+
+// A diagnostic shows at most this much of its source line, around the
+// column, and of its message: a 1 MB line must not become 1 MB of stderr.
+constexpr size_t kShownLine = 160;
+constexpr size_t kShownMessage = 300;
+
+// Control characters would garble the terminal: shown as '?'.
+std::string printable(std::string_view text) {
+  std::string out(text);
+  for (char& c : out)
+    if ((static_cast<unsigned char>(c) < 0x20 && c != '\t') || c == 0x7f) c = '?';
+  return out;
+}
+
+}  // namespace
+
 std::string Diagnostic::format() const {
-  std::string out = fmt::format("{}:{}:{}: error: {}\n", file, line, column, message);
-  out += sourceLine;
-  out += '\n';
-  for (int i = 0; i + 1 < column; ++i) {
-    bool tab = i < static_cast<int>(sourceLine.size()) && sourceLine[i] == '\t';
-    out += tab ? '\t' : ' ';
+  std::string shownMessage =
+      message.size() > kShownMessage ? message.substr(0, kShownMessage) + "..." : message;
+  std::string out =
+      fmt::format("{}:{}:{}: error: {}\n", file, line, column, printable(shownMessage));
+  // The part of the line shown, and where the caret goes in it.
+  const size_t col = column > 0 ? static_cast<size_t>(column - 1) : 0;
+  size_t from = 0, to = sourceLine.size();
+  if (to > kShownLine) {
+    from = col > kShownLine / 2 ? std::min(col - kShownLine / 2, to - kShownLine) : 0;
+    to = from + kShownLine;
   }
+  const std::string before = from > 0 ? "..." : "";
+  out += before + printable(std::string_view(sourceLine).substr(from, to - from));
+  if (to < sourceLine.size()) out += "...";
+  out += '\n';
+  out += before.empty() ? "" : "   ";
+  for (size_t i = from; i < col && i < from + (to - from) + 1; ++i)
+    out += i < sourceLine.size() && sourceLine[i] == '\t' ? '\t' : ' ';
   out += "^\n";
   return out;
 }

@@ -13,6 +13,8 @@
 // Robustness: recursion is capped ("nesting too deep"), and so is the height
 // of the trees that left-associative loops build ("expression too complex"),
 // so the code generator's recursion is bounded too.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string_view>
@@ -30,6 +32,11 @@ namespace {
 constexpr int kMaxDepth = 200;       // nested parens, blocks, unary operators, ...
 constexpr int kMaxTreeDepth = 1000;  // height of an expression tree
 constexpr int kMaxTypeDepth = 64;    // pointer/array derivations of one type
+// Counts a file could make long; each is far beyond what the era's programs
+// use (and, for parameters, what fits the expression stack of a call).
+constexpr size_t kMaxParameters = 64;
+constexpr size_t kMaxMembers = 512;
+constexpr int kMaxEnumerators = 4096;
 
 const std::unordered_set<std::string_view> kKeywords = {
     "auto",      "break",  "case",     "char",   "const",    "continue",  "default",  "do",
@@ -761,6 +768,8 @@ Type* Parser::structDecl(bool isUnion) {
       if (d.type->kind == TypeKind::Void || (isStructLike(d.type) && !d.type->complete) ||
           (d.type->kind == TypeKind::Array && d.type->arrayLen < 0))
         fail(d.pos, "member '" + d.name + "' has incomplete type");
+      if (t->members.size() >= kMaxMembers)
+        fail(d.pos, fmt::format("too many members in one {} (at most {})", word, kMaxMembers));
       for (const Member& m : t->members)
         if (m.name == d.name) fail(d.pos, "duplicate member '" + d.name + "'");
       // Packed: the Z180 has no alignment rules.
@@ -790,6 +799,7 @@ Type* Parser::enumSpecifier() {
   advance();
   int64_t next = 0;
   bool first = true;
+  int enumerators = 0;
   while (!accept("}")) {
     if (!first) {
       expect(",");
@@ -798,6 +808,8 @@ Type* Parser::enumSpecifier() {
     first = false;
     const Token& t = cur();
     if (t.kind != TokKind::Ident || isKeyword(t)) fail(t.pos, "expected identifier in enum");
+    if (++enumerators > kMaxEnumerators)
+      fail(t.pos, fmt::format("too many enumerators in one enum (at most {})", kMaxEnumerators));
     std::string name = t.text;
     Pos pos = t.pos;
     advance();
@@ -896,6 +908,8 @@ Type* Parser::funcParams(Type* ret) {
     for (;;) {
       const Token& t = cur();
       if (t.kind != TokKind::Ident || isKeyword(t)) fail(t.pos, "expected parameter name");
+      if (fn->params.size() >= kMaxParameters)
+        fail(t.pos, fmt::format("too many parameters (at most {})", kMaxParameters));
       for (const Param& p : fn->params)
         if (p.name == t.text) fail(t.pos, "redefinition of parameter '" + t.text + "'");
       fn->params.push_back(Param{t.text, tyInt(), t.pos, false});
@@ -908,6 +922,8 @@ Type* Parser::funcParams(Type* ret) {
   for (;;) {
     if (is("...")) fail(cur().pos, "variadic functions are not supported");
     Pos ppos = cur().pos;
+    if (fn->params.size() >= kMaxParameters)
+      fail(ppos, fmt::format("too many parameters (at most {})", kMaxParameters));
     if (!isDeclStart(cur())) {
       if (cur().kind == TokKind::Ident && !isKeyword(cur()))
         fail(cur().pos, "unknown type name '" + cur().text + "'");

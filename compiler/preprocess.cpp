@@ -21,6 +21,7 @@ namespace simbot::compiler {
 namespace {
 
 constexpr int kMaxExpandDepth = 32;
+constexpr size_t kMaxMacroNesting = 200;
 constexpr long kMaxExpandedTokens = 500'000;  // produced or collected as arguments
 constexpr size_t kMaxCondDepth = 200;
 
@@ -589,6 +590,11 @@ bool Preprocessor::expand(const Token& t) {
   auto it = macros_.find(t.text);
   if (it == macros_.end()) return false;
   const Macro& m = it->second;
+  // The hide set holds every macro this token came through: a chain of
+  // #defines is as deep as it is long, and each step copies the set.
+  if (t.hide && t.hide->size() >= kMaxMacroNesting)
+    fail(t.pos, "macros nested more than " + std::to_string(kMaxMacroNesting) +
+                    " deep (a chain of #defines)");
 
   if (!m.funcLike) {
     pushExpansion(substitute(m, {}, t), hideAdd(t.hide, t.text), t);
