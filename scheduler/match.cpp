@@ -758,6 +758,7 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
   bool over = false;
   while (!over) {
     ++rounds_;
+    if (config_.stop && config_.stop->load(std::memory_order_relaxed)) throw Stopped();
     const Tick t = earliestClock();
     roundStart = t;
     if (trace_.on()) trace_.flushBefore(std::min(t, arena_.now()));

@@ -32,10 +32,12 @@
 // and samples up to the plant's clock were taken at the end of the last
 // round. Records before that bound are written then.
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -121,6 +123,14 @@ struct MatchConfig {
   std::string profileName;                     // for the trace's run record
   Tick sampleInterval = kTicksPerSecond / 20;  // trace samples: 20 Hz
   MatchObserver* observer = nullptr;           // not owned; may be null
+  // Checked once a round: when it becomes true the run throws Stopped (a
+  // batch command stopping on SIGINT). Not owned; may be null.
+  const std::atomic<bool>* stop = nullptr;
+};
+
+// A run abandoned because MatchConfig::stop became true.
+struct Stopped : std::runtime_error {
+  Stopped() : std::runtime_error("stopped") {}
 };
 
 struct FaultInfo {

@@ -3,7 +3,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -160,7 +162,82 @@ scheduler::MatchConfig baseConfig(const BenchConfig& config, const plant::Profil
 
 }  // namespace
 
-BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
+CsvRow benchHeader() {
+  CsvRow header = {"program",      "run",          "seed",
+                   "start_x_ft",   "start_y_ft",   "start_heading_deg",
+                   "b_start_x_ft", "b_start_y_ft", "b_start_heading_deg",
+                   "outcome",      "fault"};
+  for (const auto& name : scheduler::metricNames()) header.push_back(name);
+  return header;
+}
+
+nlohmann::json benchSettings(const BenchConfig& c, const plant::Profile& profile) {
+  return {{"command", "bench"},
+          {"programs", c.programs},
+          {"family", c.family},
+          {"scenario", c.scenario ? nlohmann::json(c.scenario->file) : nlohmann::json(nullptr)},
+          {"opponent", c.opponent},
+          {"seeds", c.seeds},
+          {"seconds", c.seconds},
+          {"master_seed", c.masterSeed},
+          {"profile", profile.name},
+          {"profile_file", profile.file}};
+}
+
+namespace {
+
+std::string poseField(double v) { return fmt::format("{}", v); }
+
+CsvRow benchRow(const BenchRun& run) {
+  CsvRow row = {run.program,
+                std::to_string(run.index),
+                std::to_string(run.seed),
+                poseField(run.startA.x_ft),
+                poseField(run.startA.y_ft),
+                poseField(run.startA.heading_deg),
+                run.startB ? poseField(run.startB->x_ft) : "",
+                run.startB ? poseField(run.startB->y_ft) : "",
+                run.startB ? poseField(run.startB->heading_deg) : "",
+                run.outcome,
+                run.fault};
+  for (const auto& v : run.metrics.values) row.push_back(v ? fmt::format("{}", *v) : "");
+  return row;
+}
+
+// A row of an earlier batch back into its run (resume). Numbers were
+// written in their shortest exact form, so they read back exactly.
+BenchRun benchRunFromRow(const CsvRow& row) {
+  const auto real = [](const std::string& s) { return std::strtod(s.c_str(), nullptr); };
+  BenchRun run;
+  run.program = row[0];
+  run.index = std::stoi(row[1]);
+  run.seed = std::stoull(row[2]);
+  run.startA = {real(row[3]), real(row[4]), real(row[5])};
+  if (!row[6].empty()) run.startB = plant::Pose{real(row[6]), real(row[7]), real(row[8])};
+  run.outcome = row[9];
+  run.fault = row[10];
+  run.metrics.values.resize(scheduler::metricNames().size());
+  for (size_t m = 0; m < run.metrics.values.size(); ++m)
+    if (!row[11 + m].empty()) run.metrics.values[m] = real(row[11 + m]);
+  run.done = true;
+  return run;
+}
+
+// One line on what faulted in a finished run, or "".
+std::string faultLine(const scheduler::MatchResult& r) {
+  for (const auto& robot : r.robots)
+    if (robot.fault)
+      return fmt::format("robot {} faulted at {:.6f} s, line {}: {}", robot.name,
+                         robot.fault->timeS, robot.fault->line, robot.fault->message);
+  if (r.plantFault)
+    return fmt::format("the plant's integrator failed at {:.6f} s: {}", r.plantFault->timeS,
+                       r.plantFault->message);
+  return "";
+}
+
+}  // namespace
+
+void checkBenchConfig(const BenchConfig& config) {
   const auto& families = benchFamilies();
   if (config.family.empty() && !config.scenario)
     throw ToolError("simbot: bench needs --family or --scenario\n");
@@ -174,7 +251,10 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
   if (config.family == "head-to-head" && config.opponent.empty())
     throw ToolError("simbot: the head-to-head family needs --opponent FILE\n");
   if (config.programs.empty()) throw ToolError("simbot: bench needs at least one program\n");
+}
 
+BenchResult runBench(const BenchConfig& config, const plant::Profile& profile, const BenchIo& io) {
+  checkBenchConfig(config);
   std::optional<scheduler::RobotSpec> opponent;
   if (config.family == "stationary") {
     opponent = beaconSpec({}, false);
@@ -196,10 +276,34 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
   result.config = config;
   const size_t seeds = static_cast<size_t>(config.seeds);
   result.runs.resize(config.programs.size() * seeds);
+  // Runs an earlier, interrupted batch finished (--resume).
+  if (io.table) {
+    for (const CsvRow& row : io.table->previous()) {
+      BenchRun run;
+      try {
+        run = benchRunFromRow(row);
+      } catch (const std::exception&) {
+        throw ToolError(
+            fmt::format("simbot: --resume: a malformed row in {}/runs.csv\n", io.table->dir()));
+      }
+      const auto p = std::find(config.programs.begin(), config.programs.end(), run.program);
+      if (p == config.programs.end() || run.index < 0 || run.index >= config.seeds)
+        throw ToolError(
+            fmt::format("simbot: --resume: run {} of '{}' does not belong to this "
+                        "bench\n",
+                        run.index, run.program));
+      result.runs[static_cast<size_t>(p - config.programs.begin()) * seeds +
+                  static_cast<size_t>(run.index)] = std::move(run);
+    }
+  }
+  std::vector<size_t> todo;
+  for (size_t j = 0; j < result.runs.size(); ++j)
+    if (!result.runs[j].done) todo.push_back(j);
   const scheduler::Tick endTick =
       static_cast<scheduler::Tick>(std::llround(config.seconds * kTicksPerSecond));
   const std::string label = benchLabel(config);
-  auto job = [&](size_t j) {
+  auto job = [&](size_t k) {
+    const size_t j = todo[k];
     const size_t p = j / seeds;
     BenchRun& run = result.runs[j];
     run.program = config.programs[p];
@@ -217,44 +321,67 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile) {
     if (mc.arena.robots.size() > 1) run.startB = mc.arena.robots[1].start;
     mc.endTick = endTick;
     mc.seed = run.seed;
+    mc.stop = io.stop;
     scheduler::MetricsObserver observer(0);
     mc.observer = &observer;
     try {
       const scheduler::MatchResult r = scheduler::runMatch(mc);
       observer.finish(r.endTick);
       run.metrics = scheduler::collectMetrics(observer, r.robots[0]);
+      run.fault = faultLine(r);
+      run.outcome = run.fault.empty() ? "ok" : "fault";
+    } catch (const scheduler::Stopped&) {
+      return;  // abandoned: not done, run again by --resume
     } catch (const std::exception& e) {
-      // Name the run, so that it can be replayed as a match with a scenario.
+      // A bug in simbot: recorded for this run (the starts replay it with
+      // a scenario), and the others go on.
       std::string poses;
       for (const auto& robot : mc.arena.robots)
         poses += fmt::format(" ({}, {}, {} deg)", robot.start.x_ft, robot.start.y_ft,
                              robot.start.heading_deg);
-      throw ToolError(
-          fmt::format("simbot: internal error in run {} of {} (seed {}, starts{}): {}\n", run.index,
-                      run.program, run.seed, poses, e.what()));
+      run.outcome = "error";
+      run.fault = fmt::format("internal error (starts{}): {}", poses, e.what());
+      run.metrics.values.assign(scheduler::metricNames().size(), std::nullopt);
     }
+    run.done = true;
+    if (io.table) io.table->append(benchRow(run));
   };
-  parallelFor(result.runs.size(), config.threads, job, "bench " + benchLabel(config),
-              config.progress);
+  parallelFor(todo.size(), config.threads, job, "bench " + benchLabel(config), config.progress,
+              io.stop);
+  result.stopped = std::any_of(result.runs.begin(), result.runs.end(),
+                               [](const BenchRun& r) { return !r.done; });
   return result;
 }
 
+namespace {
+
+std::vector<CsvRow> doneRows(const BenchResult& result) {
+  std::vector<CsvRow> rows;
+  for (const auto& run : result.runs)
+    if (run.done) rows.push_back(benchRow(run));
+  return rows;
+}
+
+}  // namespace
+
 std::string runsCsv(const BenchResult& result) {
-  std::string out =
-      "program,run,seed,start_x_ft,start_y_ft,start_heading_deg,b_start_x_ft,b_start_y_ft,"
-      "b_start_heading_deg";
-  for (const auto& name : scheduler::metricNames()) out += "," + name;
-  out += '\n';
+  std::string out = csvLine(benchHeader()) + "\n";
+  for (const auto& row : doneRows(result)) out += csvLine(row) + "\n";
+  return out;
+}
+
+std::string benchFaults(const BenchResult& result, size_t most) {
+  std::string out;
+  size_t shown = 0, all = 0;
   for (const auto& run : result.runs) {
-    out += fmt::format("{},{},{},{},{},{}", run.program, run.index, run.seed, run.startA.x_ft,
-                       run.startA.y_ft, run.startA.heading_deg);
-    if (run.startB)
-      out += fmt::format(",{},{},{}", run.startB->x_ft, run.startB->y_ft, run.startB->heading_deg);
-    else
-      out += ",,,";
-    for (const auto& v : run.metrics.values) out += "," + (v ? fmt::format("{}", *v) : "");
-    out += '\n';
+    if (!run.done || run.outcome == "ok") continue;
+    if (shown++ < most)
+      out += fmt::format("simbot: bench: run {} of {} (seed {}): {}{}\n", run.index, run.program,
+                         run.seed, run.outcome == "error" ? "error: " : "", run.fault);
+    ++all;
   }
+  if (all > most)
+    out += fmt::format("simbot: bench: ... {} more (runs.csv lists them)\n", all - most);
   return out;
 }
 
@@ -268,8 +395,10 @@ std::vector<std::vector<scheduler::MetricSummary>> summaries(const BenchResult& 
     std::vector<scheduler::MetricSummary> per;
     for (size_t m = 0; m < names.size(); ++m) {
       std::vector<std::optional<double>> values;
-      for (size_t i = 0; i < seeds; ++i)
-        values.push_back(result.runs[p * seeds + i].metrics.values[m]);
+      for (size_t i = 0; i < seeds; ++i) {
+        const BenchRun& run = result.runs[p * seeds + i];
+        if (run.done && run.outcome != "error") values.push_back(run.metrics.values[m]);
+      }
       per.push_back(scheduler::summarize(names[m], values));
     }
     all.push_back(std::move(per));
@@ -279,6 +408,23 @@ std::vector<std::vector<scheduler::MetricSummary>> summaries(const BenchResult& 
 
 nlohmann::json optionalJson(const std::optional<double>& v) {
   return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+struct Counts {
+  int done = 0, faults = 0, errors = 0;
+};
+
+Counts countsOf(const BenchResult& result, size_t program) {
+  Counts c;
+  const size_t seeds = static_cast<size_t>(result.config.seeds);
+  for (size_t i = 0; i < seeds; ++i) {
+    const BenchRun& run = result.runs[program * seeds + i];
+    if (!run.done) continue;
+    ++c.done;
+    c.faults += run.outcome == "fault";
+    c.errors += run.outcome == "error";
+  }
+  return c;
 }
 
 }  // namespace
@@ -305,7 +451,12 @@ nlohmann::json summaryJson(const BenchResult& result) {
                          {"p90", optionalJson(s.p90)},
                          {"ci95_low", optionalJson(s.ciLow)},
                          {"ci95_high", optionalJson(s.ciHigh)}});
-    j["programs"].push_back({{"program", c.programs[p]}, {"metrics", metrics}});
+    const Counts n = countsOf(result, p);
+    j["programs"].push_back({{"program", c.programs[p]},
+                             {"runs_done", n.done},
+                             {"runs_faulted", n.faults},
+                             {"runs_failed", n.errors},
+                             {"metrics", metrics}});
   }
   return j;
 }
@@ -315,8 +466,12 @@ std::string summaryMarkdown(const BenchResult& result) {
   std::string out;
   const auto all = summaries(result);
   for (size_t p = 0; p < c.programs.size(); ++p) {
+    const Counts n = countsOf(result, p);
     out += fmt::format("### {}: {}, {} seeds x {} s\n\n", c.programs[p],
                        c.family.empty() ? benchLabel(c) : "family " + c.family, c.seeds, c.seconds);
+    if (n.done < c.seeds || n.faults || n.errors)
+      out += fmt::format("{} of {} runs done; {} with a fault, {} failed (runs.csv lists them)\n\n",
+                         n.done, c.seeds, n.faults, n.errors);
     out += "| metric | n reached | mean | median | p90 | 95% CI of mean | censored |\n";
     out += "|---|---:|---:|---:|---:|---|---:|\n";
     for (const auto& s : all[p]) {
@@ -330,17 +485,11 @@ std::string summaryMarkdown(const BenchResult& result) {
   return out;
 }
 
-void writeBenchOutputs(const BenchResult& result, const std::string& dir) {
-  std::filesystem::create_directories(dir);
-  auto write = [&](const std::string& name, const std::string& text) {
-    const auto path = std::filesystem::path(dir) / name;
-    std::ofstream out(path, std::ios::binary);
-    if (!out) throw ToolError(fmt::format("simbot: cannot write '{}'\n", path.string()));
-    out << text;
-  };
-  write("runs.csv", runsCsv(result));
-  write("summary.json", dumpJson(summaryJson(result), 2) + "\n");
-  write("summary.md", summaryMarkdown(result));
+void writeBenchOutputs(const BenchResult& result, RunTable& table) {
+  table.rewrite(doneRows(result));
+  const std::filesystem::path dir = table.dir();
+  writeFileAtomically((dir / "summary.json").string(), dumpJson(summaryJson(result), 2) + "\n");
+  writeFileAtomically((dir / "summary.md").string(), summaryMarkdown(result));
 }
 
 }  // namespace simbot::tools

@@ -1,6 +1,7 @@
 // simbot bench: scenario families run over many seeds, measured per run by
 // scheduler::MetricsObserver, summarised with censoring (README "bench").
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -9,6 +10,7 @@
 
 #include "plant/plant.h"
 #include "scheduler/metrics.h"
+#include "tools/run_table.h"
 #include "tools/scenario.h"
 
 namespace simbot::tools {
@@ -33,12 +35,25 @@ struct BenchRun {
   uint64_t seed = 0;  // streamSeed(master, "<family>/<program file name>/<index>")
   plant::Pose startA;
   std::optional<plant::Pose> startB;  // absent in solo families
+  bool done = false;                  // finished, now or in the batch this one resumes
+  // "ok"; "fault" (a robot faulted, or the plant: the run still counts,
+  // measured up to its end); "error" (simbot failed on it: no metrics).
+  std::string outcome;
+  std::string fault;  // what faulted or failed, one line; empty when ok
   scheduler::RunMetrics metrics;
 };
 
 struct BenchResult {
   BenchConfig config;
   std::vector<BenchRun> runs;  // program by program, each by run index
+  bool stopped = false;        // a signal stopped the batch: some runs are not done
+};
+
+// Where a bench writes as it goes (the bench command): its table, and the
+// flag that stops it. Without them everything stays in memory.
+struct BenchIo {
+  RunTable* table = nullptr;
+  const std::atomic<bool>* stop = nullptr;
 };
 
 const std::vector<std::string>& benchFamilies();
@@ -49,12 +64,26 @@ inline constexpr double kCircleSpeedFps = 0.5;
 // The family's name in outputs: the family, or "scenario NAME".
 std::string benchLabel(const BenchConfig& config);
 
-BenchResult runBench(const BenchConfig& config, const plant::Profile& profile);
+// ToolError if the configuration cannot run (a family, the counts).
+void checkBenchConfig(const BenchConfig& config);
+// runs.csv's columns, and the settings that identify a bench (batch.json).
+CsvRow benchHeader();
+nlohmann::json benchSettings(const BenchConfig& config, const plant::Profile& profile);
 
+// Runs every run not already in io.table (resume); each finished run goes
+// to the table as it completes. A run that faults or fails is recorded as
+// such; the others go on.
+BenchResult runBench(const BenchConfig& config, const plant::Profile& profile,
+                     const BenchIo& io = {});
+
+// The finished runs, in order (the final runs.csv).
 std::string runsCsv(const BenchResult& result);
 nlohmann::json summaryJson(const BenchResult& result);
 std::string summaryMarkdown(const BenchResult& result);
-// Writes runs.csv, summary.json and summary.md into `dir` (created).
-void writeBenchOutputs(const BenchResult& result, const std::string& dir);
+// Rewrites the table in order, and writes summary.json and summary.md
+// beside it (each through a temporary file).
+void writeBenchOutputs(const BenchResult& result, RunTable& table);
+// One line per run that faulted or failed (at most `most`, then a count).
+std::string benchFaults(const BenchResult& result, size_t most = 20);
 
 }  // namespace simbot::tools

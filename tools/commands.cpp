@@ -9,6 +9,7 @@
 
 #include "tools/bench.h"
 #include "tools/json_text.h"
+#include "tools/run_table.h"
 #include "tools/runner.h"
 #include "tools/scenario.h"
 #include "tools/tournament.h"
@@ -48,6 +49,7 @@ Subcommand addBenchCommand(CLI::App& app) {
   struct Options {
     BenchConfig config;
     std::string out, profile = "default", scenario;
+    bool resume = false;
     CLI::Option *seconds = nullptr, *seed = nullptr, *profileOption = nullptr;
   };
   auto o = std::make_shared<Options>();
@@ -66,6 +68,8 @@ Subcommand addBenchCommand(CLI::App& app) {
   cmd->add_option("--threads", o->config.threads, "worker threads (default: all cores)")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--out", o->out, "output directory (default out/bench-FAMILY)");
+  cmd->add_flag("--resume", o->resume,
+                "continue an interrupted bench from the runs.csv in its output directory");
   o->profileOption =
       cmd->add_option("--profile", o->profile, "profile name or file (default: default)");
   cmd->add_option("--opponent", o->config.opponent, "robot B's program (head-to-head)");
@@ -89,16 +93,32 @@ Subcommand addBenchCommand(CLI::App& app) {
             c.seconds = preferCommandLine(o->seconds->count() > 0, c.scenario->seconds, c.seconds);
             c.masterSeed = preferCommandLine(o->seed->count() > 0, c.scenario->seed, c.masterSeed);
           }
-          const BenchResult r = runBench(c, loadNamedProfile(profile));
+          const plant::Profile loaded = loadNamedProfile(profile);
+          checkBenchConfig(c);
           std::string label = benchLabel(c);
           std::replace(label.begin(), label.end(), ' ', '-');
           const std::string dir = o->out.empty() ? "out/bench-" + label : o->out;
-          writeBenchOutputs(r, dir);
+          // The table is opened (and the location checked) before any run.
+          RunTable table(dir, "runs.csv", benchHeader(), benchSettings(c, loaded), o->resume);
+          StopOnSignals signals;
+          const BenchResult r = runBench(c, loaded, {&table, &signals.requested()});
+          writeBenchOutputs(r, table);
           std::cout << summaryMarkdown(r);
+          std::cerr << benchFaults(r);
+          const auto done = std::count_if(r.runs.begin(), r.runs.end(),
+                                          [](const BenchRun& run) { return run.done; });
+          const double wall =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+          if (r.stopped) {
+            std::cerr << fmt::format(
+                "simbot: bench stopped by signal {} with {} of {} runs done ({:.1f} s wall); "
+                "{}/runs.csv and the summary hold them; --resume continues\n",
+                signals.signal(), done, r.runs.size(), wall, dir);
+            return 128 + signals.signal();
+          }
           std::cerr << fmt::format(
               "simbot: {} runs in {:.1f} s wall; wrote {}/runs.csv, summary.json, summary.md\n",
-              r.runs.size(),
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), dir);
+              r.runs.size(), wall, dir);
           return 0;
         });
       }};
@@ -107,8 +127,8 @@ Subcommand addBenchCommand(CLI::App& app) {
 Subcommand addTournamentCommand(CLI::App& app) {
   struct Options {
     TournamentConfig config;
-    std::string profile = "default";
-    bool json = false;
+    std::string profile = "default", out = "out/tournament";
+    bool json = false, resume = false;
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("tournament", "round robin after thesis Appendix A");
@@ -121,14 +141,32 @@ Subcommand addTournamentCommand(CLI::App& app) {
   cmd->add_option("--threads", o->config.threads, "worker threads (default: all cores)")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--profile", o->profile, "profile name or file (default: default)");
+  cmd->add_option("--out", o->out, "output directory (default out/tournament)");
+  cmd->add_flag("--resume", o->resume,
+                "continue an interrupted tournament from the games.csv in its output directory");
   cmd->add_flag("--json", o->json, "print standings and games as JSON");
   return {cmd, [o] {
             return guarded([&] {
-              const TournamentResult r = runTournament(o->config, loadNamedProfile(o->profile));
+              const plant::Profile profile = loadNamedProfile(o->profile);
+              checkTournamentConfig(o->config);
+              RunTable table(o->out, "games.csv", tournamentHeader(),
+                             tournamentSettings(o->config, profile), o->resume);
+              StopOnSignals signals;
+              const TournamentResult r =
+                  runTournament(o->config, profile, &table, &signals.requested());
+              writeTournamentOutputs(r, table);
               if (o->json)
                 std::cout << dumpJson(tournamentJson(r), 2) << '\n';
               else
                 std::cout << standingsTable(r);
+              std::cerr << tournamentFaults(r);
+              if (r.stopped) {
+                std::cerr << fmt::format(
+                    "simbot: tournament stopped by signal {}; {}/games.csv and the standings "
+                    "hold the games played; --resume continues\n",
+                    signals.signal(), o->out);
+                return 128 + signals.signal();
+              }
               return 0;
             });
           }};

@@ -67,16 +67,18 @@ double uniform(plant::RandomBits& bits, double lo, double hi) {
 }
 
 void parallelFor(size_t count, int threads, const std::function<void(size_t)>& job,
-                 const std::string& label, bool progress) {
+                 const std::string& label, bool progress, const std::atomic<bool>* stop) {
+  const auto stopped = [stop] { return stop && stop->load(); };
   const auto start = std::chrono::steady_clock::now();
   const size_t workers =
       std::min<size_t>(static_cast<size_t>(resolveThreads(threads)), std::max<size_t>(count, 1));
   std::atomic<size_t> next{0}, done{0};
+  size_t idle = 0;  // workers that took their last job (under `mutex`)
   std::vector<std::exception_ptr> errors(count);
   std::mutex mutex;
   std::condition_variable finished;
   auto work = [&] {
-    for (size_t i; (i = next.fetch_add(1)) < count;) {
+    for (size_t i; !stopped() && (i = next.fetch_add(1)) < count;) {
       try {
         job(i);
       } catch (...) {
@@ -86,6 +88,9 @@ void parallelFor(size_t count, int threads, const std::function<void(size_t)>& j
       std::lock_guard lock(mutex);
       finished.notify_all();
     }
+    std::lock_guard lock(mutex);
+    ++idle;
+    finished.notify_all();
   };
   std::vector<std::thread> pool;
   for (size_t w = 0; w < workers; ++w) pool.emplace_back(work);
@@ -107,7 +112,7 @@ void parallelFor(size_t count, int threads, const std::function<void(size_t)>& j
       std::cerr << fmt::format("\r{} [{}{}] {}/{}  {:.0f} s{}   ", label, std::string(filled, '#'),
                                std::string(kWidth - filled, '.'), d, count, t, eta)
                 << std::flush;
-      if (d == count) break;
+      if (d == count || idle == workers) break;
       finished.wait_for(lock, std::chrono::milliseconds(250));
     }
     std::cerr << '\n';

@@ -5,17 +5,83 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "scheduler/match.h"
+#include "tools/json_text.h"
 #include "tools/runner.h"
 
 namespace simbot::tools {
 
-TournamentResult runTournament(const TournamentConfig& config, const plant::Profile& profile) {
+CsvRow tournamentHeader() {
+  return {"pair_i",  "pair_j",  "round",      "a",      "b",
+          "seed",    "hits_a",  "hits_b",     "winner", "tie_broken_by_coin",
+          "fault_a", "fault_b", "plant_fault"};
+}
+
+nlohmann::json tournamentSettings(const TournamentConfig& c, const plant::Profile& profile) {
+  return {{"command", "tournament"},     {"programs", c.programs},      {"rounds", c.rounds},
+          {"seconds", c.seconds},        {"master_seed", c.masterSeed}, {"profile", profile.name},
+          {"profile_file", profile.file}};
+}
+
+namespace {
+
+CsvRow gameRow(const TournamentGame& g) {
+  return {std::to_string(g.i),
+          std::to_string(g.j),
+          std::to_string(g.round),
+          std::to_string(g.a),
+          std::to_string(g.b),
+          std::to_string(g.seed),
+          std::to_string(g.hitsA),
+          std::to_string(g.hitsB),
+          std::to_string(g.winner),
+          g.coin ? "1" : "0",
+          g.faultA,
+          g.faultB,
+          g.plantFault};
+}
+
+TournamentGame gameFromRow(const CsvRow& r) {
+  TournamentGame g;
+  g.i = std::stoi(r[0]);
+  g.j = std::stoi(r[1]);
+  g.round = std::stoi(r[2]);
+  g.a = std::stoi(r[3]);
+  g.b = std::stoi(r[4]);
+  g.seed = std::stoull(r[5]);
+  g.hitsA = std::stoi(r[6]);
+  g.hitsB = std::stoi(r[7]);
+  g.winner = std::stoi(r[8]);
+  g.coin = r[9] == "1";
+  g.faultA = r[10];
+  g.faultB = r[11];
+  g.plantFault = r[12];
+  g.done = true;
+  return g;
+}
+
+std::string robotFault(const scheduler::RobotResult& r) {
+  if (!r.fault) return "";
+  return fmt::format("faulted at {:.6f} s, line {}: {}", r.fault->timeS, r.fault->line,
+                     r.fault->message);
+}
+
+bool played(const TournamentGame& g) { return g.done && g.plantFault.rfind("error: ", 0) != 0; }
+
+}  // namespace
+
+void checkTournamentConfig(const TournamentConfig& config) {
   if (config.programs.size() < 2) throw ToolError("simbot: a tournament needs two programs\n");
   if (config.rounds <= 0) throw ToolError("simbot: --rounds must be positive\n");
   if (!(config.seconds > 0) || config.seconds > 1e6)
     throw ToolError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", config.seconds));
+}
+
+TournamentResult runTournament(const TournamentConfig& config, const plant::Profile& profile,
+                               RunTable* table, const std::atomic<bool>* stop) {
+  checkTournamentConfig(config);
   std::vector<vm::Image> images;
   for (const auto& p : config.programs) images.push_back(compileProgramFile(p));
 
@@ -35,10 +101,32 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
             scheduler::streamSeed(config.masterSeed, fmt::format("tournament/{}/{}/{}", i, j, k));
         result.games.push_back(g);
       }
+  // Games an earlier, interrupted tournament played (--resume).
+  if (table) {
+    for (const CsvRow& row : table->previous()) {
+      TournamentGame g;
+      try {
+        g = gameFromRow(row);
+      } catch (const std::exception&) {
+        throw ToolError(
+            fmt::format("simbot: --resume: a malformed row in {}/games.csv\n", table->dir()));
+      }
+      const auto at = std::find_if(result.games.begin(), result.games.end(), [&](const auto& x) {
+        return x.i == g.i && x.j == g.j && x.round == g.round;
+      });
+      if (at == result.games.end() || at->seed != g.seed)
+        throw ToolError(
+            "simbot: --resume: a game in games.csv does not belong to this tournament\n");
+      *at = g;
+    }
+  }
+  std::vector<size_t> todo;
+  for (size_t k = 0; k < result.games.size(); ++k)
+    if (!result.games[k].done) todo.push_back(k);
   const auto endTick =
       static_cast<scheduler::Tick>(std::llround(config.seconds * scheduler::kTicksPerSecond));
-  auto job = [&](size_t index) {
-    TournamentGame& g = result.games[index];
+  auto job = [&](size_t k) {
+    TournamentGame& g = result.games[todo[k]];
     scheduler::MatchConfig mc;
     mc.arena = plant::makeArenaConfig(profile, 2);
     const auto ua = static_cast<size_t>(g.a), ub = static_cast<size_t>(g.b);
@@ -46,19 +134,36 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
     mc.robots.push_back({"B", config.programs[ub], images[ub]});
     mc.endTick = endTick;
     mc.seed = g.seed;
-    const scheduler::MatchResult r = scheduler::runMatch(mc);
-    g.hitsA = r.robots[0].hits;
-    g.hitsB = r.robots[1].hits;
-    g.winner = r.winner == "A" ? g.a : g.b;
-    g.coin = r.tieBrokenByCoin;
+    mc.stop = stop;
+    try {
+      const scheduler::MatchResult r = scheduler::runMatch(mc);
+      g.hitsA = r.robots[0].hits;
+      g.hitsB = r.robots[1].hits;
+      g.winner = r.winner == "A" ? g.a : g.b;
+      g.coin = r.tieBrokenByCoin;
+      g.faultA = robotFault(r.robots[0]);
+      g.faultB = robotFault(r.robots[1]);
+      if (r.plantFault)
+        g.plantFault = fmt::format("the integrator failed at {:.6f} s: {}", r.plantFault->timeS,
+                                   r.plantFault->message);
+    } catch (const scheduler::Stopped&) {
+      return;  // abandoned: played again by --resume
+    } catch (const std::exception& e) {
+      g.plantFault = fmt::format("error: internal error: {}", e.what());
+    }
+    g.done = true;
+    if (table) table->append(gameRow(g));
   };
-  parallelFor(result.games.size(), config.threads, job, "tournament", config.progress);
+  parallelFor(todo.size(), config.threads, job, "tournament", config.progress, stop);
+  result.stopped = std::any_of(result.games.begin(), result.games.end(),
+                               [](const TournamentGame& g) { return !g.done; });
 
-  std::vector<Standing> table(static_cast<size_t>(n));
-  for (int p = 0; p < n; ++p) table[static_cast<size_t>(p)].program = p;
+  std::vector<Standing> standings(static_cast<size_t>(n));
+  for (int p = 0; p < n; ++p) standings[static_cast<size_t>(p)].program = p;
   for (const auto& g : result.games) {
-    Standing& a = table[static_cast<size_t>(g.a)];
-    Standing& b = table[static_cast<size_t>(g.b)];
+    if (!played(g)) continue;
+    Standing& a = standings[static_cast<size_t>(g.a)];
+    Standing& b = standings[static_cast<size_t>(g.b)];
     ++a.played;
     ++b.played;
     a.hitsFor += g.hitsA;
@@ -71,14 +176,14 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
     ++w.points;
     ++l.losses;
   }
-  std::stable_sort(table.begin(), table.end(), [](const Standing& x, const Standing& y) {
+  std::stable_sort(standings.begin(), standings.end(), [](const Standing& x, const Standing& y) {
     if (x.points != y.points) return x.points > y.points;
     const int dx = x.hitsFor - x.hitsAgainst, dy = y.hitsFor - y.hitsAgainst;
     if (dx != dy) return dx > dy;
     if (x.hitsFor != y.hitsFor) return x.hitsFor > y.hitsFor;
     return x.program < y.program;
   });
-  result.standings = table;
+  result.standings = standings;
   return result;
 }
 
@@ -110,7 +215,11 @@ nlohmann::json tournamentJson(const TournamentResult& result) {
                          {"hits_for", s.hitsFor},
                          {"hits_against", s.hitsAgainst},
                          {"points", s.points}});
-  for (const auto& g : result.games)
+  const auto fault = [](const std::string& f) {
+    return f.empty() ? nlohmann::json(nullptr) : nlohmann::json(f);
+  };
+  for (const auto& g : result.games) {
+    if (!g.done) continue;
     games.push_back({{"a", c.programs[static_cast<size_t>(g.a)]},
                      {"b", c.programs[static_cast<size_t>(g.b)]},
                      {"round", g.round},
@@ -118,9 +227,43 @@ nlohmann::json tournamentJson(const TournamentResult& result) {
                      {"hits_a", g.hitsA},
                      {"hits_b", g.hitsB},
                      {"winner", c.programs[static_cast<size_t>(g.winner)]},
-                     {"tie_broken_by_coin", g.coin}});
+                     {"tie_broken_by_coin", g.coin},
+                     {"fault_a", fault(g.faultA)},
+                     {"fault_b", fault(g.faultB)},
+                     {"plant_fault", fault(g.plantFault)}});
+  }
   return {{"rounds", c.rounds},          {"seconds", c.seconds},   {"master_seed", c.masterSeed},
           {"points", "1 per round won"}, {"standings", standings}, {"games", games}};
+}
+
+void writeTournamentOutputs(const TournamentResult& result, RunTable& table) {
+  std::vector<CsvRow> rows;
+  for (const auto& g : result.games)
+    if (g.done) rows.push_back(gameRow(g));
+  table.rewrite(rows);
+  const std::filesystem::path dir = table.dir();
+  writeFileAtomically((dir / "standings.json").string(),
+                      dumpJson(tournamentJson(result), 2) + "\n");
+  writeFileAtomically((dir / "standings.md").string(), standingsTable(result));
+}
+
+std::string tournamentFaults(const TournamentResult& result) {
+  std::string out;
+  const auto& names = result.config.programs;
+  for (const auto& g : result.games) {
+    if (!g.done) continue;
+    const std::string game = fmt::format("{} vs {}, round {}", names[static_cast<size_t>(g.a)],
+                                         names[static_cast<size_t>(g.b)], g.round + 1);
+    if (!g.faultA.empty())
+      out += fmt::format("simbot: tournament: {}: robot A ({}) {}\n", game,
+                         names[static_cast<size_t>(g.a)], g.faultA);
+    if (!g.faultB.empty())
+      out += fmt::format("simbot: tournament: {}: robot B ({}) {}\n", game,
+                         names[static_cast<size_t>(g.b)], g.faultB);
+    if (!g.plantFault.empty())
+      out += fmt::format("simbot: tournament: {}: {}\n", game, g.plantFault);
+  }
+  return out;
 }
 
 }  // namespace simbot::tools

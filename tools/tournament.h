@@ -5,12 +5,14 @@
 // points scheme). Standings are sorted by points, then hit difference, then
 // hits for, then the order the programs were given.
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "plant/plant.h"
+#include "tools/run_table.h"
 
 namespace simbot::tools {
 
@@ -27,9 +29,14 @@ struct TournamentGame {
   int i = 0, j = 0, round = 0;  // the pair (i < j) and the round number
   int a = 0, b = 0;             // program indices playing as A and B
   uint64_t seed = 0;            // streamSeed(master, "tournament/<i>/<j>/<round>")
+  bool done = false;            // played, now or in the batch this one resumes
   int hitsA = 0, hitsB = 0;
   int winner = 0;  // program index
   bool coin = false;
+  // One line each on what faulted (empty: nothing): robot A, robot B, the
+  // plant or simbot itself ("error: ...", a game that could not be played:
+  // it counts as a loss for neither and is not in the standings).
+  std::string faultA, faultB, plantFault;
 };
 
 struct Standing {
@@ -40,10 +47,25 @@ struct Standing {
 struct TournamentResult {
   TournamentConfig config;
   std::vector<TournamentGame> games;  // pair by pair, round by round
-  std::vector<Standing> standings;    // ranked
+  std::vector<Standing> standings;    // ranked, from the games played
+  bool stopped = false;               // a signal stopped it: some games were not played
 };
 
-TournamentResult runTournament(const TournamentConfig& config, const plant::Profile& profile);
+// ToolError if the configuration cannot run.
+void checkTournamentConfig(const TournamentConfig& config);
+// games.csv's columns, and the settings that identify a tournament.
+CsvRow tournamentHeader();
+nlohmann::json tournamentSettings(const TournamentConfig& config, const plant::Profile& profile);
+
+// Plays every game not already in `table` (resume); each finished game goes
+// to the table as it completes. `stop` (may be null) stops the tournament.
+TournamentResult runTournament(const TournamentConfig& config, const plant::Profile& profile,
+                               RunTable* table = nullptr, const std::atomic<bool>* stop = nullptr);
+// Rewrites games.csv in order and writes standings.json and standings.md
+// beside it.
+void writeTournamentOutputs(const TournamentResult& result, RunTable& table);
+// One line per game with a fault.
+std::string tournamentFaults(const TournamentResult& result);
 std::string standingsTable(const TournamentResult& result);
 nlohmann::json tournamentJson(const TournamentResult& result);
 

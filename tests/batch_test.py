@@ -1,0 +1,132 @@
+#!/usr/bin/env python3
+"""Batch work loses nothing (bench and tournament).
+
+Usage: batch_test.py SIMBOT ICEMAN FIG92 SPIRAL TURRET OUTDIR
+
+- A bench killed with SIGKILL half-way and resumed with --resume writes the
+  very runs.csv and summaries an uninterrupted bench writes (cmp).
+- A bench stopped with SIGINT exits 130, keeps every finished run (each one
+  identical to the uninterrupted bench's row) and summarises those.
+- The same kill and resume for a tournament's games.csv and standings.
+- The output location is checked before the first run; a write that fails
+  (a file-size limit) ends the bench with an error, not a success.
+- --resume refuses a table another batch wrote.
+"""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+SIMBOT, ICEMAN, FIG92, SPIRAL, TURRET, OUT = sys.argv[1:7]
+OUT = Path(OUT)
+shutil.rmtree(OUT, ignore_errors=True)
+OUT.mkdir(parents=True)
+failures = []
+
+
+def check(ok, message):
+    if not ok:
+        failures.append(message)
+        print("FAIL:", message)
+
+
+BENCH = [SIMBOT, "bench", ICEMAN, FIG92, "--family", "stationary", "--seeds", "30",
+         "--seconds", "20", "--threads", "2"]
+TOURNAMENT = [SIMBOT, "tournament", ICEMAN, FIG92, SPIRAL, TURRET, "--rounds", "2",
+              "--seconds", "30", "--threads", "2"]
+
+
+def rows(path):
+    try:
+        return path.read_text().count("\n") - 1
+    except FileNotFoundError:
+        return 0
+
+
+def start_and_wait(cmd, table, at_least):
+    """Starts a batch and waits until its table has `at_least` rows."""
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 120
+    while rows(table) < at_least and proc.poll() is None and time.time() < deadline:
+        time.sleep(0.01)
+    return proc
+
+
+def same_files(a, b, names, what):
+    for name in names:
+        x, y = (a / name).read_bytes(), (b / name).read_bytes()
+        check(x == y, f"{what}: {name} differs from the uninterrupted batch's")
+
+
+# ---- bench: uninterrupted, then killed and resumed
+whole = OUT / "bench-whole"
+subprocess.run(BENCH + ["--out", str(whole)], check=True, capture_output=True)
+total = rows(whole / "runs.csv")
+check(total == 60, f"the uninterrupted bench has 60 runs, not {total}")
+
+killed = OUT / "bench-killed"
+proc = start_and_wait(BENCH + ["--out", str(killed)], killed / "runs.csv", 12)
+proc.send_signal(signal.SIGKILL)
+proc.wait()
+kept = rows(killed / "runs.csv")
+check(0 < kept < 60, f"SIGKILL half-way: {kept} runs in the table")
+r = subprocess.run(BENCH + ["--out", str(killed), "--resume"], capture_output=True, text=True)
+check(r.returncode == 0, f"--resume exits 0: {r.returncode} {r.stderr[-300:]}")
+same_files(whole, killed, ["runs.csv", "summary.json", "summary.md"], "bench killed and resumed")
+
+# ---- bench: SIGINT keeps and summarises what it finished
+stopped = OUT / "bench-sigint"
+proc = start_and_wait(BENCH + ["--out", str(stopped)], stopped / "runs.csv", 8)
+proc.send_signal(signal.SIGINT)
+_, err = proc.communicate(timeout=120)
+check(proc.returncode == 130, f"SIGINT: exit status {proc.returncode}, expected 130")
+check("--resume continues" in err, f"SIGINT says how to go on: {err[-300:]}")
+lines = (stopped / "runs.csv").read_text().splitlines()
+finished = len(lines) - 1
+check(0 < finished < 60, f"SIGINT: {finished} runs kept")
+whole_rows = set((whole / "runs.csv").read_text().splitlines()[1:])
+check(all(line in whole_rows for line in lines[1:]),
+      "every run kept after SIGINT is the uninterrupted bench's run")
+summary = json.loads((stopped / "summary.json").read_text())
+check(sum(p["runs_done"] for p in summary["programs"]) == finished,
+      "the summary counts exactly the runs kept")
+
+# ---- tournament: killed and resumed
+whole_t = OUT / "tournament-whole"
+subprocess.run(TOURNAMENT + ["--out", str(whole_t)], check=True, capture_output=True)
+games = rows(whole_t / "games.csv")
+check(games == 12, f"4 programs, 2 rounds: 12 games, not {games}")
+killed_t = OUT / "tournament-killed"
+proc = start_and_wait(TOURNAMENT + ["--out", str(killed_t)], killed_t / "games.csv", 3)
+proc.send_signal(signal.SIGKILL)
+proc.wait()
+check(0 < rows(killed_t / "games.csv") < 12, "SIGKILL half-way through the tournament")
+r = subprocess.run(TOURNAMENT + ["--out", str(killed_t), "--resume"], capture_output=True,
+                   text=True)
+check(r.returncode == 0, f"tournament --resume exits 0: {r.stderr[-300:]}")
+same_files(whole_t, killed_t, ["games.csv", "standings.json", "standings.md"],
+           "tournament killed and resumed")
+
+# ---- the output location is checked before any run; every write is checked
+r = subprocess.run(BENCH + ["--out", "/dev/null"], capture_output=True, text=True)
+check(r.returncode == 1 and "/dev/null" in r.stderr and "runs" not in r.stderr.split("\n")[0][:5],
+      f"--out /dev/null is refused at once: {r.returncode} {r.stderr[-200:]}")
+limited = OUT / "bench-fsize"
+r = subprocess.run(["bash", "-c", "trap '' XFSZ; ulimit -f 4; exec \"$@\"", "bash"] + BENCH +
+                   ["--out", str(limited)], capture_output=True, text=True)
+check(r.returncode == 1 and "File too large" in r.stderr,
+      f"a write past a 2-KiB file-size limit is an error: {r.returncode} {r.stderr[-300:]}")
+
+# ---- --resume refuses another batch's table
+other = [arg if arg != "20" else "21" for arg in BENCH]  # 21 simulated seconds a run
+r = subprocess.run(other + ["--out", str(whole), "--resume"], capture_output=True, text=True)
+check(r.returncode == 1 and "other settings" in r.stderr,
+      f"--resume with other settings is refused: {r.returncode} {r.stderr[-300:]}")
+
+if failures:
+    sys.exit(f"{len(failures)} check(s) failed")
+print("batch_test: all checks passed")
