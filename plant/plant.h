@@ -129,6 +129,14 @@ class SolverError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Checks a TOML file's text before toml++ (3.3.0) parses it: well-formed
+// UTF-8, no non-ASCII character outside strings and comments (where TOML
+// allows none anyway), and no line-ending backslash in a multi-line string
+// followed by a non-ASCII character. toml++ 3.3.0 reaches an "unreachable"
+// state (undefined behaviour) on the last two (toml++ issues 190 and 295).
+// Throws ConfigError naming the place.
+void checkTomlText(std::string_view text, const std::string& sourceName);
+
 Profile loadProfile(const std::string& path);
 Profile parseProfile(std::string_view text, const std::string& sourceName);
 // Reads a hardware file: port bindings, plus overrides of per-robot profile

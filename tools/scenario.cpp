@@ -49,6 +49,7 @@ class Walker {
   }
 
   toml::table parse(std::string_view text) const {
+    plant::checkTomlText(text, file_);
     try {
       return toml::parse(text, file_);
     } catch (const toml::parse_error& e) {

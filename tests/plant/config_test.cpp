@@ -206,6 +206,34 @@ TEST(Profiles, HostileNumbersAreRejectedWithTheirRange) {
   }
 }
 
+// toml++ 3.3.0 reaches an "unreachable" state (undefined behaviour; an
+// assertion or UBSan report in other builds) on these inputs, from its
+// issues 190 and 295. The loaders stop them first, at their place.
+TEST(Profiles, TextTomlPlusPlusMishandlesIsStoppedFirst) {
+  struct Case {
+    std::string text;
+    const char* where;
+    const char* message;
+  } cases[] = {
+      {"s = \"\"\"\\\n\xc2\xa7\"\"\"\n", ":1:8: error:",
+       "a line-ending backslash in a multi-line string is followed by a non-ASCII character"},
+      {"a\xcc\xaa = 1\n", ":1:2: error:", "a non-ASCII character outside a string or comment"},
+      {"\xcc\xaa", ":1:1: error:", "a non-ASCII character outside a string or comment"},
+      {"name = \"x\xff\"\n", ":1:10: error:", "the file is not valid UTF-8 (byte 0xff)"},
+      {"name = \"x\xed\xa0\x80\"\n", ":1:10: error:", "the file is not valid UTF-8 (byte 0xed)"},
+  };
+  for (const Case& c : cases) {
+    const std::string msg = errorOf(c.text);
+    EXPECT_NE(msg.find(c.where), std::string::npos) << msg;
+    EXPECT_NE(msg.find(c.message), std::string::npos) << msg;
+  }
+  // Non-ASCII where TOML allows it passes the check (and the parser).
+  EXPECT_NO_THROW(
+      checkTomlText("# \xc3\xa9t\xc3\xa9\nname = \"\xe2\x82\xac \\\" \xc2\xa7\"\n"
+                    "s = '''\xf0\x9f\x98\x80'''\n",
+                    "ok.toml"));
+}
+
 TEST(Profiles, UnitsAreConverted) {
   std::string text = edit("size              = { value = 16.0,  unit = \"ft\"",
                           "size              = { value = 4.8768,  unit = \"m\"");
