@@ -14,6 +14,7 @@ packages=(
   libjs-three                  # three.js r111, inlined in replay pages
   sigrok-cli gtkwave xvfb      # tests read --vcd output with sigrok's decoder and GTKWave
   chromium                     # the browser test (headless, software WebGL)
+  clang libclang-rt-14-dev     # libFuzzer (scripts/fuzz.sh)
 )
 # Node.js and npm drive the browser test; a machine that has them (from
 # Debian or elsewhere) keeps its own.

@@ -46,8 +46,8 @@ json traceJson(const trace::Entry& e) {
   j["time_s"] = static_cast<double>(e.t) / scheduler::kTicksPerSecond;
   if (!e.watch.empty()) {
     json w = json::object();
-    for (const auto& [name, value] : e.watch)
-      std::visit([&](const auto& x) { w[name] = x; }, value);
+    for (const auto& item : e.watch)  // (clang 14 cannot capture a structured binding)
+      std::visit([&](const auto& x) { w[item.first] = x; }, item.second);
     j["watch"] = std::move(w);
   }
   return j;

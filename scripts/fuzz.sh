@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (fuzz/) with clang, ASan and UBSan into
+# build-fuzz/, and runs each for SECONDS (default 60): the compiler, the VM
+# (through a solo run) and the TOML loaders, each starting from the shipped
+# programs or configurations and the saved regressions. A crash, a leak, a
+# timeout or undefined behaviour fails the script; the input is left in
+# build-fuzz/fuzzing/ (copy it to fuzz/regressions/TARGET/ once fixed).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-60}
+CC=clang CXX=clang++ ./scripts/build.sh build-fuzz -DSIMBOT_FUZZ=ON -DSIMBOT_BENCHMARKS=OFF
+work=build-fuzz/fuzzing
+mkdir -p "$work"
+shared=../shared/programs
+run() {  # TARGET SEEDS...
+  local target=$1
+  shift
+  mkdir -p "$work/corpus-$target"
+  local dict=()
+  [ "$target" = config ] || dict=(-dict=fuzz/dynamic_c.dict)
+  build-fuzz/bin/fuzz_"$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    -max_len=8192 -print_final_stats=1 "${dict[@]}" -artifact_prefix="$work/$target-" \
+    "$work/corpus-$target" fuzz/regressions/"$target" "$@" > "$work/$target.log" 2>&1
+}
+status=0
+run compiler programs tests/programs tests/errors "$shared" & compiler=$!
+run vm programs tests/programs "$shared" & vm=$!
+wait "$compiler" || { status=1; echo "fuzz: the compiler target failed (log: $work/compiler.log)"; }
+wait "$vm" || { status=1; echo "fuzz: the vm target failed (log: $work/vm.log)"; }
+run config profiles profiles/hardware scenarios || { status=1; echo "fuzz: the config target failed (log: $work/config.log)"; }
+for target in compiler vm config; do
+  grep -E "stat::number_of_executed_units|stat::average_exec_per_sec" "$work/$target.log" |
+    tr '\n' ' ' | sed "s/^/fuzz $target: /"
+  echo
+done
+exit $status
