@@ -58,7 +58,8 @@ Diagnostic makeDiagnostic(const std::string& fileName, const std::vector<std::st
   d.line = pos.line < 1 ? 1 : pos.line;
   d.column = pos.col < 1 ? 1 : pos.col;
   d.message = std::move(message);
-  if (d.line >= 1 && static_cast<size_t>(d.line) <= lines.size()) d.sourceLine = lines[d.line - 1];
+  d.hasSourceLine = d.line >= 1 && static_cast<size_t>(d.line) <= lines.size();
+  if (d.hasSourceLine) d.sourceLine = lines[d.line - 1];
   return d;
 }
 
@@ -104,6 +105,7 @@ Result compileFile(const std::string& path, const Options& options) {
     d.line = 1;
     d.column = 1;
     d.message = "cannot read file: " + why;
+    d.hasSourceLine = false;
     r.errors.push_back(d);
     return r;
   };

@@ -16,7 +16,8 @@ struct Diagnostic {
   int line = 0;
   int column = 0;
   std::string message;
-  std::string sourceLine;  // the offending line's text, without newline
+  std::string sourceLine;     // the offending line's text, without newline
+  bool hasSourceLine = true;  // false: about the file as a whole (one line only)
   // "FILE:LINE:COL: error: MESSAGE\nSOURCE LINE\n    ^\n"
   std::string format() const;
 };

@@ -33,6 +33,7 @@ std::string Diagnostic::format() const {
       message.size() > kShownMessage ? message.substr(0, kShownMessage) + "..." : message;
   std::string out =
       fmt::format("{}:{}:{}: error: {}\n", file, line, column, printable(shownMessage));
+  if (!hasSourceLine) return out;
   // The part of the line shown, and where the caret goes in it.
   const size_t col = column > 0 ? static_cast<size_t>(column - 1) : 0;
   size_t from = 0, to = sourceLine.size();

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <type_traits>
 
@@ -45,6 +46,8 @@ constexpr const char* kRobotNames[] = {"A", "B"};
 struct ReplaySink::Columns {
   json kinds = json::object();
   json watch = json::object();
+  std::size_t records = 0;
+  std::optional<trace::Tick> truncatedAt;  // the first record left out
 };
 
 ReplaySink::ReplaySink(const std::string& path) : path_(path), columns_(new Columns) {
@@ -62,6 +65,17 @@ ReplaySink::~ReplaySink() {
 }
 
 void ReplaySink::write(const trace::Entry& e) {
+  // A page is for a person to look at: beyond this many records (a program
+  // flooding port B) the rest of the run is left out, and the page says so,
+  // so that its memory stays bounded. The end of the run is always kept.
+  constexpr std::size_t kMaxRecords = 1'000'000;
+  const bool ending = std::holds_alternative<trace::rec::RobotResult>(e.record) ||
+                      std::holds_alternative<trace::rec::End>(e.record);
+  if (columns_->records >= kMaxRecords && !ending) {
+    if (!columns_->truncatedAt) columns_->truncatedAt = e.t;
+    return;
+  }
+  ++columns_->records;
   json& cols = columns_->kinds[trace::kindOf(e.record).name];
   cols["t"].push_back(e.t);
   trace::forEachField(e.record, [&](const trace::FieldInfo& f, const auto& v) {
@@ -89,7 +103,10 @@ void ReplaySink::write(const trace::Entry& e) {
 }
 
 json ReplaySink::data() const {
-  return {{"format", "simbot-replay/1"}, {"kinds", columns_->kinds}, {"watch", columns_->watch}};
+  return {{"format", "simbot-replay/1"},
+          {"kinds", columns_->kinds},
+          {"watch", columns_->watch},
+          {"truncated_at", columns_->truncatedAt ? json(*columns_->truncatedAt) : json(nullptr)}};
 }
 
 void ReplaySink::close() {

@@ -45,6 +45,13 @@ function startViewer() {
     div.addEventListener('click', () => seek(f.t));
     $('faults').appendChild(div);
   }
+  if (model.truncatedAt !== null) {
+    const div = document.createElement('div');
+    div.className = 'fault';
+    div.textContent = `This run made more trace records than a page holds: the page shows it up to ` +
+      `${fmt(model.truncatedAt)} (and its result); the --trace file has all of it.`;
+    $('faults').appendChild(div);
+  }
   for (const f of model.plantFaults) {
     const div = document.createElement('div');
     div.className = 'fault';

@@ -88,6 +88,7 @@ function buildModel(data) {
     plantFaults: rowsOf(K.plant_fault),
     injections: rowsOf(K.injection),
     consoleLines: rowsOf(K.console),
+    truncatedAt: data.truncated_at === undefined ? null : data.truncated_at,
     winner: endRows ? K.end.winner[0] : '',
     coin: endRows ? K.end.tie_broken_by_coin[0] : false,
     steps: stepLists(K),
