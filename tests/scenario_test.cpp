@@ -151,6 +151,12 @@ TEST(Scenario, EveryMistakeNamesItsLine) {
        "s.toml:3:42: error: unknown key 'fast' in 'B.path[0]' (expected one of: forward_ft, "
        "arc_radius_ft, turn_deg, spin_deg, wait_s, speed_fps)"},
       {"[B]\nbeacon = true\nrepeat = 1\n", "s.toml:3:10: error: 'B.repeat' must be true or false"},
+      // Integers beyond 2^53 are read as integers and checked, numbers have ranges.
+      {"[A]\nstart = { x_ft = 9223372036854775807, y_ft = 0, heading_deg = 0 }\n",
+       "s.toml:2:18: error: 'A.start.x_ft' must be between -100 and 100, got "
+       "9.223372036854776e+18"},
+      {"[B]\nbeacon = true\npath = [{ forward_ft = 2, speed_fps = 1e300 }]\n",
+       "s.toml:3:39: error: 'B.path[0].speed_fps' must be between"},
   };
   for (const Bad& c : cases) {
     const std::string got = errorOf(c.text);

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <numbers>
 
 #include "tools/runner.h"
@@ -73,14 +74,23 @@ class Walker {
     }
   }
 
-  double number(const toml::node& n, const std::string& name) const {
-    if (!n.is_number()) fail(n, fmt::format("'{}' must be a number", name));
-    const double v = *n.value<double>();
+  // A number within [lo, hi]. Integers are read as integers: toml++ gives
+  // no double for one it cannot represent exactly (beyond 2^53).
+  double number(const toml::node& n, const std::string& name, double lo, double hi) const {
+    double v = 0;
+    if (const auto* i = n.as_integer())
+      v = static_cast<double>(i->get());
+    else if (const auto* f = n.as_floating_point())
+      v = f->get();
+    else
+      fail(n, fmt::format("'{}' must be a number", name));
     if (!std::isfinite(v)) fail(n, fmt::format("'{}' must be finite", name));
+    if (v < lo || v > hi)
+      fail(n, fmt::format("'{}' must be between {} and {}, got {}", name, lo, hi, v));
     return v;
   }
-  double positive(const toml::node& n, const std::string& name) const {
-    const double v = number(n, name);
+  double positive(const toml::node& n, const std::string& name, double hi) const {
+    const double v = number(n, name, -std::numeric_limits<double>::max(), hi);
     if (!(v > 0)) fail(n, fmt::format("'{}' must be greater than 0, got {}", name, v));
     return v;
   }
@@ -111,7 +121,9 @@ class Walker {
     auto need = [&](const char* key) {
       const toml::node* v = t->get(key);
       if (!v) fail(n, fmt::format("'{}' has no '{}'", name, key));
-      return number(*v, name + "." + key);
+      // Poses are checked against the field when the run is set up.
+      return key == std::string_view("heading_deg") ? number(*v, name + "." + key, -3600, 3600)
+                                                    : number(*v, name + "." + key, -100, 100);
     };
     plant::Pose p{need("x_ft"), need("y_ft"), need("heading_deg")};
     p.heading_deg = std::fmod(p.heading_deg, 360.0);
@@ -173,25 +185,25 @@ class Walker {
     if (const toml::node* w = t->get("wait_s")) {
       if (speed) fail(*speed, fmt::format("'{}': a wait has no speed_fps", name));
       leg.kind = PathLeg::Kind::Wait;
-      leg.waitS = positive(*w, name + ".wait_s");
+      leg.waitS = positive(*w, name + ".wait_s", 1e6);
       return leg;
     }
     if (!speed) fail(n, fmt::format("'{}' has no 'speed_fps'", name));
-    leg.speedFps = positive(*speed, name + ".speed_fps");
+    leg.speedFps = positive(*speed, name + ".speed_fps", 20);
     if (const toml::node* f = t->get("forward_ft")) {
       leg.kind = PathLeg::Kind::Forward;
-      leg.forwardFt = number(*f, name + ".forward_ft");
+      leg.forwardFt = number(*f, name + ".forward_ft", -1e4, 1e4);
       if (leg.forwardFt == 0) fail(*f, fmt::format("'{}.forward_ft' must not be 0", name));
     } else if (const toml::node* r = t->get("arc_radius_ft")) {
       leg.kind = PathLeg::Kind::Arc;
-      leg.radiusFt = positive(*r, name + ".arc_radius_ft");
+      leg.radiusFt = positive(*r, name + ".arc_radius_ft", 1e4);
       if (!turn) fail(n, fmt::format("'{}' has no 'turn_deg' (the arc's signed angle)", name));
-      leg.turnDeg = number(*turn, name + ".turn_deg");
+      leg.turnDeg = number(*turn, name + ".turn_deg", -36000, 36000);
       if (leg.turnDeg == 0) fail(*turn, fmt::format("'{}.turn_deg' must not be 0", name));
     } else {
       const toml::node& s = *t->get("spin_deg");
       leg.kind = PathLeg::Kind::Spin;
-      leg.turnDeg = number(s, name + ".spin_deg");
+      leg.turnDeg = number(s, name + ".spin_deg", -36000, 36000);
       if (leg.turnDeg == 0) fail(s, fmt::format("'{}.spin_deg' must not be 0", name));
     }
     return leg;
@@ -214,7 +226,7 @@ class Walker {
       }
     }
     if (const toml::node* n = root.get("seconds")) {
-      s.seconds = positive(*n, "seconds");
+      s.seconds = positive(*n, "seconds", 1e300);
       if (*s.seconds > 1e6) fail(*n, "'seconds' must be at most 1e6");
     }
     if (const toml::node* n = root.get("seed")) {
