@@ -1189,7 +1189,9 @@ void CodeGen::libCall(Node* n) {
   for (Node* a : n->list) value(a);
   int line = n->pos.line;
   curPos_ = n->pos;
-  if (n->list.size() > 255) fail(n->pos, "too many arguments");
+  if (n->list.size() > static_cast<size_t>(vm::kMaxLibArgs))
+    fail(n->pos,
+         "too many arguments to a library call (at most " + std::to_string(vm::kMaxLibArgs) + ")");
   emitU16(Op::LIB, n->lib | (static_cast<int>(n->list.size()) << 8), line);
 }
 

@@ -35,6 +35,10 @@ inline constexpr int kOpCount = static_cast<int>(Op::Count_);
 
 enum class Shape : uint8_t { NONE, U8, U16, REL16, I32, F32, LIB };
 
+// A library call takes at most this many arguments (printf's format and
+// values included): the compiler refuses more, the VM faults on more.
+inline constexpr int kMaxLibArgs = 32;
+
 constexpr int operandBytes(Shape s) {
   switch (s) {
     case Shape::NONE:

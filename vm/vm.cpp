@@ -48,7 +48,6 @@ constexpr int kEvalHeadroom = 1024;
 constexpr int kEvalGuard = 4;
 constexpr int kMaxInterruptNesting = 16;
 constexpr uint32_t kMaxStepTstates = 100;  // long library calls: boundary spacing
-constexpr int kMaxLibArgs = 32;
 // printf's largest field width and precision (assumption: Dynamic C's
 // printf formatted each field into a buffer of this size).
 constexpr long kMaxPrintfField = 127;
