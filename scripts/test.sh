@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Sets everything up and runs the whole test suite: the layout check
 # (clang-format), the normal build with warnings as errors, the same suite
-# built with AddressSanitizer and UndefinedBehaviorSanitizer, and a short
-# campaign (60 s) of each libFuzzer target.
+# built with AddressSanitizer and UndefinedBehaviorSanitizer, the threaded
+# bench and tournament built with ThreadSanitizer, and a short campaign
+# (60 s) of each libFuzzer target.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
@@ -16,4 +17,11 @@ ctest --test-dir build --output-on-failure --parallel "$jobs" --timeout 900
   -DSIMBOT_WERROR=ON
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-asan --output-on-failure --parallel "$jobs" --timeout 1800
+# ThreadSanitizer: only the suite that runs work on several threads.
+cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSIMBOT_TSAN=ON \
+  -DSIMBOT_BENCHMARKS=OFF -DSIMBOT_WERROR=ON > build-tsan.configure.log 2>&1 ||
+  { cat build-tsan.configure.log; exit 1; }
+cmake --build build-tsan --parallel "$jobs" --target bench_test
+TSAN_OPTIONS=halt_on_error=1 \
+  ctest --test-dir build-tsan -R '^(Bench|Tournament)\.' --output-on-failure --parallel "$jobs"
 ./scripts/fuzz.sh 60
