@@ -1,0 +1,106 @@
+#!/usr/bin/env python3
+"""Every command the README shows runs as written.
+
+Usage: readme_test.py README SIMBOT WORKDIR
+
+Each ```sh block of the README runs, in order, with bash -e, in a sandbox
+laid out like the project's checkout (WORKDIR/main holding build/bin/simbot,
+programs/, scenarios/, profiles/ and tests/, beside WORKDIR/shared), so that
+the files a command writes land in WORKDIR and a later block can read them.
+The Quickstart block is the exception: `.ci/run` runs `scripts/test.sh` and
+`scripts/quickstart.sh` themselves on a clean clone. A desktop program
+(GTKWave) runs under Xvfb and passes when it is still showing the file
+after a few seconds; anything else must exit with status 0.
+"""
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+CI_RUNS_THESE = {"./scripts/quickstart.sh", "./scripts/test.sh"}
+DESKTOP_PROGRAMS = {"gtkwave"}
+DESKTOP_SECONDS = 8
+
+
+def blocks(readme_text):
+    """The ```sh blocks, each a list of logical lines (continuations joined)."""
+    out = []
+    for body in re.findall(r"^```sh\n(.*?)^```", readme_text, re.S | re.M):
+        lines, pending = [], ""
+        for raw in body.splitlines():
+            if raw.endswith("\\"):
+                pending += raw[:-1] + " "
+                continue
+            lines.append(pending + raw)
+            pending = ""
+        out.append([line for line in lines if line.strip()])
+    return out
+
+
+def sandbox(source, simbot, work):
+    main = os.path.join(work, "main")
+    if os.path.exists(work):
+        shutil.rmtree(work)
+    os.makedirs(os.path.join(main, "build", "bin"))
+    os.symlink(os.path.abspath(simbot), os.path.join(main, "build", "bin", "simbot"))
+    for part in ("programs", "scenarios", "profiles", "tests"):
+        os.symlink(os.path.join(source, part), os.path.join(main, part))
+    os.symlink(os.path.abspath(os.path.join(source, "..", "shared")), os.path.join(work, "shared"))
+    return main
+
+
+def run_desktop(line, cwd):
+    """Starts a desktop program under Xvfb; it passes if it is still up."""
+    proc = subprocess.Popen(["xvfb-run", "-a", "bash", "-c", line], cwd=cwd,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+    try:
+        status = proc.wait(timeout=DESKTOP_SECONDS)
+        return f"exited with status {status} within {DESKTOP_SECONDS} s: {proc.stderr.read().decode()[-400:]}"
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, 9)
+        proc.wait()
+        return None
+
+
+def main():
+    readme, simbot, work = sys.argv[1:4]
+    source = os.path.dirname(os.path.abspath(readme))
+    cwd = sandbox(source, simbot, os.path.abspath(work))
+    failures, ran = [], 0
+    for block in blocks(open(readme, encoding="utf-8").read()):
+        if set(line.split("#")[0].strip() for line in block) <= CI_RUNS_THESE:
+            continue
+        script = []
+        for line in block:
+            if line.split()[0] in DESKTOP_PROGRAMS:
+                problem = None
+                if script:  # what comes before it runs first
+                    done = subprocess.run(["bash", "-e", "-c", "\n".join(script)], cwd=cwd,
+                                          capture_output=True, text=True)
+                    script = []
+                    if done.returncode != 0:
+                        problem = f"status {done.returncode}: {done.stderr[-600:]}"
+                problem = problem or run_desktop(line, cwd)
+                ran += 1
+                if problem:
+                    failures.append(f"{line}\n  {problem}")
+                continue
+            script.append(line)
+        if script:
+            started = time.monotonic()
+            done = subprocess.run(["bash", "-e", "-c", "\n".join(script)], cwd=cwd,
+                                  capture_output=True, text=True)
+            ran += len(script)
+            print(f"ran {len(script)} command(s) in {time.monotonic() - started:.1f} s: {script[0][:70]}")
+            if done.returncode != 0:
+                failures.append("\n".join(script) + f"\n  status {done.returncode}: {done.stderr[-600:]}")
+    for failure in failures:
+        print("FAIL: " + failure)
+    print(f"{ran} README commands run, {len(failures)} failed")
+    sys.exit(1 if failures or ran == 0 else 0)
+
+
+if __name__ == "__main__":
+    main()
