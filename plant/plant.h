@@ -105,6 +105,8 @@ struct Profile {
   FieldParams field;
   RefereeParams referee;
   double round_length_s = 180;
+  // --reload-on-fault: from a robot's fault to its program's restart (s).
+  double reload_delay_s = 20;
   RobotParams robot;
 };
 

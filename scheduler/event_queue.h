@@ -22,8 +22,9 @@ using Tick = int64_t;
 // Classes in the order they run at one tick. Plant events first (a detector
 // crossing at tick t is seen by anything else at t), then the bytes the
 // serial ports finish, then motor latches that those bytes caused, then
-// weapon and referee actions, injections, and last the observers (trace
-// samples, the end of the round), so that they see the settled state.
+// weapon and referee actions, injections, reloads of faulted robots (which
+// start from a settled state), and last the observers (trace samples, the
+// end of the round), so that they see the settled state.
 enum class EventClass : uint8_t {
   Plant = 0,
   SerialByte = 1,
@@ -31,8 +32,9 @@ enum class EventClass : uint8_t {
   Weapon = 3,
   Referee = 4,
   Injection = 5,
-  Sample = 6,
-  EndOfRound = 7,
+  Reload = 6,
+  Sample = 7,
+  EndOfRound = 8,
 };
 
 struct EventKey {

@@ -25,7 +25,7 @@ double seconds(Tick t) { return static_cast<double>(t) / kTicksPerSecond; }
 
 // Queued events; the plant's own events come from Arena::advance.
 struct QueuedEvent {
-  enum class Kind : uint8_t { SerialByte, DriveLeg, Inject, ReleaseEdge, EndOfRound } kind;
+  enum class Kind : uint8_t { SerialByte, DriveLeg, Inject, ReleaseEdge, Reload, EndOfRound } kind;
   int robot = 0;
   int index = 0;  // injection number, path leg, or the detector bit to release
 };
@@ -50,10 +50,48 @@ plant::ArenaConfig arenaConfigFor(const MatchConfig& config) {
   return arena;
 }
 
+// A VM's clock starts at 0 when it is made; a VM made for a reload starts
+// at tick `base` of the match, so every tick it reports is moved by `base`.
+class ShiftedBus : public vm::Bus {
+ public:
+  explicit ShiftedBus(vm::Bus& to) : to_(to) {}
+  Tick base = 0;
+  void out(Tick t, uint16_t port, uint8_t value) override { to_.out(t + base, port, value); }
+  uint8_t in(Tick t, uint16_t port) override { return to_.in(t + base, port); }
+  int adSample(Tick t, int channel) override { return to_.adSample(t + base, channel); }
+  void hvEnable(Tick t) override { to_.hvEnable(t + base); }
+  void serialInit(Tick t, int mode, int divisor) override {
+    to_.serialInit(t + base, mode, divisor);
+  }
+  void serialSend(Tick t, uint16_t buf, uint16_t cc) override { to_.serialSend(t + base, buf, cc); }
+  void serialTxService(Tick t, vm::Vm& v) override { to_.serialTxService(t + base, v); }
+  void console(Tick t, std::string_view line) override { to_.console(t + base, line); }
+  void interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) override {
+    to_.interruptAccepted(t + base, irq, pc);
+  }
+  void interruptReturned(Tick t, vm::Irq irq) override { to_.interruptReturned(t + base, irq); }
+  void iffChanged(Tick t, bool iff1) override { to_.iffChanged(t + base, iff1); }
+
+ private:
+  vm::Bus& to_;
+};
+
 // One robot: its VM, the devices its program talks to, and its counters.
 class Robot : public vm::Bus, public plant::RobotMemory {
  public:
   Robot(Match& match, int index, const RobotSpec& spec, const vm::CostTable& costs, uint64_t seed);
+
+  // The robot's clock (match ticks) and its program's VM.
+  Tick now() const { return bus.base + vm_->now(); }
+  vm::Vm& vm() { return *vm_; }
+  const vm::Vm& vm() const { return *vm_; }
+  // A VM as at load, its clock at t: fresh memory (with the profile's
+  // power-on fill), the breakpoints the match needs.
+  void powerOn(Tick t);
+  // --reload-on-fault: the faulted program starts again at t.
+  void reload(Tick t);
+  bool reloadPending = false;
+  bool faultSeen = false;  // this VM's fault is recorded
 
   // vm::Bus
   void out(Tick t, uint16_t port, uint8_t value) override;
@@ -66,8 +104,8 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   void interruptReturned(Tick t, vm::Irq irq) override;
   void iffChanged(Tick t, bool iff1) override;
   // plant::RobotMemory
-  uint8_t read8(uint16_t a) const override { return vm_.read8(a); }
-  void write8(uint16_t a, uint8_t v) override { vm_.write8(a, v); }
+  uint8_t read8(uint16_t a) const override { return vm_->read8(a); }
+  void write8(uint16_t a, uint8_t v) override { vm_->write8(a, v); }
 
   // Runs the VM to `horizon` (its clock ends at or after it).
   void runTo(Tick horizon);
@@ -77,6 +115,8 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   void inject(Tick t, const Injection& injection);
   uint8_t plantLow = 0, injectedLow = 0;
   std::map<uint32_t, std::vector<int>> lineInjections;  // code address -> injections
+  // Executions of each injection point, over the whole run (a reload does
+  // not restart the count).
   std::map<uint32_t, int> lineHits;
   struct Watch {
     std::string name;
@@ -106,8 +146,19 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   const RobotSpec& spec;
   int index;
   Match& match;
-  vm::Vm vm_;
+  const vm::CostTable& costs;
+  ShiftedBus bus;
+  std::unique_ptr<vm::Vm> vm_;
+  plant::SplitMix64 memoryFill;  // power-on RAM (profile random_memory)
+  // T-states of earlier VMs of this robot (reloads), for profiles.
+  std::vector<uint64_t> earlierProfile;
+  uint64_t earlierSerialIsrCycles = 0;
   plant::SerialLink link;
+  // What the serial library had still to fetch of the current send after
+  // its last step: a new send while it is above zero overwrites that frame.
+  // (Read back after each step, since the program may rewrite *cc itself.)
+  uint16_t sendCcAddress = 0;
+  int sendUnfetched = 0;
   plant::PioPortA pio;
   uint8_t edgeLines = 0xFF;
   int enb485 = -1;  // never written
@@ -134,8 +185,10 @@ class Match {
     for (size_t i = 0; i < config.robots.size(); ++i)
       robots_.push_back(std::make_unique<Robot>(*this, static_cast<int>(i), config.robots[i],
                                                 costs_, config.seed));
-    if (config.profile)
-      for (auto& r : robots_) r->vm_.enableProfile();
+    if (config.reloadOnFault && config.reloadDelay < kMinReloadDelay)
+      throw std::invalid_argument(
+          fmt::format("a reload must wait at least {} ticks (the serial port's two characters)",
+                      kMinReloadDelay));
     resolveWatches();
     queue_.schedule(config.endTick, EventClass::EndOfRound, {QueuedEvent::Kind::EndOfRound, 0, 0});
     for (size_t i = 0; i < config.robots.size(); ++i) {
@@ -156,9 +209,22 @@ class Match {
         if (at == lines.end())
           throw std::invalid_argument(
               fmt::format("{}: line {} of {} has no code", in.text, in.line, r.spec.program));
-        const auto address = static_cast<uint32_t>(at - lines.begin());
+        const std::optional<uint32_t> head = loopHead(r.spec.image, in.line);
+        if (in.pass && !head)
+          throw std::invalid_argument(fmt::format(
+              "{}: line {} of {} holds no whole loop (pass:N#K counts the passes of a loop "
+              "written on one line; line:N#K counts entries into a line)",
+              in.text, in.line, r.spec.program));
+        if (!in.pass && head)
+          warnings_.push_back(fmt::format(
+              "--inject {}: line {} of {} holds a whole loop; line:N#K counts entries into "
+              "the line (runs of its first instruction, once before each run of the loop), "
+              "not passes of the loop; for pass {} of the loop write pass:{}#{}",
+              in.text, in.line, r.spec.program, in.count, in.line, in.count));
+        const auto address = in.pass ? *head : static_cast<uint32_t>(at - lines.begin());
         r.lineInjections[address].push_back(static_cast<int>(k));
-        r.vm_.setBreakpoint(address);
+        injectionAddress_[k] = address;
+        r.vm().setBreakpoint(address);
       } else {
         queue_.schedule(in.tick, EventClass::Injection,
                         {QueuedEvent::Kind::Inject, in.robot, static_cast<int>(k)});
@@ -172,6 +238,13 @@ class Match {
 
   plant::Arena& arena() { return arena_; }
   bool tracing() const { return trace_.on(); }
+  bool profiling() const { return config_.profile; }
+  // Robot `robot` faulted at t: its reload, if the run asks for one.
+  void faulted(int robot, Tick t);
+  // Injection `injection` (one of config_.injections) fired.
+  void fired(const Injection& injection) {
+    fired_[static_cast<size_t>(&injection - config_.injections.data())] = true;
+  }
   Tick sampleInterval() const { return config_.sampleInterval; }
   // A record at tick t, with the watched variables of its robot as they are
   // now in that robot's memory.
@@ -212,6 +285,14 @@ class Match {
   EventQueue<QueuedEvent> queue_;
   std::vector<std::unique_ptr<Robot>> robots_;
   std::vector<PlantInput> inputs_;
+  std::vector<std::string> warnings_;
+  std::vector<bool> fired_ = std::vector<bool>(config_.injections.size());
+  std::vector<uint32_t> injectionAddress_ = std::vector<uint32_t>(config_.injections.size());
+  int hitsAt(const Injection& in, uint32_t address) const {
+    const auto& hits = robots_[static_cast<size_t>(in.robot)]->lineHits;
+    const auto it = hits.find(address);
+    return it == hits.end() ? 0 : it->second;
+  }
   bool betweenRounds_ = false;
   Tick nextSample_ = 0;
   uint64_t rounds_ = 0;
@@ -219,47 +300,97 @@ class Match {
 
 // ---- robot ------------------------------------------------------------------
 
-Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs, uint64_t seed)
+Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs_, uint64_t seed)
     : spec(s),
       index(i),
       match(m),
-      vm_(s.image, *this, costs),
+      costs(costs_),
+      bus(*this),
+      memoryFill(streamSeed(seed, "memory-fill-" + s.name)),
       noise(streamSeed(seed, "eye-noise-" + s.name)),
       gunLuck(streamSeed(seed, "gun-" + s.name)),
       mainReturn(s.image.entry + static_cast<uint32_t>(vm::instructionSize(vm::Op::CALL))) {
   result.name = s.name;
   result.program = s.program;
-  vm_.setBreakpoint(mainReturn);
-  if (m.robotParams(i).random_memory) {
-    plant::SplitMix64 fill(streamSeed(seed, "memory-fill-" + s.name));
-    vm_.fillMemory([&fill] { return fill.next(); });
+  powerOn(0);
+}
+
+void Robot::powerOn(Tick t) {
+  bus.base = t;
+  vm_ = std::make_unique<vm::Vm>(spec.image, bus, costs);
+  faultSeen = false;
+  vm_->setBreakpoint(mainReturn);
+  for (const auto& [address, injections] : lineInjections) vm_->setBreakpoint(address);
+  if (match.profiling()) vm_->enableProfile();
+  // A reload draws the next bytes of the same stream: RAM after a power
+  // cycle holds new garbage, not the same.
+  if (match.robotParams(index).random_memory) vm_->fillMemory([this] { return memoryFill.next(); });
+}
+
+void Robot::reload(Tick t) {
+  reloadPending = false;
+  if (match.profiling()) {
+    const auto& p = vm_->profile();
+    earlierProfile.resize(std::max(earlierProfile.size(), p.size()));
+    for (size_t a = 0; a < p.size(); ++a) earlierProfile[a] += p[a];
+    earlierSerialIsrCycles += vm_->serialIsrCycles();
   }
+  powerOn(t);
+  ++result.reloads;
+  result.exited = false;
+  // The controller's reset clears the Z180's serial port, the library and
+  // the PIO (unarmed: no edge interrupt until the program arms it again);
+  // the delay is long enough that no byte is left in the port. The motor
+  // controller keeps its latched command; the receiver's partial frame is
+  // dropped with the link's state (a fragment from before the crash never
+  // joins the reloaded program's frames).
+  if (!link.idle()) throw std::logic_error("a reload with bytes still in the serial port");
+  link = plant::SerialLink{};
+  sendCcAddress = 0;
+  sendUnfetched = 0;
+  serialEventAt = -1;
+  pio = plant::PioPortA{};
+  // The reset PIO sees the lines as they are; unarmed, it raises nothing.
+  if (pio.setInputs(edgeLines)) throw std::logic_error("an unarmed PIO raised an interrupt");
+  enb485 = -1;
+  // Samples up to t were taken from the faulted VM: the new one's start at
+  // the next sample tick.
+  snapshots.clear();
+  const Tick interval = match.sampleInterval();
+  nextSnapshot = (t / interval + 1) * interval;
+  if (match.tracing()) match.emit(t, trace::rec::Reload{index, result.reloads});
 }
 
 void Robot::runTo(Tick horizon) {
   const bool tracing = match.tracing();
   for (;;) {
     if (tracing) takeSnapshots();
-    if (vm_.now() >= horizon) return;
-    const vm::Stop stop = vm_.run(tracing ? std::min(horizon, nextSnapshot) : horizon);
+    if (now() >= horizon) return;
+    const vm::Stop stop =
+        vm_->run((tracing ? std::min(horizon, nextSnapshot) : horizon) - bus.base);
     if (stop == vm::Stop::Fault) {
-      if (!result.fault) {
-        const vm::Fault* f = vm_.fault();
-        result.fault = FaultInfo{f->message, seconds(f->tick), f->line};
-        if (tracing) match.emit(f->tick, trace::rec::Fault{index, f->message, f->line});
+      const vm::Fault* f = vm_->fault();
+      const Tick at = bus.base + f->tick;
+      if (!faultSeen) {
+        faultSeen = true;
+        FaultInfo info{f->message, seconds(at), f->line};
+        if (!result.fault) result.fault = info;
+        result.faults.push_back(info);
+        if (tracing) match.emit(at, trace::rec::Fault{index, f->message, f->line});
+        match.faulted(index, at);
       }
       return;
     }
     if (stop != vm::Stop::Breakpoint) continue;
-    if (vm_.pc() == mainReturn) {
+    if (vm_->pc() == mainReturn) {
       result.exited = true;
-      result.exitTick = vm_.now();
-      if (tracing) match.emit(vm_.now(), trace::rec::Exit{index});
+      result.exitTick = now();
+      if (tracing) match.emit(now(), trace::rec::Exit{index});
     }
-    if (auto it = lineInjections.find(vm_.pc()); it != lineInjections.end()) {
-      const int hit = ++lineHits[vm_.pc()];
+    if (auto it = lineInjections.find(vm_->pc()); it != lineInjections.end()) {
+      const int hit = ++lineHits[vm_->pc()];
       for (int k : it->second)
-        if (match.injection(k).count == hit) inject(vm_.now(), match.injection(k));
+        if (match.injection(k).count == hit) inject(now(), match.injection(k));
     }
   }
 }
@@ -267,9 +398,9 @@ void Robot::runTo(Tick horizon) {
 // The VM's state at its first boundary at or after each sample tick it has
 // reached: it was stopped there (runTo), or it idled there (halted).
 void Robot::takeSnapshots() {
-  while (nextSnapshot <= vm_.now()) {
-    snapshots.push_back(Snapshot{nextSnapshot, vm_.line(), spec.image.functionAt(vm_.pc()),
-                                 vm_.interruptDepth() > 0, watchedValues()});
+  while (nextSnapshot <= now()) {
+    snapshots.push_back(Snapshot{nextSnapshot, vm_->line(), spec.image.functionAt(vm_->pc()),
+                                 vm_->interruptDepth() > 0, watchedValues()});
     nextSnapshot += match.sampleInterval();
   }
 }
@@ -278,8 +409,8 @@ void Robot::takeSnapshots() {
 Robot::Snapshot Robot::snapshotFor(Tick t) {
   while (!snapshots.empty() && snapshots.front().tick < t) snapshots.pop_front();
   if (!snapshots.empty() && snapshots.front().tick == t) return snapshots.front();
-  const uint32_t pc = vm_.pc();
-  return Snapshot{t, vm_.fault() ? vm_.fault()->line : spec.image.lineAt(pc),
+  const uint32_t pc = vm_->pc();
+  return Snapshot{t, vm_->fault() ? vm_->fault()->line : spec.image.lineAt(pc),
                   spec.image.functionAt(pc), false, watchedValues()};
 }
 
@@ -325,14 +456,18 @@ int Robot::adSample(Tick t, int channel) {
 }
 
 void Robot::serialSend(Tick t, uint16_t buf, uint16_t cc) {
-  if (match.tracing()) match.emit(t, trace::rec::SerialSend{index, vm_.read8(cc)});
+  if (match.tracing()) match.emit(t, trace::rec::SerialSend{index, vm_->read8(cc)});
+  if (sendUnfetched > 0) ++result.framesOverwritten;
   link.send(t, buf, cc, *this);
+  sendCcAddress = cc;
+  sendUnfetched = vm_->read8(cc);
   scheduleSerial(t);
   updateSerialRequest();
 }
 
 void Robot::serialTxService(Tick t, vm::Vm&) {
   link.service(t, *this);
+  sendUnfetched = vm_->read8(sendCcAddress);
   scheduleSerial(t);
   updateSerialRequest();
 }
@@ -352,9 +487,9 @@ void Robot::scheduleSerial(Tick) {
 
 void Robot::updateSerialRequest() {
   if (link.requestingInterrupt())
-    vm_.request(vm::Irq::SerialTx);
+    vm_->request(vm::Irq::SerialTx);
   else
-    vm_.cancelRequest(vm::Irq::SerialTx);
+    vm_->cancelRequest(vm::Irq::SerialTx);
 }
 
 void Robot::byteDone(Tick t) {
@@ -385,17 +520,17 @@ trace::Watch Robot::watchedValues() const {
     const bool isUnsigned = w.type.find("unsigned") != std::string::npos;
     trace::WatchValue v;
     if (w.type.find('*') != std::string::npos) {
-      v = std::int64_t{vm_.read16(w.address)};
+      v = std::int64_t{vm_->read16(w.address)};
     } else if (w.type.find("float") != std::string::npos ||
                w.type.find("double") != std::string::npos) {
-      v = static_cast<double>(std::bit_cast<float>(vm_.read32(w.address)));
+      v = static_cast<double>(std::bit_cast<float>(vm_->read32(w.address)));
     } else if (w.type.find("long") != std::string::npos) {
-      const uint32_t raw = vm_.read32(w.address);
+      const uint32_t raw = vm_->read32(w.address);
       v = isUnsigned ? std::int64_t{raw} : std::int64_t{static_cast<int32_t>(raw)};
     } else if (w.type.find("char") != std::string::npos) {
-      v = std::int64_t{vm_.read8(w.address)};
+      v = std::int64_t{vm_->read8(w.address)};
     } else {
-      const uint16_t raw = vm_.read16(w.address);
+      const uint16_t raw = vm_->read16(w.address);
       v = isUnsigned ? std::int64_t{raw} : std::int64_t{static_cast<int16_t>(raw)};
     }
     values.emplace_back(w.name, v);
@@ -407,11 +542,12 @@ void Robot::updateEdgeLines(Tick t) {
   const auto lines = static_cast<uint8_t>(~(plantLow | injectedLow));
   if (lines != edgeLines && match.tracing()) match.emit(t, trace::rec::PortA{index, lines});
   edgeLines = lines;
-  if (pio.setInputs(edgeLines)) vm_.request(vm::Irq::Pio, pio.vector());
+  if (pio.setInputs(edgeLines)) vm_->request(vm::Irq::Pio, pio.vector());
 }
 
 void Robot::inject(Tick t, const Injection& injection) {
-  if (match.tracing()) match.emit(t, trace::rec::Injection{index, injection.text, vm_.line()});
+  match.fired(injection);
+  if (match.tracing()) match.emit(t, trace::rec::Injection{index, injection.text, vm_->line()});
   switch (injection.source) {
     case InjectSource::EdgeFore:
     case InjectSource::EdgeAft: {
@@ -473,7 +609,7 @@ void Robot::interruptReturned(Tick t, vm::Irq irq) {
   if (irq != vm::Irq::Pio) return;
   if (match.tracing())
     match.emit(t, trace::rec::InterruptReturned{index, std::string(vm::irqName(irq))});
-  if (pio.returned()) vm_.request(vm::Irq::Pio, pio.vector());
+  if (pio.returned()) vm_->request(vm::Irq::Pio, pio.vector());
 }
 
 void Robot::iffChanged(Tick t, bool iff1) {
@@ -485,7 +621,7 @@ void Robot::iffChanged(Tick t, bool iff1) {
 Tick Match::earliestClock() const {
   Tick t = INT64_MAX;
   for (const auto& r : robots_)
-    if (!r->vm_.fault()) t = std::min(t, r->vm_.now());
+    if (!r->vm().fault()) t = std::min(t, r->now());
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 
@@ -789,6 +925,10 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
           r.inject(horizon, config_.injections[static_cast<size_t>(entry.payload.index)]);
           break;
         }
+        case QueuedEvent::Kind::Reload:
+          sampleUpTo(horizon);
+          robots_[static_cast<size_t>(entry.payload.robot)]->reload(horizon);
+          break;
         case QueuedEvent::Kind::ReleaseEdge: {
           Robot& r = *robots_[static_cast<size_t>(entry.payload.robot)];
           r.injectedLow &= static_cast<uint8_t>(~entry.payload.index);
@@ -802,7 +942,7 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
     }
     betweenRounds_ = false;
     if (config_.stopWhenAllExited && std::all_of(robots_.begin(), robots_.end(), [](const auto& r) {
-          return r->result.exited || r->vm_.fault();
+          return (r->result.exited || r->vm().fault()) && !r->reloadPending;
         })) {
       over = true;
     }
@@ -813,17 +953,42 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
   }
 }
 
+void Match::faulted(int robot, Tick t) {
+  if (!config_.reloadOnFault) return;
+  const Tick at = t + config_.reloadDelay;
+  if (at >= config_.endTick) return;  // the run is over before the reload
+  robots_[static_cast<size_t>(robot)]->reloadPending = true;
+  queue_.schedule(at, EventClass::Reload, {QueuedEvent::Kind::Reload, robot, 0});
+}
+
 void Match::finish(MatchResult& result) {
   result.rounds = rounds_;
+  result.warnings = warnings_;
+  for (size_t k = 0; k < fired_.size(); ++k) {
+    if (fired_[k]) continue;
+    const Injection& in = config_.injections[k];
+    const RobotSpec& robot = config_.robots[static_cast<size_t>(in.robot)];
+    result.warnings.push_back(
+        in.line > 0
+            ? fmt::format("--inject {} never fired: {} of {} ran {} time(s) before the run ended",
+                          in.text,
+                          in.pass ? "the loop on line " + std::to_string(in.line)
+                                  : "line " + std::to_string(in.line),
+                          robot.program, hitsAt(in, injectionAddress_[k]))
+            : fmt::format("--inject {} never fired: the run ended at {:.6f} s", in.text,
+                          seconds(result.endTick)));
+  }
   result.integrator = arena_.stats();
   for (auto& r : robots_) {
     RobotResult rr = r->result;
     rr.hits = arena_.hits(r->index);
     rr.shots = arena_.shots(r->index);
-    rr.cycles = static_cast<uint64_t>(r->vm_.now());
+    rr.cycles = static_cast<uint64_t>(r->now());
     if (config_.profile) {
-      rr.profile = r->vm_.profile();
-      rr.serialIsrCycles = r->vm_.serialIsrCycles();
+      rr.profile = r->vm().profile();
+      rr.profile.resize(std::max(rr.profile.size(), r->earlierProfile.size()));
+      for (size_t a = 0; a < r->earlierProfile.size(); ++a) rr.profile[a] += r->earlierProfile[a];
+      rr.serialIsrCycles = r->vm().serialIsrCycles() + r->earlierSerialIsrCycles;
     }
     for (vm::Irq irq : {vm::Irq::Pio, vm::Irq::SerialTx})
       rr.interrupts.emplace(std::string(vm::irqName(irq)), 0);
@@ -848,11 +1013,11 @@ void Match::finish(MatchResult& result) {
   if (trace_.on()) {
     for (const auto& rr : result.robots) {
       const int i = &rr - result.robots.data();
-      emit(
-          result.endTick,
-          trace::rec::RobotResult{i, rr.hits, rr.shots, rr.framesLatched, rr.framesRejected,
-                                  static_cast<int64_t>(rr.cycles), rr.fault.has_value(), rr.exited},
-          {});
+      emit(result.endTick,
+           trace::rec::RobotResult{i, rr.hits, rr.shots, rr.framesLatched, rr.framesRejected,
+                                   rr.framesOverwritten, static_cast<int64_t>(rr.cycles),
+                                   rr.fault.has_value(), rr.reloads, rr.exited},
+           {});
     }
     emit(result.endTick, trace::rec::End{result.winner, result.tieBrokenByCoin}, {});
   }
@@ -869,7 +1034,7 @@ Tick parseDuration(const std::string& digits, int64_t ticksPerUnit, const std::s
   const auto bad = [&] {
     return std::invalid_argument("'" + whole +
                                  "': WHEN must be a time (12.5s, 800ms), a tick (115200000t) "
-                                 "or a program point (line:N#K)");
+                                 "or a program point (line:N#K, pass:N#K)");
   };
   if (digits.empty()) throw bad();
   int64_t integer = 0, fraction = 0, scale = 1;
@@ -931,10 +1096,12 @@ Injection parseInjection(const std::string& text, int robotCount) {
     throw std::invalid_argument("'" + text +
                                 "': SOURCE must be edge_fore, edge_aft, "
                                 "bumper_front or bumper_back");
-  if (when.rfind("line:", 0) == 0) {
+  const bool pass = when.rfind("pass:", 0) == 0;
+  if (when.rfind("line:", 0) == 0 || pass) {
     const auto hash = when.find('#');
     if (hash == std::string::npos)
-      throw std::invalid_argument("'" + text + "': a program point is line:N#K");
+      throw std::invalid_argument("'" + text + "': a program point is line:N#K or pass:N#K");
+    in.pass = pass;
     in.line = parsePositive(when.substr(5, hash - 5), text, "the line N");
     in.count = parsePositive(when.substr(hash + 1), text, "the execution count K");
   } else if (when.size() > 2 && when.compare(when.size() - 2, 2, "ms") == 0) {
@@ -947,6 +1114,26 @@ Injection parseInjection(const std::string& text, int robotCount) {
     parseDuration("", 1, text);  // throws the WHEN message
   }
   return in;
+}
+
+std::optional<uint32_t> loopHead(const vm::Image& image, int line) {
+  std::optional<uint32_t> head;
+  const auto& code = image.code;
+  for (uint32_t at = 0; at < code.size();) {
+    if (code[at] >= vm::kOpCount) return head;  // not code: the walk cannot go on
+    const auto op = static_cast<vm::Op>(code[at]);
+    const auto size = static_cast<uint32_t>(vm::instructionSize(op));
+    if (at + size > code.size()) break;
+    if (vm::info(op).shape == vm::Shape::REL16 && image.lineAt(at) == line) {
+      const auto rel = static_cast<int16_t>(code[at + 1] | (code[at + 2] << 8));
+      const int64_t target = int64_t{at} + size + rel;
+      if (target >= 0 && target <= at && image.lineAt(static_cast<uint32_t>(target)) == line &&
+          (!head || target < *head))
+        head = static_cast<uint32_t>(target);
+    }
+    at += size;
+  }
+  return head;
 }
 
 uint64_t streamSeed(uint64_t seed, const std::string& purpose) {

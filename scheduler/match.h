@@ -81,19 +81,30 @@ struct Injection {
   int robot = 0;
   InjectSource source = InjectSource::EdgeFore;
   // When: at `tick`, or (line > 0) at the `count`-th execution of the first
-  // instruction the line table gives for `line`, at the boundary before it.
+  // instruction the line table gives for `line` (line:N#K: it counts entries
+  // into the line), or with `pass` at the `count`-th time control reaches the
+  // head of the loop written on that line (pass:N#K: it counts passes), at
+  // the boundary before it.
   Tick tick = 0;
   int line = 0;
   int count = 1;
+  bool pass = false;
   std::string text;  // as the user wrote it, for the trace
 };
 
 // An injected edge holds its detector low for this long (assumption, DESIGN).
 inline constexpr Tick kInjectedEdgePulse = kTicksPerSecond / 20;  // 50 ms
 
-// Parses ROBOT:SOURCE@WHEN (WHEN: 12.5s, 800ms, 115200000t, line:N#K).
+// Parses ROBOT:SOURCE@WHEN (WHEN: 12.5s, 800ms, 115200000t, line:N#K,
+// pass:N#K).
 // Throws std::invalid_argument with a message naming what is wrong.
 Injection parseInjection(const std::string& text, int robotCount);
+
+// The head of the loop written on source line N: the target of a backward
+// jump whose jump and target both belong to line N (the outermost such loop
+// when there are several: the lowest target). It runs once per pass, and
+// once more for the test that ends the loop. None: no loop lies on line N.
+std::optional<uint32_t> loopHead(const vm::Image& image, int line);
 
 // Optional hooks for measurements (simbot bench). Called from the round loop
 // at the exact tick of each happening; an observer only reads, so a run with
@@ -126,7 +137,20 @@ struct MatchConfig {
   // Checked once a round: when it becomes true the run throws Stopped (a
   // batch command stopping on SIGINT). Not owned; may be null.
   const std::atomic<bool>* stop = nullptr;
+  // Thesis Appendix A, "you will be allowed to reload if the system
+  // crashes": a robot that faults is reloaded `reloadDelay` ticks later (the
+  // profile's [match] reload_delay). Its VM starts again from main with
+  // memory as at load (the power-on fill rules of the start), its PIO and
+  // serial port reset; the motor controller, a separate board, keeps the
+  // last latched command meanwhile. No reload is done at or after the end.
+  bool reloadOnFault = false;
+  Tick reloadDelay = 0;  // at least kMinReloadDelay
 };
+
+// A reload waits at least this long, so that the bytes a faulted robot's
+// serial port still held (two characters) are on the wire before its port
+// is reset.
+inline constexpr Tick kMinReloadDelay = 2 * 9'600;
 
 // A run abandoned because MatchConfig::stop became true.
 struct Stopped : std::runtime_error {
@@ -143,9 +167,14 @@ struct RobotResult {
   std::string name, program;
   int hits = 0, shots = 0;
   int framesLatched = 0, framesRejected = 0;
+  // Sends that restarted the serial library before it had fetched the last
+  // byte of the previous send (its NUL): that frame can never latch.
+  int framesOverwritten = 0;
   std::map<std::string, uint64_t> interrupts;  // per source
   uint64_t cycles = 0;
-  std::optional<FaultInfo> fault;
+  std::optional<FaultInfo> fault;  // the first fault
+  std::vector<FaultInfo> faults;   // every fault, in order (more than one after reloads)
+  int reloads = 0;                 // MatchConfig::reloadOnFault
   plant::Pose finalPose;
   std::vector<std::string> console;
   bool exited = false;
@@ -167,6 +196,10 @@ struct MatchResult {
   // The integrator failed (plant::SolverError): the run ended at the start
   // of the round that failed, and this says why (line is 0).
   std::optional<FaultInfo> plantFault;
+  // Findings about the run's set-up that did not stop it (injections that
+  // never fired, a line:N#K on a line that holds a whole loop), one line
+  // each, for the tools to print as warnings.
+  std::vector<std::string> warnings;
 };
 
 MatchResult runMatch(const MatchConfig& config);
