@@ -223,16 +223,19 @@ BenchRun benchRunFromRow(const CsvRow& row) {
   return run;
 }
 
-// One line on what faulted in a finished run, or "".
+// One line on what faulted in a finished run (every robot that did, then
+// the plant), or "".
 std::string faultLine(const scheduler::MatchResult& r) {
+  std::string line;
+  const auto add = [&line](const std::string& what) { line += (line.empty() ? "" : "; ") + what; };
   for (const auto& robot : r.robots)
     if (robot.fault)
-      return fmt::format("robot {} faulted at {:.6f} s, line {}: {}", robot.name,
-                         robot.fault->timeS, robot.fault->line, robot.fault->message);
+      add(fmt::format("robot {} faulted at {:.6f} s, line {}: {}", robot.name, robot.fault->timeS,
+                      robot.fault->line, robot.fault->message));
   if (r.plantFault)
-    return fmt::format("the plant's integrator failed at {:.6f} s: {}", r.plantFault->timeS,
-                       r.plantFault->message);
-  return "";
+    add(fmt::format("the plant's integrator failed at {:.6f} s: {}", r.plantFault->timeS,
+                    r.plantFault->message));
+  return line;
 }
 
 }  // namespace

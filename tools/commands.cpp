@@ -145,6 +145,9 @@ Subcommand addTournamentCommand(CLI::App& app) {
   cmd->add_flag("--resume", o->resume,
                 "continue an interrupted tournament from the games.csv in its output directory");
   cmd->add_flag("--json", o->json, "print standings and games as JSON");
+  cmd->add_flag("--reload-on-fault", o->config.reloadOnFault,
+                "reload a faulted program after the profile's [match] reload_delay: it starts "
+                "again from main with its memory as at load (thesis Appendix A)");
   return {cmd, [o] {
             return guarded([&] {
               const plant::Profile profile = loadNamedProfile(o->profile);

@@ -61,6 +61,7 @@ struct RunOptions {
   std::vector<std::string> watches;
   std::string scenario;
   bool json = false;
+  bool reloadOnFault = false;
   // Options given explicitly win over the scenario's values.
   CLI::Option *secondsOption = nullptr, *seedOption = nullptr, *profileOption = nullptr;
 };
@@ -83,7 +84,18 @@ constexpr int kExitBadInput = 1;
 constexpr int kExitInternalError = 2;
 constexpr int kExitRobotFault = 3;
 
-// One loud line per faulted robot, on stderr; true if any robot faulted.
+// Findings that did not stop the run (injections that never fired, ...).
+void reportWarnings(const scheduler::MatchResult& r) {
+  for (const auto& w : r.warnings) std::cerr << "simbot: warning: " << w << '\n';
+}
+
+// A robot's fault in one line: robot, time, source line, message.
+std::string faultText(const scheduler::RobotResult& rr, const scheduler::FaultInfo& f) {
+  return fmt::format("{}:{}: fault: robot {} at {:.6f} s: {}", rr.program, f.line, rr.name, f.timeS,
+                     f.message);
+}
+
+// One loud line per fault, on stderr; true if any robot faulted.
 bool reportFaults(const scheduler::MatchResult& r) {
   bool any = false;
   if (r.plantFault) {
@@ -94,10 +106,11 @@ bool reportFaults(const scheduler::MatchResult& r) {
         r.plantFault->timeS, r.plantFault->message);
   }
   for (const auto& rr : r.robots) {
-    if (!rr.fault) continue;
-    any = true;
-    std::cerr << fmt::format("{}:{}: fault: robot {} at {:.6f} s: {}\n", rr.program, rr.fault->line,
-                             rr.name, rr.fault->timeS, rr.fault->message);
+    for (size_t k = 0; k < rr.faults.size(); ++k) {
+      any = true;
+      std::cerr << faultText(rr, rr.faults[k])
+                << (k < static_cast<size_t>(rr.reloads) ? " (reloaded)" : "") << '\n';
+    }
   }
   return any;
 }
@@ -105,6 +118,12 @@ bool reportFaults(const scheduler::MatchResult& r) {
 json faultJson(const std::optional<scheduler::FaultInfo>& f) {
   if (!f) return nullptr;
   return {{"message", f->message}, {"time_s", f->timeS}, {"line", f->line}};
+}
+
+json faultsJson(const std::vector<scheduler::FaultInfo>& faults) {
+  json out = json::array();
+  for (const auto& f : faults) out.push_back(faultJson(f));
+  return out;
 }
 
 // The run's configuration from the command line and the scenario: the
@@ -157,6 +176,8 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
   config.endTick = static_cast<scheduler::Tick>(seconds * scheduler::kTicksPerSecond);
   config.seed = tools::preferCommandLine(given(o.seedOption),
                                          scenario ? scenario->seed : std::nullopt, o.seed);
+  config.reloadOnFault = o.reloadOnFault;
+  config.reloadDelay = plant::eventTickFromSeconds(profile.reload_delay_s);
   return config;
 }
 
@@ -167,6 +188,11 @@ struct Played {
 };
 
 Played play(const std::vector<std::string>& programs, const RunOptions& o, bool solo) {
+  // Watched values are written only into trace records.
+  if (!o.watches.empty() && o.trace.empty() && o.replay.empty())
+    throw tools::ToolError(
+        "simbot: --watch needs --trace FILE (or --replay FILE): watched values are written "
+        "only into the trace's records\n");
   scheduler::MatchConfig config =
       buildConfig(programs, o, solo ? tools::ScenarioUse::Solo : tools::ScenarioUse::Match);
   config.stopWhenAllExited = solo;
@@ -205,22 +231,29 @@ int soloCommand(const std::string& program, const RunOptions& o) {
       {"wall_seconds", wall},
       {"console", consoleJson(a.console)},
       {"fault", faultJson(a.fault)},
+      {"faults", faultsJson(a.faults)},
+      {"reloads", a.reloads},
       {"plant_fault", faultJson(r.plantFault)},
       {"motor_frames_latched", a.framesLatched},
       {"motor_frames_rejected", a.framesRejected},
+      {"motor_frames_overwritten", a.framesOverwritten},
       {"interrupts", a.interrupts},
       {"final_pose", poseJson(a.finalPose)}};
   if (o.json) {
     std::cout << tools::dumpJson(j, 2) << '\n';
   } else {
     for (const auto& line : a.console) std::cout << line << '\n';
-    std::cerr << fmt::format("simbot: {} {} at {:.3f} s; {} frames latched, {} rejected\n", program,
-                             a.fault    ? "faulted"
-                             : a.exited ? "exited"
-                                        : "ran",
-                             static_cast<double>(r.endTick) / scheduler::kTicksPerSecond,
-                             a.framesLatched, a.framesRejected);
+    std::cerr << fmt::format(
+        "simbot: {} {} at {:.3f} s; {} frames latched, {} rejected, {} frames overwritten{}\n",
+        program,
+        a.fault    ? "faulted"
+        : a.exited ? "exited"
+                   : "ran",
+        static_cast<double>(r.endTick) / scheduler::kTicksPerSecond, a.framesLatched,
+        a.framesRejected, a.framesOverwritten,
+        a.reloads ? fmt::format(", {} reloads", a.reloads) : "");
   }
+  reportWarnings(r);
   return reportFaults(r) ? kExitRobotFault : 0;
 }
 
@@ -236,9 +269,12 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
                       {"shots", rr.shots},
                       {"motor_frames_latched", rr.framesLatched},
                       {"motor_frames_rejected", rr.framesRejected},
+                      {"motor_frames_overwritten", rr.framesOverwritten},
                       {"interrupts", rr.interrupts},
                       {"cycles", rr.cycles},
                       {"fault", faultJson(rr.fault)},
+                      {"faults", faultsJson(rr.faults)},
+                      {"reloads", rr.reloads},
                       {"final_pose", poseJson(rr.finalPose)},
                       {"console_lines", rr.console.size()}});
   json j = {{"sim_seconds", static_cast<double>(r.endTick) / scheduler::kTicksPerSecond},
@@ -256,14 +292,19 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
   if (o.json) {
     std::cout << tools::dumpJson(j, 2) << '\n';
   } else {
-    for (const auto& rr : r.robots)
-      std::cout << fmt::format("{} {:<24} hits {:>2}  shots {:>2}  frames {:>5} (+{} rejected)\n",
-                               rr.name, rr.program, rr.hits, rr.shots, rr.framesLatched,
-                               rr.framesRejected);
+    for (const auto& rr : r.robots) {
+      std::cout << fmt::format(
+          "{} {:<24} hits {:>2}  shots {:>2}  frames {:>5} (+{} rejected, {} frames "
+          "overwritten){}\n",
+          rr.name, rr.program, rr.hits, rr.shots, rr.framesLatched, rr.framesRejected,
+          rr.framesOverwritten, rr.reloads ? fmt::format("  reloads {}", rr.reloads) : "");
+      for (const auto& f : rr.faults) std::cout << "  " << faultText(rr, f) << '\n';
+    }
     std::cout << fmt::format("winner: {}{}  ({:.1f} s simulated in {:.2f} s)\n", r.winner,
                              r.tieBrokenByCoin ? " (coin flip)" : "",
                              static_cast<double>(r.endTick) / scheduler::kTicksPerSecond, wall);
   }
+  reportWarnings(r);
   return reportFaults(r) ? kExitRobotFault : 0;
 }
 
@@ -280,6 +321,7 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
   } catch (const std::invalid_argument& e) {
     throw tools::ToolError(fmt::format("simbot: {}\n", e.what()));
   }
+  reportWarnings(r);
   const auto& robot = r.robots[0];
   std::map<int, uint64_t> byLine;
   std::map<std::string, uint64_t> byFunction;
@@ -380,10 +422,14 @@ void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
                   "eye readings) as a value change dump for GTKWave and sigrok");
   cmd->add_option("--inject", o.injections,
                   "ROBOT:SOURCE@WHEN, SOURCE edge_fore|edge_aft|bumper_front|bumper_back, "
-                  "WHEN 12.5s|800ms|115200000t|line:N#K (repeatable)");
+                  "WHEN 12.5s|800ms|115200000t|line:N#K (K-th entry into line N)|pass:N#K "
+                  "(K-th pass of the loop on line N) (repeatable)");
   cmd->add_option("--watch", o.watches,
                   "add a global or static variable (FUNCTION.NAME) to every trace record "
-                  "(repeatable)");
+                  "(repeatable; needs --trace or --replay)");
+  cmd->add_flag("--reload-on-fault", o.reloadOnFault,
+                "reload a faulted program after the profile's [match] reload_delay: it starts "
+                "again from main with its memory as at load (thesis Appendix A)");
   cmd->add_flag("--json", o.json, "print the summary as JSON");
 }
 

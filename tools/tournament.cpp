@@ -14,15 +14,21 @@
 namespace simbot::tools {
 
 CsvRow tournamentHeader() {
-  return {"pair_i",  "pair_j",  "round",      "a",      "b",
-          "seed",    "hits_a",  "hits_b",     "winner", "tie_broken_by_coin",
-          "fault_a", "fault_b", "plant_fault"};
+  return {"pair_i",  "pair_j",  "round",       "a",         "b",
+          "seed",    "hits_a",  "hits_b",      "winner",    "tie_broken_by_coin",
+          "fault_a", "fault_b", "plant_fault", "reloads_a", "reloads_b"};
 }
 
 nlohmann::json tournamentSettings(const TournamentConfig& c, const plant::Profile& profile) {
-  return {{"command", "tournament"},     {"programs", c.programs},      {"rounds", c.rounds},
-          {"seconds", c.seconds},        {"master_seed", c.masterSeed}, {"profile", profile.name},
-          {"profile_file", profile.file}};
+  return {{"command", "tournament"},
+          {"programs", c.programs},
+          {"rounds", c.rounds},
+          {"seconds", c.seconds},
+          {"master_seed", c.masterSeed},
+          {"profile", profile.name},
+          {"profile_file", profile.file},
+          {"reload_on_fault", c.reloadOnFault},
+          {"reload_delay_s", profile.reload_delay_s}};
 }
 
 namespace {
@@ -40,7 +46,9 @@ CsvRow gameRow(const TournamentGame& g) {
           g.coin ? "1" : "0",
           g.faultA,
           g.faultB,
-          g.plantFault};
+          g.plantFault,
+          std::to_string(g.reloadsA),
+          std::to_string(g.reloadsB)};
 }
 
 TournamentGame gameFromRow(const CsvRow& r) {
@@ -58,14 +66,21 @@ TournamentGame gameFromRow(const CsvRow& r) {
   g.faultA = r[10];
   g.faultB = r[11];
   g.plantFault = r[12];
+  g.reloadsA = std::stoi(r.at(13));
+  g.reloadsB = std::stoi(r.at(14));
   g.done = true;
   return g;
 }
 
+// Every fault of the robot in the game, in one line ("" if none).
 std::string robotFault(const scheduler::RobotResult& r) {
-  if (!r.fault) return "";
-  return fmt::format("faulted at {:.6f} s, line {}: {}", r.fault->timeS, r.fault->line,
-                     r.fault->message);
+  std::string out;
+  for (size_t k = 0; k < r.faults.size(); ++k) {
+    const auto& f = r.faults[k];
+    out += fmt::format("{}faulted at {:.6f} s, line {}: {}{}", out.empty() ? "" : "; ", f.timeS,
+                       f.line, f.message, k < static_cast<size_t>(r.reloads) ? " (reloaded)" : "");
+  }
+  return out;
 }
 
 bool played(const TournamentGame& g) { return g.done && g.plantFault.rfind("error: ", 0) != 0; }
@@ -135,6 +150,8 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
     mc.endTick = endTick;
     mc.seed = g.seed;
     mc.stop = stop;
+    mc.reloadOnFault = config.reloadOnFault;
+    mc.reloadDelay = plant::eventTickFromSeconds(profile.reload_delay_s);
     try {
       const scheduler::MatchResult r = scheduler::runMatch(mc);
       g.hitsA = r.robots[0].hits;
@@ -143,6 +160,8 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
       g.coin = r.tieBrokenByCoin;
       g.faultA = robotFault(r.robots[0]);
       g.faultB = robotFault(r.robots[1]);
+      g.reloadsA = r.robots[0].reloads;
+      g.reloadsB = r.robots[1].reloads;
       if (r.plantFault)
         g.plantFault = fmt::format("the integrator failed at {:.6f} s: {}", r.plantFault->timeS,
                                    r.plantFault->message);
@@ -170,6 +189,8 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
     a.hitsAgainst += g.hitsB;
     b.hitsFor += g.hitsB;
     b.hitsAgainst += g.hitsA;
+    a.faulted += !g.faultA.empty();
+    b.faulted += !g.faultB.empty();
     Standing& w = g.winner == g.a ? a : b;
     Standing& l = g.winner == g.a ? b : a;
     ++w.wins;
@@ -191,14 +212,14 @@ std::string standingsTable(const TournamentResult& result) {
   const auto& c = result.config;
   size_t width = 7;
   for (const auto& p : c.programs) width = std::max(width, p.size());
-  std::string out =
-      fmt::format("{:>4}  {:<{}}  {:>6} {:>4} {:>6} {:>8} {:>12} {:>6}\n", "rank", "program", width,
-                  "played", "wins", "losses", "hits for", "hits against", "points");
+  std::string out = fmt::format("{:>4}  {:<{}}  {:>6} {:>4} {:>6} {:>8} {:>12} {:>6} {:>7}\n",
+                                "rank", "program", width, "played", "wins", "losses", "hits for",
+                                "hits against", "points", "faulted");
   int rank = 0;
   for (const auto& s : result.standings)
-    out += fmt::format("{:>4}  {:<{}}  {:>6} {:>4} {:>6} {:>8} {:>12} {:>6}\n", ++rank,
+    out += fmt::format("{:>4}  {:<{}}  {:>6} {:>4} {:>6} {:>8} {:>12} {:>6} {:>7}\n", ++rank,
                        c.programs[static_cast<size_t>(s.program)], width, s.played, s.wins,
-                       s.losses, s.hitsFor, s.hitsAgainst, s.points);
+                       s.losses, s.hitsFor, s.hitsAgainst, s.points, s.faulted);
   return out;
 }
 
@@ -214,7 +235,8 @@ nlohmann::json tournamentJson(const TournamentResult& result) {
                          {"losses", s.losses},
                          {"hits_for", s.hitsFor},
                          {"hits_against", s.hitsAgainst},
-                         {"points", s.points}});
+                         {"points", s.points},
+                         {"faulted", s.faulted}});
   const auto fault = [](const std::string& f) {
     return f.empty() ? nlohmann::json(nullptr) : nlohmann::json(f);
   };
@@ -230,10 +252,17 @@ nlohmann::json tournamentJson(const TournamentResult& result) {
                      {"tie_broken_by_coin", g.coin},
                      {"fault_a", fault(g.faultA)},
                      {"fault_b", fault(g.faultB)},
-                     {"plant_fault", fault(g.plantFault)}});
+                     {"plant_fault", fault(g.plantFault)},
+                     {"reloads_a", g.reloadsA},
+                     {"reloads_b", g.reloadsB}});
   }
-  return {{"rounds", c.rounds},          {"seconds", c.seconds},   {"master_seed", c.masterSeed},
-          {"points", "1 per round won"}, {"standings", standings}, {"games", games}};
+  return {{"rounds", c.rounds},
+          {"seconds", c.seconds},
+          {"master_seed", c.masterSeed},
+          {"reload_on_fault", c.reloadOnFault},
+          {"points", "1 per round won"},
+          {"standings", standings},
+          {"games", games}};
 }
 
 void writeTournamentOutputs(const TournamentResult& result, RunTable& table) {

@@ -23,6 +23,10 @@ struct TournamentConfig {
   uint64_t masterSeed = 1;
   int threads = 0;
   bool progress = true;
+  // Thesis Appendix A, "you will be allowed to reload if the system
+  // crashes": a faulted program restarts after the profile's
+  // [match] reload_delay (scheduler::MatchConfig::reloadOnFault).
+  bool reloadOnFault = false;
 };
 
 struct TournamentGame {
@@ -37,11 +41,13 @@ struct TournamentGame {
   // plant or simbot itself ("error: ...", a game that could not be played:
   // it counts as a loss for neither and is not in the standings).
   std::string faultA, faultB, plantFault;
+  int reloadsA = 0, reloadsB = 0;  // --reload-on-fault
 };
 
 struct Standing {
   int program = 0;
   int played = 0, wins = 0, losses = 0, hitsFor = 0, hitsAgainst = 0, points = 0;
+  int faulted = 0;  // games in which the program faulted
 };
 
 struct TournamentResult {
@@ -64,7 +70,7 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
 // Rewrites games.csv in order and writes standings.json and standings.md
 // beside it.
 void writeTournamentOutputs(const TournamentResult& result, RunTable& table);
-// One line per game with a fault.
+// One line per game with a fault (robot A, robot B, the plant).
 std::string tournamentFaults(const TournamentResult& result);
 std::string standingsTable(const TournamentResult& result);
 nlohmann::json tournamentJson(const TournamentResult& result);
