@@ -227,6 +227,7 @@ struct Node {
   NodeKind op = NodeKind::Add;  // OpAssign: the arithmetic
   Type* opType = nullptr;       // OpAssign: type the arithmetic is done in
   bool prefix = false;          // IncDec
+  bool parenthesized = false;   // written inside "( )" (no parentheses warning)
   int delta = 1;                // IncDec: +1 or -1
   Function* callee = nullptr;   // Call
   int lib = 0;                  // LibCall: builtin id; Intrinsic: 0 EI, 1 DI
@@ -254,8 +255,14 @@ struct Program {
   std::vector<IntVecBinding> vectors;
 };
 
-// parser.cpp: the whole translation unit, type-checked; throws CompileError.
-void parse(Preprocessor& pp, const Options& options, Program& prog);
+// parser.cpp: the whole translation unit, type-checked. Errors and the
+// warnings found while parsing go to `diags`; throws StopCompiling when it
+// cannot go on.
+void parse(Preprocessor& pp, const Options& options, Program& prog, Diagnostics& diags);
+// warnings.cpp: the warnings that need whole functions or the whole program
+// (unbound-handler, uninitialized, send-without-delay), on an error-free
+// Program.
+void analyze(const Program& prog, Diagnostics& diags);
 // codegen.cpp: the image (code, line table, data, vectors, symbols).
 vm::Image generate(Program& prog);
 

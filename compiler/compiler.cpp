@@ -1,11 +1,13 @@
-// The driver: source text through the preprocessor, parser and code
-// generator to an Image, or the first error as a Diagnostic. Nothing escapes
+// The driver: source text through the preprocessor, parser, the warnings'
+// analyses and the code generator to an Image and its warnings, or every
+// error found as Diagnostics. Nothing escapes
 // compile(): compile errors, resource exhaustion and internal faults all come
 // back as a Diagnostic.
 #include "compiler/compiler.h"
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <new>
@@ -76,24 +78,54 @@ Result compile(const std::string& rawSource, const std::string& fileName, const 
   }
   const std::string source = normalizeNewlines(rawSource);
   std::vector<std::string> lines = splitLines(source);
+  Diagnostics diags;
+  std::optional<vm::Image> image;
+  // Internal faults end the compilation with what was found so far.
+  const auto record = [&](Pos pos, std::string message) {
+    try {
+      diags.error(pos, std::move(message));
+    } catch (const StopCompiling&) {
+    }
+  };
   try {
-    Preprocessor pp(source, fileName);
+    Preprocessor pp(source, fileName, diags);
     Program prog;
-    parse(pp, options, prog);
-    vm::Image image = generate(prog);
-    image.sourceName = fileName;
-    image.sourceLines = std::move(lines);
-    result.image = std::move(image);
-  } catch (const CompileError& e) {
-    result.errors.push_back(makeDiagnostic(fileName, lines, e.pos, e.message));
+    parse(pp, options, prog, diags);
+    if (diags.errorCount() == 0) {
+      analyze(prog, diags);
+      image = generate(prog);
+      image->sourceName = fileName;
+      image->sourceLines = lines;
+    }
+  } catch (const StopCompiling&) {
+  } catch (const CompileError& e) {  // code generation's limits
+    record(e.pos, e.message);
   } catch (const std::bad_alloc&) {
-    result.errors.push_back(makeDiagnostic(fileName, lines, Pos{}, "out of memory"));
+    record(Pos{}, "out of memory");
   } catch (const std::exception& e) {
-    result.errors.push_back(makeDiagnostic(fileName, lines, Pos{},
-                                           std::string("internal compiler error: ") + e.what()));
+    record(Pos{}, std::string("internal compiler error: ") + e.what());
   } catch (...) {
-    result.errors.push_back(makeDiagnostic(fileName, lines, Pos{}, "internal compiler error"));
+    record(Pos{}, "internal compiler error");
   }
+
+  // Source order, whichever stage found them (a stable sort keeps a
+  // statement's error before a later note about the same place).
+  std::vector<RawDiagnostic> all = diags.all();
+  std::stable_sort(all.begin(), all.end(), [](const RawDiagnostic& a, const RawDiagnostic& b) {
+    return a.pos.line != b.pos.line ? a.pos.line < b.pos.line : a.pos.col < b.pos.col;
+  });
+  for (const RawDiagnostic& r : all) {
+    if (!r.warning.empty() && options.disabledWarnings.count(r.warning)) continue;
+    Diagnostic d = makeDiagnostic(fileName, lines, r.pos, r.message);
+    d.warning = r.warning;
+    if (!r.warning.empty() && !options.werror) {
+      d.severity = Severity::Warning;
+      result.warnings.push_back(std::move(d));
+    } else {
+      result.errors.push_back(std::move(d));
+    }
+  }
+  if (result.errors.empty()) result.image = std::move(image);
   return result;
 }
 

@@ -2,6 +2,8 @@
 // layout, "FILE:LINE:COL: error: MESSAGE", the source line, and a caret under
 // column COL. Tabs before the column are copied so the caret lines up in any
 // terminal whatever its tab width. Long lines are cut around the column.
+#include "compiler/diagnostics.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -28,11 +30,55 @@ std::string printable(std::string_view text) {
 
 }  // namespace
 
+const std::vector<WarningInfo>& warningList() {
+  static const std::vector<WarningInfo> list = {
+      {"tautological-compare",
+       "a comparison always true or always false because of the operand's type range"},
+      {"parentheses", "an assignment used as a condition"},
+      {"unbound-handler", "an interrupt function that no #INT_VEC binds"},
+      {"define-int-vec", "'#define INT_VEC', a vector binding mistyped as a macro"},
+      {"uninitialized", "a local variable read but never assigned"},
+      {"unreachable-code", "a statement after return, break, continue or goto"},
+      {"send-without-delay", "a serial send that can follow another with no delay between"},
+      {"implicit-function-declaration", "a call to a function not yet declared"},
+  };
+  return list;
+}
+
+bool isWarningName(std::string_view name) {
+  for (const WarningInfo& w : warningList())
+    if (w.name == name) return true;
+  return false;
+}
+
+void Diagnostics::error(Pos pos, std::string message) {
+  items_.push_back(RawDiagnostic{pos, std::move(message), {}});
+  if (++errors_ >= kMaxErrors) {
+    items_.push_back(
+        RawDiagnostic{pos, fmt::format("too many errors ({}), stopping here", kMaxErrors), {}});
+    ++errors_;
+    throw StopCompiling{};
+  }
+}
+
+void Diagnostics::fatal(Pos pos, std::string message) {
+  error(pos, std::move(message));
+  throw StopCompiling{};
+}
+
+void Diagnostics::warn(Pos pos, const char* name, std::string message) {
+  items_.push_back(RawDiagnostic{pos, std::move(message), name});
+}
+
 std::string Diagnostic::format() const {
   std::string shownMessage =
       message.size() > kShownMessage ? message.substr(0, kShownMessage) + "..." : message;
-  std::string out =
-      fmt::format("{}:{}:{}: error: {}\n", file, line, column, printable(shownMessage));
+  std::string tag;
+  if (!warning.empty())
+    tag = severity == Severity::Warning ? " [-W" + warning + "]" : " [-Werror=" + warning + "]";
+  std::string out = fmt::format("{}:{}:{}: {}: {}{}\n", file, line, column,
+                                severity == Severity::Warning ? "warning" : "error",
+                                printable(shownMessage), tag);
   if (!hasSourceLine) return out;
   // The part of the line shown, and where the caret goes in it.
   const size_t col = column > 0 ? static_cast<size_t>(column - 1) : 0;

@@ -125,7 +125,26 @@ const char* opSpelling(NodeKind k) {
 bool isConst(const Node* n) { return n->kind == NodeKind::Num || n->kind == NodeKind::FNum; }
 bool truthy(const Node* n) { return n->kind == NodeKind::Num ? n->ival != 0 : n->fval != 0; }
 
-bool before(Pos a, Pos b) { return a.line < b.line || (a.line == b.line && a.col < b.col); }
+// The jump a statement ends with ("return", ...), or null if control can
+// fall out of it. Blocks and ifs count as falling out (no warning is the
+// safe side).
+const char* endsPath(const Node* n) {
+  switch (n->kind) {
+    case NodeKind::Return:
+      return "return";
+    case NodeKind::Break:
+      return "break";
+    case NodeKind::Continue:
+      return "continue";
+    case NodeKind::Goto:
+      return "goto";
+    case NodeKind::Case:
+    case NodeKind::Label:
+      return n->then ? endsPath(n->then) : nullptr;
+    default:
+      return nullptr;
+  }
+}
 
 struct VarAttr {
   bool isTypedef = false;
@@ -161,8 +180,8 @@ struct Scope {
 
 class Parser {
  public:
-  Parser(Preprocessor& pp, const Options& options, Program& prog)
-      : pp_(pp), options_(options), prog_(prog) {}
+  Parser(Preprocessor& pp, const Options& options, Program& prog, Diagnostics& diags)
+      : pp_(pp), options_(options), prog_(prog), diags_(diags) {}
   void run();
 
  private:
@@ -183,7 +202,8 @@ class Parser {
   struct DepthGuard {
     Parser& p;
     DepthGuard(Parser& parser) : p(parser) {
-      if (++p.depth_ > kMaxDepth) fail(p.cur().pos, "nesting too deep");
+      // Fatal: recovery would resume inside the very nesting it gave up on.
+      if (++p.depth_ > kMaxDepth) p.diags_.fatal(p.cur().pos, "nesting too deep");
     }
     ~DepthGuard() { --p.depth_; }
   };
@@ -225,6 +245,26 @@ class Parser {
   bool atInitEnd();
   void checkComplete(Obj* obj);
   void checkCallAgainstDefinition(Function* f, Node* call, bool kinds = true);
+
+  // ---- error recovery ----
+  // Where parsing resumes after an error: the token cursor's nesting and the
+  // parser's state at the start of the failed statement or declaration.
+  struct Resume {
+    size_t token = 0;
+    int braces = 0, parens = 0;
+    size_t scopes = 0, switches = 0;
+    int loopDepth = 0, breakDepth = 0;
+  };
+  Resume resumePoint();
+  void recordError(const CompileError& e);
+  void skipStatement(const Resume& r);
+  void skipExternalDeclaration();
+  void poisonSince(size_t token);
+  [[noreturn]] void undeclared(Pos pos, const std::string& name, const std::string& message);
+
+  // ---- warnings ----
+  void checkCondition(const Node* cond);
+  void checkTypeLimits(NodeKind k, const Node* l, const Node* r, Pos pos);
 
   // ---- statements ----
   Node* statement();
@@ -281,8 +321,16 @@ class Parser {
   Preprocessor& pp_;
   const Options& options_;
   Program& prog_;
+  Diagnostics& diags_;
   std::deque<Token> toks_;
   size_t i_ = 0;
+  int braceDepth_ = 0;             // "{" minus "}" the cursor has moved over
+  int parenDepth_ = 0;             // "(" minus ")" likewise
+  std::vector<bool> braceIsBody_;  // per open "{": a function body's
+  bool lastCloseWasBody_ = false;
+  // Names met in a declaration that failed: an error about one of them
+  // later (undeclared, undefined) follows from that failure, so is silent.
+  std::unordered_set<std::string> poisoned_;
   Pos prevPos_{1, 1, 0};
   int depth_ = 0;
   std::vector<Scope> scopes_;
@@ -305,7 +353,11 @@ class Parser {
 const Token& Parser::at(size_t idx) {
   while (toks_.size() <= idx) {
     if (!toks_.empty() && toks_.back().kind == TokKind::Eof) return toks_.back();
-    toks_.push_back(pp_.next());
+    try {
+      toks_.push_back(pp_.next());
+    } catch (const CompileError& e) {
+      diags_.fatal(e.pos, e.message);  // the token stream ends here
+    }
   }
   return toks_[idx];
 }
@@ -320,6 +372,20 @@ void Parser::settle() {
 void Parser::advance() {
   const Token& t = cur();
   if (t.kind == TokKind::Eof) return;
+  if (t.kind == TokKind::Punct) {
+    if (t.text == "{") {
+      ++braceDepth_;
+      // A function body's brace follows its ")" or its K&R parameters' ";".
+      braceIsBody_.push_back(i_ > 0 && (toks_[i_ - 1].is(")") || toks_[i_ - 1].is(";")));
+    } else if (t.text == "}") {
+      braceDepth_ = std::max(0, braceDepth_ - 1);
+      lastCloseWasBody_ = braceIsBody_.empty() || braceIsBody_.back();  // empty: unbalanced
+      if (!braceIsBody_.empty()) braceIsBody_.pop_back();
+    } else if (t.text == "(")
+      ++parenDepth_;
+    else if (t.text == ")")
+      parenDepth_ = std::max(0, parenDepth_ - 1);
+  }
   prevPos_ = t.pos;
   ++i_;
   settle();
@@ -476,42 +542,145 @@ void Parser::run() {
   settle();
   while (cur().kind != TokKind::Eof) {
     if (accept(";")) continue;
-    externalDeclaration();
+    Resume r = resumePoint();
+    try {
+      externalDeclaration();
+    } catch (const CompileError& e) {
+      recordError(e);
+      skipExternalDeclaration();
+      poisonSince(r.token);
+      scopes_.resize(2);
+      switches_.clear();
+      fn_ = nullptr;
+      loopDepth_ = breakDepth_ = 0;
+    }
   }
 
-  // Functions called but never defined: the first call in the file.
-  Function* undefinedFn = nullptr;
+  // Whole-program checks: each is an error of its own, none stops the rest.
+  const auto check = [this](Pos pos, const std::string& name, std::string message) {
+    if (!poisoned_.count(name)) diags_.error(pos, std::move(message));
+  };
   for (Function& f : prog_.funcs)
-    if (f.called && !f.defined && (!undefinedFn || before(f.firstCall, undefinedFn->firstCall)))
-      undefinedFn = &f;
-  if (undefinedFn) fail(undefinedFn->firstCall, "undefined function '" + undefinedFn->name + "'");
+    if (f.called && !f.defined) check(f.firstCall, f.name, "undefined function '" + f.name + "'");
 
   // #INT_VEC bindings.
   for (const IntVecDirective& d : pp_.intVecs()) {
     auto it = scopes_[1].vars.find(d.name);
     Obj* o = it == scopes_[1].vars.end() ? nullptr : it->second.var;
-    if (!o || o->storage != Storage::Function || !o->fn->defined) {
-      if (o && o->storage != Storage::Function)
-        fail(d.namePos, "'" + d.name + "' is not an interrupt function");
-      fail(d.namePos, "undefined interrupt function '" + d.name + "'");
+    if (o && o->storage != Storage::Function) {
+      check(d.namePos, d.name, "'" + d.name + "' is not an interrupt function");
+      continue;
     }
-    if (!o->fn->isHandler) fail(d.namePos, "'" + d.name + "' is not an interrupt function");
+    if (!o || !o->fn->defined) {
+      check(d.namePos, d.name, "undefined interrupt function '" + d.name + "'");
+      continue;
+    }
+    if (!o->fn->isHandler) {
+      check(d.namePos, d.name, "'" + d.name + "' is not an interrupt function");
+      continue;
+    }
+    bool bound = false;
     for (const IntVecBinding& b : prog_.vectors)
       if (b.vector == d.vector) {
         char buf[8];
         std::snprintf(buf, sizeof buf, "0x%02X", d.vector);
-        fail(d.pos, std::string("interrupt vector ") + buf + " is already bound");
+        diags_.error(d.pos, std::string("interrupt vector ") + buf + " is already bound");
+        bound = true;
+        break;
       }
-    prog_.vectors.push_back(IntVecBinding{d.vector, o->fn, d.pos});
+    if (!bound) prog_.vectors.push_back(IntVecBinding{d.vector, o->fn, d.pos});
+  }
+  // A handler nothing binds never runs: the thesis's "#define INT_VEC" slip.
+  for (Function* f : prog_.functions) {
+    if (!f->isHandler) continue;
+    bool bound = false;
+    for (const IntVecDirective& d : pp_.intVecs()) bound = bound || d.name == f->name;
+    if (!bound)
+      diags_.warn(f->defPos, "unbound-handler",
+                  "interrupt function '" + f->name +
+                      "' is never bound to a vector (no '#INT_VEC VECTOR " + f->name +
+                      "'), so it never runs");
   }
 
   auto it = scopes_[1].vars.find("main");
   Obj* m = it == scopes_[1].vars.end() ? nullptr : it->second.var;
-  if (!m || m->storage != Storage::Function || !m->fn->defined)
-    fail(Pos{1, 1, 1}, "no main function");
-  if (m->fn->isHandler) fail(m->fn->defPos, "'main' cannot be an interrupt function");
-  if (!m->fn->params.empty()) fail(m->fn->defPos, "'main' must not take parameters");
+  if (!m || m->storage != Storage::Function || !m->fn->defined) {
+    check(Pos{1, 1, 1}, "main", "no main function");
+    return;
+  }
+  if (m->fn->isHandler) diags_.error(m->fn->defPos, "'main' cannot be an interrupt function");
+  if (!m->fn->params.empty()) diags_.error(m->fn->defPos, "'main' must not take parameters");
   prog_.main = m->fn;
+}
+
+// ===================================================================
+// Error recovery (panic mode, as in the Dragon Book 4.1.4): drop the rest of
+// the failed statement or declaration and resume at the next one.
+
+Parser::Resume Parser::resumePoint() {
+  return Resume{i_,         braceDepth_, parenDepth_, scopes_.size(), switches_.size(),
+                loopDepth_, breakDepth_};
+}
+
+void Parser::recordError(const CompileError& e) {
+  if (!e.silent) diags_.error(e.pos, e.message);
+}
+
+// Inside a block: up to and including the ';' that ends the statement at the
+// block's own nesting, or through the '}' that closes a block the statement
+// opened, or up to (not including) the '}' that ends the enclosing block.
+// An "else" right after is part of the same statement.
+void Parser::skipStatement(const Resume& r) {
+  for (;;) {
+    const Token& t = cur();
+    if (t.kind == TokKind::Eof) return;
+    if (t.is("}") && braceDepth_ <= r.braces) break;
+    const bool semi = t.is(";"), close = t.is("}");
+    advance();
+    if (braceDepth_ != r.braces) continue;
+    if (close || (semi && parenDepth_ <= r.parens)) {
+      if (is("else")) {
+        advance();
+        continue;
+      }
+      break;
+    }
+  }
+  parenDepth_ = r.parens;
+}
+
+// At file level: through the ';' or the function body's '}' that ends it
+// (an unbalanced '}' ends it too).
+void Parser::skipExternalDeclaration() {
+  for (;;) {
+    const Token& t = cur();
+    if (t.kind == TokKind::Eof) break;
+    const bool semi = t.is(";"), close = t.is("}");
+    advance();
+    // A struct's or an initialiser's "}" leaves the declaration's ";" to come.
+    if (braceDepth_ == 0 && (semi || (close && lastCloseWasBody_))) break;
+  }
+  parenDepth_ = 0;
+}
+
+// The names a failed declaration was declaring: identifiers outside any
+// brackets, and outside initialisers.
+void Parser::poisonSince(size_t token) {
+  int depth = 0;
+  bool inInit = false;
+  for (size_t k = token; k < i_ && k < toks_.size(); ++k) {
+    const Token& t = toks_[k];
+    if (t.is("(") || t.is("[") || t.is("{")) ++depth;
+    if (t.is(")") || t.is("]") || t.is("}")) --depth;
+    if (depth == 0 && t.is("=")) inInit = true;
+    if (depth == 0 && t.is(",")) inInit = false;
+    if (depth == 0 && !inInit && t.kind == TokKind::Ident && !isKeyword(t))
+      poisoned_.insert(t.text);
+  }
+}
+
+void Parser::undeclared(Pos pos, const std::string& name, const std::string& message) {
+  throw CompileError{pos, message, poisoned_.count(name) > 0};
 }
 
 // external-declaration = declspec? declarator ("," declarator)* ";"
@@ -1092,7 +1261,7 @@ void Parser::functionDefinition(Declarator& d, const VarAttr& attr) {
   f->body = compoundStatement(false);
   leaveScope();
   for (Node* g : gotos_)
-    if (!labels_.count(g->str)) fail(g->pos, "use of undeclared label '" + g->str + "'");
+    if (!labels_.count(g->str)) diags_.error(g->pos, "use of undeclared label '" + g->str + "'");
   fn_ = nullptr;
 }
 
@@ -1406,6 +1575,7 @@ Node* Parser::statement() {
     Node* n = newNode(NodeKind::If, pos);
     expect("(");
     n->cond = value(expr());
+    checkCondition(n->cond);
     if (!isScalar(n->cond->type)) fail(n->cond->pos, "condition must have scalar type");
     expect(")");
     n->then = statement();
@@ -1473,6 +1643,7 @@ Node* Parser::statement() {
     }
     if (!is(";")) {
       n->cond = value(expr());
+      checkCondition(n->cond);
       if (!isScalar(n->cond->type)) fail(n->cond->pos, "condition must have scalar type");
     }
     expectSemi("in 'for'");
@@ -1497,6 +1668,7 @@ Node* Parser::statement() {
     Node* n = newNode(NodeKind::While, pos);
     expect("(");
     n->cond = value(expr());
+    checkCondition(n->cond);
     if (!isScalar(n->cond->type)) fail(n->cond->pos, "condition must have scalar type");
     expect(")");
     ++loopDepth_;
@@ -1521,6 +1693,7 @@ Node* Parser::statement() {
     advance();
     expect("(");
     n->cond = value(expr());
+    checkCondition(n->cond);
     if (!isScalar(n->cond->type)) fail(n->cond->pos, "condition must have scalar type");
     expect(")");
     expectSemi("after do/while statement");
@@ -1592,20 +1765,52 @@ Node* Parser::compoundStatement(bool newScope) {
   Node* n = newNode(NodeKind::Block, cur().pos);
   expect("{");
   if (newScope) enterScope();
+  const char* dead = nullptr;  // the jump that ends every path to here
+  bool warned = false;         // about this run of dead statements
   for (;;) {
     n->endPos = cur().pos;
     if (accept("}")) break;
-    const Token& t = cur();
-    if (t.kind == TokKind::Eof) fail(after(prevPos_), "expected '}' at end of input");
-    if (isDeclStart(t) && !peek(1).is(":")) {
-      localDeclaration(n->list);
-      continue;
+    if (cur().kind == TokKind::Eof) diags_.fatal(after(prevPos_), "expected '}' at end of input");
+    Resume r = resumePoint();
+    bool declaration = false;
+    try {
+      const Token& t = cur();
+      if (isDeclStart(t) && !peek(1).is(":")) {
+        declaration = true;
+        localDeclaration(n->list);
+        continue;
+      }
+      if (t.kind == TokKind::Ident && !isKeyword(t) && !findVar(t.text) &&
+          (peek(1).kind == TokKind::Ident ||
+           (peek(1).is("*") && peek(2).kind == TokKind::Ident && peek(3).is(";")))) {
+        declaration = true;
+        undeclared(t.pos, t.text, "unknown type name '" + t.text + "'");
+      }
+      Node* st = statement();
+      n->list.push_back(st);
+      // A label or case is reachable by a jump. Once per run of dead
+      // statements; "return x; break;" in a switch is a harmless idiom.
+      if (st->kind == NodeKind::Case || st->kind == NodeKind::Label) dead = nullptr;
+      if (dead && !warned && st->kind != NodeKind::Empty && st->kind != NodeKind::Break) {
+        diags_.warn(st->pos, "unreachable-code",
+                    std::string("code after '") + dead + "' is never executed");
+        warned = true;
+      }
+      if (const char* jump = endsPath(st)) {
+        if (!dead) warned = false;
+        dead = jump;
+      }
+    } catch (const CompileError& e) {
+      recordError(e);
+      skipStatement(r);
+      if (declaration) poisonSince(r.token);
+      scopes_.resize(r.scopes);
+      switches_.resize(r.switches);
+      loopDepth_ = r.loopDepth;
+      breakDepth_ = r.breakDepth;
+      // The error ate the rest of the file: "expected '}'" would only repeat it.
+      if (cur().kind == TokKind::Eof) throw StopCompiling{};
     }
-    if (t.kind == TokKind::Ident && !isKeyword(t) && !findVar(t.text) &&
-        (peek(1).kind == TokKind::Ident ||
-         (peek(1).is("*") && peek(2).kind == TokKind::Ident && peek(3).is(";"))))
-      fail(t.pos, "unknown type name '" + t.text + "'");
-    n->list.push_back(statement());
   }
   if (newScope) leaveScope();
   return n;
@@ -1800,10 +2005,88 @@ Node* Parser::newSub(Node* l, Node* r, Pos pos) {
 }
 
 // Comparisons leave int 0/1; pointers compare unsigned.
+// "if (x = 5)": an assignment as a whole condition, unless parenthesised
+// as gcc's -Wparentheses accepts ("if ((c = next()))").
+void Parser::checkCondition(const Node* cond) {
+  if ((cond->kind == NodeKind::Assign || cond->kind == NodeKind::OpAssign) && !cond->parenthesized)
+    diags_.warn(cond->pos, "parentheses",
+                "assignment used as a condition; write '==' to compare, or put the assignment "
+                "in parentheses");
+}
+
+// A comparison of an integer expression with a constant outside the range
+// of the expression's type (ICEMAN's idiom "int i; for(i=0;i<50000;i++);":
+// 50000 is a long, the int wraps at 32767, the loop never ends). Decided in
+// the type the comparison is done in, and only when converting the
+// expression to it keeps every value (an int compared as unsigned does not).
+void Parser::checkTypeLimits(NodeKind k, const Node* l, const Node* r, Pos pos) {
+  const bool constLeft = l->kind == NodeKind::Num;
+  const Node* e = constLeft ? r : l;
+  const Node* c = constLeft ? l : r;
+  if (c->kind != NodeKind::Num || e->kind == NodeKind::Num || !isInteger(e->type) ||
+      !isInteger(c->type))
+    return;
+  const auto range = [](const Type* t) -> std::pair<int64_t, int64_t> {
+    switch (t->kind) {
+      case TypeKind::Char:
+        return {0, 0xFF};
+      case TypeKind::Int:
+        return {-0x8000, 0x7FFF};
+      case TypeKind::UInt:
+        return {0, 0xFFFF};
+      case TypeKind::Long:
+        return {-0x80000000LL, 0x7FFFFFFF};
+      default:
+        return {0, 0xFFFFFFFFLL};
+    }
+  };
+  Type* common = commonType(promote(e->type), promote(c->type));
+  auto [lo, hi] = range(e->type);
+  auto [clo, chi] = range(common);
+  if (lo < clo || hi > chi) return;  // the conversion changes some values
+  const int64_t v = wrapTo(c->ival, common);
+  // x OP v with x in [lo, hi]; a constant on the left mirrors the operator.
+  NodeKind op = k;
+  if (constLeft) {
+    if (k == NodeKind::Lt) op = NodeKind::Gt;
+    if (k == NodeKind::Gt) op = NodeKind::Lt;
+    if (k == NodeKind::Le) op = NodeKind::Ge;
+    if (k == NodeKind::Ge) op = NodeKind::Le;
+  }
+  int verdict = -1;  // -1 depends on x, 0 always false, 1 always true
+  switch (op) {
+    case NodeKind::Lt:
+      verdict = hi < v ? 1 : lo >= v ? 0 : -1;
+      break;
+    case NodeKind::Le:
+      verdict = hi <= v ? 1 : lo > v ? 0 : -1;
+      break;
+    case NodeKind::Gt:
+      verdict = lo > v ? 1 : hi <= v ? 0 : -1;
+      break;
+    case NodeKind::Ge:
+      verdict = lo >= v ? 1 : hi < v ? 0 : -1;
+      break;
+    case NodeKind::Eq:
+      verdict = v < lo || v > hi ? 0 : -1;
+      break;
+    case NodeKind::Ne:
+      verdict = v < lo || v > hi ? 1 : -1;
+      break;
+    default:
+      break;
+  }
+  if (verdict < 0) return;
+  diags_.warn(pos, "tautological-compare",
+              fmt::format("comparison is always {}: a value of type '{}' lies in {}..{}",
+                          verdict ? "true" : "false", typeName(e->type), lo, hi));
+}
+
 Node* Parser::compare(NodeKind k, Node* l, Node* r, Pos pos) {
   value(l);
   value(r);
   if (isArith(l->type) && isArith(r->type)) {
+    checkTypeLimits(k, l, r, pos);
     Type* t = commonType(l->type, r->type);
     return binary(k, castTo(l, t, pos), castTo(r, t, pos), pos, tyInt());
   }
@@ -2011,6 +2294,7 @@ Node* Parser::conditional() {
   DepthGuard guard(*this);
   value(c);
   if (!isScalar(c->type)) fail(c->pos, "condition must have scalar type");
+  checkCondition(c);
   Node* a = expr();
   expect(":");
   Node* b = conditional();
@@ -2357,6 +2641,7 @@ Node* Parser::primary() {
         advance();
         Node* e = expr();
         expect(")");
+        e->parenthesized = true;
         return e;
       }
       fail(pos, "expected expression");
@@ -2449,12 +2734,16 @@ Node* Parser::primary() {
     d.type->base = tyInt();
     Function* f = declareFunction(d, VarAttr{});
     f->implicit = true;
+    if (!poisoned_.count(nameTok.text))
+      diags_.warn(pos, "implicit-function-declaration",
+                  "implicit declaration of function '" + nameTok.text + "' (taken as 'int " +
+                      nameTok.text + "()'; declare it before this call)");
     return funcall(nameTok, f);
   }
   static const std::unordered_set<std::string_view> costate = {"costate", "waitfor", "yield",
                                                                "abort", "wfd"};
   if (costate.count(nameTok.text)) fail(pos, "costatements are not supported");
-  fail(pos, "undeclared identifier '" + nameTok.text + "'");
+  undeclared(pos, nameTok.text, "undeclared identifier '" + nameTok.text + "'");
 }
 
 // funcall = ident "(" (assign ("," assign)*)? ")"
@@ -2610,8 +2899,8 @@ int64_t Parser::constExpr(Type** type) {
 
 }  // namespace
 
-void parse(Preprocessor& pp, const Options& options, Program& prog) {
-  Parser(pp, options, prog).run();
+void parse(Preprocessor& pp, const Options& options, Program& prog, Diagnostics& diags) {
+  Parser(pp, options, prog, diags).run();
 }
 
 }  // namespace simbot::compiler

@@ -258,8 +258,8 @@ class IfEval {
 
 }  // namespace
 
-Preprocessor::Preprocessor(std::string_view src, std::string fileName)
-    : lex_(src), fileName_(std::move(fileName)) {}
+Preprocessor::Preprocessor(std::string_view src, std::string fileName, Diagnostics& diags)
+    : lex_(src), fileName_(std::move(fileName)), diags_(diags) {}
 
 // The next unexpanded token: pushed back first, then the file.
 Token Preprocessor::raw(bool lenient) {
@@ -323,6 +323,17 @@ void Preprocessor::directive(const Token& hash) {
   if (name == "define") {
     std::vector<Token> line = readLine();
     if (line.empty()) fail(after(nameTok.pos), "macro name missing");
+    // The thesis's listings print the vector binding as "#define INT_VEC
+    // PIOA_VEC rimint" (text extraction ate the directive): as a macro it
+    // binds nothing, and the edge interrupt never reaches its handler.
+    if (line[0].kind == TokKind::Ident && line[0].text == "INT_VEC") {
+      std::string hint = "#INT_VEC";
+      for (size_t k = 1; k < line.size(); ++k) hint += " " + line[k].text;
+      diags_.warn(
+          hash.pos, "define-int-vec",
+          "'#define INT_VEC' defines a macro and binds no interrupt vector; did you mean '" + hint +
+              "'?");
+    }
     define(line[0], line);
   } else if (name == "undef") {
     std::vector<Token> line = readLine();

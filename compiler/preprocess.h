@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "compiler/diagnostics.h"
 #include "compiler/lexer.h"
 
 namespace simbot::compiler {
@@ -25,7 +26,8 @@ struct IntVecDirective {
 
 class Preprocessor {
  public:
-  Preprocessor(std::string_view src, std::string fileName);
+  // Warnings of directives (define-int-vec) go to `diags`; errors are thrown.
+  Preprocessor(std::string_view src, std::string fileName, Diagnostics& diags);
   // The next token after preprocessing; Eof (repeatedly) at the end.
   Token next();
   const std::vector<IntVecDirective>& intVecs() const { return intVecs_; }
@@ -61,6 +63,7 @@ class Preprocessor {
 
   Lexer lex_;
   std::string fileName_;
+  Diagnostics& diags_;
   std::vector<Token> pending_;  // pushed-back or expanded tokens, back() first
   bool noLexer_ = false;        // expanding an isolated token list
   std::unordered_map<std::string, Macro> macros_;

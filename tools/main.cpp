@@ -31,12 +31,33 @@ namespace {
 using namespace simbot;
 using nlohmann::json;
 
-int compileCommand(const std::string& file, bool disasm) {
-  const auto result = compiler::compileFile(file);
-  if (!result.image) {
-    for (const auto& d : result.errors) std::cerr << d.format();
-    return 1;
+// simbot compile FILE [--disasm] [-Wno-NAME ...] [-Werror]: the -W words
+// come through CLI11 as extras (it has no multi-letter single-dash options).
+int compileCommand(const std::string& file, bool disasm, const std::vector<std::string>& extras) {
+  compiler::Options options;
+  for (const std::string& w : extras) {
+    if (w == "-Werror") {
+      options.werror = true;
+    } else if (w.rfind("-Wno-", 0) == 0 && compiler::isWarningName(w.substr(5))) {
+      options.disabledWarnings.insert(w.substr(5));
+    } else {
+      std::string names;
+      for (const auto& info : compiler::warningList())
+        names += (names.empty() ? "" : ", ") + std::string(info.name);
+      std::cerr << "simbot: compile: unknown option '" << w << "' (warnings: " << names
+                << "; simbot compile --help lists the options)\n";
+      return 1;
+    }
   }
+  const auto result = compiler::compileFile(file, options);
+  // Errors and warnings together, in source order (each list already is).
+  std::vector<compiler::Diagnostic> all = result.warnings;
+  all.insert(all.end(), result.errors.begin(), result.errors.end());
+  std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
+    return a.line != b.line ? a.line < b.line : a.column < b.column;
+  });
+  for (const auto& d : all) std::cerr << d.format();
+  if (!result.image) return 1;
   if (disasm) std::cout << vm::disassemble(*result.image);
   return 0;
 }
@@ -444,6 +465,10 @@ int main(int argc, char** argv) {
   auto* compile = app.add_subcommand("compile", "compile a Dynamic C program");
   compile->add_option("FILE", compileFile, "program (.dc)")->required();
   compile->add_flag("--disasm", disasm, "print the bytecode, interleaved with the source");
+  compile->allow_extras();
+  compile->footer(
+      "Warnings: -Wno-NAME turns one off, -Werror makes every warning an error (see the README "
+      "for the names).");
 
   RunOptions soloOptions;
   std::string soloProgram;
@@ -501,7 +526,7 @@ int main(int argc, char** argv) {
     return kExitBadInput;
   }
   try {
-    if (*compile) return compileCommand(compileFile, disasm);
+    if (*compile) return compileCommand(compileFile, disasm, compile->remaining());
     if (*solo) return soloCommand(soloProgram, soloOptions);
     if (*match) return matchCommand(programA, programB, matchOptions);
     if (*profile) return profileCommand(profileProgram, profileOptions, profileTop);

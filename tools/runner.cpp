@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <iostream>
 #include <mutex>
+#include <set>
 #include <thread>
 #include <vector>
 
@@ -21,9 +23,26 @@ namespace {
 
 vm::Image imageOrThrow(compiler::Result result) {
   if (!result.image) {
-    std::string all;
-    for (const auto& d : result.errors) all += d.format();
-    throw ToolError(all);
+    std::vector<compiler::Diagnostic> all = result.warnings;
+    all.insert(all.end(), result.errors.begin(), result.errors.end());
+    std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
+      return a.line != b.line ? a.line < b.line : a.column < b.column;
+    });
+    std::string text;
+    for (const auto& d : all) text += d.format();
+    throw ToolError(text);
+  }
+  // Warnings go to stderr (stdout may be JSON), once per program per
+  // process however many runs compile it (bench, tournament).
+  static std::mutex mutex;
+  static std::set<std::string> shown;
+  if (!result.warnings.empty()) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (shown.insert(result.image->sourceName).second) {
+      std::string all;
+      for (const auto& d : result.warnings) all += d.format();
+      std::cerr << all << std::flush;
+    }
   }
   return std::move(*result.image);
 }
