@@ -2,6 +2,7 @@
 // program point (line:N#K), into a program sitting in a delay loop.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "plant/plant.h"
@@ -172,3 +173,98 @@ TEST(Inject, ParsesWhenForms) {
 }
 
 }  // namespace
+
+namespace {
+
+// A one-line delay loop, as ICEMAN's platform() writes it: line:N#K and
+// pass:N#K name different things on it.
+const char* kOneLine = R"(#INT_VEC PIOA_VEC edge
+int z, seen, hits;
+interrupt reti edge()
+{
+    seen = z;
+    hits++;
+}
+main()
+{
+    outport(PIOCA, 0xff);
+    outport(PIOCA, 0xff);
+    outport(PIOCA, PIOA_VEC);
+    outport(PIOCA, 0x97);
+    outport(PIOCA, 0xfc);
+    outport(PIOCA, 0x87);
+    for (z = 0; z < 700; z++);
+    printf("%d %d %d\n", z, seen, hits);
+}
+)";
+constexpr int kOneLineLoop = 16;
+
+scheduler::MatchResult oneLine(const std::vector<std::string>& injections) {
+  scheduler::MatchConfig c = soloConfig({});
+  c.robots[0] = {"A", "oneline.dc", testkit::compileOrDie(kOneLine, "oneline.dc")};
+  for (const auto& text : injections) c.injections.push_back(scheduler::parseInjection(text, 1));
+  return scheduler::runMatch(c);
+}
+
+bool mentions(const std::vector<std::string>& warnings, const std::string& what) {
+  return std::any_of(warnings.begin(), warnings.end(),
+                     [&](const std::string& w) { return w.find(what) != std::string::npos; });
+}
+
+}  // namespace
+
+TEST(Inject, PassTargetsTheKthPassOfALoopOnOneLine) {
+  // The loop's head (z < 700) runs at the start of pass K with z == K - 1,
+  // and once more, as the 701st, for the test that ends the loop (z == 700).
+  for (int k : {1, 2, 350, 700, 701}) {
+    const auto r = oneLine({"A:edge_aft@pass:16#" + std::to_string(k)});
+    EXPECT_EQ(r.robots[0].console, std::vector<std::string>{"700 " + std::to_string(k - 1) + " 1"})
+        << "pass " << k;
+    EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
+  }
+  // There is no 702nd: it never fires, and the run says so.
+  const auto never = oneLine({"A:edge_aft@pass:16#702"});
+  EXPECT_EQ(never.robots[0].console, std::vector<std::string>{"700 0 0"});
+  ASSERT_EQ(never.warnings.size(), 1u);
+  EXPECT_TRUE(mentions(never.warnings, "A:edge_aft@pass:16#702 never fired"));
+  EXPECT_TRUE(mentions(never.warnings, "ran 701 time(s)"));
+}
+
+TEST(Inject, LineOnALineHoldingALoopCountsEntriesAndSaysSo) {
+  // The line is entered once: line:16#1 fires before z = 0 runs (z still
+  // 0 from power-on), line:16#2 never fires; each says what it counts.
+  const auto first = oneLine({"A:edge_fore@line:16#1"});
+  EXPECT_EQ(first.robots[0].console, std::vector<std::string>{"700 0 1"});
+  EXPECT_TRUE(mentions(first.warnings, "line:N#K counts entries into the line"));
+  EXPECT_TRUE(mentions(first.warnings, "pass:16#1"));
+  const auto second = oneLine({"A:edge_fore@line:16#2"});
+  EXPECT_EQ(second.robots[0].console, std::vector<std::string>{"700 0 0"});
+  EXPECT_TRUE(mentions(second.warnings, "A:edge_fore@line:16#2 never fired: line 16"));
+  EXPECT_TRUE(mentions(second.warnings, "ran 1 time(s)"));
+  // The body line of the other program holds no whole loop: no note there.
+  EXPECT_TRUE(
+      solo({"A:edge_aft@line:" + std::to_string(kLoopBodyLine) + "#5"}).result.warnings.empty());
+}
+
+TEST(Inject, PassNeedsALoopOnTheLine) {
+  const auto img = testkit::compileOrDie(kOneLine, "oneline.dc");
+  EXPECT_TRUE(scheduler::loopHead(img, kOneLineLoop).has_value());
+  EXPECT_FALSE(scheduler::loopHead(img, 17).has_value());  // the printf
+  EXPECT_THROW(oneLine({"A:edge_aft@pass:17#1"}), std::invalid_argument);
+  EXPECT_THROW(scheduler::parseInjection("A:edge_aft@pass:16", 1), std::invalid_argument);
+  EXPECT_TRUE(scheduler::parseInjection("A:edge_aft@pass:16#3", 1).pass);
+}
+
+TEST(Inject, InjectionsThatNeverFiredAreNamed) {
+  // The program returns from main long before 9 s (20,000 passes of a few
+  // hundred T-states: about half a second), so the run ends first; the
+  // 100-ms one fires.
+  // The loop body runs 20,000 times, never a 20,001st.
+  const std::string body = "A:edge_aft@line:" + std::to_string(kLoopBodyLine) + "#20001";
+  const SoloRun run = solo({"A:edge_fore@100ms", "A:bumper_front@9s", body});
+  ASSERT_EQ(run.result.warnings.size(), 2u);
+  EXPECT_TRUE(mentions(run.result.warnings, "A:bumper_front@9s never fired: the run ended at"));
+  EXPECT_TRUE(mentions(run.result.warnings, body + " never fired"));
+  EXPECT_TRUE(mentions(run.result.warnings, "ran 20000 time(s)"));
+  EXPECT_FALSE(mentions(run.result.warnings, "A:edge_fore@100ms"));
+}
