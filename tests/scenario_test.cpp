@@ -114,7 +114,7 @@ TEST(Scenario, EveryMistakeNamesItsLine) {
        "bumper_back"},
       {"[A]\ninject = [\"edge_fore@soon\"]\n",
        "s.toml:2:11: error: 'edge_fore@soon': WHEN must be a time (12.5s, 800ms), a tick "
-       "(115200000t) or a program point (line:N#K)"},
+       "(115200000t) or a program point (line:N#K, pass:N#K)"},
       {"[B]\nprogram = \"nope.dc\"\n",
        ("s.toml:2:11: error: 'B.program': no file '" + kSource + "/nope.dc'")},
       {"[B]\nprogram = \"programs/spiral.dc\"\nbeacon = true\n",
