@@ -8,7 +8,8 @@ INT_VEC ...") but arms the PIO, and backs onto the south wire: it faults at
 its first crossing, well inside a second.
 
 - solo: exit status 3 (a robot faulted), not 1 (bad input, also checked);
-  the fault line on stderr; the JSON's fault.
+  the fault line on stderr; the JSON's fault. profile: the same status and
+  its JSON's fault.
 - match: a fault line in the text output (robot, time, source line,
   message); --reload-on-fault restarts it 20 s (the profile's
   [match] reload_delay) after the fault and the match runs to its end.
@@ -59,6 +60,11 @@ j = json.loads(solo_json.stdout)
 check(j["fault"] is not None and "no #INT_VEC binds" in j["fault"]["message"],
       f"solo JSON has the fault: {j['fault']}")
 check(j["reloads"] == 0 and j["motor_frames_overwritten"] == 0, "solo JSON counts")
+
+# profile: the fault in its JSON, exit 3.
+prof = run("profile", FAULTING, "--seconds", "5", "--json")
+check(prof.returncode == 3, f"profile of a faulting program exits 3, got {prof.returncode}")
+check("no #INT_VEC binds" in json.loads(prof.stdout)["fault"]["message"], "profile JSON fault")
 
 # match: a fault line in the text output (stdout), exit 3.
 match = run("match", FAULTING, TURRET, "--seconds", "10")

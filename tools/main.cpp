@@ -343,6 +343,8 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
     throw tools::ToolError(fmt::format("simbot: {}\n", e.what()));
   }
   reportWarnings(r);
+  // A faulted run is profiled up to the fault, and said so (exit status 3).
+  const int status = reportFaults(r) ? kExitRobotFault : 0;
   const auto& robot = r.robots[0];
   std::map<int, uint64_t> byLine;
   std::map<std::string, uint64_t> byFunction;
@@ -375,9 +377,13 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
   const double tps = static_cast<double>(scheduler::kTicksPerSecond);
   auto pct = [&](uint64_t c) { return total ? 100.0 * static_cast<double>(c) / total : 0.0; };
   if (o.json) {
-    json j = {{"program", program},    {"sim_seconds", static_cast<double>(total) / tps},
-              {"cycles", total},       {"serial_isr_cycles", robot.serialIsrCycles},
-              {"idle_cycles", idle},   {"functions", json::array()},
+    json j = {{"program", program},
+              {"sim_seconds", static_cast<double>(total) / tps},
+              {"cycles", total},
+              {"serial_isr_cycles", robot.serialIsrCycles},
+              {"idle_cycles", idle},
+              {"fault", faultJson(robot.fault)},
+              {"functions", json::array()},
               {"lines", json::array()}};
     for (const auto& [name, cycles] : functions)
       j["functions"].push_back({{"function", name},
@@ -395,7 +401,7 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
                           ? image.sourceLines[static_cast<size_t>(line - 1)]
                           : ""}});
     std::cout << tools::dumpJson(j, 2) << '\n';
-    return 0;
+    return status;
   }
   std::cout << fmt::format("{}: {:.3f} simulated seconds, {} T-states{}\n\n", program,
                            static_cast<double>(total) / tps, total,
@@ -422,7 +428,7 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
     std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {:>5}  {}\n", cycles,
                              static_cast<double>(cycles) / tps, pct(cycles), line, text);
   }
-  return 0;
+  return status;
 }
 
 void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
