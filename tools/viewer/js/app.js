@@ -73,6 +73,7 @@ function startViewer() {
   const logEntries = [];
   for (const i of model.injections) logEntries.push([i.t, `${names[i.robot]} injection ${i.what} at line ${i.line}`]);
   for (const f of model.faults) logEntries.push([f.t, `${names[f.robot]} FAULT line ${f.line}: ${f.message}`]);
+  for (const l of model.reloads) logEntries.push([l.t, `${names[l.robot]} reloaded (reload ${l.reloads}): main starts again`]);
   for (const c of model.consoleLines.slice(0, 2000)) logEntries.push([c.t, `${names[c.robot]} console: ${c.text}`]);
   logEntries.sort((a, b) => a[0] - b[0]);
   for (const [t, text] of logEntries) {
@@ -194,8 +195,10 @@ function startViewer() {
     try {
       const poses = model.robots.map((r) => poseAt(r, cursor));
       const states = model.robots.map((r) => {
-        const fault = model.faults.find((f) => f.robot === r.robot);
-        return { inHandler: handlerAt(r, cursor) !== null, faulted: Boolean(fault && fault.t <= cursor) };
+        // Faulted from its latest fault up to the reload after it (--reload-on-fault).
+        const latest = (rows) => rows.filter((x) => x.robot === r.robot && x.t <= cursor).pop();
+        const fault = latest(model.faults), reload = latest(model.reloads);
+        return { inHandler: handlerAt(r, cursor) !== null, faulted: Boolean(fault && (!reload || reload.t < fault.t)) };
       });
       field.draw(cursor, poses, states);
       scene.update(cursor, poses);

@@ -85,6 +85,7 @@ function buildModel(data) {
     marks: fieldMarks(K),
     events: eventList(K),
     faults: rowsOf(K.fault),
+    reloads: rowsOf(K.reload),
     plantFaults: rowsOf(K.plant_fault),
     injections: rowsOf(K.injection),
     consoleLines: rowsOf(K.console),
@@ -283,6 +284,7 @@ const EVENT_STYLE = {
   referee_put_back: { glyph: 'P', color: '#ffffff', label: 'referee put back' },
   injection: { glyph: '!', color: '#40ffa0', label: 'injection' },
   fault: { glyph: 'F', color: '#ff2020', label: 'FAULT' },
+  reload: { glyph: 'L', color: '#ffa040', label: 'reloaded' },
   console: { glyph: 'c', color: '#c0c0c0', label: 'console' },
   exit: { glyph: 'E', color: '#c0c0c0', label: 'main returned' },
 };
@@ -297,6 +299,7 @@ function describeEvent(kind, c, i) {
     case 'ball_miss': return `${c.hit[i]}` + (c.closest_ft[i] === null ? '' : `, closest ${c.closest_ft[i].toFixed(2)} ft`);
     case 'injection': return `${c.what[i]} (line ${c.line[i]})`;
     case 'fault': return `line ${c.line[i]}: ${c.message[i]}`;
+    case 'reload': return `reload ${c.reloads[i]}: main starts again`;
     case 'console': return c.text[i];
     default: return '';
   }
@@ -331,7 +334,7 @@ const STEP_KINDS = [
   ['misses', 'misses', ['ball_miss']],
   ['referee', 'referee', ['referee_turn', 'referee_put_back']],
   ['injections', 'injections', ['injection']],
-  ['faults', 'faults', ['fault']],
+  ['faults', 'faults and reloads', ['fault', 'reload']],
   ['console', 'console', ['console']],
 ];
 
