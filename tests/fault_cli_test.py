@@ -16,7 +16,8 @@ its first crossing, well inside a second.
 - tournament --json: the fault in its game; --reload-on-fault counts reloads.
 - bench: the runs.csv fault column, faults per program in summary.json.
 - --watch without --trace: an error, exit 1.
-- an injection that never fired: a warning on stderr naming it.
+- an injection that never fired: a warning on stderr naming it (solo; each
+  run of a bench).
 - frames overwritten: shown in match text output and counted in the JSON.
 """
 import csv
@@ -130,6 +131,14 @@ never = run("solo", ICEMAN, "--seconds", "1", "--inject", "A:edge_fore@2s")
 check(never.returncode == 0, f"exit 0, got {never.returncode}")
 check("warning: --inject A:edge_fore@2s never fired" in never.stderr,
       f"the unfired injection is named: {never.stderr}")
+
+# bench: a scenario's injection that never fired, in each run, is named.
+(OUT / "late.toml").write_text('[A]\ninject = ["edge_fore@50s"]\n')
+late = run("bench", ICEMAN, "--family", "stationary", "--scenario", str(OUT / "late.toml"),
+           "--seeds", "2", "--seconds", "2", "--threads", "2", "--out", str(OUT / "late"))
+check(late.returncode == 0, f"bench exits 0, got {late.returncode}: {late.stderr}")
+check(late.stderr.count("--inject A:edge_fore@50s never fired") == 2,
+      f"each run's unfired injection is named: {late.stderr}")
 
 if failures:
     print(f"{len(failures)} failure(s)")

@@ -333,6 +333,7 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile, c
       run.metrics = scheduler::collectMetrics(observer, r.robots[0]);
       run.fault = faultLine(r);
       run.outcome = run.fault.empty() ? "ok" : "fault";
+      run.warnings = r.warnings;
     } catch (const scheduler::Stopped&) {
       return;  // abandoned: not done, run again by --resume
     } catch (const std::exception& e) {
@@ -385,6 +386,21 @@ std::string benchFaults(const BenchResult& result, size_t most) {
   }
   if (all > most)
     out += fmt::format("simbot: bench: ... {} more (runs.csv lists them)\n", all - most);
+  return out;
+}
+
+std::string benchWarnings(const BenchResult& result, size_t most) {
+  std::string out;
+  size_t shown = 0, all = 0;
+  for (const auto& run : result.runs) {
+    for (const auto& w : run.warnings) {
+      if (shown++ < most)
+        out += fmt::format("simbot: warning: bench: run {} of {} (seed {}): {}\n", run.index,
+                           run.program, run.seed, w);
+      ++all;
+    }
+  }
+  if (all > most) out += fmt::format("simbot: warning: bench: ... {} more\n", all - most);
   return out;
 }
 

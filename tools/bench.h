@@ -41,6 +41,9 @@ struct BenchRun {
   std::string outcome;
   std::string fault;  // what faulted or failed, one line; empty when ok
   scheduler::RunMetrics metrics;
+  // The run's warnings (injections that never fired, ...): for stderr
+  // only, not kept in runs.csv (a resumed run's are not shown again).
+  std::vector<std::string> warnings;
 };
 
 struct BenchResult {
@@ -85,5 +88,7 @@ std::string summaryMarkdown(const BenchResult& result);
 void writeBenchOutputs(const BenchResult& result, RunTable& table);
 // One line per run that faulted or failed (at most `most`, then a count).
 std::string benchFaults(const BenchResult& result, size_t most = 20);
+// One line per warning of a run (at most `most`, then a count).
+std::string benchWarnings(const BenchResult& result, size_t most = 20);
 
 }  // namespace simbot::tools

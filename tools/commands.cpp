@@ -104,7 +104,7 @@ Subcommand addBenchCommand(CLI::App& app) {
           const BenchResult r = runBench(c, loaded, {&table, &signals.requested()});
           writeBenchOutputs(r, table);
           std::cout << summaryMarkdown(r);
-          std::cerr << benchFaults(r);
+          std::cerr << benchWarnings(r) << benchFaults(r);
           const auto done = std::count_if(r.runs.begin(), r.runs.end(),
                                           [](const BenchRun& run) { return run.done; });
           const double wall =
