@@ -146,6 +146,10 @@ const char* endsPath(const Node* n) {
   }
 }
 
+// Thrown inside a function body that lacks its '}' when the next function
+// begins: every open block ends and parsing resumes at file level.
+struct BackToFileLevel {};
+
 struct VarAttr {
   bool isTypedef = false;
   bool isStatic = false;
@@ -260,6 +264,7 @@ class Parser {
   void skipStatement(const Resume& r);
   void skipExternalDeclaration();
   void poisonSince(size_t token);
+  bool atFunctionDefinition();
   [[noreturn]] void undeclared(Pos pos, const std::string& name, const std::string& message);
 
   // ---- warnings ----
@@ -331,6 +336,8 @@ class Parser {
   // Names met in a declaration that failed: an error about one of them
   // later (undeclared, undefined) follows from that failure, so is silent.
   std::unordered_set<std::string> poisoned_;
+  std::unordered_set<std::string> undeclaredHere_;  // reported in this function
+  std::string functionNameAhead_;                   // atFunctionDefinition's find
   Pos prevPos_{1, 1, 0};
   int depth_ = 0;
   std::vector<Scope> scopes_;
@@ -375,8 +382,10 @@ void Parser::advance() {
   if (t.kind == TokKind::Punct) {
     if (t.text == "{") {
       ++braceDepth_;
-      // A function body's brace follows its ")" or its K&R parameters' ";".
-      braceIsBody_.push_back(i_ > 0 && (toks_[i_ - 1].is(")") || toks_[i_ - 1].is(";")));
+      // A function body's brace follows its ")" or its K&R parameters' ";"
+      // (or a parameter list whose ")" is missing).
+      braceIsBody_.push_back(parenDepth_ > 0 ||
+                             (i_ > 0 && (toks_[i_ - 1].is(")") || toks_[i_ - 1].is(";"))));
     } else if (t.text == "}") {
       braceDepth_ = std::max(0, braceDepth_ - 1);
       lastCloseWasBody_ = braceIsBody_.empty() || braceIsBody_.back();  // empty: unbalanced
@@ -549,11 +558,14 @@ void Parser::run() {
       recordError(e);
       skipExternalDeclaration();
       poisonSince(r.token);
-      scopes_.resize(2);
-      switches_.clear();
-      fn_ = nullptr;
-      loopDepth_ = breakDepth_ = 0;
+    } catch (const BackToFileLevel&) {
+      braceDepth_ = parenDepth_ = 0;
+      braceIsBody_.clear();
     }
+    scopes_.resize(2);
+    switches_.clear();
+    fn_ = nullptr;
+    loopDepth_ = breakDepth_ = 0;
   }
 
   // Whole-program checks: each is an error of its own, none stops the rest.
@@ -671,7 +683,7 @@ void Parser::poisonSince(size_t token) {
   for (size_t k = token; k < i_ && k < toks_.size(); ++k) {
     const Token& t = toks_[k];
     if (t.is("(") || t.is("[") || t.is("{")) ++depth;
-    if (t.is(")") || t.is("]") || t.is("}")) --depth;
+    if (t.is(")") || t.is("]") || t.is("}")) depth = std::max(0, depth - 1);
     if (depth == 0 && t.is("=")) inInit = true;
     if (depth == 0 && t.is(",")) inInit = false;
     if (depth == 0 && !inInit && t.kind == TokKind::Ident && !isKeyword(t))
@@ -679,8 +691,61 @@ void Parser::poisonSince(size_t token) {
   }
 }
 
+// Reported once per function, as gcc does: the other uses say nothing new.
+// At column 1, "NAME ( PARAMS ) {", "TYPE NAME ( PARAMS ) {", "NAME (
+// PARAMS ) TYPE" (K&R parameters) or "interrupt", PARAMS holding only
+// names, type words, '*', ',' and '[ N ]': never a statement, always a
+// function definition; seen inside a block, the block's '}' is missing.
+// (A mistyped "if (x == 1) {" has an operator inside and is no match.)
+bool Parser::atFunctionDefinition() {
+  // The tokens ahead, pragmas skipped, read once each (a long argument list
+  // costs its length, not its square).
+  std::vector<const Token*> ahead;
+  for (size_t j = i_; ahead.size() < 200; ++j) {
+    const Token& t = at(j);
+    if (t.kind == TokKind::Pragma) continue;
+    ahead.push_back(&t);
+    if (t.kind == TokKind::Eof || t.is(";") || t.is("{") || t.is("}")) break;
+  }
+  // The token after the run read so far (Eof or a ';' ... ends the run).
+  const auto tok = [&](size_t k) -> const Token& { return *ahead[std::min(k, ahead.size() - 1)]; };
+  if (tok(0).pos.col != 1) return false;
+  if (tok(0).is("interrupt")) {
+    functionNameAhead_.clear();
+    for (size_t k = 1; k < ahead.size(); ++k)
+      if (tok(k).kind == TokKind::Ident && !isKeyword(tok(k))) {
+        functionNameAhead_ = tok(k).text;
+        break;
+      }
+    return true;
+  }
+  size_t k = 0;
+  while (k < ahead.size() &&
+         (tok(k).is("*") || (tok(k).kind == TokKind::Ident && kDeclWords.count(tok(k).text))))
+    ++k;
+  const Token& name = tok(k);
+  if (name.kind != TokKind::Ident || isKeyword(name) || !tok(k + 1).is("(")) return false;
+  int depth = 0;
+  for (size_t j = k + 1; j + 1 < ahead.size(); ++j) {
+    const Token& t = tok(j);
+    if (!(t.kind == TokKind::Ident || t.kind == TokKind::Number || t.is("(") || t.is(")") ||
+          t.is(",") || t.is("*") || t.is("[") || t.is("]") || t.is("...")))
+      return false;
+    if (tok(j).is("(")) ++depth;
+    if (tok(j).is(")") && --depth == 0) {
+      const Token& next = tok(j + 1);
+      if (!next.is("{") && !(next.kind == TokKind::Ident && kDeclWords.count(next.text)))
+        return false;
+      functionNameAhead_ = name.text;
+      return true;
+    }
+  }
+  return false;
+}
+
 void Parser::undeclared(Pos pos, const std::string& name, const std::string& message) {
-  throw CompileError{pos, message, poisoned_.count(name) > 0};
+  const bool again = !undeclaredHere_.insert(name).second;
+  throw CompileError{pos, message, again || poisoned_.count(name) > 0};
 }
 
 // external-declaration = declspec? declarator ("," declarator)* ";"
@@ -1258,6 +1323,7 @@ void Parser::functionDefinition(Declarator& d, const VarAttr& attr) {
 
   labels_.clear();
   gotos_.clear();
+  undeclaredHere_.clear();
   f->body = compoundStatement(false);
   leaveScope();
   for (Node* g : gotos_)
@@ -1771,6 +1837,13 @@ Node* Parser::compoundStatement(bool newScope) {
     n->endPos = cur().pos;
     if (accept("}")) break;
     if (cur().kind == TokKind::Eof) diags_.fatal(after(prevPos_), "expected '}' at end of input");
+    // A missing '}': what follows is the next function. Every open block
+    // ends here and parsing resumes at file level.
+    if (atFunctionDefinition()) {
+      diags_.error(after(prevPos_),
+                   "expected '}' before the definition of '" + functionNameAhead_ + "'");
+      throw BackToFileLevel{};
+    }
     Resume r = resumePoint();
     bool declaration = false;
     try {

@@ -703,6 +703,42 @@ TEST(CompilerDiagnostics, NoCascadeAfterAFailedDeclaration) {
   EXPECT_TRUE(r.warnings.empty());
 }
 
+TEST(CompilerDiagnostics, MissingCloseBraceEndsAtTheNextFunction) {
+  // main's '}' is missing: one error, just after the last '}' read (line 6,
+  // col 2), and platform() and the handler parse as functions of their own.
+  Result r = compile(
+      "int x;\n"
+      "main()\n"
+      "{\n"
+      "    while (1) {\n"
+      "        x = 1;\n"
+      "}\n"
+      "platform()\n"
+      "{\n"
+      "    x = 2;\n"
+      "}\n"
+      "#INT_VEC PIOA_VEC edge\n"
+      "interrupt reti edge() { x = 3; }\n",
+      "b.dc");
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_EQ(r.errors[0].format(),
+            "b.dc:6:2: error: expected '}' before the definition of 'platform'\n}\n ^\n");
+  // A mistyped "if" ("f(x == 1) {") is a statement gone wrong, not a function.
+  Result m = compile("int x;\nmain()\n{\nf(x == 1) { x = 2; }\n}\n", "m.dc");
+  ASSERT_EQ(m.errors.size(), 2u);
+  EXPECT_EQ(m.errors[0].message, "undefined function 'f'");
+  EXPECT_EQ(m.errors[1].message, "expected ';' after expression");
+}
+
+TEST(CompilerDiagnostics, UndeclaredReportedOncePerFunction) {
+  Result r = compile("main() { y = 1; y = 2; }\nf() { y = 3; }\n", "u.dc");
+  ASSERT_EQ(r.errors.size(), 2u);
+  EXPECT_EQ(r.errors[0].line, 1);  // col 10, main's first use
+  EXPECT_EQ(r.errors[0].column, 10);
+  EXPECT_EQ(r.errors[1].line, 2);  // col 7, f's
+  EXPECT_EQ(r.errors[1].column, 7);
+}
+
 TEST(CompilerDiagnostics, ErrorsAreCapped) {
   std::string src = "main() {\n";
   for (int i = 0; i < 80; ++i) src += "  x" + std::to_string(i) + " = 1;\n";
