@@ -15,5 +15,6 @@ CLI::Validator seedValidator();
 
 Subcommand addBenchCommand(CLI::App& app);
 Subcommand addTournamentCommand(CLI::App& app);
+Subcommand addExplainCommand(CLI::App& app);  // tools/explain_command.cpp
 
 }  // namespace simbot::tools

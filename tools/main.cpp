@@ -517,6 +517,7 @@ int main(int argc, char** argv) {
 
   const auto bench = simbot::tools::addBenchCommand(app);
   const auto tournament = simbot::tools::addTournamentCommand(app);
+  const auto explain = simbot::tools::addExplainCommand(app);
 
   try {
     app.parse(argc, argv);
@@ -539,6 +540,7 @@ int main(int argc, char** argv) {
     if (*view) return viewCommand(viewTrace, viewOut);
     if (*bench.app) return bench.run();
     if (*tournament.app) return tournament.run();
+    if (*explain.app) return explain.run();
   } catch (const tools::ToolError& e) {
     std::cerr << e.what();
     return kExitBadInput;

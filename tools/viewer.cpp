@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "tools/explain.h"
 #include "tools/json_text.h"
 #include "tools/runner.h"
 #include "tools/viewer_assets.h"
@@ -48,6 +49,7 @@ struct ReplaySink::Columns {
   json watch = json::object();
   std::size_t records = 0;
   std::optional<trace::Tick> truncatedAt;  // the first record left out
+  explain::Explainer explainer;            // the Explain panel: sees every record
 };
 
 ReplaySink::ReplaySink(const std::string& path) : path_(path), columns_(new Columns) {
@@ -65,6 +67,7 @@ ReplaySink::~ReplaySink() {
 }
 
 void ReplaySink::write(const trace::Entry& e) {
+  columns_->explainer.write(e);
   // A page is for a person to look at: beyond this many records (a program
   // flooding port B) the rest of the run is left out, and the page says so,
   // so that its memory stays bounded. The end of the run is always kept.
@@ -103,7 +106,13 @@ void ReplaySink::write(const trace::Entry& e) {
 }
 
 json ReplaySink::data() const {
+  // The Explain panel: the text report of `simbot explain`, line by line,
+  // each with the tick it is about (or null).
+  json report = json::array();
+  for (const auto& line : explain::textLines(columns_->explainer.report()))
+    report.push_back({jsonString(line.text, false), line.t ? json(*line.t) : json(nullptr)});
   return {{"format", "simbot-replay/1"},
+          {"explain", std::move(report)},
           {"kinds", columns_->kinds},
           {"watch", columns_->watch},
           {"truncated_at", columns_->truncatedAt ? json(*columns_->truncatedAt) : json(nullptr)}};

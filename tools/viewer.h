@@ -1,8 +1,9 @@
 // The replay viewer: one self-contained HTML page (scripts, styles, three.js
 // and the run's data inlined; no network, no server) that shows a run from
 // its trace: the field from above, a 3-D view with the 1997 program's six
-// cameras, playback, event lanes and eye curves on one time axis, and each
-// robot's source with the line it is executing.
+// cameras, playback, event lanes and eye curves on one time axis, each
+// robot's source with the line it is executing, and the Explain panel (the
+// report of `simbot explain`, tools/explain.h).
 //
 // The page's data is built from the trace records alone (trace/trace.h),
 // so `simbot match --replay F.html` and `simbot view TRACE.jsonl -o F.html`

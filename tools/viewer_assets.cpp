@@ -36,6 +36,7 @@ SIMBOT_INCBIN(field2d, SIMBOT_VIEWER_DIR "/js/field2d.js")
 SIMBOT_INCBIN(scene3d, SIMBOT_VIEWER_DIR "/js/scene3d.js")
 SIMBOT_INCBIN(timeline, SIMBOT_VIEWER_DIR "/js/timeline.js")
 SIMBOT_INCBIN(source, SIMBOT_VIEWER_DIR "/js/source.js")
+SIMBOT_INCBIN(explain, SIMBOT_VIEWER_DIR "/js/explain.js")
 SIMBOT_INCBIN(app, SIMBOT_VIEWER_DIR "/js/app.js")
 SIMBOT_INCBIN(three, SIMBOT_THREE_JS)
 SIMBOT_INCBIN(orbit, SIMBOT_ORBIT_JS)
@@ -46,7 +47,8 @@ std::string_view viewerCss() { return asset_css(); }
 std::vector<std::pair<std::string_view, std::string_view>> viewerScripts() {
   return {{"model.js", asset_model()},     {"field2d.js", asset_field2d()},
           {"scene3d.js", asset_scene3d()}, {"timeline.js", asset_timeline()},
-          {"source.js", asset_source()},   {"app.js", asset_app()}};
+          {"source.js", asset_source()},   {"explain.js", asset_explain()},
+          {"app.js", asset_app()}};
 }
 std::string_view threeJs() { return asset_three(); }
 std::string_view orbitControlsJs() { return asset_orbit(); }

@@ -2,7 +2,8 @@
 // playwright-core): the page of a 180-s ICEMAN vs fig92 match must open
 // without console errors, draw the robots where the trace puts them at
 // three seek positions, advance time when playing, highlight the source
-// line the trace gives, and render every camera preset. It writes
+// line the trace gives, render every camera preset, and show the report of
+// `simbot explain` in its Explain panel. It writes
 // screenshots of the 2-D view, the 3-D view and the timeline.
 //
 // Usage: node viewer_test.mjs SIMBOT ICEMAN FIG92 OUTDIR
@@ -125,6 +126,20 @@ const played = await page.evaluate(() => {
 check(played.playing, 'playing after play()');
 check(played.t > 10 * TPS + 0.2 * TPS && played.t < 10 * TPS + 5 * TPS,
   `0.7 s of playback at 1x moved the cursor from 10 s to ${played.t / TPS} s`);
+
+// ---- the Explain panel: the report of `simbot explain` on this trace, line for
+// line, and a click on the longest stall seeks to where it starts
+const explained = execFileSync(simbot, ['explain', tracePath], { encoding: 'utf8' });
+const panelText = await page.evaluate(() =>
+  [...document.querySelectorAll('#explain-body div')].map((d) => d.textContent.replace(/\u00a0/g, '')).join('\n') + '\n');
+check(panelText === explained, 'the Explain panel shows what simbot explain prints');
+check(/one-eye dead-lock/.test(panelText), 'the Explain panel names the one-eye dead-lock');
+const longest = page.locator('#explain-body div.seek', { hasText: 'longest:' });
+const stallStart = Number(/longest: A ([0-9.]+) s/.exec(panelText)[1]);
+await longest.click();
+const seekTo = await page.evaluate(() => window.simbotViewer.time());
+check(Math.abs(seekTo / TPS - stallStart) < 0.001,
+  `clicking the longest stall seeks to ${stallStart} s (cursor at ${seekTo / TPS} s)`);
 
 // ---- every camera preset renders something; screenshots
 await page.evaluate((t) => window.simbotViewer.seek(t), 95 * TPS);

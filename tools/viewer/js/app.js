@@ -11,7 +11,8 @@ function startViewer() {
   window.addEventListener('error', (e) => hook.errors.push(String(e.message || e)));
   const $ = (id) => document.getElementById(id);
 
-  const model = buildModel(JSON.parse($('simbot-data').textContent));
+  const data = JSON.parse($('simbot-data').textContent);
+  const model = buildModel(data);
   const tps = model.tps;
   const names = model.robots.map((r) => r.name);
   const fmt = (t) => `${(t / tps).toFixed(6)} s`;
@@ -83,6 +84,8 @@ function startViewer() {
     div.addEventListener('click', () => seek(t));
     $('log').appendChild(div);
   }
+
+  createExplainPanel($('explain-body'), data.explain || [], (t) => seek(t));
 
   // ---- controls
   for (const s of SPEEDS) {
@@ -232,6 +235,7 @@ function startViewer() {
     cameras: () => scene.presets.slice(),
     setCamera: (name) => { scene.setPreset(name); render(); },
     view3dStats: () => scene.stats(),
+    explainText: () => $('explain-body').textContent,
   });
   render();
   hook.ready = true;

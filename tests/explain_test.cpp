@@ -1,0 +1,352 @@
+// simbot explain (tools/explain.h), checked against the raw trace records
+// with the geometry computed here, independently of the report's code.
+#include "tools/explain.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include "plant/plant.h"
+#include "scheduler/match.h"
+#include "support/test_host.h"
+#include "tools/runner.h"
+#include "tools/trace_jsonl.h"
+
+using namespace simbot;
+namespace rec = trace::rec;
+namespace ex = tools::explain;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTps = static_cast<double>(scheduler::kTicksPerSecond);
+
+scheduler::MatchConfig config(const std::vector<std::string>& programs, double seconds,
+                              const std::string& profile = "default") {
+  scheduler::MatchConfig c;
+  c.arena =
+      plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/" + profile + ".toml"),
+                             static_cast<int>(programs.size()));
+  c.profileName = profile;
+  const char* names[] = {"A", "B"};
+  for (size_t i = 0; i < programs.size(); ++i)
+    c.robots.push_back({names[i], programs[i], tools::compileProgramFile(programs[i])});
+  c.endTick = static_cast<scheduler::Tick>(seconds * kTps);
+  c.seed = 1;
+  return c;
+}
+
+struct Traced {
+  std::vector<trace::Entry> entries;
+  ex::Report report;
+  template <class R>
+  std::vector<std::pair<trace::Tick, R>> all(int robot = -1) const {
+    std::vector<std::pair<trace::Tick, R>> out;
+    for (const auto& e : entries)
+      if (const R* r = std::get_if<R>(&e.record))
+        if (robot < 0 || trace::robotOf(e.record) == robot) out.emplace_back(e.t, *r);
+    return out;
+  }
+};
+
+Traced run(scheduler::MatchConfig c) {
+  trace::Collector collector;
+  ex::Explainer explainer;
+  c.sinks.push_back(&collector);
+  c.sinks.push_back(&explainer);
+  scheduler::runMatch(c);
+  return {std::move(collector.entries), explainer.report()};
+}
+
+// The 180-s match of the issue, run once for all the tests here (~1 s).
+const Traced& icemanVsFig92() {
+  static const Traced r = run(config(
+      {SIMBOT_SHARED_DIR "/programs/iceman.dc", SIMBOT_SHARED_DIR "/programs/fig92.dc"}, 180));
+  return r;
+}
+
+// Degrees in (-180, 180].
+double wrap(double d) {
+  while (d > 180) d -= 360;
+  while (d <= -180) d += 360;
+  return d;
+}
+
+// The opponent is in view of `self` (DESIGN.md, eyes): its bearing off
+// self's heading, gamma = atan2(dx, dy) - heading (headings clockwise from
+// +y), within 90 deg, and the segment between the centres misses the
+// divider, the rectangle |x - divider_x| <= thickness / 2, south <= y <=
+// north (checked by sampling the segment finely: independent of the
+// plant's slab clipping).
+bool inView(const rec::Sample& self, const rec::Sample& other, const rec::Run& run) {
+  const double dx = other.x_ft - self.x_ft, dy = other.y_ft - self.y_ft;
+  const double gamma = wrap(std::atan2(dx, dy) * 180 / kPi - self.heading_deg);
+  if (!(std::abs(gamma) < 90)) return false;
+  for (int i = 0; i <= 10000; ++i) {
+    const double s = i / 10000.0, x = self.x_ft + s * dx, y = self.y_ft + s * dy;
+    if (std::abs(x - run.divider_x_ft) <= run.divider_thickness_ft / 2 &&
+        y >= run.divider_south_ft && y <= run.divider_north_ft)
+      return false;
+  }
+  return true;
+}
+
+TEST(Explain, IcemanShotsAgainstTheTraceRecords) {
+  const Traced& r = icemanVsFig92();
+  const auto launches = r.all<rec::BallLaunch>();
+  const auto hits = r.all<rec::BallHit>();
+  const auto misses = r.all<rec::BallMiss>();
+  const auto results = r.all<rec::RobotResult>(0);
+  ASSERT_EQ(results.size(), 1u);
+  EXPECT_EQ(results[0].second.shots, 30);
+  ASSERT_EQ(launches.size(), 30u);
+  ASSERT_EQ(r.report.shots.size(), 30u);
+  // Independently: the first ball_hit or ball_miss with the same ball number
+  // after each launch ends it; a miss's distance is its closest_ft.
+  int hitCount = 0;
+  for (size_t i = 0; i < launches.size(); ++i) {
+    const auto& [t, launch] = launches[i];
+    const ex::Shot& shot = r.report.shots[i];
+    EXPECT_EQ(shot.t, t);
+    EXPECT_EQ(shot.robot, 0);
+    EXPECT_DOUBLE_EQ(shot.muzzle_fps, std::hypot(launch.vx_fps, launch.vy_fps));
+    auto ball = [&](const auto& e) { return e.first >= t && e.second.ball == launch.ball; };
+    const auto hit = std::find_if(hits.begin(), hits.end(), ball);
+    const auto miss = std::find_if(misses.begin(), misses.end(), ball);
+    const bool isHit = hit != hits.end() && (miss == misses.end() || hit->first <= miss->first);
+    EXPECT_EQ(shot.hit, isHit);
+    if (isHit) {
+      ++hitCount;
+      EXPECT_EQ(*shot.end_t, hit->first);
+      EXPECT_FALSE(shot.miss_ft);
+    } else {
+      ASSERT_NE(miss, misses.end());
+      ASSERT_TRUE(shot.miss_ft && miss->second.closest_ft);
+      EXPECT_EQ(*shot.miss_ft, *miss->second.closest_ft);
+      EXPECT_EQ(shot.ended, miss->second.hit);
+    }
+  }
+  EXPECT_EQ(hitCount, results[0].second.hits);
+}
+
+// One shot's range and bearing error, from the records: the shooter's
+// heading is the ball's velocity direction, h = atan2(vx, vy) (the gun fires
+// along the heading), and its centre is the muzzle less a body radius along
+// it, C = M - (d / 2) v / |v| (the muzzle is flush with the body edge); the
+// target's centre at the launch tick t is interpolated linearly between its
+// samples at t0 <= t < t1: P = P0 + (t - t0) / (t1 - t0) (P1 - P0). Then
+// range = |P - C| and bearing error = atan2(Px - Cx, Py - Cy) - h, wrapped
+// to (-180, 180] (+ = target to the right).
+TEST(Explain, OneShotsRangeAndBearingFromThePoses) {
+  const Traced& r = icemanVsFig92();
+  const auto launches = r.all<rec::BallLaunch>();
+  const auto setups = r.all<rec::RobotSetup>();
+  const auto targetSamples = r.all<rec::Sample>(1);
+  const auto shooterSamples = r.all<rec::Sample>(0);
+  ASSERT_EQ(setups.size(), 2u);
+  const double radius = setups[0].second.body_diameter_ft / 2;
+  // The seventh launch (any would do).
+  const auto& [t, launch] = launches[6];
+  const double speed = std::hypot(launch.vx_fps, launch.vy_fps);
+  const double heading = std::atan2(launch.vx_fps, launch.vy_fps) * 180 / kPi;
+  const double cx = launch.x_ft - radius * launch.vx_fps / speed;
+  const double cy = launch.y_ft - radius * launch.vy_fps / speed;
+  size_t k = 0;
+  while (k + 1 < targetSamples.size() && targetSamples[k + 1].first <= t) ++k;
+  ASSERT_LT(k + 1, targetSamples.size());
+  const auto& [t0, p0] = targetSamples[k];
+  const auto& [t1, p1] = targetSamples[k + 1];
+  ASSERT_LE(t0, t);
+  ASSERT_GT(t1, t);
+  const double f = static_cast<double>(t - t0) / static_cast<double>(t1 - t0);
+  const double px = p0.x_ft + f * (p1.x_ft - p0.x_ft), py = p0.y_ft + f * (p1.y_ft - p0.y_ft);
+  const double range = std::hypot(px - cx, py - cy);
+  const double bearing = wrap(std::atan2(px - cx, py - cy) * 180 / kPi - heading);
+
+  const ex::Shot& shot = r.report.shots[6];
+  ASSERT_TRUE(shot.range_ft && shot.bearing_error_deg);
+  EXPECT_NEAR(*shot.range_ft, range, 1e-9);
+  EXPECT_NEAR(*shot.bearing_error_deg, bearing, 1e-9);
+  // The shooter's own samples agree with the centre and heading taken from
+  // the launch (within 50 ms of motion).
+  size_t j = 0;
+  while (j + 1 < shooterSamples.size() && shooterSamples[j + 1].first <= t) ++j;
+  EXPECT_NEAR(shooterSamples[j].second.x_ft, cx, 0.2);
+  EXPECT_NEAR(shooterSamples[j].second.y_ft, cy, 0.2);
+  EXPECT_NEAR(wrap(shooterSamples[j].second.heading_deg - heading), 0, 5);
+  // A sanity bound: inside the 16-ft field, and aimed roughly at it.
+  EXPECT_GT(range, 1);
+  EXPECT_LT(range, 23);
+  EXPECT_LT(std::abs(bearing), 90);
+}
+
+// Stalls recomputed from the records: at each pair of samples, ICEMAN
+// either sees fig92 (inView) or not; a stall runs from the later of the
+// first sample of the current in-view run and the latest frame latched, to
+// the next frame latched, the next sample out of view, or the end; those
+// longer than 1 s count.
+TEST(Explain, IcemanStallsAgainstTheRecords) {
+  const Traced& r = icemanVsFig92();
+  const auto runs = r.all<rec::Run>();
+  const auto a = r.all<rec::Sample>(0), b = r.all<rec::Sample>(1);
+  const auto latches = r.all<rec::FrameLatched>(0);
+  ASSERT_EQ(a.size(), b.size());
+  const trace::Tick end = r.entries.back().t;
+  std::vector<std::pair<trace::Tick, trace::Tick>> want;
+  trace::Tick visibleSince = -1, lastLatch = 0;
+  bool sampled = false;  // a sample in view since the window's start
+  size_t next = 0;       // next latch
+  auto close = [&](trace::Tick to) {
+    const trace::Tick from = std::max(visibleSince, lastLatch);
+    if (visibleSince >= 0 && sampled && static_cast<double>(to - from) > kTps)
+      want.emplace_back(from, to);
+    sampled = false;
+  };
+  for (size_t i = 0; i < a.size(); ++i) {
+    const trace::Tick t = a[i].first;
+    ASSERT_EQ(b[i].first, t);
+    for (; next < latches.size() && latches[next].first < t; ++next) {
+      close(latches[next].first);
+      lastLatch = latches[next].first;
+    }
+    if (!inView(a[i].second, b[i].second, runs[0].second)) {
+      close(t);
+      visibleSince = -1;
+    } else {
+      if (visibleSince < 0) visibleSince = t;
+      sampled = true;
+    }
+  }
+  for (; next < latches.size(); ++next) {
+    close(latches[next].first);
+    lastLatch = latches[next].first;
+  }
+  close(end);
+  std::vector<std::pair<trace::Tick, trace::Tick>> got;
+  for (const auto& s : r.report.stalls)
+    if (s.robot == 0) got.emplace_back(s.from, s.to);
+  EXPECT_EQ(got, want);
+
+  // Thesis chapter X: the longest one-eye stall, from about 45 s, with the
+  // near eye bright and the far eye at background (16), the program in
+  // read() and main()'s tests.
+  const ex::Stall* oneEye = nullptr;
+  for (const auto& s : r.report.stalls)
+    if (s.robot == 0 && s.one_eye && (!oneEye || s.to - s.from > oneEye->to - oneEye->from))
+      oneEye = &s;
+  ASSERT_NE(oneEye, nullptr);
+  EXPECT_GT(oneEye->from / kTps, 40.0);
+  EXPECT_LT(oneEye->from / kTps, 50.0);
+  EXPECT_EQ(oneEye->eye_right_median, 16);
+  EXPECT_GT(oneEye->eye_left_median, 1000);
+  ASSERT_FALSE(oneEye->lines.empty());
+  EXPECT_EQ(oneEye->lines[0].function, "read");
+
+  const std::string text = ex::text(r.report);
+  EXPECT_NE(text.find("one-eye dead-lock"), std::string::npos) << text;
+  EXPECT_NE(text.find("Shots (30)"), std::string::npos);
+  EXPECT_NE(ex::markdown(r.report).find("## Shots (30)"), std::string::npos);
+}
+
+// The same report from the JSONL file as from the records; bad files are one
+// FILE:LINE: error: line.
+TEST(Explain, FromTheJsonlFile) {
+  const Traced& r = icemanVsFig92();
+  const std::string path = ::testing::TempDir() + "explain_test.jsonl";
+  {
+    tools::JsonlSink sink(path);
+    for (const auto& e : r.entries) sink.write(e);
+    sink.close();
+  }
+  EXPECT_EQ(ex::text(ex::explainFile(path)), ex::text(r.report));
+  EXPECT_EQ(ex::json(ex::explainFile(path)), ex::json(r.report));
+  const auto onlyB = ex::onlyRobot(r.report, 1);
+  EXPECT_TRUE(onlyB.shots.empty());
+  EXPECT_TRUE(onlyB.stalls.empty() || onlyB.stalls[0].robot == 1);
+
+  const std::string bad = ::testing::TempDir() + "explain_bad.jsonl";
+  {
+    std::ofstream out(bad);
+    out << tools::traceLine(r.entries[0]) << "\n{\"type\": \"sample\"\n";
+  }
+  try {
+    ex::explainFile(bad);
+    FAIL() << "a malformed trace must be an error";
+  } catch (const tools::ToolError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(bad + ":2: error: ", 0), 0u) << e.what();
+  }
+  std::remove(path.c_str());
+  std::remove(bad.c_str());
+}
+
+// A send that restarts the previous one: the first frame never latches.
+TEST(Explain, OverwrittenSend) {
+  const std::string source =
+      "#include \"serial.lib\"\n"
+      "char buf[9];\n"
+      "char cc;\n"
+      "main()\n"
+      "{\n"
+      "int i;\n"
+      "  ser_init_z1(0, 9600/1200);\n"
+      "  for (i = 0; i < 5000; i++);\n"
+      "  outport(ENB485, 1);\n"
+      "  strcpy(buf, \"cfgrcfgr\");\n"
+      "  cc = sizeof(buf);\n"
+      "  ser_send_z1(buf, &cc);\n"
+      "  strcpy(buf, \"8fgr8rgr\");\n"
+      "  cc = sizeof(buf);\n"
+      "  ser_send_z1(buf, &cc);\n"
+      "}\n";
+  scheduler::MatchConfig c;
+  c.arena =
+      plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/thesis-1997.toml"), 1);
+  c.robots.push_back({"A", "twice.dc", testkit::compileOrDie(source)});
+  c.endTick = static_cast<scheduler::Tick>(0.5 * kTps);
+  const Traced r = run(c);
+  const auto sends = r.all<rec::SerialSend>(0);
+  const auto latched = r.all<rec::FrameLatched>(0);
+  ASSERT_EQ(sends.size(), 2u);
+  // Only the second frame reaches the controller.
+  ASSERT_EQ(latched.size(), 1u);
+  EXPECT_EQ(latched[0].second.bytes, "8fgr8rgr");
+  ASSERT_EQ(r.report.overwritten.size(), 1u);
+  const auto& o = r.report.overwritten[0];
+  EXPECT_EQ(o.t, sends[1].first);
+  EXPECT_EQ(o.previous_t, sends[0].first);
+  EXPECT_EQ(o.previous_count, 9);
+  EXPECT_LT(o.previous_bytes_fetched, 9);
+  EXPECT_EQ(o.function, "main");
+  // Solo: no opponent, so no range, no stall.
+  EXPECT_TRUE(r.report.stalls.empty());
+}
+
+// An injected edge runs ICEMAN's handler: its run is acceptance to RETI,
+// with the frames latched in between.
+TEST(Explain, HandlerRunFromAnInjectedEdge) {
+  auto c = config({SIMBOT_SHARED_DIR "/programs/iceman.dc"}, 12);
+  c.injections.push_back(scheduler::parseInjection("A:edge_fore@5s", 1));
+  const Traced r = run(c);
+  const auto accepted = r.all<rec::InterruptAccepted>(0);
+  const auto returned = r.all<rec::InterruptReturned>(0);
+  ASSERT_FALSE(accepted.empty());
+  ASSERT_FALSE(returned.empty());
+  ASSERT_FALSE(r.report.handler_runs.empty());
+  const ex::HandlerRun& h = r.report.handler_runs[0];
+  EXPECT_EQ(h.from, accepted[0].first);
+  ASSERT_TRUE(h.to);
+  EXPECT_EQ(*h.to, returned[0].first);
+  EXPECT_EQ(h.handler, accepted[0].second.handler);
+  std::vector<std::string> frames;
+  for (const auto& [t, f] : r.all<rec::FrameLatched>(0))
+    if (t >= h.from && t <= *h.to) frames.push_back(f.bytes);
+  EXPECT_EQ(h.frames, frames);
+  EXPECT_FALSE(frames.empty());
+  ASSERT_FALSE(r.report.handler_totals.empty());
+  EXPECT_EQ(r.report.handler_totals[0].total, *h.to - h.from);
+}
+
+}  // namespace
