@@ -1,7 +1,8 @@
-// Diagnostic::format: the one place that knows the tool contract's error
-// layout, "FILE:LINE:COL: error: MESSAGE", the source line, and a caret under
-// column COL. Tabs before the column are copied so the caret lines up in any
-// terminal whatever its tab width. Long lines are cut around the column.
+// Diagnostic::format: the one place that knows the tool contract's layout,
+// "FILE:LINE:COL: error: MESSAGE" (or "warning: MESSAGE [-WNAME]"), the source
+// line, and a caret under column COL. Tabs before the column are copied so
+// the caret lines up in any terminal whatever its tab width. Long lines are
+// cut around the column. Also the list of warning names and the collector.
 #include "compiler/diagnostics.h"
 
 #include <fmt/format.h>
