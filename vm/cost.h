@@ -1,6 +1,7 @@
 // The cycle model: every opcode and library call costs the T-states of the
 // Z180 sequence written beside it (opcodes.def, builtins.def), summed here at
-// compile time from the Z180 timings in z180.def, plus memory wait states.
+// compile time from the Z180 timings in z180.def, plus wait states and DRAM
+// refresh.
 // Calibration may move only the knobs in CostKnobs; nothing depends on a
 // program's text.
 #pragma once
@@ -16,57 +17,140 @@ struct Z180Insn {
   std::string_view mnemonic;
   int tstates;
   int memCycles;
+  int ioCycles;
+  // Conditional branches (Z180_BRANCH): tstates/memCycles above are the
+  // not-taken figures, these the taken ones.
+  bool branch;
+  int takenTstates;
+  int takenMemCycles;
 };
 
 inline constexpr Z180Insn kZ180[] = {
-#define Z180_INSN(m, t, mc) {m, t, mc},
+#define Z180_INSN(m, t, mc, io) {m, t, mc, io, false, t, mc},
+#define Z180_BRANCH(m, nt, nmc, tt, tmc) {m, nt, nmc, 0, true, tt, tmc},
 #include "z180.def"
+#undef Z180_BRANCH
 #undef Z180_INSN
 };
 
 struct SeqCost {
   int tstates = 0;
   int memCycles = 0;
+  int ioCycles = 0;
   int insns = 0;
+  int branches = 0;  // conditional branches in the sequence
 };
 
-// Sum of a "MNEMONIC; MNEMONIC; ..." sequence. An unknown mnemonic is a
-// compile-time error (the throw is not a constant expression).
-constexpr SeqCost sequenceCost(std::string_view seq) {
+// Branches. A sequence is the code as emitted; a conditional branch in it
+// (JP cc,nn or JR cc,e) costs the Z180's taken or not-taken figure by the
+// way it goes, and the instructions it jumps over when taken are written
+// in brackets right after it: "LD rr,nn; JR cc,e; [INC rr]" runs INC HL
+// only when JR falls through. `taken` has bit k set when the k-th branch
+// of the sequence is taken; the VM picks the bits from the operands
+// (vm.cpp) and charges the difference from the all-not-taken figure.
+//
+// Sum of a "MNEMONIC; MNEMONIC; ..." sequence along the path `taken`. An
+// unknown mnemonic or a stray bracket is a compile-time error (the throw is
+// not a constant expression).
+constexpr SeqCost sequenceCost(std::string_view seq, unsigned taken = 0) {
   SeqCost total;
+  bool skipping = false;      // inside a bracket group jumped over
+  bool inGroup = false;       // inside a bracket group
+  bool groupAllowed = false;  // the previous item was a branch
   while (!seq.empty()) {
     auto end = seq.find(';');
     auto item = seq.substr(0, end);
     while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
     while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
     if (!item.empty()) {
+      bool closes = false;
+      if (item.front() == '[') {
+        if (!groupAllowed || inGroup) throw "a bracket group must follow a conditional branch";
+        item.remove_prefix(1);
+        inGroup = true;
+      } else if (!inGroup) {
+        skipping = false;
+      }
+      if (!item.empty() && item.back() == ']') {
+        if (!inGroup) throw "unbalanced bracket in cost sequence";
+        item.remove_suffix(1);
+        closes = true;
+      }
+      groupAllowed = false;
       bool found = false;
       for (const auto& z : kZ180) {
-        if (z.mnemonic == item) {
+        if (z.mnemonic != item) continue;
+        found = true;
+        if (skipping) break;
+        if (z.branch) {
+          if (inGroup) throw "a branch inside a bracket group is not supported";
+          const bool isTaken = (taken >> total.branches) & 1u;
+          total.tstates += isTaken ? z.takenTstates : z.tstates;
+          total.memCycles += isTaken ? z.takenMemCycles : z.memCycles;
+          ++total.branches;
+          groupAllowed = true;
+          skipping = isTaken;  // applies to the bracket group that follows
+        } else {
           total.tstates += z.tstates;
           total.memCycles += z.memCycles;
-          ++total.insns;
-          found = true;
-          break;
+          total.ioCycles += z.ioCycles;
         }
+        ++total.insns;
+        break;
       }
       if (!found) throw "unknown Z180 mnemonic in cost sequence";
+      if (closes) {
+        inGroup = false;
+        skipping = false;
+      }
     }
     if (end == std::string_view::npos) break;
     seq.remove_prefix(end + 1);
   }
+  if (inGroup) throw "unbalanced bracket in cost sequence";
   return total;
 }
 
-inline constexpr auto kOpSeqCost = [] {
-  std::array<SeqCost, kOpCount> a{};
-  for (int i = 0; i < kOpCount; ++i) a[i] = sequenceCost(kOpInfo[i].z180);
+// Paths through an opcode's sequence: at most two branches, so four paths.
+inline constexpr int kMaxOpBranches = 2;
+inline constexpr int kOpPaths = 1 << kMaxOpBranches;
+
+inline constexpr auto kOpPathCost = [] {
+  std::array<std::array<SeqCost, kOpPaths>, kOpCount> a{};
+  for (int i = 0; i < kOpCount; ++i) {
+    for (unsigned p = 0; p < kOpPaths; ++p) a[i][p] = sequenceCost(kOpInfo[i].z180, p);
+    if (a[i][0].branches > kMaxOpBranches) throw "an opcode with more than two branches";
+  }
   return a;
 }();
 
+// All branches not taken: what the VM charges when an instruction starts.
+inline constexpr auto kOpSeqCost = [] {
+  std::array<SeqCost, kOpCount> a{};
+  for (int i = 0; i < kOpCount; ++i) a[i] = kOpPathCost[i][0];
+  return a;
+}();
+
+// Library call sequences are charged whole when the call starts, so every
+// path through one must cost the same (ser_*'s "JP PO; [EI]": 9 taken,
+// 6 + 3 not taken). Checked here at compile time.
+constexpr bool pathsCostTheSame(std::string_view seq) {
+  const SeqCost first = sequenceCost(seq, 0);
+  for (unsigned p = 1; p < (1u << first.branches); ++p) {
+    const SeqCost other = sequenceCost(seq, p);
+    if (other.tstates != first.tstates || other.memCycles != first.memCycles ||
+        other.ioCycles != first.ioCycles)
+      return false;
+  }
+  return true;
+}
+
 inline constexpr auto kLibCallCost = [] {
   std::array<SeqCost, kLibCount> a{};
-  for (int i = 0; i < kLibCount; ++i) a[i] = sequenceCost(kLibInfo[i].callSeq);
+  for (int i = 0; i < kLibCount; ++i) {
+    if (!pathsCostTheSame(kLibInfo[i].callSeq)) throw "library call paths differ in cost";
+    a[i] = sequenceCost(kLibInfo[i].callSeq);
+  }
   return a;
 }();
 
@@ -76,13 +160,39 @@ inline constexpr auto kLibStepCost = [] {
   return a;
 }();
 
-// The only numbers calibration may move (README, "Cycle model").
+// A library call whose sequence saves the interrupt state and disables
+// interrupts (the serial library's "LD A,I; PUSH AF; DI ... POP AF; JP PO;
+// EI") is atomic: no instruction boundary inside it (DESIGN.md,
+// "Interrupts").
+inline constexpr auto kLibAtomic = [] {
+  std::array<bool, kLibCount> a{};
+  for (int i = 0; i < kLibCount; ++i)
+    a[i] = kLibInfo[i].callSeq.find("LD A,I; PUSH rr; DI;") != std::string_view::npos;
+  return a;
+}();
+
+// The RST 28h debug hook's body, run at every statement of a debug build
+// (the RST itself is in the DBG opcode's sequence): PUSH AF; LD A,(nn);
+// OR A; JR NZ,to_debugger (not taken: no debugger is attached); POP AF; RET.
+inline constexpr std::string_view kDebugHookSeq = "PUSH rr; LD A,(nn); OR r; JR cc,e; POP rr; RET";
+// What RET adds for a #class auto frame (the frame ENTER set up).
+inline constexpr std::string_view kAutoFrameRetSeq = "POP IX";
+
+// The only numbers calibration may move (README, "Cycle model"); each has a
+// hardware meaning and a hardware range, checked by makeCostTable.
 struct CostKnobs {
-  // Extra T-states per memory cycle (Z180 DCNTL MWI bits: 0..3).
+  // Extra T-states per memory cycle (Z180 DCNTL MWI bits: 0..3; the chip
+  // resets to 3).
   int memWaitStates = 0;
-  // Body of the RST 28h debug hook run at each statement of a debug build
-  // (the RST itself is in the DBG opcode's sequence).
-  int debugHookTstates = 0;
+  // Extra T-states per I/O cycle (Z180 DCNTL IWI bits: 1..4; the chip
+  // resets to 4).
+  int ioWaitStates = 1;
+  // DRAM refresh (Z180 RCR): 0 = off, else a refresh cycle of 2 or 3
+  // T-states (REFW) every refreshInterval T-states (CYC: 10, 20, 40, 80).
+  // The chip resets to 3 every 10. Charged as an average stretch of every
+  // CPU sequence, rounded per instruction.
+  int refreshTstates = 0;
+  int refreshInterval = 80;
   // A/D conversion time inside ad_rd8, from start of conversion to result.
   int adConversionTstates = 0;
   // Serial library's transmit-interrupt service body per byte (after the
@@ -99,6 +209,10 @@ struct CostTable {
   std::array<uint32_t, kOpCount> op{};
   std::array<uint32_t, kLibCount> libCall{};
   std::array<uint32_t, kLibCount> libStep{};
+  // Added to op[] when the instruction's branches go the way `path` says
+  // (bit k: k-th branch taken); path 0 is 0 (op[] is the not-taken path).
+  std::array<std::array<int32_t, kOpPaths>, kOpCount> branchDelta{};
+  uint32_t autoFrameRet = 0;     // RET of a frame that ran ENTER: POP IX
   uint32_t interruptAccept = 0;  // IM2 acknowledge + handler register saves
   uint32_t serialIsr = 0;        // acceptance + library ISR body
   uint32_t adConversion = 0;
@@ -106,6 +220,7 @@ struct CostTable {
   CostKnobs knobs;
 };
 
+// Throws std::invalid_argument when a knob is outside its hardware range.
 CostTable makeCostTable(const CostKnobs& knobs);
 
 // The knobs' calibrated values (README states the prediction before them).

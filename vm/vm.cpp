@@ -77,6 +77,7 @@ struct CallFrame {
   uint32_t retPc;
   uint32_t msp;
   uint32_t mfp;
+  bool autoFrame = false;  // ENTER ran: RET also pops IX
 };
 
 struct InterruptFrame {
@@ -388,7 +389,11 @@ void Vm::State::libCall(Lib id, int argc, uint32_t instructionPc) {
   lib.remaining = 0;
   lib.result = 0;
   const uint32_t callCost = costs.libCall[static_cast<int>(id)];
-  const uint32_t first = std::min(kMaxStepTstates, callCost);
+  // An atomic call (the serial library's DI ... restore idiom) runs its
+  // whole sequence with no boundary inside; its effect happens at the next
+  // boundary, before any interrupt can be accepted there.
+  const uint32_t first =
+      kLibAtomic[static_cast<int>(id)] ? callCost : std::min(kMaxStepTstates, callCost);
   now += first;
   if (profiling) profile[instructionPc] += first;
   lib.setup = callCost - first;
@@ -420,9 +425,9 @@ void Vm::State::libBegin() {
       busTouched = true;
       return;
     case Lib::SER_INIT_Z1:
+      // The routine restores the caller's interrupt state (JP PO; EI): IFF1
+      // is as it was before the call.
       bus.serialInit(now, asInt16(a[0]), asInt16(a[1]));
-      if (!iff1) bus.iffChanged(now, true);
-      iff1 = iff2 = true;  // the routine ends with EI
       busTouched = true;
       return;
     case Lib::SER_SEND_Z1:
@@ -599,6 +604,7 @@ Stop Vm::State::run(Tick until) {
     }
     if (now >= until) return halted ? Stop::Halted : Stop::Horizon;
     if (lib.awaitingBegin) {  // the end of a library call's sequence: no boundary
+      // (for an atomic call this also keeps interrupts out until its effect)
       libBegin();
       continue;
     }
@@ -665,6 +671,37 @@ Stop Vm::State::run(Tick until) {
     const uint32_t a = TOP;  \
     TOP = (expr);            \
   }                          \
+  NEXT
+      // The instruction's branches went the way `path` says (bit k: k-th
+      // branch taken): charge the difference from the not-taken figure.
+#define BRANCH_COST(path)                                                       \
+  {                                                                             \
+    const int32_t d = costs.branchDelta[op][(path)];                            \
+    now += d;                                                                   \
+    if constexpr (kProfile) profile[opPc] += static_cast<uint64_t>(int64_t{d}); \
+  }
+      // A comparison that materialises 0/1: its one branch is taken when the
+      // result is 0 (it jumps over INC HL).
+#define COMPARE(expr)                \
+  {                                  \
+    const uint32_t b = POPV;         \
+    const uint32_t a = TOP;          \
+    TOP = (expr) ? 1u : 0u;          \
+    BRANCH_COST(TOP == 0 ? 1u : 0u); \
+  }                                  \
+  NEXT
+      // Signed: first branch (JP PO) taken when the subtraction HL - DE did
+      // not overflow (it jumps over the sign correction), second taken when
+      // the result is 0.
+#define SIGNED_COMPARE(expr, hl, de)                                  \
+  {                                                                   \
+    const uint32_t b = POPV;                                          \
+    const uint32_t a = TOP;                                           \
+    const int32_t diff = int32_t{asInt16(hl)} - int32_t{asInt16(de)}; \
+    const bool overflow = diff < -32768 || diff > 32767;              \
+    TOP = (expr) ? 1u : 0u;                                           \
+    BRANCH_COST((overflow ? 0u : 1u) | (TOP == 0 ? 2u : 0u));         \
+  }                                                                   \
   NEXT
 #if SIMBOT_COMPUTED_GOTO
       goto* kLabels[op];
@@ -831,20 +868,24 @@ Stop Vm::State::run(Tick until) {
       NEXT;
       CASE(NOTW) TOP = ~TOP & 0xFFFF;
       NEXT;
-      CASE(LNOTW) TOP = (TOP & 0xFFFF) == 0;
+      CASE(LNOTW) {
+        TOP = (TOP & 0xFFFF) == 0;
+        BRANCH_COST(TOP == 0 ? 1u : 0u);
+      }
       NEXT;
       CASE(W2B) TOP &= 0xFF;
       NEXT;
-      CASE(EQW) BINARY((a & 0xFFFF) == (b & 0xFFFF));
-      CASE(NEW) BINARY((a & 0xFFFF) != (b & 0xFFFF));
-      CASE(LTW) BINARY(asInt16(a) < asInt16(b));
-      CASE(LEW) BINARY(asInt16(a) <= asInt16(b));
-      CASE(GTW) BINARY(asInt16(a) > asInt16(b));
-      CASE(GEW) BINARY(asInt16(a) >= asInt16(b));
-      CASE(LTUW) BINARY((a & 0xFFFF) < (b & 0xFFFF));
-      CASE(LEUW) BINARY((a & 0xFFFF) <= (b & 0xFFFF));
-      CASE(GTUW) BINARY((a & 0xFFFF) > (b & 0xFFFF));
-      CASE(GEUW) BINARY((a & 0xFFFF) >= (b & 0xFFFF));
+      CASE(EQW) COMPARE((a & 0xFFFF) == (b & 0xFFFF));
+      CASE(NEW) COMPARE((a & 0xFFFF) != (b & 0xFFFF));
+      // LTW and GEW compute a - b (EX DE,HL first); LEW and GTW b - a.
+      CASE(LTW) SIGNED_COMPARE(asInt16(a) < asInt16(b), a, b);
+      CASE(LEW) SIGNED_COMPARE(asInt16(a) <= asInt16(b), b, a);
+      CASE(GTW) SIGNED_COMPARE(asInt16(a) > asInt16(b), b, a);
+      CASE(GEW) SIGNED_COMPARE(asInt16(a) >= asInt16(b), a, b);
+      CASE(LTUW) COMPARE((a & 0xFFFF) < (b & 0xFFFF));
+      CASE(LEUW) COMPARE((a & 0xFFFF) <= (b & 0xFFFF));
+      CASE(GTUW) COMPARE((a & 0xFFFF) > (b & 0xFFFF));
+      CASE(GEUW) COMPARE((a & 0xFFFF) >= (b & 0xFFFF));
 
       CASE(ADDL) BINARY(a + b);
       CASE(SUBL) BINARY(a - b);
@@ -896,7 +937,10 @@ Stop Vm::State::run(Tick until) {
       NEXT;
       CASE(NOTL) TOP = ~TOP;
       NEXT;
-      CASE(TESTL) TOP = TOP != 0;
+      CASE(TESTL) {
+        TOP = TOP != 0;
+        BRANCH_COST(TOP == 0 ? 1u : 0u);
+      }
       NEXT;
       CASE(EQL) BINARY(a == b);
       CASE(NEL) BINARY(a != b);
@@ -961,13 +1005,17 @@ Stop Vm::State::run(Tick until) {
       CASE(JZ) {
         const uint32_t target =
             static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
-        if ((POPV & 0xFFFF) == 0) pc = target;
+        const bool taken = (POPV & 0xFFFF) == 0;
+        BRANCH_COST(taken ? 1u : 0u);
+        if (taken) pc = target;
       }
       NEXT;
       CASE(JNZ) {
         const uint32_t target =
             static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
-        if ((POPV & 0xFFFF) != 0) pc = target;
+        const bool taken = (POPV & 0xFFFF) != 0;
+        BRANCH_COST(taken ? 1u : 0u);
+        if (taken) pc = target;
       }
       NEXT;
       CASE(CALL) {
@@ -979,7 +1027,7 @@ Stop Vm::State::run(Tick until) {
           raiseFault("stack overflow (expression stack)", opPc);
           NEXT;
         }
-        calls.push_back(CallFrame{pc, msp, mfp});
+        calls.push_back(CallFrame{pc, msp, mfp, false});
         msp -= kCallFrameBytes;
         pc = u16();
       }
@@ -992,6 +1040,11 @@ Stop Vm::State::run(Tick until) {
         }
         msp -= size;
         mfp = msp;
+        // The frame now holds the caller's IX (ENTER's PUSH IX): its RET
+        // pops it. (ENTER in main or in a handler has no CallFrame of its
+        // own; a handler's RETI restores IX anyway.)
+        if (static_cast<int>(calls.size()) > (ints.empty() ? 0 : ints.back().callDepth))
+          calls.back().autoFrame = true;
       }
       NEXT;
       CASE(RET) {
@@ -1002,6 +1055,10 @@ Stop Vm::State::run(Tick until) {
         }
         const CallFrame f = calls.back();
         calls.pop_back();
+        if (f.autoFrame) {  // POP IX: only #class auto frames set IX up
+          now += costs.autoFrameRet;
+          if constexpr (kProfile) profile[opPc] += costs.autoFrameRet;
+        }
         pc = f.retPc;
         msp = f.msp;
         mfp = f.mfp;
@@ -1069,6 +1126,9 @@ Stop Vm::State::run(Tick until) {
 #undef POPV
 #undef PUSHV
 #undef BINARY
+#undef BRANCH_COST
+#undef COMPARE
+#undef SIGNED_COMPARE
   }
 }
 #undef CASE

@@ -13,7 +13,9 @@
 // and the compiler's epilogue sets IFF1 again unless the knob drops it.
 // Pending requests are taken in priority order Pio, SerialTx, Timer. Long
 // library calls run as steps of <= 100 T-states with a boundary between
-// steps; a handler accepted there resumes the call when it returns.
+// steps; a handler accepted there resumes the call when it returns. The
+// serial library's calls are atomic (cost.h kLibAtomic): no boundary inside
+// them, and IFF1 after them is what it was before.
 #pragma once
 #include <array>
 #include <cstdint>
