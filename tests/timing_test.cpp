@@ -3,6 +3,8 @@
 // the middle of a delay loop or of a long library call.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -54,7 +56,15 @@ uint32_t returnAddressOfFirstCall(const vm::Image& img, const vm::Symbol& caller
 
 double seconds(Tick t) { return static_cast<double>(t) / vm::kTicksPerSecond; }
 
-TEST(IcemanTiming, FiveHundredSlowSpinPassesTakeAboutTenSeconds) {
+struct IcemanRun {
+  Tick searchTicks = 0;  // the first search()
+  Tick lostTicks = 0;    // first search()'s return to the next entry
+  int passes = 0;        // slow-spin passes in between
+  size_t sends = 0;
+  bool faulted = false;
+};
+
+IcemanRun runIceman(const vm::CostTable& table) {
   const auto img =
       testkit::compileOrDie(readFile(SIMBOT_SHARED_DIR "/programs/iceman.dc"), "iceman.dc");
   const auto& search = testkit::symbol(img, "search");
@@ -63,40 +73,95 @@ TEST(IcemanTiming, FiveHundredSlowSpinPassesTakeAboutTenSeconds) {
   const uint32_t slowSpinPass = firstAddressOfLine(img, lineContaining(img, "cnt++;"));
 
   TestHost host;  // both eyes read the background value 16
-  vm::Vm v(img, host, costs());
+  vm::Vm v(img, host, table);
   v.setBreakpoint(search.address);
   v.setBreakpoint(afterFirstSearch);
   v.setBreakpoint(slowSpinPass);
   std::vector<Tick> entries;
   Tick firstReturn = -1;
-  int passes = 0;
+  IcemanRun r;
   while (entries.size() < 2) {
     const Stop stop = host.runUntil(v, 120 * vm::kTicksPerSecond);
-    ASSERT_EQ(stop, Stop::Breakpoint) << "ICEMAN did not re-enter search() within 120 s";
+    if (stop != Stop::Breakpoint) {
+      ADD_FAILURE() << "ICEMAN did not re-enter search() within 120 s";
+      return r;
+    }
     if (v.pc() == search.address) entries.push_back(v.now());
     if (v.pc() == afterFirstSearch && firstReturn < 0) firstReturn = v.now();
-    if (v.pc() == slowSpinPass && firstReturn >= 0) ++passes;
+    if (v.pc() == slowSpinPass && firstReturn >= 0) ++r.passes;
   }
-  ASSERT_GE(firstReturn, 0);
-  const double searchSeconds = seconds(firstReturn - entries[0]);
-  const double lostSeconds = seconds(entries[1] - firstReturn);
+  r.searchTicks = firstReturn - entries[0];
+  r.lostTicks = entries[1] - firstReturn;
+  r.sends = host.sends.size();
+  r.faulted = v.fault() != nullptr;
+  return r;
+}
+
+TEST(IcemanTiming, FiveHundredSlowSpinPassesTakeAboutTenSeconds) {
+  const IcemanRun r = runIceman(costs());
+  const double searchSeconds = seconds(r.searchTicks);
+  const double lostSeconds = seconds(r.lostTicks);
   std::cout << "[ ICEMAN ] first search(): " << searchSeconds
-            << " s; 500 slow-spin passes: " << lostSeconds << " s (" << (entries[1] - firstReturn)
+            << " s; 500 slow-spin passes: " << lostSeconds << " s (" << r.lostTicks
             << " ticks); per pass " << lostSeconds / 500 * 1000
-            << " ms; motor strings sent: " << host.sends.size() << "\n";
+            << " ms; motor strings sent: " << r.sends << "\n";
   RecordProperty("search_seconds", std::to_string(searchSeconds));
   RecordProperty("lost_seconds", std::to_string(lostSeconds));
-  EXPECT_EQ(passes, 500);
+  EXPECT_EQ(r.passes, 500);
   EXPECT_GE(lostSeconds, 8.0);
   EXPECT_LE(lostSeconds, 12.0);
-  EXPECT_EQ(v.fault(), nullptr);
+  EXPECT_FALSE(r.faulted);
+}
+
+// The calibration (README, "The cycle model"): ICEMAN's 500-pass time under
+// every hardware setting of the knobs calibration may move, DCNTL's memory
+// (0-3) and I/O (1-4) wait states and RCR's DRAM refresh (off, or 2 or 3
+// T-states every 10/20/40/80). The calibrated knobs must be the setting
+// nearest 10 s; the table printed here is the README's.
+TEST(IcemanTiming, CalibratedKnobsAreTheHardwareSettingNearestTenSeconds) {
+  struct Row {
+    vm::CostKnobs knobs;
+    double seconds;
+  };
+  std::vector<Row> rows;
+  const vm::CostKnobs base = vm::calibratedKnobs();
+  for (int refresh : {0, 2, 3}) {
+    for (int interval : {10, 20, 40, 80}) {
+      if (refresh == 0 && interval != 80) continue;
+      for (int mwi = 0; mwi <= 3; ++mwi) {
+        for (int iwi = 1; iwi <= 4; ++iwi) {
+          vm::CostKnobs k = base;
+          k.memWaitStates = mwi;
+          k.ioWaitStates = iwi;
+          k.refreshTstates = refresh;
+          k.refreshInterval = interval;
+          const IcemanRun r = runIceman(vm::makeCostTable(k));
+          ASSERT_EQ(r.passes, 500);
+          rows.push_back({k, seconds(r.lostTicks)});
+          std::cout << "[ ICEMAN ] MWI " << mwi << " IWI " << iwi << " refresh "
+                    << (refresh ? std::to_string(refresh) + "/" + std::to_string(interval)
+                                : std::string("off"))
+                    << ": " << rows.back().seconds << " s\n";
+        }
+      }
+    }
+  }
+  const auto nearest = std::min_element(rows.begin(), rows.end(), [](const Row& a, const Row& b) {
+    return std::abs(a.seconds - 10.0) < std::abs(b.seconds - 10.0);
+  });
+  EXPECT_EQ(nearest->knobs.memWaitStates, base.memWaitStates);
+  EXPECT_EQ(nearest->knobs.ioWaitStates, base.ioWaitStates);
+  EXPECT_EQ(nearest->knobs.refreshTstates, base.refreshTstates);
+  if (base.refreshTstates != 0) {
+    EXPECT_EQ(nearest->knobs.refreshInterval, base.refreshInterval);
+  }
 }
 
 // Simulated time from start to the return of main.
-Tick runToHalt(const std::string& source) {
+Tick runToHalt(const std::string& source, const vm::CostTable& table = costs()) {
   const auto img = testkit::compileOrDie(source);
   TestHost host;
-  vm::Vm v(img, host, costs());
+  vm::Vm v(img, host, table);
   v.setBreakpoint(img.entry + vm::instructionSize(vm::Op::CALL));  // main returned
   EXPECT_EQ(v.run(1000 * vm::kTicksPerSecond), Stop::Breakpoint);
   return v.now();
@@ -116,6 +181,33 @@ TEST(DelayLoop, TwiceThePassesTakeTwiceTheTime) {
     // Delay loops are executed exactly: the per-pass cost is a whole number.
     EXPECT_EQ((twoN - n) % 5000, 0) << type;
   }
+}
+
+// One pass of `for(z=0;z<700;z++);` from the disassembly (simbot compile
+// --disasm): LDGW z; PUSHW 700; LTW; JZ out; DBG; INCGW z; JMP back.
+// With no wait states and no refresh (the Z180 table):
+//   LDGW   PUSH HL 11; LD HL,(nn) 15                                   26
+//   PUSHW  PUSH HL 11; LD HL,nn 9                                      20
+//   LTW    POP 9; EX 3; OR 4; SBC 10; LD HL,0 9; JP PO taken (no
+//          overflow) 9; JP P not taken (z < 700) 6; INC HL 4           54
+//   JZ     LD A,L 4; OR H 4; POP HL 9; JP Z not taken 6                23
+//   DBG    RST 28h 11; hook PUSH AF 11; LD A,(nn) 12; OR A 4;
+//          JR NZ not taken 6; POP AF 9; RET 9                          62
+//   INCGW  LD HL,(nn) 15; INC HL 4; LD (nn),HL 16                      35
+//   JMP    JP nn 9                                                      9
+//                                                                     229
+// Calibrated (refresh 2 T-states every 20: +10 %, rounded per sequence):
+// LDGW 29, PUSHW 22, LTW 59 (its not-taken path 55 -> 61, less the
+// branches' 2), JZ 25, DBG 12 + 56, INCGW 39, JMP 10 = 252.
+TEST(DelayLoop, PassCostIsTheSumOfItsSequences) {
+  const auto plain = vm::makeCostTable(vm::uncalibratedKnobs());
+  auto perPass = [](const vm::CostTable& table) {
+    return (runToHalt(delayProgram("int", 1700), table) -
+            runToHalt(delayProgram("int", 700), table)) /
+           1000;
+  };
+  EXPECT_EQ(perPass(plain), 26 + 20 + 54 + 23 + 62 + 35 + 9);
+  EXPECT_EQ(perPass(costs()), 29 + 22 + 59 + 25 + 68 + 39 + 10);
 }
 
 const char* kLoopWithHandler = R"(#INT_VEC PIOA_VEC edge
@@ -181,6 +273,11 @@ TEST(InterruptTiming, RequestMidDelayLoopLandsOnNextBoundaryAndLoopResumes) {
   ASSERT_EQ(v.pc(), mainReturn);
   ASSERT_EQ(host.events.size(), 2u);
   const Tick handlerTime = host.events[1].tick - accepted;  // acceptance to end of RETI
+  // By hand, calibrated (refresh 2 every 20, rounded per sequence):
+  // acceptance INTACK 19 + 4 x PUSH 11 + 2 x PUSH IX 14 = 91 -> 100;
+  // DBG 68; LDGW z 29; STGW seen (LD (nn),HL 16; POP 9 = 25) 28; DBG 68;
+  // INCGW hits 39; RETI (POP IX x 2 24, POP x 4 36, EI 3, RETI 12 = 75) 83.
+  EXPECT_EQ(handlerTime, 100 + 68 + 29 + 28 + 68 + 39 + 83);
   EXPECT_EQ(v.now(), plainTime + handlerTime);
   EXPECT_EQ(v.read16(zAddress), 1000);
   EXPECT_EQ(v.read16(static_cast<uint16_t>(testkit::symbol(img, "hits").address)), 1);

@@ -37,6 +37,104 @@ TEST(Vm, ChargesEachInstructionItsCost) {
   EXPECT_EQ(v.now(), 1'000'000);
 }
 
+// The ticks from the start to the breakpoint at `stopAt`, on a table with
+// no wait states and no refresh, so that the figures are the Z180 table's.
+vm::Tick ticksTo(Assembler& a, uint32_t stopAt) {
+  static const vm::CostTable plain = vm::makeCostTable(vm::uncalibratedKnobs());
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, plain);
+  v.setBreakpoint(stopAt);
+  EXPECT_EQ(v.run(1'000'000), Stop::Breakpoint);
+  return v.now();
+}
+
+TEST(Vm, ChargesEachInstructionTheZ180SumOfItsSequence) {
+  // PUSHW: PUSH HL 11; LD HL,nn 9 = 20. POP: POP HL 9. INCGW: LD HL,(nn) 15;
+  // INC HL 4; LD (nn),HL 16 = 35. DBG: RST 28h 11 + hook 51 = 62.
+  Assembler a;
+  const uint16_t n = a.data(2);
+  a.op(Op::PUSHW, 7).op(Op::POP).op(Op::INCGW, n).op(Op::DBG).bind("end").op(Op::HALT);
+  EXPECT_EQ(ticksTo(a, a.label("end")), 20 + 9 + 35 + 62);
+}
+
+TEST(Vm, ConditionalJumpsChargeTakenOrNotTaken) {
+  // PUSHW 20, then JZ: LD A,L 4; OR H 4; POP HL 9; JP Z 9 taken / 6 not.
+  for (int value : {0, 1}) {
+    Assembler a;
+    a.op(Op::PUSHW, static_cast<uint32_t>(value)).jump(Op::JZ, "end").bind("end").op(Op::HALT);
+    EXPECT_EQ(ticksTo(a, a.label("end")), 20 + 4 + 4 + 9 + (value == 0 ? 9 : 6)) << value;
+  }
+  for (int value : {0, 1}) {
+    Assembler a;
+    a.op(Op::PUSHW, static_cast<uint32_t>(value)).jump(Op::JNZ, "end").bind("end").op(Op::HALT);
+    EXPECT_EQ(ticksTo(a, a.label("end")), 20 + 4 + 4 + 9 + (value != 0 ? 9 : 6)) << value;
+  }
+}
+
+TEST(Vm, ComparisonsChargeTheWayTheirBranchesGo) {
+  struct Case {
+    Op op;
+    uint32_t a, b;
+    int tstates;  // of the comparison alone
+  };
+  const Case cases[] = {
+      // EQW: POP 9; OR 4; SBC 10; LD HL,0 9 = 32; + JR NZ 6 + INC 4 when
+      // equal (42), + JR NZ taken 8 when not (40).
+      {Op::EQW, 5, 5, 42},
+      {Op::EQW, 5, 6, 40},
+      // LTW: POP 9; EX 3; OR 4; SBC 10; LD 9 = 35; then JP PO (9 taken when
+      // a - b does not overflow, 6 + XOR 4 when it does), JP (6 + INC 4
+      // when true, 9 when false).
+      {Op::LTW, 3, 5, 35 + 9 + 6 + 4},            // no overflow, true: 54
+      {Op::LTW, 5, 3, 35 + 9 + 9},                // no overflow, false: 53
+      {Op::LTW, 0x8000, 1, 35 + 6 + 4 + 6 + 4},   // -32768 - 1 overflows, true: 55
+      {Op::LTW, 0x7FFF, 0xFFFF, 35 + 6 + 4 + 9},  // 32767 - (-1) overflows, false: 54
+      // LTUW: POP 9; EX 3; OR 4; SBC 10; LD 9 = 35; JR NC 6 + INC 4 when
+      // true, 8 when false.
+      {Op::LTUW, 3, 5, 35 + 6 + 4},
+      {Op::LTUW, 5, 3, 35 + 8},
+  };
+  for (const auto& c : cases) {
+    Assembler a;
+    a.op(Op::PUSHW, c.a).op(Op::PUSHW, c.b).op(c.op).bind("end").op(Op::HALT);
+    EXPECT_EQ(ticksTo(a, a.label("end")), 20 + 20 + c.tstates)
+        << vm::info(c.op).name << " " << c.a << " " << c.b;
+  }
+}
+
+TEST(Vm, RetPopsIxOnlyAfterEnter) {
+  // CALL 16; RET 9 for a static-class function.
+  {
+    Assembler a;
+    a.op(Op::CALL, 4).bind("end").op(Op::HALT).bind("f").op(Op::RET);
+    ASSERT_EQ(a.label("f"), 4u);
+    EXPECT_EQ(ticksTo(a, a.label("end")), 16 + 9);
+  }
+  // #class auto: ENTER is PUSH IX 14; LD DE,nn 9; ADD IX,DE 10; LD HL,nn 9;
+  // ADD HL,SP 7; LD SP,HL 4 = 53, and RET is POP IX 12 + RET 9.
+  {
+    Assembler a;
+    a.op(Op::CALL, 4).bind("end").op(Op::HALT).bind("f").op(Op::ENTER, 2).op(Op::RET);
+    ASSERT_EQ(a.label("f"), 4u);
+    EXPECT_EQ(ticksTo(a, a.label("end")), 16 + 53 + 12 + 9);
+  }
+}
+
+TEST(Vm, LibraryCallIsChargedOneCall) {
+  // PUSHW 20 x 2, then outport's sequence alone: POP 9; POP 9; CALL 16;
+  // LD C,L 4; OUT (C),A 10 + 1 I/O wait; RET 9 = 58. The write happens at
+  // the end of the sequence.
+  Assembler a;
+  a.op(Op::PUSHW, vm::kPortPIODB).op(Op::PUSHW, 0x88).lib(vm::Lib::OUTPORT, 2).op(Op::HALT);
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, vm::makeCostTable(vm::uncalibratedKnobs()));
+  host.runUntil(v, 1000);
+  ASSERT_EQ(host.outs.size(), 1u);
+  EXPECT_EQ(host.outs[0].tick, 20 + 20 + 58);
+}
+
 TEST(Vm, RunStopsAtFirstBoundaryAtOrAfterHorizon) {
   Assembler a;
   a.bind("loop").op(Op::DBG).jump(Op::JMP, "loop");
