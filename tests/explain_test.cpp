@@ -346,7 +346,13 @@ TEST(Explain, HandlerRunFromAnInjectedEdge) {
   EXPECT_EQ(h.frames, frames);
   EXPECT_FALSE(frames.empty());
   ASSERT_FALSE(r.report.handler_totals.empty());
-  EXPECT_EQ(r.report.handler_totals[0].total, *h.to - h.from);
+  // The total is every run of the handler: within the 12 s ICEMAN may also
+  // reach the wire itself (with the issue-11 cycle model it does, at about
+  // 9 s, and that run is as long as the injected one).
+  trace::Tick total = 0;
+  for (const auto& run : r.report.handler_runs)
+    if (run.robot == 0 && run.handler == h.handler && run.to) total += *run.to - run.from;
+  EXPECT_EQ(r.report.handler_totals[0].total, total);
 }
 
 }  // namespace
