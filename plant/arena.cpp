@@ -5,7 +5,8 @@
 // stiff) integrates, per robot, x, y, heading (radians, unwrapped), the two
 // wheel ground speeds (first-order lag toward the commanded speed), a signed
 // odometer (for the bumper reflex distance) and the two gun-wheel speeds
-// (fraction of full speed, first-order spin-up/down). Balls in flight are
+// (fraction of full speed, first-order spin-up with the motor on, coast-down
+// with its own time constant with it off). Balls in flight are
 // closed forms of time (straight line at the muzzle speed, z = h - g t^2 / 2)
 // that live only in the root functions, so a launch does not grow the state.
 // A zero time constant is handled by holding that state constant in the RHS
@@ -90,6 +91,11 @@ constexpr int kRing = 16;
 // (re)initialisation; a fixed horizon keeps it independent of the caller.
 constexpr double kFirstStepHorizon = 1.0;  // s
 constexpr double kNoStopTime = 1e12;       // s, far beyond any match
+// A crossing this close after a tick (in ticks) is taken as on the tick.
+// Round-off in a root function is far smaller: an odometer of 300 ft has an
+// ulp of 6e-14 ft, top speed moves 1.6e-7 ft per tick; CVODE's root
+// tolerance (100 ulp of t) is 3e-6 tick after 3 minutes.
+constexpr double kOnTickFraction = 1.0 / 1024;
 
 enum class RootKind : std::uint8_t {
   EdgeFore,
@@ -367,12 +373,12 @@ struct Arena::Impl {
     const double above = std::max(z - P(tgt).target_height_ft, 0.0);
     return std::hypot(across, above);
   }
+  // The field walls stop a ball (DESIGN.md: a ball reaching a field wall
+  // is a miss), at the field's edge.
   double ballOutG(const Ball& b, double t) const {
     double x, yy, z;
     ballAt(b, t, x, yy, z);
-    double rmax = 0;
-    for (int i = 0; i < nR; ++i) rmax = std::max(rmax, radius(i));
-    return half + rmax - std::max(std::abs(x), std::abs(yy));
+    return half - std::max(std::abs(x), std::abs(yy));
   }
   // Signed distance past the divider's near face along the ball's x
   // travel: linear in t, so a thin wall cannot be stepped over unnoticed.
@@ -444,9 +450,19 @@ struct Arena::Impl {
       d[VR] = p.motor_lag_s > 0 ? (wt[1] - r[VR]) / p.motor_lag_s : 0.0;
       d[S] = v;
       const auto& gt = gunTarget[static_cast<std::size_t>(i)];
-      d[G1] = p.gun_wheel_lag_s > 0 ? (gt[0] - r[G1]) / p.gun_wheel_lag_s : 0.0;
-      d[G2] = p.gun_wheel_lag_s > 0 ? (gt[1] - r[G2]) / p.gun_wheel_lag_s : 0.0;
+      for (int g = 0; g < 2; ++g) {
+        const double target = gt[static_cast<std::size_t>(g)];
+        const double tau = gunTau(p, target);
+        d[G1 + g] = tau > 0 ? (target - r[G1 + g]) / tau : 0.0;
+      }
     }
+  }
+
+  // A gun wheel spins up under its motor and coasts down, more slowly,
+  // when the motor is off (DESIGN.md "Guns"): the time constant follows
+  // the motor, not the direction of change.
+  static double gunTau(const RobotParams& p, double target) {
+    return target > 0 ? p.gun_wheel_lag_s : p.gun_wheel_coast_s;
   }
 
   // ------------------------------------------------------------ targets and reinit
@@ -479,9 +495,9 @@ struct Arena::Impl {
         r[VL] = wheelTarget[static_cast<std::size_t>(i)][0];
         r[VR] = wheelTarget[static_cast<std::size_t>(i)][1];
       }
-      if (p.gun_wheel_lag_s <= 0) {
-        r[G1] = gunTarget[static_cast<std::size_t>(i)][0];
-        r[G2] = gunTarget[static_cast<std::size_t>(i)][1];
+      for (int g = 0; g < 2; ++g) {
+        const double target = gunTarget[static_cast<std::size_t>(i)][static_cast<std::size_t>(g)];
+        if (gunTau(p, target) <= 0) r[G1 + g] = target;
       }
     }
   }
@@ -833,27 +849,33 @@ struct Arena::Impl {
     for (int pass = 0; pass < 3; ++pass) {
       const int* f = pass == 0 ? found : nullptr;
       contacts(T, d, y, f, ev);
-      edges(T, d, y, f, ev);
+      edges(d, y, f, ev);
       bool turned = false;
-      for (int i = 0; i < nR; ++i) {
-        RobotDisc& r = d.r[static_cast<std::size_t>(i)];
-        const std::int64_t from =
-            T - static_cast<std::int64_t>(
-                    std::llround(cfg.referee.window_s * static_cast<double>(kTicksPerSecond)));
-        if (r.reflexTicks.countSince(from) > cfg.referee.reflex_limit ||
-            r.eventTicks.countSince(from) > cfg.referee.event_limit) {
-          ys[i * kPerRobot + H] += geom::degToRad(cfg.referee.turn_deg);
-          r.reflexTicks.n = 0;
-          r.eventTicks.n = 0;
-          Event e{EventKind::RefereeTurn};
-          e.robot = static_cast<std::int8_t>(i);
-          ev.push(e);
-          turned = true;
-        }
-      }
+      for (int i = 0; i < nR; ++i) turned = refereeTurn(T, d, y, i, ev) || turned;
       if (!turned && !(moved && pass == 0)) break;
       moved = false;
     }
+  }
+
+  // Thesis VI.D auto_ref: more than reflex_limit bumper reflexes, or more
+  // than event_limit reflexes and edge-handler entries, within the window
+  // turn the robot by turn_deg and start the count again.
+  bool refereeDue(const RobotDisc& r, std::int64_t T) const {
+    const std::int64_t from = T - static_cast<std::int64_t>(std::llround(
+                                      cfg.referee.window_s * static_cast<double>(kTicksPerSecond)));
+    return r.reflexTicks.countSince(from) > cfg.referee.reflex_limit ||
+           r.eventTicks.countSince(from) > cfg.referee.event_limit;
+  }
+  bool refereeTurn(std::int64_t T, Discrete& d, std::vector<double>& y, int i, EventList& ev) {
+    RobotDisc& r = d.r[static_cast<std::size_t>(i)];
+    if (!refereeDue(r, T)) return false;
+    y[static_cast<std::size_t>(i * kPerRobot + H)] += geom::degToRad(cfg.referee.turn_deg);
+    r.reflexTicks.n = 0;
+    r.eventTicks.n = 0;
+    Event e{EventKind::RefereeTurn};
+    e.robot = static_cast<std::int8_t>(i);
+    ev.push(e);
+    return true;
   }
 
   void contacts(std::int64_t T, Discrete& d, std::vector<double>& y, const int* found,
@@ -910,7 +932,7 @@ struct Arena::Impl {
     }
   }
 
-  void edges(std::int64_t T, Discrete& d, std::vector<double>& y, const int* found, EventList& ev) {
+  void edges(Discrete& d, std::vector<double>& y, const int* found, EventList& ev) {
     for (int i = 0; i < nR; ++i) {
       RobotDisc& r = d.r[static_cast<std::size_t>(i)];
       for (int k = 0; k < 2; ++k) {
@@ -922,7 +944,8 @@ struct Arena::Impl {
         e.robot = static_cast<std::int8_t>(i);
         e.detector = k == 0 ? Detector::Fore : Detector::Aft;
         ev.push(e);
-        if (low) r.eventTicks.push(T);
+        // Not counted for the referee: a crossing counts only when the
+        // program's edge handler is entered (edgeHandlerEntered).
       }
     }
   }
@@ -959,6 +982,31 @@ struct Arena::Impl {
       for (std::int64_t lt : D.r[static_cast<std::size_t>(i)].launchTick)
         if (lt >= 0 && (best < 0 || lt < best)) best = lt;
     return best;
+  }
+
+  // DESIGN.md: an event happens at the first integer tick at which its root
+  // function has crossed. CVODE returns the right end of its root bracket,
+  // a hair past the crossing, so T0 = ceil(tret) is one tick late when the
+  // crossing falls exactly on tick T0 - 1 (a contact at constant speed, a
+  // reflex of exactly 1.5 ft at 1.5 ft/s). Decide from dense output at the
+  // two neighbouring ticks: T0 - 1 if a reported root function is already
+  // on its new side there, or within kOnTickFraction of a tick of it
+  // (linearly between the ticks), which round-off cannot tell from zero.
+  std::int64_t crossedTick(std::int64_t T0) {
+    const std::int64_t k = T0 - 1;
+    if (k <= segTick) return T0;  // the segment's first tick is not a crossing
+    const double tk = secondsFromTick(k), tT = secondsFromTick(T0);
+    evalAt(tk, tmp);
+    evalAt(tT, qtmp);
+    for (int j = 0; j < nRoots; ++j) {
+      const int dir = rootsFound[static_cast<std::size_t>(j)];
+      if (dir == 0) continue;
+      const RootDesc& rd = roots[static_cast<std::size_t>(j)];
+      const double gk = rootValue(rd, tk, tmp.data());
+      const double gT = rootValue(rd, tT, qtmp.data());
+      if (dir * gk >= 0 || std::abs(gk) <= kOnTickFraction * std::abs(gT - gk)) return k;
+    }
+    return T0;
   }
 
   // Computes the events at T (time te) from the current segment's state
@@ -1022,9 +1070,15 @@ struct Arena::Impl {
       if (flag != CV_ROOT_RETURN) continue;
       ++acc.roots;
       cv::check(CVodeGetRootInfo(mem.get(), rootsFound.data()), "CVodeGetRootInfo");
-      std::int64_t T = std::max(eventTickFromSeconds(tret), now);
+      const std::int64_t T0 = eventTickFromSeconds(tret);
+      const std::int64_t k = crossedTick(T0);
+      std::int64_t T = std::max(k, now);
       if (launchStop >= 0) T = std::min(T, launchStop);  // tret <= the stop time
-      const double te = std::max(timeOfTick(T), tret);
+      // At the tick before ceil(tret) the state is taken at tret itself (a
+      // hair later, within kOnTickFraction of a tick): it lies on the far
+      // side of the crossing, so the new segment sees the root function
+      // leave zero in the right direction.
+      const double te = T < T0 ? tret : std::max(timeOfTick(T), tret);
       if (T <= stop) {
         if (predict(T, te, rootsFound.data(), res.events)) {
           res.tick = T;
@@ -1179,6 +1233,45 @@ EventList Arena::triggerReflex(int robot, Bumper side, std::int64_t tick) {
   m.checkRobot(robot);
   m.rewindTo(tick);
   m.startReflex(m.D, m.tmp, robot, side, tick, ev);
+  m.reinit(tick, m.timeOfTick(tick), m.tmp);
+  return ev;
+}
+
+EventList Arena::edgeHandlerEntered(int robot, std::int64_t tick) {
+  Impl& m = *impl_;
+  EventList ev;
+  m.checkRobot(robot);
+  m.checkInputTick(tick);
+  if (m.pending && tick == m.pendingTick) m.commit();
+  const auto i = static_cast<std::size_t>(robot);
+  RobotDisc& r = m.D.r[i];
+  // The prediction at a later tick stays valid unless it counted events of
+  // this robot itself (its referee check there did not see this entry).
+  const bool keep = !m.pending || (m.pendingD.r[i].eventTicks.n == r.eventTicks.n &&
+                                   m.pendingD.r[i].eventTicks.t == r.eventTicks.t);
+  r.eventTicks.push(tick);
+  if (!m.refereeDue(r, tick)) {
+    if (m.pending) {
+      if (keep) {
+        m.pendingD.r[i].eventTicks.push(tick);
+      } else {
+        m.rewindTo(tick);
+        m.reinit(tick, m.timeOfTick(tick), m.tmp);
+      }
+    }
+    return ev;
+  }
+  m.rewindTo(tick);
+  m.refereeTurn(tick, m.D, m.tmp, robot, ev);
+  // The turn moves the robot: contacts and edges are reconciled after it,
+  // as after a turn at a plant event (process()).
+  for (int pass = 0; pass < 3; ++pass) {
+    m.contacts(tick, m.D, m.tmp, nullptr, ev);
+    m.edges(m.D, m.tmp, nullptr, ev);
+    bool turned = false;
+    for (int j = 0; j < m.nR; ++j) turned = m.refereeTurn(tick, m.D, m.tmp, j, ev) || turned;
+    if (!turned) break;
+  }
   m.reinit(tick, m.timeOfTick(tick), m.tmp);
   return ev;
 }

@@ -65,7 +65,8 @@ struct RobotParams {
   double bad_reading_probability = 0;  // reading replaced by a random A/D value
   bool thesis_swapped_eyes = false;    // Appendix C: far eye gets the full value
   // guns
-  double gun_wheel_lag_s = 0;         // first-order spin-up/down; 0 = instant
+  double gun_wheel_lag_s = 0;         // first-order spin-up, motor on; 0 = instant
+  double gun_wheel_coast_s = 0;       // first-order coast-down, motor off; 0 = instant
   bool gun_motors_always_on = false;  // thesis Appendix E: port B motor bits ignored
   double stroke_s = 0;                // solenoid rising edge -> launch
   double muzzle_speed_fps = 0;        // at full gun-wheel speed
@@ -93,7 +94,7 @@ struct FieldParams {
 
 struct RefereeParams {
   int reflex_limit = 3;  // more than this many reflexes in the window -> turn
-  int event_limit = 5;   // more than this many bumper+edge events -> turn
+  int event_limit = 5;   // more than this many reflexes + edge-handler entries -> turn
   double window_s = 10;
   double putback_ft = 1.5;  // inside the wire
   double turn_deg = 45;
@@ -388,6 +389,13 @@ class Arena {
   int shots(int robot) const;
   int hits(int robot) const;
   IntegratorStats stats() const;
+
+  // The program's PIO (edge) interrupt handler was entered at `tick` (the
+  // scheduler: a PIO interrupt accepted). The referee counts these with the
+  // bumper reflexes (thesis VI.D: robots stuck in the edge routine); a wire
+  // crossing of a robot whose PIO is not armed counts for nothing. Returns
+  // the RefereeTurn event if this entry makes the referee turn the robot.
+  EventList edgeHandlerEntered(int robot, std::int64_t tick);
 
   struct Impl;
 

@@ -152,6 +152,7 @@ const std::vector<KeyDef>& keyTable() {
        D(p.robot.bad_reading_probability)},
       {"eyes", "thesis_swapped_eyes", Kind::Bool, {0, 0}, true, B(p.robot.thesis_swapped_eyes)},
       {"gun", "wheel_lag", Kind::Time, {0.001, 10, true}, true, D(p.robot.gun_wheel_lag_s)},
+      {"gun", "wheel_coast", Kind::Time, {0.001, 60, true}, true, D(p.robot.gun_wheel_coast_s)},
       {"gun", "motors_always_on", Kind::Bool, {0, 0}, true, B(p.robot.gun_motors_always_on)},
       {"gun", "stroke_time", Kind::Time, {0, 2}, true, D(p.robot.stroke_s)},
       {"gun", "muzzle_speed", Kind::Speed, {1, 1000}, true, D(p.robot.muzzle_speed_fps)},

@@ -30,12 +30,13 @@ struct QueuedEvent {
   int index = 0;  // injection number, path leg, or the detector bit to release
 };
 
-// A plant input made by a robot during a round: a port B write, or a bump
-// injected at a program point. Applied after the round, in tick order.
+// A plant input made by a robot during a round: a port B write, a bump
+// injected at a program point, or the entry into its PIO (edge) handler,
+// which the referee counts. Applied after the round, in tick order.
 struct PlantInput {
   Tick tick;
   int robot;
-  enum class Kind : uint8_t { PortB, Reflex } kind;
+  enum class Kind : uint8_t { PortB, Reflex, EdgeHandler } kind;
   uint8_t value;  // port B
   plant::Bumper bumper;
 };
@@ -589,7 +590,10 @@ std::string Robot::handlerName() const {
 void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
   ++result.interrupts[std::string(vm::irqName(irq))];
   if (match.observer()) match.observer()->onInterruptAccepted(index, t, irq);
-  if (irq == vm::Irq::Pio) pio.accepted();
+  if (irq == vm::Irq::Pio) {
+    pio.accepted();
+    match.inputs().push_back({t, index, PlantInput::Kind::EdgeHandler, 0, plant::Bumper::Front});
+  }
   if (!match.tracing()) return;
   if (irq == vm::Irq::SerialTx) {
     serialIsrAccepted = t;  // traced as one span when it returns
@@ -760,6 +764,11 @@ void Match::applyInputs() {
     }
     if (w.kind == PlantInput::Kind::Reflex) {
       applyReflex(w.tick, w.robot, w.bumper);
+      continue;
+    }
+    if (w.kind == PlantInput::Kind::EdgeHandler) {
+      sampleUpTo(w.tick);
+      handlePlantEvents(w.tick, arena_.edgeHandlerEntered(w.robot, w.tick));
       continue;
     }
     sampleUpTo(w.tick);

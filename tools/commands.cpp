@@ -129,13 +129,16 @@ Subcommand addTournamentCommand(CLI::App& app) {
     TournamentConfig config;
     std::string profile = "default", out = "out/tournament";
     bool json = false, resume = false;
+    double seconds = 0;  // copied to config.seconds only if given
+    CLI::Option* secondsOption = nullptr;
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("tournament", "round robin after thesis Appendix A");
   cmd->add_option("PROGRAM", o->config.programs, "the programs (two or more)")->required();
   cmd->add_option("--rounds", o->config.rounds, "rounds per pair, sides swapped (default 2)")
       ->check(CLI::Range(1, 10'000));
-  cmd->add_option("--seconds", o->config.seconds, "round length (default 180)");
+  o->secondsOption = cmd->add_option("--seconds", o->seconds,
+                                     "round length (default: the profile's round_length)");
   cmd->add_option("--seed", o->config.masterSeed, "master seed (default 1)")
       ->check(seedValidator());
   cmd->add_option("--threads", o->config.threads, "worker threads (default: all cores)")
@@ -151,6 +154,7 @@ Subcommand addTournamentCommand(CLI::App& app) {
   return {cmd, [o] {
             return guarded([&] {
               const plant::Profile profile = loadNamedProfile(o->profile);
+              if (o->secondsOption->count() > 0) o->config.seconds = o->seconds;
               checkTournamentConfig(o->config);
               RunTable table(o->out, "games.csv", tournamentHeader(),
                              tournamentSettings(o->config, profile), o->resume);

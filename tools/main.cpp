@@ -71,7 +71,7 @@ int viewCommand(const std::string& tracePath, const std::string& out) {
 }
 
 struct RunOptions {
-  double seconds = 180;
+  double seconds = 0;  // not given: the profile's [match] round_length
   uint64_t seed = 1;
   std::string profile = "default";
   std::vector<std::string> hw;
@@ -154,12 +154,14 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
                                    tools::ScenarioUse use) {
   std::optional<tools::Scenario> scenario;
   if (!o.scenario.empty()) scenario = tools::loadScenario(o.scenario);
-  const double seconds = tools::preferCommandLine(
-      given(o.secondsOption), scenario ? scenario->seconds : std::nullopt, o.seconds);
-  if (!(seconds > 0) || seconds > 1e6)
-    throw tools::ToolError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", seconds));
   const plant::Profile profile = tools::loadNamedProfile(tools::preferCommandLine(
       given(o.profileOption), scenario ? scenario->profile : std::nullopt, o.profile));
+  // Without --seconds or a scenario's, a run lasts the profile's round.
+  const double seconds = tools::preferCommandLine(
+      given(o.secondsOption), scenario ? scenario->seconds : std::nullopt,
+      given(o.secondsOption) || o.seconds > 0 ? o.seconds : profile.round_length_s);
+  if (!(seconds > 0) || seconds > 1e6)
+    throw tools::ToolError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", seconds));
   scheduler::MatchConfig config;
   config.arena = plant::makeArenaConfig(profile, static_cast<int>(programs.size()));
   config.profileName = profile.name;
@@ -432,7 +434,8 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
 }
 
 void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
-  o.secondsOption = cmd->add_option("--seconds", o.seconds, "simulated seconds (default 180)");
+  o.secondsOption = cmd->add_option("--seconds", o.seconds,
+                                    "simulated seconds (default: the profile's round_length)");
   o.seedOption =
       cmd->add_option("--seed", o.seed, "master seed (default 1)")->check(tools::seedValidator());
   o.profileOption =

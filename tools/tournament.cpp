@@ -23,7 +23,7 @@ nlohmann::json tournamentSettings(const TournamentConfig& c, const plant::Profil
   return {{"command", "tournament"},
           {"programs", c.programs},
           {"rounds", c.rounds},
-          {"seconds", c.seconds},
+          {"seconds", roundSeconds(c, profile)},
           {"master_seed", c.masterSeed},
           {"profile", profile.name},
           {"profile_file", profile.file},
@@ -90,8 +90,13 @@ bool played(const TournamentGame& g) { return g.done && g.plantFault.rfind("erro
 void checkTournamentConfig(const TournamentConfig& config) {
   if (config.programs.size() < 2) throw ToolError("simbot: a tournament needs two programs\n");
   if (config.rounds <= 0) throw ToolError("simbot: --rounds must be positive\n");
-  if (!(config.seconds > 0) || config.seconds > 1e6)
-    throw ToolError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", config.seconds));
+  if (config.seconds && (!(*config.seconds > 0) || *config.seconds > 1e6))
+    throw ToolError(
+        fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", *config.seconds));
+}
+
+double roundSeconds(const TournamentConfig& config, const plant::Profile& profile) {
+  return config.seconds.value_or(profile.round_length_s);
 }
 
 TournamentResult runTournament(const TournamentConfig& config, const plant::Profile& profile,
@@ -102,6 +107,7 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
 
   TournamentResult result;
   result.config = config;
+  result.config.seconds = roundSeconds(config, profile);
   const int n = static_cast<int>(config.programs.size());
   for (int i = 0; i < n; ++i)
     for (int j = i + 1; j < n; ++j)
@@ -138,8 +144,8 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
   std::vector<size_t> todo;
   for (size_t k = 0; k < result.games.size(); ++k)
     if (!result.games[k].done) todo.push_back(k);
-  const auto endTick =
-      static_cast<scheduler::Tick>(std::llround(config.seconds * scheduler::kTicksPerSecond));
+  const auto endTick = static_cast<scheduler::Tick>(
+      std::llround(*result.config.seconds * scheduler::kTicksPerSecond));
   auto job = [&](size_t k) {
     TournamentGame& g = result.games[todo[k]];
     scheduler::MatchConfig mc;
@@ -257,7 +263,7 @@ nlohmann::json tournamentJson(const TournamentResult& result) {
                      {"reloads_b", g.reloadsB}});
   }
   return {{"rounds", c.rounds},
-          {"seconds", c.seconds},
+          {"seconds", c.seconds.value_or(0)},  // runTournament always sets it
           {"master_seed", c.masterSeed},
           {"reload_on_fault", c.reloadOnFault},
           {"points", "1 per round won"},

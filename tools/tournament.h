@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,7 @@ namespace simbot::tools {
 struct TournamentConfig {
   std::vector<std::string> programs;
   int rounds = 2;
-  double seconds = 180;
+  std::optional<double> seconds;  // round length; none: the profile's [match] round_length
   uint64_t masterSeed = 1;
   int threads = 0;
   bool progress = true;
@@ -59,6 +60,8 @@ struct TournamentResult {
 
 // ToolError if the configuration cannot run.
 void checkTournamentConfig(const TournamentConfig& config);
+// The round length: --seconds if given, else the profile's round_length.
+double roundSeconds(const TournamentConfig& config, const plant::Profile& profile);
 // games.csv's columns, and the settings that identify a tournament.
 CsvRow tournamentHeader();
 nlohmann::json tournamentSettings(const TournamentConfig& config, const plant::Profile& profile);

@@ -1,5 +1,6 @@
 // Motor frames and the TOML profile and hardware loaders.
 #include <fstream>
+#include <numbers>
 #include <regex>
 
 #include "plant_support.h"
@@ -58,10 +59,11 @@ TEST(Profiles, BothShippedProfilesLoad) {
   const Profile t = thesis();
   EXPECT_EQ(t.name, "thesis-1997");
   EXPECT_DOUBLE_EQ(t.field.size_ft, 16.0);
-  EXPECT_DOUBLE_EQ(t.field.wire_inset_ft, 5.0 / 12);
+  EXPECT_DOUBLE_EQ(t.field.wire_inset_ft, 0.5);  // the Simbot's 50 units (VI.C.4)
   EXPECT_DOUBLE_EQ(t.field.divider_thickness_ft, 0.75 / 12);
   EXPECT_DOUBLE_EQ(t.robot.body_diameter_ft, 12.75 / 12);
-  EXPECT_DOUBLE_EQ(t.robot.track_ft, 0.75);
+  // Effective track for Appendix C's 150 deg/s spin at 1.5 ft/s: 3.6 / pi ft.
+  EXPECT_NEAR(t.robot.track_ft, 3.6 / std::numbers::pi, 1e-7);
   EXPECT_EQ(t.robot.motor_lag_s, 0.0);
   EXPECT_EQ(t.robot.eye_max, 4080);
   EXPECT_EQ(t.robot.balls_per_gun, 15);
@@ -125,8 +127,8 @@ TEST(Profiles, UnknownKeyIsReportedAtItsPosition) {
 }
 
 TEST(Profiles, WrongUnitIsReportedAtTheUnit) {
-  const std::string text = edit("unit = \"in\", source = \"thesis VI.B.1: approximately 9",
-                                "unit = \"s\", source = \"thesis VI.B.1: approximately 9");
+  const std::string text = edit("unit = \"in\", source = \"thesis Appendix C / VI.C.1",
+                                "unit = \"s\", source = \"thesis Appendix C / VI.C.1");
   const std::string msg = errorOf(text);
   EXPECT_EQ(errLine(msg), lineOf(text, "track ")) << msg;
   EXPECT_NE(msg.find("wrong unit 's' for 'robot.track'"), std::string::npos) << msg;
