@@ -135,6 +135,13 @@ function buildArena(scene, model, half) {
     new THREE.MeshPhongMaterial({ color: 0x2c3f2e }));
   floor.rotation.x = -Math.PI / 2;
   scene.add(floor);
+  // The room's floor around the field: a robot's eye view over a low wall
+  // still shows the ground it looks at, not an empty sky.
+  const room = new THREE.Mesh(new THREE.PlaneGeometry(8 * half, 8 * half),
+    new THREE.MeshPhongMaterial({ color: 0x3a3631 }));
+  room.rotation.x = -Math.PI / 2;
+  room.position.y = -0.01;
+  scene.add(room);
   const grid = new THREE.GridHelper(2 * half, 2 * half, 0x3d5540, 0x3d5540);
   grid.position.y = 0.002;
   scene.add(grid);
