@@ -861,8 +861,7 @@ struct Arena::Impl {
   // than event_limit reflexes and edge-handler entries, within the window
   // turn the robot by turn_deg and start the count again.
   bool refereeDue(const RobotDisc& r, std::int64_t T) const {
-    const std::int64_t from = T - static_cast<std::int64_t>(std::llround(
-                                      cfg.referee.window_s * static_cast<double>(kTicksPerSecond)));
+    const std::int64_t from = T - timebase::ticksFromSeconds(cfg.referee.window_s);
     return r.reflexTicks.countSince(from) > cfg.referee.reflex_limit ||
            r.eventTicks.countSince(from) > cfg.referee.event_limit;
   }
@@ -1201,8 +1200,7 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
         e.kind = EventKind::GunMisfire;
       } else {
         next.launchTick[static_cast<std::size_t>(g)] =
-            tick + static_cast<std::int64_t>(
-                       std::llround(p.stroke_s * static_cast<double>(kTicksPerSecond)));
+            tick + timebase::ticksFromSeconds(p.stroke_s);
         scheduleChanges = true;
       }
       ev.push(e);

@@ -24,10 +24,13 @@
 #include <string_view>
 #include <vector>
 
+#include "timebase/tick.h"
+
 namespace simbot::plant {
 
 // ---------------------------------------------------------------- time
-inline constexpr std::int64_t kTicksPerSecond = 9'216'000;
+// The clock is defined once, in timebase/tick.h.
+using timebase::kTicksPerSecond;
 
 // Tick of a continuous-time event found at t seconds: ceil(t * 9,216,000),
 // the ceiling of the exact real product (not of the rounded double product).

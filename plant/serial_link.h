@@ -28,7 +28,7 @@
 
 namespace simbot::plant {
 
-using Tick = int64_t;
+using timebase::Tick;
 inline constexpr Tick kTicksPerChar = 9600;
 
 // The robot memory the serial library reads from and writes to.

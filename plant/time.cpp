@@ -24,8 +24,6 @@ std::int64_t eventTickFromSeconds(double t) {
   return static_cast<std::int64_t>(c);
 }
 
-double secondsFromTick(std::int64_t tick) {
-  return static_cast<double>(tick) / static_cast<double>(kTicksPerSecond);
-}
+double secondsFromTick(std::int64_t tick) { return timebase::secondsFromTicks(tick); }
 
 }  // namespace simbot::plant

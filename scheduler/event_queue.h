@@ -15,9 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "timebase/tick.h"
+
 namespace simbot::scheduler {
 
-using Tick = int64_t;
+using timebase::Tick;
 
 // Classes in the order they run at one tick. Plant events first (a detector
 // crossing at tick t is seen by anything else at t), then the bytes the

@@ -992,7 +992,11 @@ void Match::finish(MatchResult& result) {
     RobotResult rr = r->result;
     rr.hits = arena_.hits(r->index);
     rr.shots = arena_.shots(r->index);
-    rr.cycles = static_cast<uint64_t>(r->now());
+    // The clock at main's return, or at the end of the run: a VM's clock
+    // runs on to the last round's horizon after main returns, and may stand
+    // one instruction past the end.
+    rr.cycles = static_cast<uint64_t>(rr.exited ? rr.exitTick : std::min(r->now(), result.endTick));
+    rr.vmClock = static_cast<uint64_t>(r->now());
     if (config_.profile) {
       rr.profile = r->vm().profile();
       rr.profile.resize(std::max(rr.profile.size(), r->earlierProfile.size()));

@@ -43,6 +43,7 @@
 #include <vector>
 
 #include "plant/plant.h"
+#include "timebase/tick.h"
 #include "trace/trace.h"
 #include "vm/cost.h"
 #include "vm/image.h"
@@ -50,8 +51,9 @@
 
 namespace simbot::scheduler {
 
-using Tick = int64_t;
-inline constexpr Tick kTicksPerSecond = 9'216'000;
+// The clock is defined once, in timebase/tick.h.
+using timebase::kTicksPerSecond;
+using timebase::Tick;
 
 // One leg of a scripted drive: the wheels' ground speeds for a duration.
 struct DriveLeg {
@@ -171,7 +173,11 @@ struct RobotResult {
   // byte of the previous send (its NUL): that frame can never latch.
   int framesOverwritten = 0;
   std::map<std::string, uint64_t> interrupts;  // per source
-  uint64_t cycles = 0;
+  uint64_t cycles = 0;  // the clock at main's return, or at the end of the run
+  // The VM's own clock when the run ended: all it charged, including the
+  // instruction straddling the end and anything after main returned
+  // (interrupt handlers, halted time). simbot profile adds up to this.
+  uint64_t vmClock = 0;
   std::optional<FaultInfo> fault;  // the first fault
   std::vector<FaultInfo> faults;   // every fault, in order (more than one after reloads)
   int reloads = 0;                 // MatchConfig::reloadOnFault

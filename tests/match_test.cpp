@@ -39,7 +39,7 @@ scheduler::MatchConfig matchConfig(std::vector<scheduler::RobotSpec> robots, dou
       plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/" + profile + ".toml"),
                              static_cast<int>(robots.size()));
   c.robots = std::move(robots);
-  c.endTick = static_cast<scheduler::Tick>(seconds * scheduler::kTicksPerSecond);
+  c.endTick = timebase::ticksFromSeconds(seconds);
   return c;
 }
 
@@ -300,6 +300,27 @@ TEST(Match, TwoPlantChangingPortBWritesInOneRound) {
 
 // DESIGN.md's rules: a robot that faulted loses a tied round; the coin is
 // for ties between robots that both ran (or both faulted).
+// cycles: the robot's clock when main returned, or at the end of the run,
+// never the end of the co-simulation round it happened in.
+TEST(Match, CyclesAreTheClockAtMainsReturnOrTheEnd) {
+  scheduler::MatchConfig quick = matchConfig(
+      {{"A", "quick.dc", compileSource("main()\n{\n  int i;\n  for (i = 0; i < 10; i++);\n}\n")}},
+      1.0);
+  quick.stopWhenAllExited = true;
+  const auto q = scheduler::runMatch(quick);
+  ASSERT_TRUE(q.robots[0].exited);
+  // main returns within the first round (9,600 ticks); the run ends there.
+  EXPECT_LT(q.robots[0].exitTick, 9'600);
+  EXPECT_EQ(q.robots[0].cycles, static_cast<uint64_t>(q.robots[0].exitTick));
+
+  // A program that never returns, stopped at 0.043 s = tick 396,288.
+  const auto r = scheduler::runMatch(
+      matchConfig({{"A", "spin.dc", compileSource("main()\n{\n  for (;;);\n}\n")}}, 0.043));
+  EXPECT_FALSE(r.robots[0].exited);
+  EXPECT_EQ(r.endTick, 396'288);
+  EXPECT_EQ(r.robots[0].cycles, 396'288u);
+}
+
 TEST(Match, AFaultedRobotLosesATiedRound) {
   const char* kFaults = "int *p;\nmain()\n{\n    *p = 1;\n}\n";  // null pointer at once
   for (uint64_t seed = 1; seed <= 8; ++seed) {

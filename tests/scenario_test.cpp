@@ -239,8 +239,9 @@ path = [ { arc_radius_ft = 3, turn_deg = 90, speed_fps = 0.5 },
   ASSERT_EQ(c.robots.size(), 2u);
   ASSERT_EQ(c.robots[1].path.size(), 3u);
   const double quarter = 3 * std::numbers::pi / 2 / 0.5;  // seconds
-  EXPECT_EQ(c.robots[1].path[0].duration,
-            static_cast<scheduler::Tick>(std::round(quarter * scheduler::kTicksPerSecond)));
+  // 9.42477796076938 s * 9,216,000 = 86,858,753.686...: the nearest tick.
+  EXPECT_EQ(c.robots[1].path[0].duration, 86'858'754);
+  EXPECT_EQ(c.robots[1].path[0].duration, timebase::ticksFromSeconds(quarter));
   EXPECT_EQ(c.robots[1].path[1].duration, 8 * scheduler::kTicksPerSecond);
   c.endTick = 40 * scheduler::kTicksPerSecond;  // path over at about 9.4 + 8 + 3.5 s
   const auto r = testkit::runTraced(c);

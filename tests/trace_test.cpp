@@ -51,7 +51,7 @@ scheduler::MatchConfig solo(const std::string& source, double seconds,
   scheduler::MatchConfig c;
   c.arena = plant::makeArenaConfig(profile(profileName), 1);
   c.robots.push_back({"A", "test.dc", testkit::compileOrDie(source)});
-  c.endTick = static_cast<scheduler::Tick>(seconds * scheduler::kTicksPerSecond);
+  c.endTick = timebase::ticksFromSeconds(seconds);
   return c;
 }
 
@@ -64,7 +64,7 @@ scheduler::MatchConfig duel(const std::string& shooter, plant::Pose a, plant::Po
   c.arena.robots[1].start = b;
   c.robots.push_back({"A", "shooter.dc", testkit::compileOrDie(shooter)});
   c.robots.push_back({"B", "beacon.dc", testkit::compileOrDie("main()\n{\n}\n")});
-  c.endTick = static_cast<scheduler::Tick>(seconds * scheduler::kTicksPerSecond);
+  c.endTick = timebase::ticksFromSeconds(seconds);
   return c;
 }
 

@@ -11,14 +11,13 @@
 #include <numbers>
 
 #include "scheduler/match.h"
+#include "timebase/tick.h"
 #include "tools/json_text.h"
 #include "tools/runner.h"
 
 namespace simbot::tools {
 
 namespace {
-
-using scheduler::kTicksPerSecond;
 
 double radians(double deg) { return deg * std::numbers::pi / 180; }
 double normalizeHeading(double deg) {
@@ -302,8 +301,7 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile, c
   std::vector<size_t> todo;
   for (size_t j = 0; j < result.runs.size(); ++j)
     if (!result.runs[j].done) todo.push_back(j);
-  const scheduler::Tick endTick =
-      static_cast<scheduler::Tick>(std::llround(config.seconds * kTicksPerSecond));
+  const scheduler::Tick endTick = timebase::ticksFromSeconds(config.seconds);
   const std::string label = benchLabel(config);
   auto job = [&](size_t k) {
     const size_t j = todo[k];

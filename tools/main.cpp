@@ -17,6 +17,7 @@
 #include "compiler/compiler.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
+#include "timebase/tick.h"
 #include "tools/commands.h"
 #include "tools/json_text.h"
 #include "tools/runner.h"
@@ -196,11 +197,11 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
       throw tools::ToolError(fmt::format("simbot: --inject {}\n", e.what()));
     }
   }
-  config.endTick = static_cast<scheduler::Tick>(seconds * scheduler::kTicksPerSecond);
+  config.endTick = timebase::ticksFromSeconds(seconds);
   config.seed = tools::preferCommandLine(given(o.seedOption),
                                          scenario ? scenario->seed : std::nullopt, o.seed);
   config.reloadOnFault = o.reloadOnFault;
-  config.reloadDelay = plant::eventTickFromSeconds(profile.reload_delay_s);
+  config.reloadDelay = timebase::ticksFromSeconds(profile.reload_delay_s);
   return config;
 }
 
@@ -359,7 +360,7 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
     const vm::Symbol* fn = image.functionAt(at);
     byFunction[fn ? fn->name : "(start-up)"] += cycles;
   }
-  const uint64_t total = robot.cycles;
+  const uint64_t total = robot.vmClock;  // everything the profile counts
   const uint64_t idle = total > busy ? total - busy : 0;
   auto functionOf = [&](int line) {
     for (uint32_t at = 0; at < image.lines.size(); ++at)

@@ -20,6 +20,7 @@
 #include <limits>
 #include <numbers>
 
+#include "timebase/tick.h"
 #include "tools/runner.h"
 
 namespace simbot::tools {
@@ -335,12 +336,14 @@ std::vector<scheduler::DriveLeg> driveLegs(const std::string& sourceName,
         seconds = leg.waitS;
         break;
     }
-    const double ticks = std::round(seconds * static_cast<double>(scheduler::kTicksPerSecond));
-    if (!(ticks >= 1) || ticks > 1e15)
+    // The range first: ticksFromSeconds refuses NaN and huge values.
+    const scheduler::Tick ticks =
+        seconds >= 0 && seconds <= 1e8 ? timebase::ticksFromSeconds(seconds) : 0;
+    if (ticks < 1)
       throw plant::ConfigError(scenarioError(
           sourceName, leg.pos,
           fmt::format("this leg lasts {} s, which is not between one tick and 1e8 s", seconds)));
-    out.push_back({static_cast<scheduler::Tick>(ticks), left, right});
+    out.push_back({ticks, left, right});
   }
   return out;
 }

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "scheduler/match.h"
+#include "timebase/tick.h"
 #include "tools/json_text.h"
 #include "tools/runner.h"
 
@@ -144,8 +145,7 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
   std::vector<size_t> todo;
   for (size_t k = 0; k < result.games.size(); ++k)
     if (!result.games[k].done) todo.push_back(k);
-  const auto endTick = static_cast<scheduler::Tick>(
-      std::llround(*result.config.seconds * scheduler::kTicksPerSecond));
+  const scheduler::Tick endTick = timebase::ticksFromSeconds(*result.config.seconds);
   auto job = [&](size_t k) {
     TournamentGame& g = result.games[todo[k]];
     scheduler::MatchConfig mc;
@@ -157,7 +157,7 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
     mc.seed = g.seed;
     mc.stop = stop;
     mc.reloadOnFault = config.reloadOnFault;
-    mc.reloadDelay = plant::eventTickFromSeconds(profile.reload_delay_s);
+    mc.reloadDelay = timebase::ticksFromSeconds(profile.reload_delay_s);
     try {
       const scheduler::MatchResult r = scheduler::runMatch(mc);
       g.hitsA = r.robots[0].hits;

@@ -27,9 +27,11 @@
 #include <variant>
 #include <vector>
 
+#include "timebase/tick.h"
+
 namespace simbot::trace {
 
-using Tick = std::int64_t;
+using timebase::Tick;
 
 enum class FieldKind : std::uint8_t { Robot, Int, Real, Bool, Text, Bytes, OptInt, OptReal };
 

@@ -25,13 +25,15 @@
 #include <string_view>
 #include <vector>
 
+#include "timebase/tick.h"
 #include "vm/cost.h"
 #include "vm/image.h"
 
 namespace simbot::vm {
 
-using Tick = int64_t;
-inline constexpr Tick kTicksPerSecond = 9'216'000;
+// The clock is defined once, in timebase/tick.h.
+using timebase::kTicksPerSecond;
+using timebase::Tick;
 
 // Interrupt sources in priority order (0 = highest).
 enum class Irq : uint8_t { Pio = 0, SerialTx = 1, Timer = 2 };

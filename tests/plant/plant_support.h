@@ -20,9 +20,7 @@ inline std::string profilePath(const char* name) {
 inline Profile thesis() { return loadProfile(profilePath("thesis-1997")); }
 inline Profile defaults() { return loadProfile(profilePath("default")); }
 
-inline std::int64_t ticks(double seconds) {
-  return static_cast<std::int64_t>(std::llround(seconds * kTicksPerSecond));
-}
+inline std::int64_t ticks(double seconds) { return simbot::timebase::ticksFromSeconds(seconds); }
 
 inline MotorFrame frame(const char* s) {
   auto f = parseMotorFrame(s);
