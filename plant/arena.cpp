@@ -84,9 +84,13 @@ namespace {
 
 constexpr int kPerRobot = 8;
 enum : int { X = 0, Y = 1, H = 2, VL = 3, VR = 4, S = 5, G1 = 6, G2 = 7 };
+// Every ball two robots with two full magazines can have in flight: balls
+// are never reloaded, so a launch always finds a free slot.
 constexpr int kMaxBalls = 64;
+static_assert(kMaxBalls >= 2 * 2 * kMaxBallsPerGun, "the ball table must hold every magazine");
 constexpr int kMaxRoots = 2 * 6 + 1 + kMaxBalls * 4;
 constexpr int kRing = 16;
+static_assert(kRing > kMaxRefereeLimit, "the referee must see one event more than its limit");
 // CVode's tout in CV_ONE_STEP mode only bounds the first step's guess after a
 // (re)initialisation; a fixed horizon keeps it independent of the caller.
 constexpr double kFirstStepHorizon = 1.0;  // s
@@ -724,7 +728,7 @@ struct Arena::Impl {
         int slot = -1;
         for (int b = 0; b < kMaxBalls && slot < 0; ++b)
           if (!d.balls[static_cast<std::size_t>(b)].active) slot = b;
-        if (slot < 0) continue;
+        if (slot < 0) throw std::logic_error("plant: the ball table is full (see kMaxBalls)");
         r.ballsLeft[static_cast<std::size_t>(g)]--;
         r.shots++;
         const RobotParams& p = P(i);

@@ -47,6 +47,10 @@ struct Pose {
   double heading_deg = 0;  // clockwise from +y, in [0, 360)
 };
 
+// A gun's magazine holds at most this many balls (the thesis: 15). The
+// arena's table of balls in flight is sized from it (arena.cpp kMaxBalls).
+inline constexpr int kMaxBallsPerGun = 16;
+
 struct RobotParams {
   // body
   double body_diameter_ft = 0;
@@ -94,6 +98,10 @@ struct FieldParams {
   double gravity_fps2 = 0;
   bool count_floor_skips = false;
 };
+
+// The referee's limits are at most this; arena.cpp keeps the last
+// kMaxRefereeLimit + 1 event ticks per robot, enough to see one too many.
+inline constexpr int kMaxRefereeLimit = 15;
 
 struct RefereeParams {
   int reflex_limit = 3;  // more than this many reflexes in the window -> turn
@@ -274,8 +282,12 @@ class EventList {
     std::copy(o.begin(), o.end(), items_.begin());
     return *this;
   }
+  // A full list is a bug in this capacity, never a reason to lose an event.
   void push(const Event& e) {
-    if (n_ < kCapacity) items_[n_++] = e;
+    if (n_ == kCapacity)
+      throw std::length_error("plant: more than " + std::to_string(kCapacity) +
+                              " events at one tick");
+    items_[n_++] = e;
   }
   void clear() { n_ = 0; }
   std::size_t size() const { return n_; }

@@ -157,7 +157,7 @@ const std::vector<KeyDef>& keyTable() {
       {"gun", "stroke_time", Kind::Time, {0, 2}, true, D(p.robot.stroke_s)},
       {"gun", "muzzle_speed", Kind::Speed, {1, 1000}, true, D(p.robot.muzzle_speed_fps)},
       {"gun", "launch_height", Kind::Length, {0.05, 10}, true, D(p.robot.launch_height_ft)},
-      {"gun", "balls_per_gun", Kind::Count, {0, 16}, true, I(p.robot.balls_per_gun)},
+      {"gun", "balls_per_gun", Kind::Count, {0, kMaxBallsPerGun}, true, I(p.robot.balls_per_gun)},
       {"gun", "jam_probability", Kind::Probability, {0, 1}, true, D(p.robot.jam_probability)},
       {"gun",
        "misfire_probability",
@@ -168,8 +168,18 @@ const std::vector<KeyDef>& keyTable() {
       {"controller", "random_memory", Kind::Bool, {0, 0}, true, B(p.robot.random_memory)},
       {"projectile", "gravity", Kind::Accel, {1, 1000}, false, D(p.field.gravity_fps2)},
       {"projectile", "count_floor_skips", Kind::Bool, {0, 0}, false, B(p.field.count_floor_skips)},
-      {"referee", "reflex_limit", Kind::Count, {0, 15}, false, I(p.referee.reflex_limit)},
-      {"referee", "event_limit", Kind::Count, {0, 15}, false, I(p.referee.event_limit)},
+      {"referee",
+       "reflex_limit",
+       Kind::Count,
+       {0, kMaxRefereeLimit},
+       false,
+       I(p.referee.reflex_limit)},
+      {"referee",
+       "event_limit",
+       Kind::Count,
+       {0, kMaxRefereeLimit},
+       false,
+       I(p.referee.event_limit)},
       {"referee", "window", Kind::Time, {0.1, 3600}, false, D(p.referee.window_s)},
       {"referee", "putback", Kind::Length, {0, 10}, false, D(p.referee.putback_ft)},
       {"referee", "turn", Kind::Angle, {-360, 360}, false, D(p.referee.turn_deg)},
@@ -493,9 +503,11 @@ void crossChecks(const Profile& p, const Checker& c, const toml::table& doc) {
     c.fail(where("field"), "divider_north must not be south of divider_south");
   if (p.robot.edge_detector_inset_ft * 2 >= p.robot.body_diameter_ft)
     c.fail(where("robot"), "edge_detector_inset puts the detectors past the centre");
-  if (p.referee.reflex_limit > 15 || p.referee.event_limit > 15)
-    c.fail(where("referee"), "reflex_limit and event_limit must be at most 15");
-  if (p.robot.balls_per_gun > 16) c.fail(where("gun"), "balls_per_gun must be at most 16");
+  if (p.referee.reflex_limit > kMaxRefereeLimit || p.referee.event_limit > kMaxRefereeLimit)
+    c.fail(where("referee"),
+           fmt::format("reflex_limit and event_limit must be at most {}", kMaxRefereeLimit));
+  if (p.robot.balls_per_gun > kMaxBallsPerGun)
+    c.fail(where("gun"), fmt::format("balls_per_gun must be at most {}", kMaxBallsPerGun));
   if (p.robot.jam_probability + p.robot.misfire_probability > 1)
     c.fail(where("gun"), "jam_probability + misfire_probability must be at most 1");
   if (p.referee.putback_ft * 2 >= p.field.size_ft - 2 * p.field.wire_inset_ft)
@@ -650,9 +662,10 @@ Hardware parseHardware(std::string_view text, const std::string& sourceName, Rob
         c.fail(n ? n->source() : doc.source(),
                fmt::format("port B bit {} is bound twice", bits[i]));
       }
-  if (p.robot.balls_per_gun > 16) {
+  if (p.robot.balls_per_gun > kMaxBallsPerGun) {
     const toml::node* n = doc.get("gun");
-    c.fail(n ? n->source() : doc.source(), "balls_per_gun must be at most 16");
+    c.fail(n ? n->source() : doc.source(),
+           fmt::format("balls_per_gun must be at most {}", kMaxBallsPerGun));
   }
   if (p.robot.jam_probability + p.robot.misfire_probability > 1) {
     const toml::node* n = doc.get("gun");

@@ -81,6 +81,11 @@ enum class Lib : uint8_t {
   Count_
 };
 inline constexpr int kLibCount = static_cast<int>(Lib::Count_);
+// The LIB operand is the routine's id in its low byte and the argument
+// count in its high byte (codegen.cpp libCall, vm.cpp LIB).
+static_assert(kLibCount <= 256, "a library id must fit the LIB operand's low byte");
+static_assert(kMaxLibArgs >= 1 && kMaxLibArgs <= 255,
+              "the argument limit must fit the LIB operand's high byte");
 
 struct LibInfo {
   std::string_view name;

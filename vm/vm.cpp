@@ -46,6 +46,8 @@ constexpr int kEvalHeadroom = 1024;
 // this much room at every boundary keeps any program (8,200 arguments, a
 // deep nest of calls) from writing past the expression stack.
 constexpr int kEvalGuard = 4;
+static_assert(kEvalHeadroom > kMaxLibArgs + kEvalGuard,
+              "a call's headroom must hold a library call's arguments");
 constexpr int kMaxInterruptNesting = 16;
 constexpr uint32_t kMaxStepTstates = 100;  // long library calls: boundary spacing
 // printf's largest field width and precision (assumption: Dynamic C's
