@@ -21,8 +21,6 @@ namespace {
 
 constexpr Tick kLookahead = plant::kTicksPerChar;
 
-double seconds(Tick t) { return static_cast<double>(t) / kTicksPerSecond; }
-
 // Queued events; the plant's own events come from Arena::advance.
 struct QueuedEvent {
   enum class Kind : uint8_t { SerialByte, DriveLeg, Inject, ReleaseEdge, Reload, EndOfRound } kind;
@@ -374,7 +372,7 @@ void Robot::runTo(Tick horizon) {
       const Tick at = bus.base + f->tick;
       if (!faultSeen) {
         faultSeen = true;
-        FaultInfo info{f->message, seconds(at), f->line};
+        FaultInfo info{f->message, timebase::secondsFromTicks(at), f->line};
         if (!result.fault) result.fault = info;
         result.faults.push_back(info);
         if (tracing) match.emit(at, trace::rec::Fault{index, f->message, f->line});
@@ -891,7 +889,7 @@ MatchResult Match::run() {
   } catch (const plant::SolverError& e) {
     // The plant cannot go on: the run ends where the failing round began,
     // with everything before it kept.
-    result.plantFault = FaultInfo{e.what(), seconds(roundStart), 0};
+    result.plantFault = FaultInfo{e.what(), timebase::secondsFromTicks(roundStart), 0};
     result.endTick = roundStart;
     if (trace_.on()) emit(roundStart, trace::rec::PlantFault{e.what()}, {});
   }
@@ -985,7 +983,7 @@ void Match::finish(MatchResult& result) {
                                   : "line " + std::to_string(in.line),
                           robot.program, hitsAt(in, injectionAddress_[k]))
             : fmt::format("--inject {} never fired: the run ended at {:.6f} s", in.text,
-                          seconds(result.endTick)));
+                          timebase::secondsFromTicks(result.endTick)));
   }
   result.integrator = arena_.stats();
   for (auto& r : robots_) {

@@ -7,12 +7,6 @@
 
 namespace simbot::scheduler {
 
-namespace {
-
-double secondsOf(Tick t) { return static_cast<double>(t) / kTicksPerSecond; }
-
-}  // namespace
-
 // ---- observer
 
 void MetricsObserver::accumulateStall(Tick t) {
@@ -116,12 +110,12 @@ const std::vector<std::string>& metricNames() {
 RunMetrics collectMetrics(const MetricsObserver& o, const RobotResult& robot) {
   auto time = [](const std::optional<Tick>& t) -> std::optional<double> {
     if (!t) return std::nullopt;
-    return secondsOf(*t);
+    return timebase::secondsFromTicks(*t);
   };
   auto leg = [](const std::optional<Tick>& from,
                 const std::optional<Tick>& to) -> std::optional<double> {
     if (!from || !to) return std::nullopt;
-    return secondsOf(*to - *from);
+    return timebase::secondsFromTicks(*to - *from);
   };
   RunMetrics m;
   m.values = {time(o.acquire),
@@ -136,7 +130,7 @@ RunMetrics collectMetrics(const MetricsObserver& o, const RobotResult& robot) {
               leg(o.edgeAccept, o.edgeLatch),
               leg(o.edgeLatch, o.edgeLeave),
               static_cast<double>(o.framesRejected),
-              secondsOf(o.stallTicks)};
+              timebase::secondsFromTicks(o.stallTicks)};
   return m;
 }
 

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "timebase/tick.h"
 #include "trace/trace.h"
 
 namespace simbot::tools::explain {
@@ -130,8 +131,9 @@ struct RobotInfo {
 };
 
 struct Report {
-  double ticks_per_second = 9216000;
-  Tick end_t = 0;  // the last record's tick
+  double ticks_per_second =
+      static_cast<double>(timebase::kTicksPerSecond);  // until the run record says
+  Tick end_t = 0;                                      // the last record's tick
   std::uint64_t seed = 0;
   std::string profile, winner;
   bool coin = false;

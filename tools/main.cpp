@@ -248,10 +248,9 @@ int soloCommand(const std::string& program, const RunOptions& o) {
   const auto& a = r.robots[0];
   json j = {
       {"exited", a.exited},
-      {"exit_time_s", a.exited ? json(static_cast<double>(a.exitTick) / scheduler::kTicksPerSecond)
-                               : json(nullptr)},
+      {"exit_time_s", a.exited ? json(timebase::secondsFromTicks(a.exitTick)) : json(nullptr)},
       {"cycles", a.cycles},
-      {"sim_seconds", static_cast<double>(r.endTick) / scheduler::kTicksPerSecond},
+      {"sim_seconds", timebase::secondsFromTicks(r.endTick)},
       {"wall_seconds", wall},
       {"console", consoleJson(a.console)},
       {"fault", faultJson(a.fault)},
@@ -273,9 +272,8 @@ int soloCommand(const std::string& program, const RunOptions& o) {
         a.fault    ? "faulted"
         : a.exited ? "exited"
                    : "ran",
-        static_cast<double>(r.endTick) / scheduler::kTicksPerSecond, a.framesLatched,
-        a.framesRejected, a.framesOverwritten,
-        a.reloads ? fmt::format(", {} reloads", a.reloads) : "");
+        timebase::secondsFromTicks(r.endTick), a.framesLatched, a.framesRejected,
+        a.framesOverwritten, a.reloads ? fmt::format(", {} reloads", a.reloads) : "");
   }
   reportWarnings(r);
   return reportFaults(r) ? kExitRobotFault : 0;
@@ -301,7 +299,7 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
                       {"reloads", rr.reloads},
                       {"final_pose", poseJson(rr.finalPose)},
                       {"console_lines", rr.console.size()}});
-  json j = {{"sim_seconds", static_cast<double>(r.endTick) / scheduler::kTicksPerSecond},
+  json j = {{"sim_seconds", timebase::secondsFromTicks(r.endTick)},
             {"wall_seconds", wall},
             {"seed", played.seed},
             {"winner", r.winner},
@@ -326,7 +324,7 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
     }
     std::cout << fmt::format("winner: {}{}  ({:.1f} s simulated in {:.2f} s)\n", r.winner,
                              r.tieBrokenByCoin ? " (coin flip)" : "",
-                             static_cast<double>(r.endTick) / scheduler::kTicksPerSecond, wall);
+                             timebase::secondsFromTicks(r.endTick), wall);
   }
   reportWarnings(r);
   return reportFaults(r) ? kExitRobotFault : 0;

@@ -43,7 +43,7 @@ json traceJson(const trace::Entry& e) {
     }
   });
   j["t"] = e.t;
-  j["time_s"] = static_cast<double>(e.t) / scheduler::kTicksPerSecond;
+  j["time_s"] = timebase::secondsFromTicks(e.t);
   if (!e.watch.empty()) {
     json w = json::object();
     for (const auto& item : e.watch)  // (clang 14 cannot capture a structured binding)
