@@ -11,6 +11,7 @@
 
 #include "plant/plant.h"
 #include "scheduler/match.h"
+#include "support/records.h"
 #include "support/test_host.h"
 #include "tools/runner.h"
 #include "tools/trace_jsonl.h"
@@ -44,11 +45,7 @@ struct Traced {
   ex::Report report;
   template <class R>
   std::vector<std::pair<trace::Tick, R>> all(int robot = -1) const {
-    std::vector<std::pair<trace::Tick, R>> out;
-    for (const auto& e : entries)
-      if (const R* r = std::get_if<R>(&e.record))
-        if (robot < 0 || trace::robotOf(e.record) == robot) out.emplace_back(e.t, *r);
-    return out;
+    return testkit::recordsOf<R>(entries, robot);
   }
 };
 
