@@ -97,6 +97,9 @@ struct InterruptFrame {
 float asFloat(uint32_t bits) { return std::bit_cast<float>(bits); }
 uint32_t fromFloat(float f) { return std::bit_cast<uint32_t>(f); }
 int16_t asInt16(uint32_t v) { return static_cast<int16_t>(static_cast<uint16_t>(v)); }
+static_assert(Tick{kPrtTicks} * kTimerHz == kTicksPerSecond,
+              "PRT0's period must divide the clock into Dynamic C's 1,024 Hz tick");
+
 uint32_t w(int32_t v) { return static_cast<uint32_t>(v) & 0xFFFFu; }
 
 int64_t truncToRange(float f, double lo, double hi) {
@@ -111,10 +114,10 @@ std::string_view irqName(Irq irq) {
   switch (irq) {
     case Irq::Pio:
       return "pio_a";
-    case Irq::SerialTx:
-      return "serial_tx";
     case Irq::Timer:
       return "timer";
+    case Irq::SerialTx:
+      return "serial_tx";
   }
   return "?";
 }
@@ -158,6 +161,15 @@ struct Vm::State {
   bool profiling = false;
   std::vector<uint64_t> profile;
   uint64_t serialIsrCycles = 0;
+  // PRT0: the next tick at which it requests the timer interrupt
+  // (kNoTimer when the service does not run).
+  static constexpr Tick kNoTimer = INT64_MAX;
+  Tick nextTimer = kNoTimer;
+  uint64_t timerIsrCycles = 0;
+  // The BIOS's counters when the program has no timer block of its own.
+  uint32_t biosTicks = 0;
+  uint8_t biosMsFraction = 0;
+  bool costateEvents = false;
   std::string consoleLine;
   Vm* self = nullptr;
 
@@ -217,6 +229,25 @@ struct Vm::State {
   }
   // Accepts the highest-priority pending request at the current boundary.
   void accept();
+  // PRT0 reached nextTimer: raise its request (one flag: a tick that comes
+  // while the last one is still pending is lost) and schedule the next.
+  void timerTick() {
+    pend[static_cast<int>(Irq::Timer)] = true;
+    anyPending = true;
+    nextTimer += static_cast<Tick>((now - nextTimer) / kPrtTicks + 1) * kPrtTicks;
+  }
+  void timerService();
+  // ---- costatements ----
+  void costateEvent(uint32_t coData, Bus::CostateEvent kind, uint32_t atPc) {
+    if (costateEvents) bus.costate(now, static_cast<uint16_t>(coData), kind, image.lineAt(atPc));
+  }
+  void costateEnd(uint32_t coData, bool done) {
+    wr16(coData + kCoLastLoc, 0);
+    wr8(coData + kCoLastLocCbr, 0);
+    wr8(coData + kCoChkSum, 0);
+    if (done) wr8(coData + kCoState, kCoStopped | kCoInit);
+  }
+  bool delayDone(const uint32_t* a, uint32_t timerAddress, uint32_t instructionPc);
   // ---- library ----
   void libCall(Lib id, int argc, uint32_t instructionPc);
   void libBegin();
@@ -236,6 +267,10 @@ void Vm::State::accept() {
   updatePending();
   ++stats.interrupts[i];
   const uint32_t interruptedPc = lib.active ? lib.pc : burn ? burnPc : pc;
+  if (irq == Irq::Timer) {
+    timerService();
+    return;
+  }
   if (irq == Irq::SerialTx) {
     // The serial library's own ISR: short and atomic, leaves IFF1 set.
     bus.interruptAccepted(now, irq, interruptedPc);
@@ -274,6 +309,45 @@ void Vm::State::accept() {
   now += costs.interruptAccept;
   if (profiling) profile[handler] += costs.interruptAccept;
   pc = static_cast<uint32_t>(handler);
+}
+
+// The BIOS timer service (cost.h kTimerIsrSeq): atomic, like the serial
+// library's ISR: interrupts stay disabled inside it and its EI; RETI leaves
+// IFF1 set as it was at acceptance.
+void Vm::State::timerService() {
+  const uint32_t interruptedPc = lib.active ? lib.pc : burn ? burnPc : pc;
+  bus.interruptAccepted(now, Irq::Timer, interruptedPc);
+  const TimerBlock& tb = image.timer;
+  const uint32_t ticks = (tb.used() ? rd32(tb.tick) : biosTicks) + 1;
+  const uint32_t fraction = (tb.used() ? rd8(tb.msFraction) : biosMsFraction) + kMsFractionStep;
+  const bool msDue = fraction >= kMsFractionOne;
+  const bool secDue = (ticks & (kTimerHz - 1)) == 0;
+  const uint8_t newFraction = static_cast<uint8_t>(fraction % kMsFractionOne);
+  if (tb.used()) {
+    wr32(tb.tick, ticks);
+    wr8(tb.msFraction, newFraction);
+    if (msDue) wr32(tb.ms, rd32(tb.ms) + 1);
+    if (secDue) wr32(tb.sec, rd32(tb.sec) + 1);
+  } else {
+    biosTicks = ticks;
+    biosMsFraction = newFraction;
+  }
+  const uint32_t cost = costs.timerIsr[(msDue ? 0u : 1u) | (secDue ? 0u : 2u)];
+  now += cost;
+  timerIsrCycles += cost;
+  bus.interruptReturned(now, Irq::Timer);
+}
+
+// A firsttime Delay function: a[0] the CoData, a[1] the interval.
+bool Vm::State::delayDone(const uint32_t* a, uint32_t timerAddress, uint32_t instructionPc) {
+  const uint32_t cd = a[0] & 0xFFFF;
+  if (!checkAccess(cd, kCoDataSize, instructionPc)) return false;
+  const uint32_t timer = timerAddress ? rd32(timerAddress) : 0;
+  if (rd8(cd + kCoFirstTime)) {
+    wr8(cd + kCoFirstTime, 0);
+    wr32(cd + kCoContent, timer);
+  }
+  return static_cast<int32_t>(timer - rd32(cd + kCoContent)) >= static_cast<int32_t>(a[1]);
 }
 
 // ---- library calls -------------------------------------------------------
@@ -448,6 +522,47 @@ void Vm::State::libBegin() {
     case Lib::FABS:
       eval[sp++] = a[0] & 0x7FFFFFFFu;
       return;
+    case Lib::DELAYMS:
+      eval[sp++] = delayDone(a, image.timer.ms, instructionPc) ? 1u : 0u;
+      return;
+    case Lib::DELAYSEC:
+      eval[sp++] = delayDone(a, image.timer.sec, instructionPc) ? 1u : 0u;
+      return;
+    case Lib::DELAYTICKS: {
+      const uint32_t args[2] = {a[0], a[1] & 0xFFFF};
+      eval[sp++] = delayDone(args, image.timer.tick, instructionPc) ? 1u : 0u;
+      return;
+    }
+    case Lib::COBEGIN:
+    case Lib::CORESET:
+    case Lib::COPAUSE:
+    case Lib::CORESUME:
+    case Lib::ISCODONE:
+    case Lib::ISCORUNNING: {
+      const uint32_t cd = a[0] & 0xFFFF;
+      if (!checkAccess(cd, kCoDataSize, instructionPc)) return;
+      const uint8_t state = rd8(cd + kCoState);
+      switch (id) {
+        case Lib::COBEGIN:
+        case Lib::CORESET:
+          costateEnd(cd, false);
+          wr8(cd + kCoFirstTime, 0);
+          wr8(cd + kCoState, id == Lib::COBEGIN ? kCoInit : kCoStopped | kCoInit);
+          return;
+        case Lib::COPAUSE:
+          wr8(cd + kCoState, state | kCoStopped);
+          return;
+        case Lib::CORESUME:
+          wr8(cd + kCoState, state & ~kCoStopped);
+          return;
+        case Lib::ISCODONE:
+          eval[sp++] = (state & (kCoStopped | kCoInit)) == (kCoStopped | kCoInit) ? 1u : 0u;
+          return;
+        default:
+          eval[sp++] = (state & kCoStopped) ? 0u : 1u;
+          return;
+      }
+    }
     case Lib::STRCPY:
     case Lib::MEMSET:
     case Lib::MEMCPY:
@@ -604,6 +719,7 @@ Stop Vm::State::run(Tick until) {
       busTouched = false;
       return Stop::Io;
     }
+    if (now >= nextTimer) timerTick();
     if (now >= until) return halted ? Stop::Halted : Stop::Horizon;
     if (lib.awaitingBegin) {  // the end of a library call's sequence: no boundary
       // (for an atomic call this also keeps interrupts out until its effect)
@@ -627,7 +743,13 @@ Stop Vm::State::run(Tick until) {
       continue;
     }
     if (halted) {
-      now = until;  // HALT: idle until the horizon or the next interrupt
+      // HALT: idle until the horizon, the next interrupt request from the
+      // host, or PRT0's next tick.
+      if (nextTimer < until) {
+        now = nextTimer;
+        continue;
+      }
+      now = until;
       return Stop::Halted;
     }
     if (pc >= codeSize) {
@@ -1119,6 +1241,58 @@ Stop Vm::State::run(Tick until) {
       }
       NEXT;
       CASE(DBG) NEXT;
+      CASE(COSTATE) {
+        const uint32_t cd = u16();
+        const uint32_t end = static_cast<uint32_t>(
+            static_cast<int32_t>(pc) + static_cast<int16_t>(operand[2] | (operand[3] << 8)));
+        if (!checkAccess(cd, kCoDataSize, opPc)) NEXT;
+        const uint8_t state = rd8(cd + kCoState);
+        if (state & kCoStopped) {
+          now += costs.costateStoppedDelta;
+          if constexpr (kProfile)
+            profile[opPc] += static_cast<uint64_t>(int64_t{costs.costateStoppedDelta});
+          pc = end;
+          NEXT;
+        }
+        wr8(cd + kCoState, state & ~kCoInit);
+        const uint32_t resume = rd16(cd + kCoLastLoc);
+        if (resume == 0) {
+          BRANCH_COST(2u);  // JR Z taken over JP (HL)
+        } else {
+          if (((resume & 0xFF) ^ (resume >> 8) ^ rd8(cd + kCoLastLocCbr)) != rd8(cd + kCoChkSum)) {
+            raiseFault("costatement's resume address is corrupted (CoData checksum)", opPc);
+            NEXT;
+          }
+          if (!std::binary_search(image.resumePoints.begin(), image.resumePoints.end(),
+                                  static_cast<uint16_t>(resume))) {
+            raiseFault(fmt::format("costatement resumes at 0x{:04x}, not a yield point", resume),
+                       opPc);
+            NEXT;
+          }
+          pc = resume;
+        }
+        costateEvent(cd, Bus::CostateEvent::Enter, pc);
+      }
+      NEXT;
+      CASE(COYIELD) {
+        const uint32_t cd = u16();
+        const uint32_t resume = static_cast<uint32_t>(
+            static_cast<int32_t>(pc) + static_cast<int16_t>(operand[2] | (operand[3] << 8)));
+        if (!checkAccess(cd, kCoDataSize, opPc)) NEXT;
+        wr16(cd + kCoLastLoc, resume);
+        wr8(cd + kCoLastLocCbr, 0);
+        wr8(cd + kCoChkSum, (resume & 0xFF) ^ (resume >> 8));
+        costateEvent(cd, Bus::CostateEvent::Yield, opPc);
+      }
+      NEXT;
+      CASE(COEND)
+      CASE(CODONE) {
+        const uint32_t cd = u16();
+        if (!checkAccess(cd, kCoDataSize, opPc)) NEXT;
+        costateEnd(cd, op == static_cast<uint8_t>(Op::CODONE));
+        costateEvent(cd, Bus::CostateEvent::End, opPc);
+      }
+      NEXT;
 #if !SIMBOT_COMPUTED_GOTO
       case Op::Count_:
         break;
@@ -1150,6 +1324,10 @@ Vm::Vm(const Image& image, Bus& bus, const CostTable& costs)
   for (const auto& v : image.vectors) s.handlerFor[v.vector] = v.handler;
   s.calls.reserve(kMemorySize / kCallFrameBytes);
   s.ints.reserve(kMaxInterruptNesting);
+  const TimerService service = costs.knobs.timerService;
+  if (service == TimerService::Always || (service == TimerService::Auto && image.timer.used()))
+    s.nextTimer = kPrtTicks;
+  s.costateEvents = bus.wantCostateEvents();
 }
 
 Vm::~Vm() = default;
@@ -1215,5 +1393,6 @@ void Vm::enableProfile() {
 }
 const std::vector<uint64_t>& Vm::profile() const { return s_->profile; }
 uint64_t Vm::serialIsrCycles() const { return s_->serialIsrCycles; }
+uint64_t Vm::timerIsrCycles() const { return s_->timerIsrCycles; }
 
 }  // namespace simbot::vm
