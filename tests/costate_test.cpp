@@ -1,10 +1,13 @@
 // The Z180 timer and costatements at the VM level: interrupt priority with
 // the timer among the sources, the BIOS timer service's cost and counters
 // against Dynamic C's rule, and a waitfor on a variable an interrupt handler
-// sets. The costatement constructs' console behaviour is in
+// sets, and the profile knob that decides whether the service runs. The
+// costatement constructs' console behaviour is in
 // tests/programs/costate_*.dc and timer_counters.dc.
 #include <gtest/gtest.h>
 
+#include "plant/plant.h"
+#include "scheduler/match.h"
 #include "support/test_host.h"
 
 using namespace simbot;
@@ -188,6 +191,47 @@ main()
   EXPECT_EQ(host.runUntil(v, vm::kTicksPerSecond), vm::Stop::Fault);
   ASSERT_NE(v.fault(), nullptr);
   EXPECT_NE(v.fault()->message.find("checksum"), std::string::npos) << v.fault()->message;
+}
+
+}  // namespace
+
+namespace {
+
+vm::Image compileFile(const std::string& path) {
+  auto r = compiler::compileFile(path);
+  if (!r.image) throw std::runtime_error(r.errors[0].format());
+  return std::move(*r.image);
+}
+
+scheduler::MatchConfig soloConfig(const std::string& file, int timerService, double seconds) {
+  auto profile = plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
+  profile.robot.timer_service = timerService;
+  scheduler::MatchConfig c;
+  c.arena = plant::makeArenaConfig(profile, 1);
+  c.robots.push_back({"A", file, compileFile(file)});
+  c.endTick = timebase::ticksFromSeconds(seconds);
+  return c;
+}
+
+// The profile's [controller] timer_service: "auto" runs the service only in
+// a program that uses the timer library, "always" in every program (ICEMAN
+// then takes 1,024 timer interrupts a second: 2,048 in 2 s less the one at
+// exactly 2 s), "never" in none (a DelayMs never ends).
+TEST(Timer, ProfileKnobDecidesWhetherTheServiceRuns) {
+  const std::string iceman = SIMBOT_SHARED_DIR "/programs/iceman.dc";
+  const std::string toggler = SIMBOT_SOURCE_DIR "/tests/programs/costate_delayms.dc";
+  const auto autoIceman = scheduler::runMatch(soloConfig(iceman, 0, 2));
+  EXPECT_EQ(autoIceman.robots[0].interrupts.at("timer"), 0u);
+  auto always = soloConfig(iceman, 1, 2);
+  always.profile = true;  // the service's cycles are a profile figure
+  const auto alwaysIceman = scheduler::runMatch(always);
+  EXPECT_EQ(alwaysIceman.robots[0].interrupts.at("timer"), 2047u);
+  EXPECT_GT(alwaysIceman.robots[0].timerIsrCycles, 0u);
+  const auto autoToggler = scheduler::runMatch(soloConfig(toggler, 0, 2));
+  EXPECT_TRUE(autoToggler.robots[0].exited);
+  const auto neverToggler = scheduler::runMatch(soloConfig(toggler, 2, 2));
+  EXPECT_FALSE(neverToggler.robots[0].exited);
+  EXPECT_EQ(neverToggler.robots[0].interrupts.at("timer"), 0u);
 }
 
 }  // namespace
