@@ -98,6 +98,7 @@ class CodeGen {
   void stmt(Node* n);
   void declInit(Node* n);
   void costate(Node* n);
+  bool isDelayLoop(const Node* n) const;
   void waitfor(Node* n);
   void costateYield(Node* costate, int resumeLabel, int line);
   void autoInitStores(const Init* init, int off, int line);
@@ -532,6 +533,7 @@ void CodeGen::stmt(Node* n) {
       }
       int ltop = newLabel(), lcont = newLabel(), lend = newLabel();
       bind(ltop);
+      const int top = static_cast<int>(img_.code.size());
       if (n->cond) cond(n->cond, lend, false);
       breaks_.push_back(lend);
       continues_.push_back(lcont);
@@ -542,6 +544,9 @@ void CodeGen::stmt(Node* n) {
       if (n->inc) effect(n->inc->lhs);
       jump(Op::JMP, ltop, line);
       bind(lend);
+      if (isDelayLoop(n))
+        img_.delayLoops.push_back(
+            {static_cast<uint16_t>(top), static_cast<uint16_t>(img_.code.size())});
       return;
     }
     case NodeKind::Switch: {
@@ -629,6 +634,25 @@ void CodeGen::stmt(Node* n) {
     default:
       fail(n->pos, "internal error: unexpected statement");
   }
+}
+
+// A counting loop with nothing in it: `for (...; v < N; v++) ;` (or <=) on
+// a static or global 16-bit integer. The VM checks the code's shape too.
+bool CodeGen::isDelayLoop(const Node* n) const {
+  const Node* body = n->then;
+  const bool empty =
+      body->kind == NodeKind::Empty || (body->kind == NodeKind::Block && body->list.empty());
+  if (!empty || !n->cond || !n->inc) return false;
+  const Node* c = n->cond;
+  if ((c->kind != NodeKind::Lt && c->kind != NodeKind::Le) || c->lhs->kind != NodeKind::Var ||
+      c->rhs->kind != NodeKind::Num)
+    return false;
+  const Obj* v = c->lhs->var;
+  if (v->storage != Storage::Global && v->storage != Storage::Static) return false;
+  if (v->type->kind != TypeKind::Int && v->type->kind != TypeKind::UInt) return false;
+  const Node* inc = n->inc->lhs;
+  return inc->kind == NodeKind::IncDec && inc->delta == 1 && inc->lhs->kind == NodeKind::Var &&
+         inc->lhs->var == v;
 }
 
 // costate { body }:

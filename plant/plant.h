@@ -88,6 +88,8 @@ struct RobotParams {
   // The BIOS timer service (PRT0): 0 auto (only in programs that use the
   // timer library), 1 always, 2 never (vm::TimerService's order).
   int timer_service = 0;
+  // Delay loops run in one exact step (vm CostKnobs::fastForward).
+  bool fast_forward = true;
 };
 
 struct FieldParams {

@@ -173,6 +173,7 @@ const std::vector<KeyDef>& keyTable() {
        D(p.robot.misfire_probability)},
       {"controller", "random_memory", Kind::Bool, {0, 0}, true, B(p.robot.random_memory)},
       {"controller", "timer_service", Kind::Choice, {0, 0}, true, I(p.robot.timer_service)},
+      {"controller", "fast_forward", Kind::Bool, {0, 0}, true, B(p.robot.fast_forward)},
       {"projectile", "gravity", Kind::Accel, {1, 1000}, false, D(p.field.gravity_fps2)},
       {"projectile", "count_floor_skips", Kind::Bool, {0, 0}, false, B(p.field.count_floor_skips)},
       {"referee",

@@ -327,6 +327,7 @@ void Robot::powerOn(Tick t) {
   // The timer service is this robot's controller's (profile [controller]).
   vm::CostTable table = costs;
   table.knobs.timerService = static_cast<vm::TimerService>(match.robotParams(index).timer_service);
+  table.knobs.fastForward = costs.knobs.fastForward && match.robotParams(index).fast_forward;
   vm_ = std::make_unique<vm::Vm>(spec.image, bus, table);
   faultSeen = false;
   vm_->setBreakpoint(mainReturn);

@@ -82,6 +82,7 @@ struct RunOptions {
   std::vector<std::string> injections;
   std::vector<std::string> watches;
   bool traceCostate = false;
+  bool noFastForward = false;
   std::string scenario;
   bool json = false;
   bool reloadOnFault = false;
@@ -225,6 +226,7 @@ Played play(const std::vector<std::string>& programs, const RunOptions& o, bool 
   if (o.traceCostate && o.trace.empty() && o.replay.empty())
     throw tools::ToolError("simbot: --trace-costate needs --trace FILE (or --replay FILE)\n");
   config.traceCostate = o.traceCostate;
+  if (o.noFastForward) config.knobs.fastForward = false;
   // Sinks open their files before the run: a bad path costs nothing.
   std::optional<tools::JsonlSink> jsonl;
   std::optional<tools::VcdSink> vcd;
@@ -465,6 +467,9 @@ void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
   cmd->add_option("--watch", o.watches,
                   "add a global or static variable (FUNCTION.NAME) to every trace record "
                   "(repeatable; needs --trace or --replay)");
+  cmd->add_flag("--no-fast-forward", o.noFastForward,
+                "step every pass of every delay loop (the result is the same, slower: for "
+                "checking)");
   cmd->add_flag("--trace-costate", o.traceCostate,
                 "add a record each time a costatement is entered, gives way or ends (needs "
                 "--trace or --replay)");

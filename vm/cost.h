@@ -238,6 +238,9 @@ struct CostKnobs {
   bool epilogueEi = true;
   // Not calibration: whether PRT0 and the BIOS timer service run.
   TimerService timerService = TimerService::Auto;
+  // Not calibration: run marked delay loops in one step where nothing can
+  // happen to the robot meanwhile (exact; off for checking).
+  bool fastForward = true;
 };
 
 // Tables resolved against the knobs, built once per VM configuration.

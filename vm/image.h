@@ -97,6 +97,15 @@ struct Image {
   // Code addresses a costatement may resume at (yield and waitfor points),
   // sorted: a lastlocADDR that is not one of them is a fault.
   std::vector<uint16_t> resumePoints;
+  // Delay loops the compiler marked for fast-forward (DESIGN.md, issue 13):
+  // `for (v = ...; v < N; v++) ;` on a static or global int, whose code is
+  // top: LDGW v; PUSHW N; LTW|LTUW|LEW|LEUW; JZ exit; [DBG]; INCGW v;
+  // JMP top; exit:. The VM checks that shape before trusting a mark.
+  struct DelayLoop {
+    uint16_t top;
+    uint16_t exit;
+  };
+  std::vector<DelayLoop> delayLoops;
   // First code address of each function, for profiles and fault messages.
   const Symbol* functionAt(uint32_t codeAddress) const;
   int lineAt(uint32_t codeAddress) const {

@@ -170,6 +170,27 @@ struct Vm::State {
   uint32_t biosTicks = 0;
   uint8_t biosMsFraction = 0;
   bool costateEvents = false;
+  // ---- fast-forward of delay loops ----
+  struct Loop {
+    uint32_t top, exit, counter;
+    uint16_t limit;
+    Op compare;
+  };
+  std::vector<Loop> loops;
+  std::vector<int16_t> loopAtTop;  // per code byte: index into loops, or -1
+  // The pass being measured: from one arrival at a loop's top to the next.
+  static constexpr uint32_t kMaxLoopBytes = 32;
+  struct Measure {
+    int loop = -1;
+    Tick start = 0;
+    uint32_t counter = 0;
+    uint64_t instructions = 0;
+    uint64_t accepted = 0;
+    std::array<uint64_t, kMaxLoopBytes> profile{};
+  } measure;
+  uint64_t acceptances = 0;  // interrupts accepted so far (a pass with one is no measure)
+  void findLoops();
+  bool fastForward(Tick until);
   std::string consoleLine;
   Vm* self = nullptr;
 
@@ -260,6 +281,7 @@ struct Vm::State {
 };
 
 void Vm::State::accept() {
+  ++acceptances;
   int i = 0;
   while (!pend[i]) ++i;
   const Irq irq = static_cast<Irq>(i);
@@ -348,6 +370,111 @@ bool Vm::State::delayDone(const uint32_t* a, uint32_t timerAddress, uint32_t ins
     wr32(cd + kCoContent, timer);
   }
   return static_cast<int32_t>(timer - rd32(cd + kCoContent)) >= static_cast<int32_t>(a[1]);
+}
+
+// ---- fast-forward of delay loops -------------------------------------------
+//
+// A marked loop (Image::delayLoops) whose code has the expected shape runs
+// many passes in one step. Every pass from the same counter regime costs
+// the same and touches nothing but its counter, so the VM measures one pass
+// as stepped (arrival at the top to the next arrival, with no interrupt
+// accepted in between) and then applies n more at once: the counter +n, the
+// clock +n x the pass, the instruction count and the profile likewise. n
+// stops short of the loop's exit and lands at or before the earliest tick
+// at which anything can happen to this robot: the horizon of run() (the
+// host stops a robot at every tick it raises a request or a device acts)
+// and PRT0's next tick. The boundaries it skips are all before those, so
+// nothing could have been accepted or stopped there; where it lands, the
+// ordinary boundary follows. Breakpoints inside the loop turn it off.
+
+void Vm::State::findLoops() {
+  const auto& code = image.code;
+  auto at = [&](uint32_t a) -> int { return a < code.size() ? code[a] : -1; };
+  auto u16at = [&](uint32_t a) { return static_cast<uint32_t>(code[a] | (code[a + 1] << 8)); };
+  auto rel = [&](uint32_t operand) {
+    return static_cast<uint32_t>(static_cast<int32_t>(operand + 2) +
+                                 static_cast<int16_t>(u16at(operand)));
+  };
+  for (const auto& mark : image.delayLoops) {
+    uint32_t a = mark.top;
+    if (mark.exit > code.size() || mark.exit <= a || mark.exit - a > kMaxLoopBytes) continue;
+    if (at(a) != static_cast<int>(Op::LDGW)) continue;
+    const uint32_t counter = u16at(a + 1);
+    a += 3;
+    if (at(a) != static_cast<int>(Op::PUSHW)) continue;
+    const auto limit = static_cast<uint16_t>(u16at(a + 1));
+    a += 3;
+    const int cmp = at(a);
+    if (cmp != static_cast<int>(Op::LTW) && cmp != static_cast<int>(Op::LTUW) &&
+        cmp != static_cast<int>(Op::LEW) && cmp != static_cast<int>(Op::LEUW))
+      continue;
+    a += 1;
+    if (at(a) != static_cast<int>(Op::JZ) || rel(a + 1) != mark.exit) continue;
+    a += 3;
+    if (at(a) == static_cast<int>(Op::DBG)) a += 1;
+    if (at(a) != static_cast<int>(Op::INCGW) || u16at(a + 1) != counter) continue;
+    a += 3;
+    if (at(a) != static_cast<int>(Op::JMP) || rel(a + 1) != mark.top || a + 3 != mark.exit)
+      continue;
+    if (counter < kDataBase || counter + 1 >= kMemorySize) continue;
+    if (loopAtTop.empty()) loopAtTop.assign(code.size() + 1, -1);
+    if (loopAtTop[mark.top] >= 0) continue;
+    loopAtTop[mark.top] = static_cast<int16_t>(loops.size());
+    loops.push_back(Loop{mark.top, mark.exit, counter, limit, static_cast<Op>(cmp)});
+  }
+}
+
+bool Vm::State::fastForward(Tick until) {
+  const int index = loopAtTop[pc];
+  const Loop& loop = loops[static_cast<size_t>(index)];
+  const uint32_t v = rd16(loop.counter);
+  const bool isSigned = loop.compare == Op::LTW || loop.compare == Op::LEW;
+  const bool inclusive = loop.compare == Op::LEW || loop.compare == Op::LEUW;
+  // Passes still to run from v, and the largest counter of the regime in
+  // which every pass costs the same (signed: no overflow in v - N when both
+  // are non-negative; the counter must not wrap).
+  auto passesLeft = [&](uint32_t from) -> int64_t {
+    const int64_t x = isSigned ? static_cast<int16_t>(from) : static_cast<int64_t>(from);
+    const int64_t n =
+        isSigned ? static_cast<int16_t>(loop.limit) : static_cast<int64_t>(loop.limit);
+    const int64_t top = isSigned ? 32767 : 65535;
+    const int64_t last = std::min(inclusive ? n : n - 1, top - 1);  // v + 1 stays in range
+    return last >= x ? last - x + 1 : 0;
+  };
+  const bool regime =
+      !isSigned || (static_cast<int16_t>(v) >= 0 && static_cast<int16_t>(loop.limit) >= 0);
+  const bool anyBreak =
+      anyBreakpoint && std::any_of(breakpoints.begin() + loop.top, breakpoints.begin() + loop.exit,
+                                   [](uint8_t b) { return b != 0; });
+  if (measure.loop == index && measure.accepted == acceptances &&
+      v == ((measure.counter + 1) & 0xFFFF) && regime && !anyBreak &&
+      static_cast<int16_t>(measure.counter) >= (isSigned ? 0 : INT16_MIN)) {
+    const Tick pass = now - measure.start;
+    const Tick bound = std::min(until, nextTimer);
+    const int64_t n =
+        pass > 0 && bound > now ? std::min<int64_t>(passesLeft(v), (bound - now) / pass) : 0;
+    if (n > 0) {
+      wr16(loop.counter, v + static_cast<uint32_t>(n));
+      now += n * pass;
+      const uint64_t skipped =
+          static_cast<uint64_t>(n) * (stats.instructions - measure.instructions);
+      stats.instructions += skipped;
+      stats.fastForwarded += skipped;
+      if (profiling)
+        for (uint32_t a = loop.top; a < loop.exit; ++a)
+          profile[a] += static_cast<uint64_t>(n) * (profile[a] - measure.profile[a - loop.top]);
+      measure.loop = -1;
+      return true;
+    }
+  }
+  measure.loop = index;
+  measure.start = now;
+  measure.counter = v;
+  measure.instructions = stats.instructions;
+  measure.accepted = acceptances;
+  if (profiling)
+    std::copy(profile.begin() + loop.top, profile.begin() + loop.exit, measure.profile.begin());
+  return false;
 }
 
 // ---- library calls -------------------------------------------------------
@@ -692,6 +819,8 @@ Stop Vm::State::run(Tick until) {
   const uint8_t* const code = image.code.data();
   const uint32_t codeSize = static_cast<uint32_t>(image.code.size());
   const uint32_t* const opCost = costs.op.data();
+  const int16_t* const loopTop =
+      costs.knobs.fastForward && !loopAtTop.empty() ? loopAtTop.data() : nullptr;
   busTouched = false;
 
 #if SIMBOT_COMPUTED_GOTO
@@ -760,6 +889,7 @@ Stop Vm::State::run(Tick until) {
       resumeAtBreakpoint = true;
       return Stop::Breakpoint;
     }
+    if (loopTop && loopTop[pc] >= 0 && fastForward(until)) continue;
     resumeAtBreakpoint = false;
     opPc = pc;
     op = code[pc];
@@ -1328,6 +1458,7 @@ Vm::Vm(const Image& image, Bus& bus, const CostTable& costs)
   if (service == TimerService::Always || (service == TimerService::Auto && image.timer.used()))
     s.nextTimer = kPrtTicks;
   s.costateEvents = bus.wantCostateEvents();
+  s.findLoops();
 }
 
 Vm::~Vm() = default;

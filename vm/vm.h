@@ -100,6 +100,8 @@ enum class Stop : uint8_t {
 
 struct VmStats {
   uint64_t instructions = 0;  // bytecode instructions and library steps
+  // Of those, the ones fast-forward applied without dispatching them.
+  uint64_t fastForwarded = 0;
   std::array<uint64_t, kIrqCount> interrupts{};
 };
 
