@@ -356,4 +356,31 @@ TEST(Match, AnIntegratorFailureEndsTheRunWithAPlantFault) {
   EXPECT_TRUE(std::isfinite(r.robots[0].finalPose.x_ft));
 }
 
+// programs/costate_hunter.dc, the costatement-style robot, against ICEMAN
+// for a full 180-s round: its steering costatement sends a frame only once
+// the previous one has gone (cc back at 0), so it latches frames all round
+// and overwrites none; it finds ICEMAN and shoots; a rerun is identical.
+TEST(Match, CostateHunterPlaysIcemanAndLatchesFrames) {
+  const std::string hunter = SIMBOT_SOURCE_DIR "/programs/costate_hunter.dc";
+  auto make = [&] {
+    return matchConfig({{"A", hunter, compileFile(hunter)}, {"B", kIceman, compileFile(kIceman)}},
+                       180);
+  };
+  const auto r1 = testkit::runTraced(make());
+  const auto r2 = testkit::runTraced(make());
+  EXPECT_EQ(summary(r1), summary(r2));
+  EXPECT_EQ(r1.trace, r2.trace);
+  ASSERT_EQ(r1.robots.size(), 2u);
+  const auto& a = r1.robots[0];
+  const auto& b = r1.robots[1];
+  EXPECT_FALSE(a.fault.has_value());
+  EXPECT_FALSE(b.fault.has_value());
+  EXPECT_GT(a.framesLatched, 50);
+  EXPECT_GT(b.framesLatched, 0);
+  EXPECT_EQ(a.framesOverwritten, 0);
+  EXPECT_EQ(a.framesRejected, 0);
+  EXPECT_GT(a.shots, 0);
+  EXPECT_GT(a.hits, 0);
+}
+
 }  // namespace
