@@ -8,9 +8,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <variant>
 
 #include "compiler/compiler.h"
 #include "plant/plant.h"
+#include "plant/serial_link.h"
+#include "support/records.h"
 #include "support/traced.h"
 
 using namespace simbot;
@@ -354,6 +357,82 @@ TEST(Match, AnIntegratorFailureEndsTheRunWithAPlantFault) {
   EXPECT_EQ(r.plantFault->timeS, static_cast<double>(r.endTick) / scheduler::kTicksPerSecond);
   EXPECT_GT(r.robots[0].framesLatched, 0);  // the frame that made the plant fail
   EXPECT_TRUE(std::isfinite(r.robots[0].finalPose.x_ft));
+}
+
+// Keeps only the trace records of the kinds listed (a 180-s match writes
+// some 100,000 records; the tests below need a few hundred).
+template <class... Kinds>
+class KeepSink final : public trace::Sink {
+ public:
+  void write(const trace::Entry& e) override {
+    if ((std::holds_alternative<Kinds>(e.record) || ...)) entries.push_back(e);
+  }
+  std::vector<trace::Entry> entries;
+};
+
+// Thesis VI.D: more than event_limit (5) edge-handler entries within the
+// window (10 s) make the referee turn the robot by turn_deg (45). The
+// entries are counted at the tick their PIO interrupt is accepted
+// (Robot::interruptAccepted records it during the round, the arena applies
+// it after the round at that tick: Arena::edgeHandlerEntered rewinds the
+// plant to it). So the turn must be at the sixth acceptance's tick, not
+// at the end of the round it fell in. The program keeps interrupts off
+// most of the time, so that each request waits for an EI and is accepted
+// in the middle of a round; six edges are injected 1.2 s apart.
+TEST(Match, RefereeTurnsAtTheTickOfTheCountedHandlerEntry) {
+  const char* kEdgy = R"(#INT_VEC PIOA_VEC edge
+int z, hits;
+interrupt reti edge()
+{
+    hits++;
+}
+main()
+{
+    outport(PIOCA, 0xff);
+    outport(PIOCA, 0xff);
+    outport(PIOCA, PIOA_VEC);
+    outport(PIOCA, 0x97);
+    outport(PIOCA, 0xfc);
+    outport(PIOCA, 0x87);
+    while (1) {
+        DI();
+        for (z = 0; z < 37; z++)
+            ;
+        EI();
+    }
+}
+)";
+  auto run = [&](bool inject) {
+    auto c = matchConfig({{"A", "edgy.dc", compileSource(kEdgy)}}, 9);
+    if (inject)
+      for (int k = 1; k <= 6; ++k)
+        c.injections.push_back(
+            scheduler::parseInjection("A:edge_fore@" + std::to_string(1.2 * k) + "s", 1));
+    KeepSink<trace::rec::InterruptAccepted, trace::rec::RefereeTurn> keep;
+    c.sinks.push_back(&keep);
+    auto r = scheduler::runMatch(c);
+    return std::make_pair(r, keep.entries);
+  };
+  const auto [plain, plainTrace] = run(false);
+  const auto [turned, trace] = run(true);
+  ASSERT_EQ(matchConfig({}, 1).arena.referee.event_limit, 5);
+  const auto accepted = testkit::recordsOf<trace::rec::InterruptAccepted>(trace, 0);
+  const auto turns = testkit::recordsOf<trace::rec::RefereeTurn>(trace, 0);
+  ASSERT_EQ(accepted.size(), 6u);
+  for (size_t k = 0; k < accepted.size(); ++k) {
+    EXPECT_EQ(accepted[k].second.source, "pio_a");
+    // Mid-round: not at the injection's tick (a round's end) but at the
+    // EI that lets it in, later in the round.
+    const timebase::Tick injected = timebase::ticksFromSeconds(1.2 * static_cast<double>(k + 1));
+    EXPECT_GT(accepted[k].first - injected, 100) << k;
+    EXPECT_LT(accepted[k].first - injected, plant::kTicksPerChar) << k;
+  }
+  ASSERT_EQ(turns.size(), 1u);
+  EXPECT_EQ(turns[0].first, accepted[5].first);
+  // The robot stands still: the turn is all its heading changed by.
+  EXPECT_NEAR(turned.robots[0].finalPose.heading_deg,
+              std::fmod(plain.robots[0].finalPose.heading_deg + 45.0, 360.0), 1e-9);
+  EXPECT_TRUE(testkit::recordsOf<trace::rec::RefereeTurn>(plainTrace).empty());
 }
 
 }  // namespace
