@@ -435,4 +435,74 @@ main()
   EXPECT_TRUE(testkit::recordsOf<trace::rec::RefereeTurn>(plainTrace).empty());
 }
 
+// The 180-s ICEMAN vs fig92 match (`simbot match iceman.dc fig92.dc`:
+// default profile, seed 1, the profile's 180-s round). The counts and ticks
+// below are REGRESSION values read from the run, not an oracle: a change
+// to the cost table, the plant or the scheduler that moves them must say
+// why. Two relations are checked as an oracle:
+//
+// - ICEMAN's first send, by hand from the cost table (calibrated, the
+//   figures `simbot compile --disasm` prints; no interrupt can come before
+//   it, as nothing moves yet): CALL main 18; ser_init_z1's line DBG 68 +
+//   2 PUSHW 22 + 196 = 308; hv_enb's 68 + 50 = 118; 8 outport lines of
+//   68 + 2 x 22 + 67 = 179 each = 1432; cnt=0 and shcnt=0, 68 + 22 + 28 =
+//   118 each; read(); = DBG 68 + CALL 18 + POP 10 + read's two lines of
+//   DBG 68 + PUSHW 22 + ad_rd8 163 + the 276-T-state conversion + STGW 28
+//   = 557 and its return 68 + 22 + RET 10 = 1310; the delay loop of line 44,
+//   DBG 68 + PUSHL 44 + STGL 58 = 170, then 50,000 passes of LDGL 61 +
+//   PUSHL 44 + LTUL 94 + JZ not taken 25 + DBG 68 + INCGL 92 + JMP 10 = 394
+//   = 19,700,000, and the exit LDGL 61 + PUSHL 44 + LTUL 94 + JZ taken 29
+//   = 228; search(); DBG 68 + CALL 18; search's test x<=48 && y<=48 (both
+//   eyes at background): DBG 68 + 2 x (LDGW 29 + PUSHW 22 + LEW 56, no
+//   overflow and true + JZ not taken 25) = 332; strcpy(buf,"cfgrcfgr"):
+//   DBG 68 + 2 PUSHW 22 + strcpy 59 + 9 bytes x 34 + POP 10 = 487;
+//   platform(); DBG 68 + CALL 18; cc = sizeof(buf): 68 + 22 + STGB 29 =
+//   119; outport(ENB485,1): 179; ser_send_z1(buf,&cc): 68 + 2 x 22 + 189
+//   = 301. In all 19,705,410: the send returns (T0) at that tick.
+// - The frame latches when the NUL's stop bit ends: 8 characters and the
+//   NUL, 9 character times of kTicksPerChar = 9,600 ticks (10 bits at 9,600
+//   baud, 960 characters a second) after T0: 19,705,410 + 86,400 =
+//   19,791,810.
+TEST(Match, IcemanAgainstFig92For180SecondsPinsItsKeyFigures) {
+  auto c =
+      matchConfig({{"A", kIceman, compileFile(kIceman)}, {"B", kFig92, compileFile(kFig92)}},
+                  plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml").round_length_s);
+  ASSERT_EQ(c.seed, 1u);  // simbot match's default
+  ASSERT_EQ(c.endTick, 180 * timebase::kTicksPerSecond);
+  KeepSink<trace::rec::SerialSend, trace::rec::FrameLatched, trace::rec::SolenoidStroke,
+           trace::rec::BallLaunch>
+      keep;
+  c.sinks.push_back(&keep);
+  const auto r = scheduler::runMatch(c);
+  ASSERT_EQ(r.robots.size(), 2u);
+  // Regression values.
+  EXPECT_EQ(r.robots[0].framesLatched, 422);
+  EXPECT_EQ(r.robots[1].framesLatched, 8622);
+  EXPECT_EQ(r.robots[0].shots, 30);
+  EXPECT_EQ(r.robots[1].shots, 0);
+  EXPECT_EQ(r.robots[0].hits, 2);
+  EXPECT_EQ(r.robots[1].hits, 0);
+  EXPECT_EQ(r.winner, "A");
+  const auto sends = testkit::recordsOf<trace::rec::SerialSend>(keep.entries, 0);
+  const auto frames = testkit::recordsOf<trace::rec::FrameLatched>(keep.entries, 0);
+  const auto strokes = testkit::recordsOf<trace::rec::SolenoidStroke>(keep.entries, 0);
+  const auto launches = testkit::recordsOf<trace::rec::BallLaunch>(keep.entries, 0);
+  ASSERT_FALSE(sends.empty());
+  ASSERT_FALSE(frames.empty());
+  ASSERT_FALSE(strokes.empty());
+  ASSERT_FALSE(launches.empty());
+  EXPECT_EQ(static_cast<int>(frames.size()), r.robots[0].framesLatched);
+  EXPECT_EQ(static_cast<int>(launches.size()), r.robots[0].shots);
+  // The oracle: T0 summed by hand above, the latch 9 characters later.
+  EXPECT_EQ(sends[0].first, 19'705'410);
+  EXPECT_EQ(frames[0].first - sends[0].first, 9 * plant::kTicksPerChar);
+  EXPECT_EQ(frames[0].first, 19'791'810);
+  EXPECT_EQ(frames[0].second.bytes, "cfgrcfgr");
+  // Regression values: the first fire()'s solenoids (port B 0x30, both
+  // guns), and its launch one stroke (0.03 s = 276,480 ticks) later.
+  EXPECT_EQ(strokes[0].first, 54'265'154);
+  EXPECT_EQ(launches[0].first, 54'541'634);
+  EXPECT_EQ(launches[0].first - strokes[0].first, 276'480);
+}
+
 }  // namespace
