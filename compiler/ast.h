@@ -7,6 +7,7 @@
 // Cast nodes for implicit conversions and folds constant subtrees, so the
 // code generator never has to reason about C's typing rules.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <string>
@@ -111,6 +112,7 @@ struct Obj {
   Init* init = nullptr;    // Global/Static: initial value (Image::data)
   Function* fn = nullptr;  // Storage::Function
   int address = -1;        // data address, or frame offset for autos
+  bool biosTimer = false;  // TICK_TIMER, MS_TIMER, SEC_TIMER (the BIOS's)
 };
 
 struct Function {
@@ -199,6 +201,11 @@ enum class NodeKind : uint8_t {
   Label,
   Empty,
   DeclInit,
+  // costatements (Dynamic C)
+  Costate,  // var: its CoData; then: body; ival: 1 if always_on
+  Waitfor,  // cond: the expression; costate: the enclosing Costate
+  Yield,    // costate: the enclosing Costate
+  Abort,    // costate: the enclosing Costate
 };
 
 struct Node {
@@ -233,6 +240,7 @@ struct Node {
   int lib = 0;                  // LibCall: builtin id; Intrinsic: 0 EI, 1 DI
   bool isDefault = false;       // Case
   std::vector<Node*> cases;     // Switch: its case and default labels
+  Node* costate = nullptr;      // Waitfor/Yield/Abort: the enclosing Costate
   int label = -1;               // code generation
 };
 
@@ -253,6 +261,10 @@ struct Program {
   std::vector<Function*> functions;  // defined functions, in order
   Function* main = nullptr;
   std::vector<IntVecBinding> vectors;
+  // The BIOS timer's counters (TICK_TIMER, MS_TIMER, SEC_TIMER, the
+  // millisecond fraction): set, and defined in globals, once the program
+  // uses the timer library (a timer variable or a Delay function).
+  std::array<Obj*, 4> timer{};
 };
 
 // parser.cpp: the whole translation unit, type-checked. Errors and the

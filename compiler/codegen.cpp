@@ -14,6 +14,7 @@
 // packed without alignment: first the globals in declaration order, then the
 // string literals their initialisers use, then, function by function as they
 // are compiled, their statics, switch temporaries and string literals.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -79,6 +80,7 @@ class CodeGen {
   int newLabel();
   void bind(int label);
   void jump(Op op, int label, int line);
+  void coJump(Op op, int coData, int label, int line);  // CO shape
   void pushConst(const Type* t, int64_t v, int line);
 
   // ---- data ----
@@ -95,6 +97,10 @@ class CodeGen {
   void function(Function* f);
   void stmt(Node* n);
   void declInit(Node* n);
+  void costate(Node* n);
+  bool isDelayLoop(const Node* n) const;
+  void waitfor(Node* n);
+  void costateYield(Node* costate, int resumeLabel, int line);
   void autoInitStores(const Init* init, int off, int line);
 
   // ---- expressions ----
@@ -173,6 +179,13 @@ void CodeGen::bind(int label) { labels_[label].addr = static_cast<int>(img_.code
 
 void CodeGen::jump(Op op, int label, int line) {
   emit(op, line);
+  labels_[label].fixups.push_back(static_cast<int>(img_.code.size()));
+  emitByte(0, line);
+  emitByte(0, line);
+}
+
+void CodeGen::coJump(Op op, int coData, int label, int line) {
+  emitU16(op, coData, line);
   labels_[label].fixups.push_back(static_cast<int>(img_.code.size()));
   emitByte(0, line);
   emitByte(0, line);
@@ -348,6 +361,11 @@ vm::Image CodeGen::run() {
     }
 
   for (Function* f : prog_.functions) function(f);
+  std::sort(img_.resumePoints.begin(), img_.resumePoints.end());
+  if (Obj* const* t = prog_.timer.data(); t[0])
+    img_.timer =
+        vm::TimerBlock{static_cast<uint16_t>(t[0]->address), static_cast<uint16_t>(t[1]->address),
+                       static_cast<uint16_t>(t[2]->address), static_cast<uint16_t>(t[3]->address)};
 
   for (auto [at, f] : callFixups_) {
     img_.code[static_cast<size_t>(at)] = static_cast<uint8_t>(f->address & 0xFF);
@@ -515,6 +533,7 @@ void CodeGen::stmt(Node* n) {
       }
       int ltop = newLabel(), lcont = newLabel(), lend = newLabel();
       bind(ltop);
+      const int top = static_cast<int>(img_.code.size());
       if (n->cond) cond(n->cond, lend, false);
       breaks_.push_back(lend);
       continues_.push_back(lcont);
@@ -525,6 +544,9 @@ void CodeGen::stmt(Node* n) {
       if (n->inc) effect(n->inc->lhs);
       jump(Op::JMP, ltop, line);
       bind(lend);
+      if (isDelayLoop(n))
+        img_.delayLoops.push_back(
+            {static_cast<uint16_t>(top), static_cast<uint16_t>(img_.code.size())});
       return;
     }
     case NodeKind::Switch: {
@@ -592,9 +614,86 @@ void CodeGen::stmt(Node* n) {
       stmt(n->then);
       return;
     }
+    case NodeKind::Costate:
+      costate(n);
+      return;
+    case NodeKind::Waitfor:
+      waitfor(n);
+      return;
+    case NodeKind::Yield: {
+      const int resume = newLabel();
+      costateYield(n->costate, resume, line);
+      bind(resume);
+      img_.resumePoints.push_back(static_cast<uint16_t>(img_.code.size()));
+      return;
+    }
+    case NodeKind::Abort:
+      emitU16(n->costate->ival ? Op::COEND : Op::CODONE, n->costate->var->address, line);
+      jump(Op::JMP, n->costate->label, line);
+      return;
     default:
       fail(n->pos, "internal error: unexpected statement");
   }
+}
+
+// A counting loop with nothing in it: `for (...; v < N; v++) ;` (or <=) on
+// a static or global 16-bit integer. The VM checks the code's shape too.
+bool CodeGen::isDelayLoop(const Node* n) const {
+  const Node* body = n->then;
+  const bool empty =
+      body->kind == NodeKind::Empty || (body->kind == NodeKind::Block && body->list.empty());
+  if (!empty || !n->cond || !n->inc) return false;
+  const Node* c = n->cond;
+  if ((c->kind != NodeKind::Lt && c->kind != NodeKind::Le) || c->lhs->kind != NodeKind::Var ||
+      c->rhs->kind != NodeKind::Num)
+    return false;
+  const Obj* v = c->lhs->var;
+  if (v->storage != Storage::Global && v->storage != Storage::Static) return false;
+  if (v->type->kind != TypeKind::Int && v->type->kind != TypeKind::UInt) return false;
+  const Node* inc = n->inc->lhs;
+  return inc->kind == NodeKind::IncDec && inc->delta == 1 && inc->lhs->kind == NodeKind::Var &&
+         inc->lhs->var == v;
+}
+
+// costate { body }:
+//         COSTATE cd, end      ; resume where it gave way, or from the top
+//         body
+//         COEND cd / CODONE cd ; its closing brace: next pass from the top
+//   end:
+void CodeGen::costate(Node* n) {
+  const int line = n->pos.line;
+  const int end = newLabel();
+  n->label = end;
+  coJump(Op::COSTATE, n->var->address, end, line);
+  stmt(n->then);
+  const int close = n->then->endPos.line;
+  emitU16(n->ival ? Op::COEND : Op::CODONE, n->var->address, close > 0 ? close : line);
+  bind(end);
+}
+
+// Gives way: lastlocADDR := resume, then leave through the costatement's end.
+void CodeGen::costateYield(Node* costate, int resumeLabel, int line) {
+  coJump(Op::COYIELD, costate->var->address, resumeLabel, line);
+  jump(Op::JMP, costate->label, line);
+}
+
+// waitfor(expr):
+//         firsttime := 1       ; reached afresh: a Delay function starts timing
+//   test: expr, JNZ go         ; resumed here while it is false
+//         COYIELD cd, test
+//         JMP end
+//   go:
+void CodeGen::waitfor(Node* n) {
+  const int line = n->pos.line;
+  const int cd = n->costate->var->address;
+  emitU16(Op::PUSHW, 1, line);
+  emitU16(Op::STGB, cd + vm::kCoFirstTime, line);
+  const int test = newLabel(), go = newLabel();
+  bind(test);
+  img_.resumePoints.push_back(static_cast<uint16_t>(img_.code.size()));
+  cond(n->cond, go, true);
+  costateYield(n->costate, test, line);
+  bind(go);
 }
 
 // An auto variable's initialiser, run at each entry to its block.

@@ -39,11 +39,12 @@ constexpr size_t kMaxMembers = 512;
 constexpr int kMaxEnumerators = 4096;
 
 const std::unordered_set<std::string_view> kKeywords = {
-    "auto",      "break",  "case",     "char",   "const",    "continue",  "default",  "do",
-    "double",    "else",   "enum",     "extern", "float",    "for",       "goto",     "if",
-    "int",       "long",   "register", "return", "short",    "signed",    "sizeof",   "static",
-    "struct",    "switch", "typedef",  "union",  "unsigned", "void",      "volatile", "while",
-    "interrupt", "reti",   "nodebug",  "debug",  "shared",   "protected", "root",     "xmem"};
+    "auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else", "enum",
+    "extern", "float", "for", "goto", "if", "int", "long", "register", "return", "short", "signed",
+    "sizeof", "static", "struct", "switch", "typedef", "union", "unsigned", "void", "volatile",
+    "while", "interrupt", "reti", "nodebug", "debug", "shared", "protected", "root", "xmem",
+    // Dynamic C's costatement words
+    "costate", "waitfor", "yield", "abort", "always_on", "init_on", "wfd", "waitfordone"};
 
 const std::unordered_set<std::string_view> kDeclWords = {
     "void",   "char",     "short",     "int",   "long",     "float",   "double",
@@ -323,6 +324,14 @@ class Parser {
 
   void applyPragma(const Token& t);
 
+  // ---- costatements ----
+  void predefineCostateNames();
+  Node* costateStatement();
+  Node* waitforStatement();
+  Node* costateControl(NodeKind kind);
+  Obj* coDataNamed(const Token& name, int initialState);
+  void useTimer();
+
   Preprocessor& pp_;
   const Options& options_;
   Program& prog_;
@@ -348,6 +357,10 @@ class Parser {
   Function* fn_ = nullptr;
   int loopDepth_ = 0;
   int breakDepth_ = 0;
+  std::vector<Node*> costates_;  // the costatements being parsed, innermost last
+  Type* coDataType_ = nullptr;
+  std::array<Obj*, 4> timerObjs_{};
+  bool timerUsed_ = false;
   std::vector<Node*> switches_;
   std::unordered_map<std::string, Node*> labels_;
   std::vector<Node*> gotos_;
@@ -547,6 +560,7 @@ void Parser::run() {
     e.value = value;
     scopes_[0].vars[name] = e;
   }
+  predefineCostateNames();
   enterScope();  // file scope
   settle();
   while (cur().kind != TokKind::Eof) {
@@ -756,6 +770,9 @@ void Parser::externalDeclaration() {
   VarAttr attr;
   Type* base;
   const Token& t = cur();
+  if (t.is("cofunc") || t.is("scofunc") || t.is("firsttime"))
+    fail(t.pos, "'" + t.text + "' functions (cofunctions) are not supported by simbot");
+  if (t.is("slice")) fail(t.pos, "'slice' statements are not supported by simbot");
   if (isDeclStart(t)) {
     base = declspec(&attr);
   } else if (t.kind == TokKind::Ident && !isKeyword(t) && peek(1).is("(")) {
@@ -1780,6 +1797,8 @@ Node* Parser::statement() {
 
   if (t.is("break")) {
     advance();
+    if (breakDepth_ == 0 && !costates_.empty())
+      fail(pos, "'break' cannot leave a costatement (use 'abort' to end its pass)");
     if (breakDepth_ == 0) fail(pos, "break statement not in loop or switch");
     expectSemi("after 'break'");
     return newNode(NodeKind::Break, pos);
@@ -1787,6 +1806,8 @@ Node* Parser::statement() {
 
   if (t.is("continue")) {
     advance();
+    if (loopDepth_ == 0 && !costates_.empty())
+      fail(pos, "'continue' cannot leave a costatement (use 'yield' to give way)");
     if (loopDepth_ == 0) fail(pos, "continue statement not in loop");
     expectSemi("after 'continue'");
     return newNode(NodeKind::Continue, pos);
@@ -1802,6 +1823,14 @@ Node* Parser::statement() {
     n->then = statement();
     return n;
   }
+
+  if (t.is("costate")) return costateStatement();
+  if (t.is("waitfor")) return waitforStatement();
+  if (t.is("yield")) return costateControl(NodeKind::Yield);
+  if (t.is("abort")) return costateControl(NodeKind::Abort);
+  if (t.is("wfd") || t.is("waitfordone"))
+    fail(pos, "'" + t.text + "' (cofunctions) is not supported by simbot");
+  if (t.is("slice")) fail(pos, "'slice' statements are not supported by simbot");
 
   if (t.is("{")) return compoundStatement(true);
 
@@ -2784,6 +2813,7 @@ Node* Parser::primary() {
     Node* n = newNode(NodeKind::Var, pos, o->type);
     n->var = o;
     if (is("(")) fail(cur().pos, "called object '" + nameTok.text + "' is not a function");
+    if (o->biosTimer) useTimer();
     return n;
   }
   if (is("(")) {
@@ -2813,9 +2843,8 @@ Node* Parser::primary() {
                       nameTok.text + "()'; declare it before this call)");
     return funcall(nameTok, f);
   }
-  static const std::unordered_set<std::string_view> costate = {"costate", "waitfor", "yield",
-                                                               "abort", "wfd"};
-  if (costate.count(nameTok.text)) fail(pos, "costatements are not supported");
+  if (nameTok.text == "wfd" || nameTok.text == "waitfordone")
+    fail(pos, "'" + nameTok.text + "' (cofunctions) is not supported by simbot");
   undeclared(pos, nameTok.text, "undeclared identifier '" + nameTok.text + "'");
 }
 
@@ -2883,6 +2912,21 @@ Node* Parser::libcall(const Token& nameTok, int lib) {
   bool variadic = !letters.empty() && letters.back() == '.';
   if (variadic) letters.remove_suffix(1);
   std::string name(info.name);
+  // Dynamic C's firsttime functions take the enclosing costatement's CoData
+  // as a hidden first argument.
+  const bool firsttime = lib == static_cast<int>(vm::Lib::DELAYMS) ||
+                         lib == static_cast<int>(vm::Lib::DELAYSEC) ||
+                         lib == static_cast<int>(vm::Lib::DELAYTICKS);
+  Node* hidden = nullptr;
+  if (firsttime) {
+    if (costates_.empty())
+      fail(pos, "'" + name + "' is used inside a costatement, as in 'waitfor(" + name + "(...));'");
+    Node* cd = newNode(NodeKind::Var, pos, coDataType_);
+    cd->var = costates_.back()->var;
+    hidden = newAddr(cd, pos);
+    letters.remove_prefix(1);
+    useTimer();
+  }
   if (args.size() > letters.size() && !variadic)
     fail(pos, "too many arguments to function '" + name + "' (expected " +
                   std::to_string(letters.size()) + ", got " + std::to_string(args.size()) + ")");
@@ -2892,11 +2936,15 @@ Node* Parser::libcall(const Token& nameTok, int lib) {
                   ", got " + std::to_string(args.size()) + ")");
   Node* n = newNode(NodeKind::LibCall, pos);
   n->lib = lib;
+  if (hidden) {
+    n->list.push_back(hidden);
+    n->argPos.push_back(pos);
+  }
   for (size_t i = 0; i < args.size(); ++i) {
     Node* a = value(args[i]);
     Pos ap = argPos[i];
     std::string what = "argument " + std::to_string(i + 1) + " to '" + name + "'";
-    char letter = i < letters.size() ? letters[i] : '.';
+    const char letter = i < letters.size() ? letters[i] : '.';
     auto bad = [&]() {
       fail(ap, "incompatible type for " + what + " ('" + typeName(a->type) + "')");
     };
@@ -2958,6 +3006,150 @@ Node* Parser::libcall(const Token& nameTok, int lib) {
       n->type = pointerTo(tyChar(), pos);
       break;
   }
+  return n;
+}
+
+// ===================================================================
+// Costatements (Dynamic C User's Manual, chapter 5).
+//
+// A costatement is a block that keeps its own resume point, in a CoData
+// structure, across passes of the loop around it: control that reaches it
+// resumes where it last gave way (a yield, or a waitfor whose expression
+// was false) and leaves through its closing brace. Unnamed costatements are
+// always_on; a named one is a CoData variable of that name (created, or an
+// existing global CoData) that starts paused unless always_on or init_on.
+// The firsttime Delay functions and the timer variables are in libcall()
+// and useTimer(); the code is laid out in codegen.cpp (costate()).
+
+// The names a costatement program uses without declaring them: the CoData
+// type (User's Manual 5.4.1: CSState, lastlocADDR, lastlocCBR, ChkSum,
+// firsttime, content, ChkSum2) and the BIOS timer's shared counters.
+void Parser::predefineCostateNames() {
+  Type* co = newType(TypeKind::Struct, vm::kCoDataSize);
+  co->tag = "CoData";
+  const std::pair<const char*, std::pair<Type*, int>> members[] = {
+      {"CSState", {tyChar(), vm::kCoState}},         {"lastlocADDR", {tyUInt(), vm::kCoLastLoc}},
+      {"lastlocCBR", {tyChar(), vm::kCoLastLocCbr}}, {"ChkSum", {tyChar(), vm::kCoChkSum}},
+      {"firsttime", {tyChar(), vm::kCoFirstTime}},   {"content", {tyULong(), vm::kCoContent}},
+      {"ChkSum2", {tyChar(), vm::kCoChkSum2}}};
+  for (const auto& [name, m] : members) co->members.push_back(Member{name, m.first, m.second});
+  coDataType_ = co;
+  ScopeEntry type;
+  type.typeDef = co;
+  scopes_[0].vars["CoData"] = type;
+
+  const char* names[] = {"TICK_TIMER", "MS_TIMER", "SEC_TIMER", "bios_ms_fraction"};
+  for (int i = 0; i < 4; ++i) {
+    Obj* o = newObj(names[i], i == 3 ? tyChar() : tyULong(), Pos{}, Storage::Global);
+    o->biosTimer = true;
+    o->init = newInit(o->type);  // the BIOS zeroes them at start-up
+    o->init->expr = num(0, o->type, Pos{});
+    timerObjs_[i] = o;
+    if (i < 3) {
+      ScopeEntry e;
+      e.var = o;
+      scopes_[0].vars[names[i]] = e;
+    }
+  }
+}
+
+// The program uses the timer library: the BIOS's counters become data of
+// the image (and the timer service runs, profile knob permitting).
+void Parser::useTimer() {
+  if (timerUsed_) return;
+  timerUsed_ = true;
+  for (Obj* o : timerObjs_) prog_.globals.push_back(o);
+  prog_.timer = timerObjs_;
+}
+
+// The CoData a named costatement uses: an existing global CoData of that
+// name, or a new one (file scope, so that CoBegin(&name) works anywhere
+// after it).
+Obj* Parser::coDataNamed(const Token& name, int initialState) {
+  if (ScopeEntry* e = findVar(name.text)) {
+    if (!e->var || e->var->type != coDataType_ ||
+        (e->var->storage != Storage::Global && e->var->storage != Storage::Static))
+      fail(name.pos, "'" + name.text + "' names something other than a static CoData");
+    return e->var;
+  }
+  Obj* o = newObj(name.text, coDataType_, name.pos, Storage::Global);
+  o->init = newInit(coDataType_);
+  Init* state = newInit(tyChar());
+  state->expr = num(initialState, tyChar(), name.pos);
+  o->init->children.push_back(state);
+  ScopeEntry e;
+  e.var = o;
+  scopes_[1].vars[name.text] = e;
+  prog_.globals.push_back(o);
+  return o;
+}
+
+// costate-stmt = "costate" (ident ("always_on" | "init_on")?)? compound-stmt
+Node* Parser::costateStatement() {
+  Pos pos = cur().pos;
+  advance();  // "costate"
+  Node* n = newNode(NodeKind::Costate, pos);
+  if (cur().kind == TokKind::Ident && !isKeyword(cur())) {
+    Token name = cur();
+    advance();
+    int state = vm::kCoStopped | vm::kCoInit;  // named, no state: paused
+    n->ival = 0;
+    if (accept("always_on")) {
+      state = 0;
+      n->ival = 1;
+    } else if (accept("init_on")) {
+      state = vm::kCoInit;
+    }
+    n->var = coDataNamed(name, state);
+    n->str = name.text;
+  } else {
+    if (is("always_on") || is("init_on"))
+      fail(cur().pos, "'" + cur().text + "' needs a costatement name before it");
+    // Unnamed: always_on, its CoData a static of the function.
+    n->ival = 1;
+    n->str = fmt::format("costate@{}", pos.line);
+    Obj* o = newObj(n->str, coDataType_, pos, Storage::Static);
+    o->symName = fn_->name + "." + n->str;
+    o->init = newInit(coDataType_);
+    fn_->locals.push_back(o);
+    n->var = o;
+  }
+  if (!is("{")) fail(cur().pos, "expected '{' after 'costate'");
+  const int savedLoop = loopDepth_, savedBreak = breakDepth_;
+  loopDepth_ = breakDepth_ = 0;
+  costates_.push_back(n);
+  n->then = compoundStatement(true);
+  costates_.pop_back();
+  loopDepth_ = savedLoop;
+  breakDepth_ = savedBreak;
+  return n;
+}
+
+// waitfor-stmt = "waitfor" "(" expr ")" ";"
+Node* Parser::waitforStatement() {
+  Pos pos = cur().pos;
+  if (costates_.empty()) fail(pos, "'waitfor' outside a costatement");
+  advance();
+  Node* n = newNode(NodeKind::Waitfor, pos);
+  n->costate = costates_.back();
+  expect("(");
+  n->cond = value(expr());
+  if (!isScalar(n->cond->type)) fail(n->cond->pos, "condition must have scalar type");
+  expect(")");
+  expectSemi("after 'waitfor'");
+  return n;
+}
+
+// yield-stmt = "yield" ";"
+// abort-stmt = "abort" ";"
+Node* Parser::costateControl(NodeKind kind) {
+  Pos pos = cur().pos;
+  const std::string word = cur().text;
+  if (costates_.empty()) fail(pos, "'" + word + "' outside a costatement");
+  advance();
+  Node* n = newNode(kind, pos);
+  n->costate = costates_.back();
+  expectSemi("after '" + word + "'");
   return n;
 }
 

@@ -85,6 +85,11 @@ struct RobotParams {
   double jam_probability = 0, misfire_probability = 0;
   // controller
   bool random_memory = false;  // power-on RAM from a seeded stream, not zeros
+  // The BIOS timer service (PRT0): 0 auto (only in programs that use the
+  // timer library), 1 always, 2 never (vm::TimerService's order).
+  int timer_service = 0;
+  // Delay loops run in one exact step (vm CostKnobs::fastForward).
+  bool fast_forward = true;
 };
 
 struct FieldParams {

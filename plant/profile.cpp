@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <optional>
@@ -41,6 +42,7 @@ enum class Kind {
   Step,         // "step", integer 0..15
   Bit,          // "bit", integer 0..7
   Bool,         // no unit
+  Choice,       // no unit; one of the words in kChoices, stored as its index
   SpeedTable,   // array of 16 speeds
 };
 
@@ -53,6 +55,10 @@ struct Bounds {
   double lo, hi;
   bool orZero = false;
 };
+
+// The words a Choice key accepts (only [controller] timer_service): the
+// index of the word is what lands in the target (plant.h TimerService).
+constexpr std::array<const char*, 3> kChoices = {"auto", "always", "never"};
 
 struct Target {
   double* d = nullptr;
@@ -166,6 +172,8 @@ const std::vector<KeyDef>& keyTable() {
        true,
        D(p.robot.misfire_probability)},
       {"controller", "random_memory", Kind::Bool, {0, 0}, true, B(p.robot.random_memory)},
+      {"controller", "timer_service", Kind::Choice, {0, 0}, true, I(p.robot.timer_service)},
+      {"controller", "fast_forward", Kind::Bool, {0, 0}, true, B(p.robot.fast_forward)},
       {"projectile", "gravity", Kind::Accel, {1, 1000}, false, D(p.field.gravity_fps2)},
       {"projectile", "count_floor_skips", Kind::Bool, {0, 0}, false, B(p.field.count_floor_skips)},
       {"referee",
@@ -251,6 +259,7 @@ double unitFactor(Kind k, std::string_view u) {
       if (u == "bit") return 1.0;
       break;
     case Kind::Bool:
+    case Kind::Choice:
       break;
   }
   return std::nan("");
@@ -281,6 +290,7 @@ const char* allowedUnits(Kind k) {
     case Kind::Bit:
       return "bit";
     case Kind::Bool:
+    case Kind::Choice:
       return "(none)";
   }
   return "";
@@ -349,15 +359,17 @@ class Checker {
     const std::string name = fmt::format("{}.{}", def.section, def.key);
     const toml::table* tbl = node.as_table();
     if (!tbl)
-      fail(node.source(), fmt::format("'{}' must be a table {{ value = ..., {}source = \"...\" }}",
-                                      name, def.kind == Kind::Bool ? "" : "unit = \"...\", "));
+      fail(node.source(),
+           fmt::format(
+               "'{}' must be a table {{ value = ..., {}source = \"...\" }}", name,
+               def.kind == Kind::Bool || def.kind == Kind::Choice ? "" : "unit = \"...\", "));
     const toml::node* value = nullptr;
     const toml::node* unit = nullptr;
     const toml::node* source = nullptr;
     for (auto&& [k, v] : *tbl) {
       if (k.str() == "value") {
         value = &v;
-      } else if (k.str() == "unit" && def.kind != Kind::Bool) {
+      } else if (k.str() == "unit" && def.kind != Kind::Bool && def.kind != Kind::Choice) {
         unit = &v;
       } else if (k.str() == "source") {
         source = &v;
@@ -371,7 +383,7 @@ class Checker {
       fail(source->source(), fmt::format("'{}.source' must be a string", name));
 
     double factor = 1.0;
-    if (def.kind != Kind::Bool) {
+    if (def.kind != Kind::Bool && def.kind != Kind::Choice) {
       if (!unit)
         fail(node.source(),
              fmt::format("'{}' has no 'unit' (one of: {})", name, allowedUnits(def.kind)));
@@ -389,6 +401,16 @@ class Checker {
           fail(value->source(), fmt::format("'{}' must be true or false", name));
         *t.b = *value->value<bool>();
         return;
+      case Kind::Choice: {
+        const auto word = value->value<std::string>();
+        for (size_t i = 0; word && i < kChoices.size(); ++i)
+          if (*word == kChoices[i]) {
+            *t.i = static_cast<int>(i);
+            return;
+          }
+        fail(value->source(), fmt::format("'{}' must be \"{}\", \"{}\" or \"{}\"", name,
+                                          kChoices[0], kChoices[1], kChoices[2]));
+      }
       case Kind::Count:
       case Kind::Step:
       case Kind::Bit: {

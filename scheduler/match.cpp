@@ -70,6 +70,10 @@ class ShiftedBus : public vm::Bus {
   }
   void interruptReturned(Tick t, vm::Irq irq) override { to_.interruptReturned(t + base, irq); }
   void iffChanged(Tick t, bool iff1) override { to_.iffChanged(t + base, iff1); }
+  bool wantCostateEvents() const override { return to_.wantCostateEvents(); }
+  void costate(Tick t, uint16_t coData, CostateEvent e, int line) override {
+    to_.costate(t + base, coData, e, line);
+  }
 
  private:
   vm::Bus& to_;
@@ -102,6 +106,8 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   void interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) override;
   void interruptReturned(Tick t, vm::Irq irq) override;
   void iffChanged(Tick t, bool iff1) override;
+  bool wantCostateEvents() const override;
+  void costate(Tick t, uint16_t coData, CostateEvent e, int line) override;
   // plant::RobotMemory
   uint8_t read8(uint16_t a) const override { return vm_->read8(a); }
   void write8(uint16_t a, uint8_t v) override { vm_->write8(a, v); }
@@ -152,6 +158,7 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   // T-states of earlier VMs of this robot (reloads), for profiles.
   std::vector<uint64_t> earlierProfile;
   uint64_t earlierSerialIsrCycles = 0;
+  uint64_t earlierTimerIsrCycles = 0;
   plant::SerialLink link;
   // What the serial library had still to fetch of the current send after
   // its last step: a new send while it is above zero overwrites that frame.
@@ -238,6 +245,7 @@ class Match {
   plant::Arena& arena() { return arena_; }
   bool tracing() const { return trace_.on(); }
   bool profiling() const { return config_.profile; }
+  bool tracingCostates() const { return config_.traceCostate && trace_.on(); }
   // Robot `robot` faulted at t: its reload, if the run asks for one.
   void faulted(int robot, Tick t);
   // Injection `injection` (one of config_.injections) fired.
@@ -316,7 +324,11 @@ Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs_, u
 
 void Robot::powerOn(Tick t) {
   bus.base = t;
-  vm_ = std::make_unique<vm::Vm>(spec.image, bus, costs);
+  // The timer service is this robot's controller's (profile [controller]).
+  vm::CostTable table = costs;
+  table.knobs.timerService = static_cast<vm::TimerService>(match.robotParams(index).timer_service);
+  table.knobs.fastForward = costs.knobs.fastForward && match.robotParams(index).fast_forward;
+  vm_ = std::make_unique<vm::Vm>(spec.image, bus, table);
   faultSeen = false;
   vm_->setBreakpoint(mainReturn);
   for (const auto& [address, injections] : lineInjections) vm_->setBreakpoint(address);
@@ -333,6 +345,7 @@ void Robot::reload(Tick t) {
     earlierProfile.resize(std::max(earlierProfile.size(), p.size()));
     for (size_t a = 0; a < p.size(); ++a) earlierProfile[a] += p[a];
     earlierSerialIsrCycles += vm_->serialIsrCycles();
+    earlierTimerIsrCycles += vm_->timerIsrCycles();
   }
   powerOn(t);
   ++result.reloads;
@@ -592,7 +605,8 @@ void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
     pio.accepted();
     match.inputs().push_back({t, index, PlantInput::Kind::EdgeHandler, 0, plant::Bumper::Front});
   }
-  if (!match.tracing()) return;
+  // The BIOS timer service (1,024 a second) is counted, not traced.
+  if (!match.tracing() || irq == vm::Irq::Timer) return;
   if (irq == vm::Irq::SerialTx) {
     serialIsrAccepted = t;  // traced as one span when it returns
     return;
@@ -616,6 +630,22 @@ void Robot::interruptReturned(Tick t, vm::Irq irq) {
 
 void Robot::iffChanged(Tick t, bool iff1) {
   if (match.tracing()) match.emit(t, trace::rec::Iff1{index, iff1});
+}
+
+bool Robot::wantCostateEvents() const { return match.tracingCostates(); }
+
+// The costatement is named by its CoData's symbol: the name a named one
+// was given, "costate@LINE" for an unnamed one (FUNCTION.costate@LINE).
+void Robot::costate(Tick t, uint16_t coData, CostateEvent e, int line) {
+  std::string name = fmt::format("0x{:04x}", coData);
+  for (const auto& s : spec.image.symbols)
+    if (s.address == coData && s.size == vm::kCoDataSize &&
+        (s.kind == vm::Symbol::Kind::Global || s.kind == vm::Symbol::Kind::Static)) {
+      name = s.name.substr(s.name.find('.') + 1);
+      break;
+    }
+  static constexpr const char* kEvent[] = {"enter", "yield", "end"};
+  match.emit(t, trace::rec::Costate{index, name, kEvent[static_cast<int>(e)], line});
 }
 
 // ---- match ------------------------------------------------------------------
@@ -1000,8 +1030,9 @@ void Match::finish(MatchResult& result) {
       rr.profile.resize(std::max(rr.profile.size(), r->earlierProfile.size()));
       for (size_t a = 0; a < r->earlierProfile.size(); ++a) rr.profile[a] += r->earlierProfile[a];
       rr.serialIsrCycles = r->vm().serialIsrCycles() + r->earlierSerialIsrCycles;
+      rr.timerIsrCycles = r->vm().timerIsrCycles() + r->earlierTimerIsrCycles;
     }
-    for (vm::Irq irq : {vm::Irq::Pio, vm::Irq::SerialTx})
+    for (vm::Irq irq : {vm::Irq::Pio, vm::Irq::Timer, vm::Irq::SerialTx})
       rr.interrupts.emplace(std::string(vm::irqName(irq)), 0);
     // After a plant fault the plant answers only from its last re-initialisation.
     rr.finalPose =

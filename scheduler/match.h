@@ -129,6 +129,7 @@ struct MatchConfig {
   vm::CostKnobs knobs = vm::calibratedKnobs();
   std::vector<Injection> injections;
   std::vector<std::string> watches;  // variables added to trace records
+  bool traceCostate = false;         // costate records (--trace-costate)
   bool profile = false;              // per-instruction cycle counts (simbot profile)
   // The trace goes to each sink (not owned), in tick order; none: no trace
   // is built at all.
@@ -190,6 +191,7 @@ struct RobotResult {
   // of the serial library's transmit interrupts.
   std::vector<uint64_t> profile;
   uint64_t serialIsrCycles = 0;
+  uint64_t timerIsrCycles = 0;  // the BIOS timer service (PRT0)
 };
 
 struct MatchResult {

@@ -97,6 +97,7 @@ std::vector<Insn> decode(const Image& img, uint32_t begin, uint32_t end) {
         operand = p[0];
         break;
       case simbot::vm::Shape::U16:
+      case simbot::vm::Shape::CO:  // the CoData address
         operand = p[0] | (p[1] << 8);
         break;
       case simbot::vm::Shape::REL16:

@@ -81,6 +81,8 @@ struct RunOptions {
   std::string replay;
   std::vector<std::string> injections;
   std::vector<std::string> watches;
+  bool traceCostate = false;
+  bool noFastForward = false;
   std::string scenario;
   bool json = false;
   bool reloadOnFault = false;
@@ -221,6 +223,10 @@ Played play(const std::vector<std::string>& programs, const RunOptions& o, bool 
       buildConfig(programs, o, solo ? tools::ScenarioUse::Solo : tools::ScenarioUse::Match);
   config.stopWhenAllExited = solo;
   config.watches = o.watches;
+  if (o.traceCostate && o.trace.empty() && o.replay.empty())
+    throw tools::ToolError("simbot: --trace-costate needs --trace FILE (or --replay FILE)\n");
+  config.traceCostate = o.traceCostate;
+  if (o.noFastForward) config.knobs.fastForward = false;
   // Sinks open their files before the run: a bad path costs nothing.
   std::optional<tools::JsonlSink> jsonl;
   std::optional<tools::VcdSink> vcd;
@@ -349,7 +355,7 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
   const auto& robot = r.robots[0];
   std::map<int, uint64_t> byLine;
   std::map<std::string, uint64_t> byFunction;
-  uint64_t busy = robot.serialIsrCycles;
+  uint64_t busy = robot.serialIsrCycles + robot.timerIsrCycles;
   for (uint32_t at = 0; at < robot.profile.size(); ++at) {
     const uint64_t cycles = robot.profile[at];
     if (cycles == 0) continue;
@@ -382,6 +388,7 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
               {"sim_seconds", static_cast<double>(total) / tps},
               {"cycles", total},
               {"serial_isr_cycles", robot.serialIsrCycles},
+              {"timer_isr_cycles", robot.timerIsrCycles},
               {"idle_cycles", idle},
               {"fault", faultJson(robot.fault)},
               {"functions", json::array()},
@@ -415,6 +422,10 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
     std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {}\n", robot.serialIsrCycles,
                              static_cast<double>(robot.serialIsrCycles) / tps,
                              pct(robot.serialIsrCycles), "(serial transmit interrupts)");
+  if (robot.timerIsrCycles)
+    std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {}\n", robot.timerIsrCycles,
+                             static_cast<double>(robot.timerIsrCycles) / tps,
+                             pct(robot.timerIsrCycles), "(timer service, PRT0 at 1,024 Hz)");
   if (idle)
     std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {}\n", idle,
                              static_cast<double>(idle) / tps, pct(idle), "(halted)");
@@ -456,6 +467,12 @@ void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
   cmd->add_option("--watch", o.watches,
                   "add a global or static variable (FUNCTION.NAME) to every trace record "
                   "(repeatable; needs --trace or --replay)");
+  cmd->add_flag("--no-fast-forward", o.noFastForward,
+                "step every pass of every delay loop (the result is the same, slower: for "
+                "checking)");
+  cmd->add_flag("--trace-costate", o.traceCostate,
+                "add a record each time a costatement is entered, gives way or ends (needs "
+                "--trace or --replay)");
   cmd->add_flag("--reload-on-fault", o.reloadOnFault,
                 "reload a faulted program after the profile's [match] reload_delay: it starts "
                 "again from main with its memory as at load (thesis Appendix A)");

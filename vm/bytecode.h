@@ -14,6 +14,7 @@
 //              I32    i32  constant
 //              F32    f32  constant (IEEE single bits)
 //              LIB    u8 builtin id, u8 argument count
+//              CO     u16 CoData address, then i16 relative target as REL16
 //
 // The eval stack holds 32-bit slots: a W value uses its low 16 bits, a B
 // value is zero-extended, an F value is its IEEE bits. Functions leave one
@@ -33,7 +34,7 @@ enum class Op : uint8_t {
 };
 inline constexpr int kOpCount = static_cast<int>(Op::Count_);
 
-enum class Shape : uint8_t { NONE, U8, U16, REL16, I32, F32, LIB };
+enum class Shape : uint8_t { NONE, U8, U16, REL16, I32, F32, LIB, CO };
 
 // A library call takes at most this many arguments (printf's format and
 // values included): the compiler refuses more, the VM faults on more.
@@ -51,6 +52,7 @@ constexpr int operandBytes(Shape s) {
       return 2;
     case Shape::I32:
     case Shape::F32:
+    case Shape::CO:
       return 4;
   }
   return 0;

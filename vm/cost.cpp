@@ -28,6 +28,13 @@ constexpr SeqCost kAcceptSeq =
 // (body: knob), restore, EI, RETI.
 constexpr SeqCost kSerialIsrSeq =
     sequenceCost("INTACK IM2; PUSH rr; PUSH rr; PUSH rr; POP rr; POP rr; POP rr; EI; RETI");
+constexpr SeqCost kCoStoppedSeq = sequenceCost(kCostateStoppedSeq, 1);
+constexpr auto kTimerPathSeq = [] {
+  std::array<SeqCost, kTimerIsrPaths> a{};
+  for (unsigned p = 0; p < kTimerIsrPaths; ++p) a[p] = sequenceCost(kTimerIsrSeq, p);
+  if (a[0].branches != 2) throw "the timer service has two branches";
+  return a;
+}();
 constexpr SeqCost kEiSeq = sequenceCost("EI");
 constexpr SeqCost kHookSeq = sequenceCost(kDebugHookSeq);
 constexpr SeqCost kAutoRetSeq = sequenceCost(kAutoFrameRetSeq);
@@ -70,6 +77,9 @@ CostTable makeCostTable(const CostKnobs& knobs) {
   t.autoFrameRet = resolve(kAutoRetSeq, knobs);
   t.interruptAccept = resolve(kAcceptSeq, knobs);
   t.serialIsr = resolve(kSerialIsrSeq, knobs) + static_cast<uint32_t>(knobs.serialIsrTstates);
+  for (int p = 0; p < kTimerIsrPaths; ++p) t.timerIsr[p] = resolve(kTimerPathSeq[p], knobs);
+  t.costateStoppedDelta = static_cast<int32_t>(resolve(kCoStoppedSeq, knobs)) -
+                          static_cast<int32_t>(t.op[static_cast<int>(Op::COSTATE)]);
   t.adConversion = static_cast<uint32_t>(knobs.adConversionTstates);
   t.printfChar = static_cast<uint32_t>(knobs.printfCharTstates);
   return t;

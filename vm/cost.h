@@ -269,6 +269,40 @@ inline constexpr std::string_view kDebugHookSeq = "PUSH rr; LD A,(nn); OR r; JR 
 // What RET adds for a #class auto frame (the frame ENTER set up).
 inline constexpr std::string_view kAutoFrameRetSeq = "POP IX";
 
+// A named costatement that is STOPPED: COSTATE goes no further than its
+// JP Z to the end (taken).
+inline constexpr std::string_view kCostateStoppedSeq = "LD rr,nn; BIT b,(HL); JP cc,nn";
+
+// The BIOS's periodic service on PRT0 (Dynamic C keeps TICK_TIMER, MS_TIMER
+// and SEC_TIMER with it; DESIGN.md "Costatements"): acknowledge, save AF,
+// HL, DE; read TCR then TMDR0L, which clears TIF0; TICK_TIMER += 1 (32 bits:
+// ADD HL,DE then ADC HL,DE with DE = 0); the millisecond fraction += 125 in
+// 7 bits and, when it carried into bit 7, MS_TIMER += 1 (so MS_TIMER =
+// floor(TICK_TIMER * 125 / 128) = floor(TICK_TIMER * 1000 / 1024)); when
+// TICK_TIMER's low 10 bits are 0, SEC_TIMER += 1; restore, EI, RETI.
+// Branch 0 is taken when no millisecond is due, branch 1 when no second is.
+inline constexpr std::string_view kTimerIsrSeq =
+    "INTACK IM2; PUSH rr; PUSH rr; PUSH rr; IN0 r,(n); IN0 r,(n); "
+    "LD HL,(nn); LD rr,nn; ADD HL,rr; LD (nn),HL; LD HL,(nn); DEC rr; ADC HL,rr; LD (nn),HL; "
+    "LD A,(nn); ADD A,n; LD r,r; AND n; LD (nn),A; BIT b,r; JR cc,e; "
+    "[LD HL,(nn); LD rr,nn; ADD HL,rr; LD (nn),HL; LD HL,(nn); DEC rr; ADC HL,rr; LD (nn),HL]; "
+    "LD HL,(nn); LD r,r; AND n; OR r; JR cc,e; "
+    "[LD HL,(nn); LD rr,nn; ADD HL,rr; LD (nn),HL; LD HL,(nn); DEC rr; ADC HL,rr; LD (nn),HL]; "
+    "POP rr; POP rr; POP rr; EI; RETI";
+inline constexpr int kTimerIsrPaths = 4;
+// The service's millisecond rule, as numbers: each tick adds 125/128 ms.
+inline constexpr uint32_t kMsFractionStep = 125;
+inline constexpr uint32_t kMsFractionOne = 128;
+static_assert(kMsFractionStep * 1024 == kMsFractionOne * 1000, "125/128 ms a tick is 1000/1024");
+
+// Whether the BIOS timer service runs (DESIGN.md: Dynamic C links only the
+// libraries a program uses). Not a calibration knob: a profile option.
+enum class TimerService : uint8_t {
+  Auto,    // only when the program uses the timer library (Image::timer)
+  Always,  // in every program (the service's time is stolen from all)
+  Never,   // never (the counters stand still)
+};
+
 // The only numbers calibration may move (README, "Cycle model"); each has a
 // hardware meaning and a hardware range, checked by makeCostTable.
 struct CostKnobs {
@@ -293,6 +327,11 @@ struct CostKnobs {
   int printfCharTstates = 0;
   // Whether the handler epilogue ends with EI before RETI (DESIGN.md).
   bool epilogueEi = true;
+  // Not calibration: whether PRT0 and the BIOS timer service run.
+  TimerService timerService = TimerService::Auto;
+  // Not calibration: run marked delay loops in one step where nothing can
+  // happen to the robot meanwhile (exact; off for checking).
+  bool fastForward = true;
 };
 
 // Tables resolved against the knobs, built once per VM configuration.
@@ -313,6 +352,10 @@ struct CostTable {
   uint32_t autoFrameRet = 0;     // RET of a frame that ran ENTER: POP IX
   uint32_t interruptAccept = 0;  // IM2 acknowledge + handler register saves
   uint32_t serialIsr = 0;        // acceptance + library ISR body
+  // The timer service along each path (bit 0: no millisecond due, bit 1:
+  // no second due), acceptance included.
+  std::array<uint32_t, kTimerIsrPaths> timerIsr{};
+  int32_t costateStoppedDelta = 0;  // COSTATE on a STOPPED costatement
   uint32_t adConversion = 0;
   uint32_t printfChar = 0;
   CostKnobs knobs;

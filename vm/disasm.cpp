@@ -40,6 +40,10 @@ std::string libOperand(const Image& img, uint32_t at) {
   return fmt::format("{}, {} args", name, img.code[at + 1]);
 }
 
+std::string coOperand(const Image& img, uint32_t at) {
+  return fmt::format("0x{:04x}, {}", readU16(img, at), rel16Operand(img, at + 2));
+}
+
 std::string operandText(Shape shape, const Image& img, uint32_t at) {
   switch (shape) {
     case Shape::NONE:
@@ -56,6 +60,8 @@ std::string operandText(Shape shape, const Image& img, uint32_t at) {
       return f32Operand(img, at);
     case Shape::LIB:
       return libOperand(img, at);
+    case Shape::CO:
+      return coOperand(img, at);
   }
   return "";
 }
@@ -63,12 +69,13 @@ std::string operandText(Shape shape, const Image& img, uint32_t at) {
 // Names a data address or a code address where the symbol table knows it.
 std::string annotate(const Image& img, Op op, uint32_t at) {
   const Shape shape = info(op).shape;
-  if (shape != Shape::U16) return "";
+  if (shape != Shape::U16 && shape != Shape::CO) return "";
   const uint32_t value = readU16(img, at);
   const bool codeAddress = op == Op::CALL;
   const bool dataAddress = op == Op::LDGB || op == Op::LDGW || op == Op::LDGL || op == Op::STGB ||
                            op == Op::STGW || op == Op::STGL || op == Op::INCGW || op == Op::DECGW ||
-                           op == Op::INCGL;
+                           op == Op::INCGL || shape == Shape::CO || op == Op::COEND ||
+                           op == Op::CODONE;
   for (const auto& s : img.symbols) {
     const bool isCode = s.kind == Symbol::Kind::Function || s.kind == Symbol::Kind::Handler;
     if (codeAddress && isCode && s.address == value) return s.name;

@@ -25,6 +25,42 @@ inline constexpr uint16_t kPortENB485 = 0xC0;
 // Interrupt vector names (IM2 vector bytes a program writes to the PIO).
 inline constexpr uint8_t kVecPIOA = 0x10;
 
+// The Z180's PRT0 as Dynamic C's BIOS sets it: the 9.216 MHz clock divided
+// by 20 (the PRT prescaler) and a reload of 450 gives the 1,024 Hz tick.
+inline constexpr uint32_t kPrtPrescale = 20;
+inline constexpr uint32_t kPrtReload = 450;
+inline constexpr uint32_t kPrtTicks = kPrtPrescale * kPrtReload;  // 9,000 ticks a period
+inline constexpr uint32_t kTimerHz = 1024;
+
+// Dynamic C's CoData (User's Manual 5.4.1), one per costatement, laid out as
+// that manual draws it: CSState, lastlocADDR, lastlocCBR, ChkSum (XOR of the
+// three address bytes), firsttime, content (the Delay functions' start),
+// ChkSum2. lastlocADDR 0 means "from the top".
+inline constexpr uint16_t kCoState = 0;
+inline constexpr uint16_t kCoLastLoc = 1;
+inline constexpr uint16_t kCoLastLocCbr = 3;
+inline constexpr uint16_t kCoChkSum = 4;
+inline constexpr uint16_t kCoFirstTime = 5;
+inline constexpr uint16_t kCoContent = 6;
+inline constexpr uint16_t kCoChkSum2 = 10;
+inline constexpr uint16_t kCoDataSize = 11;
+// CSState flags (User's Manual Table 5-1): STOPPED and INIT both set is
+// "done" (or reset); STOPPED alone is paused; INIT alone is initialised to
+// run; neither is running.
+inline constexpr uint8_t kCoStopped = 0x01;
+inline constexpr uint8_t kCoInit = 0x02;
+
+// Where the BIOS timer service keeps its counters: TICK_TIMER, MS_TIMER and
+// SEC_TIMER (unsigned long each) and the service's millisecond fraction
+// byte. All zero when the program does not use the timer library.
+struct TimerBlock {
+  uint16_t tick = 0;
+  uint16_t ms = 0;
+  uint16_t sec = 0;
+  uint16_t msFraction = 0;
+  bool used() const { return tick != 0; }
+};
+
 struct VectorBinding {
   uint8_t vector;    // IM2 vector byte
   uint16_t handler;  // code address of the interrupt reti function
@@ -57,6 +93,19 @@ struct Image {
   std::vector<uint8_t> initialised;
   std::vector<VectorBinding> vectors;
   std::vector<Symbol> symbols;
+  TimerBlock timer;
+  // Code addresses a costatement may resume at (yield and waitfor points),
+  // sorted: a lastlocADDR that is not one of them is a fault.
+  std::vector<uint16_t> resumePoints;
+  // Delay loops the compiler marked for fast-forward (DESIGN.md, issue 13):
+  // `for (v = ...; v < N; v++) ;` on a static or global int, whose code is
+  // top: LDGW v; PUSHW N; LTW|LTUW|LEW|LEUW; JZ exit; [DBG]; INCGW v;
+  // JMP top; exit:. The VM checks that shape before trusting a mark.
+  struct DelayLoop {
+    uint16_t top;
+    uint16_t exit;
+  };
+  std::vector<DelayLoop> delayLoops;
   // First code address of each function, for profiles and fault messages.
   const Symbol* functionAt(uint32_t codeAddress) const;
   int lineAt(uint32_t codeAddress) const {

@@ -97,6 +97,9 @@ struct InterruptFrame {
 float asFloat(uint32_t bits) { return std::bit_cast<float>(bits); }
 uint32_t fromFloat(float f) { return std::bit_cast<uint32_t>(f); }
 int16_t asInt16(uint32_t v) { return static_cast<int16_t>(static_cast<uint16_t>(v)); }
+static_assert(Tick{kPrtTicks} * kTimerHz == kTicksPerSecond,
+              "PRT0's period must divide the clock into Dynamic C's 1,024 Hz tick");
+
 uint32_t w(int32_t v) { return static_cast<uint32_t>(v) & 0xFFFFu; }
 
 int64_t truncToRange(float f, double lo, double hi) {
@@ -111,10 +114,10 @@ std::string_view irqName(Irq irq) {
   switch (irq) {
     case Irq::Pio:
       return "pio_a";
-    case Irq::SerialTx:
-      return "serial_tx";
     case Irq::Timer:
       return "timer";
+    case Irq::SerialTx:
+      return "serial_tx";
   }
   return "?";
 }
@@ -158,6 +161,36 @@ struct Vm::State {
   bool profiling = false;
   std::vector<uint64_t> profile;
   uint64_t serialIsrCycles = 0;
+  // PRT0: the next tick at which it requests the timer interrupt
+  // (kNoTimer when the service does not run).
+  static constexpr Tick kNoTimer = INT64_MAX;
+  Tick nextTimer = kNoTimer;
+  uint64_t timerIsrCycles = 0;
+  // The BIOS's counters when the program has no timer block of its own.
+  uint32_t biosTicks = 0;
+  uint8_t biosMsFraction = 0;
+  bool costateEvents = false;
+  // ---- fast-forward of delay loops ----
+  struct Loop {
+    uint32_t top, exit, counter;
+    uint16_t limit;
+    Op compare;
+  };
+  std::vector<Loop> loops;
+  std::vector<int16_t> loopAtTop;  // per code byte: index into loops, or -1
+  // The pass being measured: from one arrival at a loop's top to the next.
+  static constexpr uint32_t kMaxLoopBytes = 32;
+  struct Measure {
+    int loop = -1;
+    Tick start = 0;
+    uint32_t counter = 0;
+    uint64_t instructions = 0;
+    uint64_t accepted = 0;
+    std::array<uint64_t, kMaxLoopBytes> profile{};
+  } measure;
+  uint64_t acceptances = 0;  // interrupts accepted so far (a pass with one is no measure)
+  void findLoops();
+  bool fastForward(Tick until);
   std::string consoleLine;
   Vm* self = nullptr;
 
@@ -217,6 +250,25 @@ struct Vm::State {
   }
   // Accepts the highest-priority pending request at the current boundary.
   void accept();
+  // PRT0 reached nextTimer: raise its request (one flag: a tick that comes
+  // while the last one is still pending is lost) and schedule the next.
+  void timerTick() {
+    pend[static_cast<int>(Irq::Timer)] = true;
+    anyPending = true;
+    nextTimer += static_cast<Tick>((now - nextTimer) / kPrtTicks + 1) * kPrtTicks;
+  }
+  void timerService();
+  // ---- costatements ----
+  void costateEvent(uint32_t coData, Bus::CostateEvent kind, uint32_t atPc) {
+    if (costateEvents) bus.costate(now, static_cast<uint16_t>(coData), kind, image.lineAt(atPc));
+  }
+  void costateEnd(uint32_t coData, bool done) {
+    wr16(coData + kCoLastLoc, 0);
+    wr8(coData + kCoLastLocCbr, 0);
+    wr8(coData + kCoChkSum, 0);
+    if (done) wr8(coData + kCoState, kCoStopped | kCoInit);
+  }
+  bool delayDone(const uint32_t* a, uint32_t timerAddress, uint32_t instructionPc);
   // ---- library ----
   void libCall(Lib id, int argc, uint32_t instructionPc);
   void libBegin();
@@ -229,6 +281,7 @@ struct Vm::State {
 };
 
 void Vm::State::accept() {
+  ++acceptances;
   int i = 0;
   while (!pend[i]) ++i;
   const Irq irq = static_cast<Irq>(i);
@@ -236,6 +289,10 @@ void Vm::State::accept() {
   updatePending();
   ++stats.interrupts[i];
   const uint32_t interruptedPc = lib.active ? lib.pc : burn ? burnPc : pc;
+  if (irq == Irq::Timer) {
+    timerService();
+    return;
+  }
   if (irq == Irq::SerialTx) {
     // The serial library's own ISR: short and atomic, leaves IFF1 set.
     bus.interruptAccepted(now, irq, interruptedPc);
@@ -274,6 +331,150 @@ void Vm::State::accept() {
   now += costs.interruptAccept;
   if (profiling) profile[handler] += costs.interruptAccept;
   pc = static_cast<uint32_t>(handler);
+}
+
+// The BIOS timer service (cost.h kTimerIsrSeq): atomic, like the serial
+// library's ISR: interrupts stay disabled inside it and its EI; RETI leaves
+// IFF1 set as it was at acceptance.
+void Vm::State::timerService() {
+  const uint32_t interruptedPc = lib.active ? lib.pc : burn ? burnPc : pc;
+  bus.interruptAccepted(now, Irq::Timer, interruptedPc);
+  const TimerBlock& tb = image.timer;
+  const uint32_t ticks = (tb.used() ? rd32(tb.tick) : biosTicks) + 1;
+  const uint32_t fraction = (tb.used() ? rd8(tb.msFraction) : biosMsFraction) + kMsFractionStep;
+  const bool msDue = fraction >= kMsFractionOne;
+  const bool secDue = (ticks & (kTimerHz - 1)) == 0;
+  const uint8_t newFraction = static_cast<uint8_t>(fraction % kMsFractionOne);
+  if (tb.used()) {
+    wr32(tb.tick, ticks);
+    wr8(tb.msFraction, newFraction);
+    if (msDue) wr32(tb.ms, rd32(tb.ms) + 1);
+    if (secDue) wr32(tb.sec, rd32(tb.sec) + 1);
+  } else {
+    biosTicks = ticks;
+    biosMsFraction = newFraction;
+  }
+  const uint32_t cost = costs.timerIsr[(msDue ? 0u : 1u) | (secDue ? 0u : 2u)];
+  now += cost;
+  timerIsrCycles += cost;
+  bus.interruptReturned(now, Irq::Timer);
+}
+
+// A firsttime Delay function: a[0] the CoData, a[1] the interval.
+bool Vm::State::delayDone(const uint32_t* a, uint32_t timerAddress, uint32_t instructionPc) {
+  const uint32_t cd = a[0] & 0xFFFF;
+  if (!checkAccess(cd, kCoDataSize, instructionPc)) return false;
+  const uint32_t timer = timerAddress ? rd32(timerAddress) : 0;
+  if (rd8(cd + kCoFirstTime)) {
+    wr8(cd + kCoFirstTime, 0);
+    wr32(cd + kCoContent, timer);
+  }
+  return static_cast<int32_t>(timer - rd32(cd + kCoContent)) >= static_cast<int32_t>(a[1]);
+}
+
+// ---- fast-forward of delay loops -------------------------------------------
+//
+// A marked loop (Image::delayLoops) whose code has the expected shape runs
+// many passes in one step. Every pass from the same counter regime costs
+// the same and touches nothing but its counter, so the VM measures one pass
+// as stepped (arrival at the top to the next arrival, with no interrupt
+// accepted in between) and then applies n more at once: the counter +n, the
+// clock +n x the pass, the instruction count and the profile likewise. n
+// stops short of the loop's exit and lands at or before the earliest tick
+// at which anything can happen to this robot: the horizon of run() (the
+// host stops a robot at every tick it raises a request or a device acts)
+// and PRT0's next tick. The boundaries it skips are all before those, so
+// nothing could have been accepted or stopped there; where it lands, the
+// ordinary boundary follows. Breakpoints inside the loop turn it off.
+
+void Vm::State::findLoops() {
+  const auto& code = image.code;
+  auto at = [&](uint32_t a) -> int { return a < code.size() ? code[a] : -1; };
+  auto u16at = [&](uint32_t a) { return static_cast<uint32_t>(code[a] | (code[a + 1] << 8)); };
+  auto rel = [&](uint32_t operand) {
+    return static_cast<uint32_t>(static_cast<int32_t>(operand + 2) +
+                                 static_cast<int16_t>(u16at(operand)));
+  };
+  for (const auto& mark : image.delayLoops) {
+    uint32_t a = mark.top;
+    if (mark.exit > code.size() || mark.exit <= a || mark.exit - a > kMaxLoopBytes) continue;
+    if (at(a) != static_cast<int>(Op::LDGW)) continue;
+    const uint32_t counter = u16at(a + 1);
+    a += 3;
+    if (at(a) != static_cast<int>(Op::PUSHW)) continue;
+    const auto limit = static_cast<uint16_t>(u16at(a + 1));
+    a += 3;
+    const int cmp = at(a);
+    if (cmp != static_cast<int>(Op::LTW) && cmp != static_cast<int>(Op::LTUW) &&
+        cmp != static_cast<int>(Op::LEW) && cmp != static_cast<int>(Op::LEUW))
+      continue;
+    a += 1;
+    if (at(a) != static_cast<int>(Op::JZ) || rel(a + 1) != mark.exit) continue;
+    a += 3;
+    if (at(a) == static_cast<int>(Op::DBG)) a += 1;
+    if (at(a) != static_cast<int>(Op::INCGW) || u16at(a + 1) != counter) continue;
+    a += 3;
+    if (at(a) != static_cast<int>(Op::JMP) || rel(a + 1) != mark.top || a + 3 != mark.exit)
+      continue;
+    if (counter < kDataBase || counter + 1 >= kMemorySize) continue;
+    if (loopAtTop.empty()) loopAtTop.assign(code.size() + 1, -1);
+    if (loopAtTop[mark.top] >= 0) continue;
+    loopAtTop[mark.top] = static_cast<int16_t>(loops.size());
+    loops.push_back(Loop{mark.top, mark.exit, counter, limit, static_cast<Op>(cmp)});
+  }
+}
+
+bool Vm::State::fastForward(Tick until) {
+  const int index = loopAtTop[pc];
+  const Loop& loop = loops[static_cast<size_t>(index)];
+  const uint32_t v = rd16(loop.counter);
+  const bool isSigned = loop.compare == Op::LTW || loop.compare == Op::LEW;
+  const bool inclusive = loop.compare == Op::LEW || loop.compare == Op::LEUW;
+  // Passes still to run from v, and the largest counter of the regime in
+  // which every pass costs the same (signed: no overflow in v - N when both
+  // are non-negative; the counter must not wrap).
+  auto passesLeft = [&](uint32_t from) -> int64_t {
+    const int64_t x = isSigned ? static_cast<int16_t>(from) : static_cast<int64_t>(from);
+    const int64_t n =
+        isSigned ? static_cast<int16_t>(loop.limit) : static_cast<int64_t>(loop.limit);
+    const int64_t top = isSigned ? 32767 : 65535;
+    const int64_t last = std::min(inclusive ? n : n - 1, top - 1);  // v + 1 stays in range
+    return last >= x ? last - x + 1 : 0;
+  };
+  const bool regime =
+      !isSigned || (static_cast<int16_t>(v) >= 0 && static_cast<int16_t>(loop.limit) >= 0);
+  const bool anyBreak =
+      anyBreakpoint && std::any_of(breakpoints.begin() + loop.top, breakpoints.begin() + loop.exit,
+                                   [](uint8_t b) { return b != 0; });
+  if (measure.loop == index && measure.accepted == acceptances &&
+      v == ((measure.counter + 1) & 0xFFFF) && regime && !anyBreak &&
+      static_cast<int16_t>(measure.counter) >= (isSigned ? 0 : INT16_MIN)) {
+    const Tick pass = now - measure.start;
+    const Tick bound = std::min(until, nextTimer);
+    const int64_t n =
+        pass > 0 && bound > now ? std::min<int64_t>(passesLeft(v), (bound - now) / pass) : 0;
+    if (n > 0) {
+      wr16(loop.counter, v + static_cast<uint32_t>(n));
+      now += n * pass;
+      const uint64_t skipped =
+          static_cast<uint64_t>(n) * (stats.instructions - measure.instructions);
+      stats.instructions += skipped;
+      stats.fastForwarded += skipped;
+      if (profiling)
+        for (uint32_t a = loop.top; a < loop.exit; ++a)
+          profile[a] += static_cast<uint64_t>(n) * (profile[a] - measure.profile[a - loop.top]);
+      measure.loop = -1;
+      return true;
+    }
+  }
+  measure.loop = index;
+  measure.start = now;
+  measure.counter = v;
+  measure.instructions = stats.instructions;
+  measure.accepted = acceptances;
+  if (profiling)
+    std::copy(profile.begin() + loop.top, profile.begin() + loop.exit, measure.profile.begin());
+  return false;
 }
 
 // ---- library calls -------------------------------------------------------
@@ -453,6 +654,47 @@ void Vm::State::libBegin() {
     case Lib::FABS:
       eval[sp++] = a[0] & 0x7FFFFFFFu;
       return;
+    case Lib::DELAYMS:
+      eval[sp++] = delayDone(a, image.timer.ms, instructionPc) ? 1u : 0u;
+      return;
+    case Lib::DELAYSEC:
+      eval[sp++] = delayDone(a, image.timer.sec, instructionPc) ? 1u : 0u;
+      return;
+    case Lib::DELAYTICKS: {
+      const uint32_t args[2] = {a[0], a[1] & 0xFFFF};
+      eval[sp++] = delayDone(args, image.timer.tick, instructionPc) ? 1u : 0u;
+      return;
+    }
+    case Lib::COBEGIN:
+    case Lib::CORESET:
+    case Lib::COPAUSE:
+    case Lib::CORESUME:
+    case Lib::ISCODONE:
+    case Lib::ISCORUNNING: {
+      const uint32_t cd = a[0] & 0xFFFF;
+      if (!checkAccess(cd, kCoDataSize, instructionPc)) return;
+      const uint8_t state = rd8(cd + kCoState);
+      switch (id) {
+        case Lib::COBEGIN:
+        case Lib::CORESET:
+          costateEnd(cd, false);
+          wr8(cd + kCoFirstTime, 0);
+          wr8(cd + kCoState, id == Lib::COBEGIN ? kCoInit : kCoStopped | kCoInit);
+          return;
+        case Lib::COPAUSE:
+          wr8(cd + kCoState, state | kCoStopped);
+          return;
+        case Lib::CORESUME:
+          wr8(cd + kCoState, state & ~kCoStopped);
+          return;
+        case Lib::ISCODONE:
+          eval[sp++] = (state & (kCoStopped | kCoInit)) == (kCoStopped | kCoInit) ? 1u : 0u;
+          return;
+        default:
+          eval[sp++] = (state & kCoStopped) ? 0u : 1u;
+          return;
+      }
+    }
     case Lib::STRCPY:
     case Lib::MEMSET:
     case Lib::MEMCPY:
@@ -582,6 +824,8 @@ Stop Vm::State::run(Tick until) {
   const uint8_t* const code = image.code.data();
   const uint32_t codeSize = static_cast<uint32_t>(image.code.size());
   const uint32_t* const opCost = costs.op.data();
+  const int16_t* const loopTop =
+      costs.knobs.fastForward && !loopAtTop.empty() ? loopAtTop.data() : nullptr;
   busTouched = false;
 
 #if SIMBOT_COMPUTED_GOTO
@@ -609,6 +853,7 @@ Stop Vm::State::run(Tick until) {
       busTouched = false;
       return Stop::Io;
     }
+    if (now >= nextTimer) timerTick();
     if (now >= until) return halted ? Stop::Halted : Stop::Horizon;
     if (lib.awaitingBegin) {  // the end of a library call's sequence: no boundary
       // (for an atomic call this also keeps interrupts out until its effect)
@@ -632,7 +877,13 @@ Stop Vm::State::run(Tick until) {
       continue;
     }
     if (halted) {
-      now = until;  // HALT: idle until the horizon or the next interrupt
+      // HALT: idle until the horizon, the next interrupt request from the
+      // host, or PRT0's next tick.
+      if (nextTimer < until) {
+        now = nextTimer;
+        continue;
+      }
+      now = until;
       return Stop::Halted;
     }
     if (pc >= codeSize) {
@@ -643,6 +894,7 @@ Stop Vm::State::run(Tick until) {
       resumeAtBreakpoint = true;
       return Stop::Breakpoint;
     }
+    if (loopTop && loopTop[pc] >= 0 && fastForward(until)) continue;
     resumeAtBreakpoint = false;
     opPc = pc;
     op = code[pc];
@@ -1144,6 +1396,58 @@ Stop Vm::State::run(Tick until) {
       }
       NEXT;
       CASE(DBG) NEXT;
+      CASE(COSTATE) {
+        const uint32_t cd = u16();
+        const uint32_t end = static_cast<uint32_t>(
+            static_cast<int32_t>(pc) + static_cast<int16_t>(operand[2] | (operand[3] << 8)));
+        if (!checkAccess(cd, kCoDataSize, opPc)) NEXT;
+        const uint8_t state = rd8(cd + kCoState);
+        if (state & kCoStopped) {
+          now += costs.costateStoppedDelta;
+          if constexpr (kProfile)
+            profile[opPc] += static_cast<uint64_t>(int64_t{costs.costateStoppedDelta});
+          pc = end;
+          NEXT;
+        }
+        wr8(cd + kCoState, state & ~kCoInit);
+        const uint32_t resume = rd16(cd + kCoLastLoc);
+        if (resume == 0) {
+          BRANCH_COST(2u);  // JR Z taken over JP (HL)
+        } else {
+          if (((resume & 0xFF) ^ (resume >> 8) ^ rd8(cd + kCoLastLocCbr)) != rd8(cd + kCoChkSum)) {
+            raiseFault("costatement's resume address is corrupted (CoData checksum)", opPc);
+            NEXT;
+          }
+          if (!std::binary_search(image.resumePoints.begin(), image.resumePoints.end(),
+                                  static_cast<uint16_t>(resume))) {
+            raiseFault(fmt::format("costatement resumes at 0x{:04x}, not a yield point", resume),
+                       opPc);
+            NEXT;
+          }
+          pc = resume;
+        }
+        costateEvent(cd, Bus::CostateEvent::Enter, pc);
+      }
+      NEXT;
+      CASE(COYIELD) {
+        const uint32_t cd = u16();
+        const uint32_t resume = static_cast<uint32_t>(
+            static_cast<int32_t>(pc) + static_cast<int16_t>(operand[2] | (operand[3] << 8)));
+        if (!checkAccess(cd, kCoDataSize, opPc)) NEXT;
+        wr16(cd + kCoLastLoc, resume);
+        wr8(cd + kCoLastLocCbr, 0);
+        wr8(cd + kCoChkSum, (resume & 0xFF) ^ (resume >> 8));
+        costateEvent(cd, Bus::CostateEvent::Yield, opPc);
+      }
+      NEXT;
+      CASE(COEND)
+      CASE(CODONE) {
+        const uint32_t cd = u16();
+        if (!checkAccess(cd, kCoDataSize, opPc)) NEXT;
+        costateEnd(cd, op == static_cast<uint8_t>(Op::CODONE));
+        costateEvent(cd, Bus::CostateEvent::End, opPc);
+      }
+      NEXT;
 #if !SIMBOT_COMPUTED_GOTO
       case Op::Count_:
         break;
@@ -1176,6 +1480,11 @@ Vm::Vm(const Image& image, Bus& bus, const CostTable& costs)
   for (const auto& v : image.vectors) s.handlerFor[v.vector] = v.handler;
   s.calls.reserve(kMemorySize / kCallFrameBytes);
   s.ints.reserve(kMaxInterruptNesting);
+  const TimerService service = costs.knobs.timerService;
+  if (service == TimerService::Always || (service == TimerService::Auto && image.timer.used()))
+    s.nextTimer = kPrtTicks;
+  s.costateEvents = bus.wantCostateEvents();
+  s.findLoops();
 }
 
 Vm::~Vm() = default;
@@ -1241,5 +1550,6 @@ void Vm::enableProfile() {
 }
 const std::vector<uint64_t>& Vm::profile() const { return s_->profile; }
 uint64_t Vm::serialIsrCycles() const { return s_->serialIsrCycles; }
+uint64_t Vm::timerIsrCycles() const { return s_->timerIsrCycles; }
 
 }  // namespace simbot::vm

@@ -11,11 +11,20 @@
 // IFF1/IFF2, pushes the interrupted state and charges the acceptance cost;
 // the handler's first instruction starts at b + that cost. RETI restores,
 // and the compiler's epilogue sets IFF1 again unless the knob drops it.
-// Pending requests are taken in priority order Pio, SerialTx, Timer. Long
+// Pending requests are taken in the Z180's fixed priority order: the PIO
+// (INT0), then PRT0 (the timer), then the ASCI (serial transmit). Long
 // library calls run as steps of <= 100 T-states with a boundary between
 // steps; a handler accepted there resumes the call when it returns. The
 // serial library's calls are atomic (cost.h kLibAtomic): no boundary inside
 // them, and IFF1 after them is what it was before.
+//
+// The timer: when the program uses the timer library (Image::timer) or the
+// knob says always, PRT0 requests Irq::Timer at every multiple of
+// kPrtTicks of the VM's clock (9.216 MHz / 20 / 450 = 1,024 Hz). The BIOS
+// service runs atomically at acceptance like the serial library's ISR, costs
+// CostTable::timerIsr and advances TICK_TIMER, MS_TIMER and SEC_TIMER in
+// robot memory. A request not yet accepted when the next tick comes is the
+// same request (PRT0's TIF0 is one flag): that tick is lost, as on the chip.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -35,10 +44,11 @@ namespace simbot::vm {
 using timebase::kTicksPerSecond;
 using timebase::Tick;
 
-// Interrupt sources in priority order (0 = highest).
-enum class Irq : uint8_t { Pio = 0, SerialTx = 1, Timer = 2 };
+// Interrupt sources in the Z180's priority order (0 = highest): INT0 (the
+// PIO), PRT0 (the timer), ASCI (the serial port).
+enum class Irq : uint8_t { Pio = 0, Timer = 1, SerialTx = 2 };
 inline constexpr int kIrqCount = 3;
-std::string_view irqName(Irq irq);  // "pio_a", "serial_tx", "timer"
+std::string_view irqName(Irq irq);  // "pio_a", "timer", "serial_tx"
 
 class Vm;
 
@@ -65,6 +75,13 @@ class Bus {
   // IFF1 changed at t: EI, DI, a handler's acceptance or its RETI (the
   // serial library's own interrupt leaves IFF1 as it was).
   virtual void iffChanged(Tick, bool /*iff1*/) {}
+  // A costatement (its CoData at `coData`) was entered, yielded (a yield,
+  // or a waitfor whose expression was false) or ended (its closing brace or
+  // abort), at t; `line` is the source line it resumes at, yields at or ends
+  // at. Called only after wantCostateEvents() answered true.
+  enum class CostateEvent : uint8_t { Enter, Yield, End };
+  virtual bool wantCostateEvents() const { return false; }
+  virtual void costate(Tick, uint16_t /*coData*/, CostateEvent, int /*line*/) {}
 };
 
 struct Fault {
@@ -83,6 +100,8 @@ enum class Stop : uint8_t {
 
 struct VmStats {
   uint64_t instructions = 0;  // bytecode instructions and library steps
+  // Of those, the ones fast-forward applied without dispatching them.
+  uint64_t fastForwarded = 0;
   std::array<uint64_t, kIrqCount> interrupts{};
 };
 
@@ -137,6 +156,7 @@ class Vm {
   void enableProfile();
   const std::vector<uint64_t>& profile() const;
   uint64_t serialIsrCycles() const;
+  uint64_t timerIsrCycles() const;  // the BIOS timer service's time
 
   struct State;
 

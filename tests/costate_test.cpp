@@ -1,0 +1,237 @@
+// The Z180 timer and costatements at the VM level: interrupt priority with
+// the timer among the sources, the BIOS timer service's cost and counters
+// against Dynamic C's rule, and a waitfor on a variable an interrupt handler
+// sets, and the profile knob that decides whether the service runs. The
+// costatement constructs' console behaviour is in
+// tests/programs/costate_*.dc and timer_counters.dc.
+#include <gtest/gtest.h>
+
+#include "plant/plant.h"
+#include "scheduler/match.h"
+#include "support/test_host.h"
+
+using namespace simbot;
+using simbot::testkit::TestHost;
+using vm::Irq;
+using vm::Tick;
+
+namespace {
+
+const vm::CostTable& costs() { return testkit::calibratedCosts(); }
+
+// Z180 priority (DESIGN.md, "Interrupts"): INT0 (the PIO) above PRT0 (the
+// timer) above the ASCI (serial transmit). All three are made pending while
+// interrupts are disabled; EI lets them in one at a time, highest first.
+TEST(Timer, PioThenTimerThenSerialWhenPendingTogether) {
+  const auto img = testkit::compileOrDie(R"(#INT_VEC PIOA_VEC edge
+int edges;
+unsigned long seen;
+interrupt reti edge() { edges++; }
+main()
+{
+    int i;
+    DI();
+    for (i = 0; i < 100; i++) ;   /* about 25,000 T-states: past PRT0's first tick at 9,000 */
+    EI();
+    for (i = 0; i < 10; i++) ;
+    seen = MS_TIMER;
+}
+)");
+  TestHost host;
+  host.schedule(100, Irq::SerialTx);
+  host.schedule(200, Irq::Pio);
+  vm::Vm v(img, host, costs());
+  ASSERT_EQ(host.runUntil(v, vm::kTicksPerSecond / 10), vm::Stop::Halted);
+  std::vector<Irq> order;
+  for (const auto& e : host.events)
+    if (e.accepted) order.push_back(e.irq);
+  ASSERT_GE(order.size(), 3u);
+  EXPECT_EQ(order[0], Irq::Pio);
+  EXPECT_EQ(order[1], Irq::Timer);
+  EXPECT_EQ(order[2], Irq::SerialTx);
+  // All three were waiting for the same EI: each is accepted when the one
+  // before it has returned (the PIO handler's RETI, the timer service's).
+  EXPECT_GT(host.events[0].tick, Tick{9000});
+}
+
+// The timer service runs at PRT0's ticks, 9,000 T-states apart from reset
+// (9.216 MHz / 20 / 450 = 1,024 Hz), costs kTimerIsrSeq along its path, and
+// keeps MS_TIMER = floor(TICK_TIMER * 125 / 128) and SEC_TIMER =
+// TICK_TIMER / 1024 (a halted program: nothing delays the acceptances).
+TEST(Timer, CountersFollowDynamicCsRuleAndServiceCostsItsSequence) {
+  const auto img = testkit::compileOrDie("unsigned long t; main() { t = TICK_TIMER; }");
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  const auto& tick = testkit::symbol(img, "TICK_TIMER");
+  const auto& ms = testkit::symbol(img, "MS_TIMER");
+  const auto& sec = testkit::symbol(img, "SEC_TIMER");
+  for (uint32_t n : {1u, 2u, 3u, 127u, 128u, 1023u, 1024u, 1025u, 3000u}) {
+    host.runUntil(v, Tick{n} * 9000 + 1000);
+    EXPECT_EQ(v.read32(static_cast<uint16_t>(tick.address)), n);
+    EXPECT_EQ(v.read32(static_cast<uint16_t>(ms.address)), n * 125 / 128) << "tick " << n;
+    EXPECT_EQ(v.read32(static_cast<uint16_t>(sec.address)), n / 1024) << "tick " << n;
+  }
+  // Acceptance at exactly 9,000 k (the VM idles in HALT until then); the
+  // service's time to its return.
+  uint64_t serviceTime = 0;
+  Tick lastAccept = 0;
+  for (size_t i = 0; i + 1 < host.events.size(); ++i) {
+    if (host.events[i].irq != Irq::Timer || !host.events[i].accepted) continue;
+    EXPECT_EQ(host.events[i].tick % 9000, 0) << i;
+    lastAccept = host.events[i].tick;
+    serviceTime = static_cast<uint64_t>(host.events[i + 1].tick - host.events[i].tick);
+  }
+  EXPECT_EQ(lastAccept, Tick{3000} * 9000);
+  // By hand, the service at tick 3000 (the fraction before it is
+  // 2999 * 125 mod 128 = 91; 91 + 125 = 216 >= 128: a millisecond is due;
+  // 3000 mod 1024 != 0: no second), from z180.def: INTACK 19, 3 x PUSH 33,
+  // 2 x IN0 24, TICK_TIMER += 1 (LD HL,(nn) 15, LD rr,nn 9, ADD HL,rr 7,
+  // LD (nn),HL 16, LD HL,(nn) 15, DEC rr 4, ADC HL,rr 10, LD (nn),HL 16 = 92),
+  // the fraction (LD A,(nn) 12, ADD A,n 6, LD r,r 4, AND n 6, LD (nn),A 13,
+  // BIT b,r 6, JR cc not taken 6 = 53), MS_TIMER += 1 (92), the second's
+  // test (LD HL,(nn) 15, LD r,r 4, AND n 6, OR r 4, JR cc taken 8 = 37),
+  // 3 x POP 27, EI 3, RETI 12: 392 T-states. Calibrated knobs: no memory
+  // wait states; 4 I/O wait states on the two IN0: 400; refresh 2 every 20
+  // adds (400 * 2 + 10) / 20 = 40 (rounded): 440.
+  EXPECT_EQ(serviceTime, 440u);
+}
+
+// Without the timer library (and the knob at auto) no timer interrupt runs:
+// ICEMAN's timing is what it was.
+TEST(Timer, RunsOnlyWhenTheProgramUsesIt) {
+  const auto img = testkit::compileOrDie("int x; main() { x = 1; }");
+  EXPECT_FALSE(img.timer.used());
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  host.runUntil(v, vm::kTicksPerSecond);
+  EXPECT_TRUE(host.events.empty());
+  vm::CostKnobs always = vm::calibratedKnobs();
+  always.timerService = vm::TimerService::Always;
+  const auto table = vm::makeCostTable(always);
+  TestHost host2;
+  vm::Vm v2(img, host2, table);
+  host2.runUntil(v2, vm::kTicksPerSecond);
+  // Ticks 9,000 k for k = 1..1023 fall before 1 s (the 1,024th is at it):
+  // each accepted and returned.
+  EXPECT_EQ(host2.events.size(), 2u * 1023u);
+}
+
+// waitfor on a variable an interrupt handler sets resumes at the first
+// evaluation of the waitfor after the handler ran: in the same pass if the
+// handler ran before the costatement's test in that pass, else in the next.
+// The program records which: the test's own function notes the pass it ran
+// in (with interrupts off while it reads the flag), and the handler
+// compares. Swept over a window of request ticks that
+// covers a whole pass, so both cases occur.
+TEST(Costate, WaitforOnHandlerVariableResumesOnTheFirstPassAfter) {
+  const auto img = testkit::compileOrDie(R"(#INT_VEC PIOA_VEC edge
+int flag, passes, tested, irqPass, afterTest, resumedPass;
+interrupt reti edge()
+{
+    flag = 1;
+    irqPass = passes;
+    afterTest = tested == passes;
+}
+int check()
+{
+    int f;
+    DI();   /* the handler lands before or after this, never between */
+    tested = passes;
+    f = flag;
+    EI();
+    return f;
+}
+main()
+{
+    while (resumedPass == 0) {
+        passes++;
+        costate {
+            waitfor(check());
+            resumedPass = passes;
+        }
+    }
+}
+)");
+  int sameCase = 0, nextCase = 0;
+  for (Tick at = 20000; at < 22000; at += 37) {
+    TestHost host;
+    host.schedule(at, Irq::Pio);
+    vm::Vm v(img, host, costs());
+    ASSERT_EQ(host.runUntil(v, vm::kTicksPerSecond), vm::Stop::Halted);
+    auto word = [&](const char* name) {
+      return static_cast<int16_t>(
+          v.read16(static_cast<uint16_t>(testkit::symbol(img, name).address)));
+    };
+    const int expected = word("irqPass") + word("afterTest");
+    EXPECT_EQ(word("resumedPass"), expected) << "request at " << at;
+    (word("afterTest") ? nextCase : sameCase)++;
+  }
+  EXPECT_GT(sameCase, 0);
+  EXPECT_GT(nextCase, 0);
+}
+
+// A CoData whose resume address is overwritten faults that robot, never the
+// host: the checksum no longer matches.
+TEST(Costate, CorruptedResumeAddressFaults) {
+  const auto img = testkit::compileOrDie(R"(int i;
+CoData *p;
+main()
+{
+    for (i = 0; i < 3; i++) {
+        costate blink always_on {
+            yield;
+        }
+        p = &blink;
+        p->lastlocADDR = 0x1234;
+    }
+}
+)");
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(host.runUntil(v, vm::kTicksPerSecond), vm::Stop::Fault);
+  ASSERT_NE(v.fault(), nullptr);
+  EXPECT_NE(v.fault()->message.find("checksum"), std::string::npos) << v.fault()->message;
+}
+
+}  // namespace
+
+namespace {
+
+vm::Image compileFile(const std::string& path) {
+  auto r = compiler::compileFile(path);
+  if (!r.image) throw std::runtime_error(r.errors[0].format());
+  return std::move(*r.image);
+}
+
+scheduler::MatchConfig soloConfig(const std::string& file, int timerService, double seconds) {
+  auto profile = plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
+  profile.robot.timer_service = timerService;
+  scheduler::MatchConfig c;
+  c.arena = plant::makeArenaConfig(profile, 1);
+  c.robots.push_back({"A", file, compileFile(file)});
+  c.endTick = timebase::ticksFromSeconds(seconds);
+  return c;
+}
+
+// The profile's [controller] timer_service: "auto" runs the service only in
+// a program that uses the timer library, "always" in every program (ICEMAN
+// then takes 1,024 timer interrupts a second: 2,048 in 2 s less the one at
+// exactly 2 s), "never" in none (a DelayMs never ends).
+TEST(Timer, ProfileKnobDecidesWhetherTheServiceRuns) {
+  const std::string iceman = SIMBOT_SHARED_DIR "/programs/iceman.dc";
+  const std::string toggler = SIMBOT_SOURCE_DIR "/tests/programs/costate_delayms.dc";
+  const auto autoIceman = scheduler::runMatch(soloConfig(iceman, 0, 2));
+  EXPECT_EQ(autoIceman.robots[0].interrupts.at("timer"), 0u);
+  auto always = soloConfig(iceman, 1, 2);
+  always.profile = true;  // the service's cycles are a profile figure
+  const auto alwaysIceman = scheduler::runMatch(always);
+  EXPECT_EQ(alwaysIceman.robots[0].interrupts.at("timer"), 2047u);
+  EXPECT_GT(alwaysIceman.robots[0].timerIsrCycles, 0u);
+  const auto autoToggler = scheduler::runMatch(soloConfig(toggler, 0, 2));
+  EXPECT_TRUE(autoToggler.robots[0].exited);
+  const auto neverToggler = scheduler::runMatch(soloConfig(toggler, 2, 2));
+  EXPECT_FALSE(neverToggler.robots[0].exited);
+  EXPECT_EQ(neverToggler.robots[0].interrupts.at("timer"), 0u);
+}
+
+}  // namespace

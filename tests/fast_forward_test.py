@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+"""Fast-forward of delay loops is exact (issue 13).
+
+Usage: fast_forward_test.py SIMBOT SOURCE_DIR SHARED_DIR WORKDIR [--sanitized]
+
+Runs every program in programs/, tests/programs/ and the two reference
+programs solo and in a match against fig92, each with and without
+fast-forward (--no-fast-forward), and requires the same JSON summary (but
+for its wall-clock field) and a byte-identical trace. Under the sanitizers
+(slow) only programs/ and the reference programs run.
+"""
+import json
+import pathlib
+import subprocess
+import sys
+
+
+def run(simbot, args, trace):
+    out = subprocess.run([simbot, *args, "--json", "--trace", str(trace)],
+                         capture_output=True, text=True)
+    if out.returncode not in (0, 3):
+        sys.exit(f"FAIL: {' '.join(args)} exited {out.returncode}: {out.stderr}")
+    summary = json.loads(out.stdout)
+    summary.pop("wall_seconds", None)
+    return summary
+
+
+def main():
+    simbot, source, shared, work = sys.argv[1:5]
+    sanitized = "--sanitized" in sys.argv[5:]
+    source, shared, work = pathlib.Path(source), pathlib.Path(shared), pathlib.Path(work)
+    work.mkdir(parents=True, exist_ok=True)
+    fig92 = shared / "programs" / "fig92.dc"
+    programs = sorted((source / "programs").glob("*.dc"))
+    programs += [shared / "programs" / "iceman.dc", fig92]
+    if not sanitized:
+        programs += sorted((source / "tests" / "programs").glob("*.dc"))
+    seconds = "10" if sanitized else "20"
+    runs = []
+    for p in programs:
+        runs.append((f"solo-{p.stem}", ["solo", str(p), "--seconds", seconds]))
+        runs.append((f"match-{p.stem}", ["match", str(p), str(fig92), "--seconds", seconds]))
+    if not sanitized:
+        runs.append(("match-iceman-fig92-180s",
+                     ["match", str(shared / "programs" / "iceman.dc"), str(fig92)]))
+    failures = 0
+    for name, args in runs:
+        fast_trace, slow_trace = work / f"{name}.ff.jsonl", work / f"{name}.step.jsonl"
+        fast = run(simbot, args, fast_trace)
+        slow = run(simbot, args + ["--no-fast-forward"], slow_trace)
+        if fast != slow:
+            failures += 1
+            print(f"FAIL {name}: JSON differs\n  fast: {fast}\n  step: {slow}")
+        elif fast_trace.read_bytes() != slow_trace.read_bytes():
+            failures += 1
+            print(f"FAIL {name}: traces differ ({fast_trace} vs {slow_trace})")
+        else:
+            print(f"ok   {name}")
+    if failures:
+        sys.exit(f"{failures} of {len(runs)} runs differ with fast-forward")
+    print(f"all {len(runs)} runs identical with and without fast-forward")
+
+
+if __name__ == "__main__":
+    main()

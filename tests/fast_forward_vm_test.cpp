@@ -1,0 +1,97 @@
+// Fast-forward of delay loops at the VM level (issue 13): the loop is run
+// in one step only where nothing can happen to the robot, so an interrupt
+// requested at any tick inside the loop is accepted at the same boundary,
+// and sees the same counter, as when every pass is stepped.
+#include <gtest/gtest.h>
+
+#include "support/test_host.h"
+
+using namespace simbot;
+using simbot::testkit::TestHost;
+using vm::Irq;
+using vm::Tick;
+
+namespace {
+
+const char* kDelayWithHandler = R"(#INT_VEC PIOA_VEC edge
+int z, seen, seenAt;
+interrupt reti edge() { seen = z; seenAt = 1; }
+main()
+{
+    for (z = 0; z < 700; z++) ;
+}
+)";
+
+struct Outcome {
+  int seen;
+  Tick accepted;
+  Tick end;
+  uint64_t instructions;
+};
+
+Outcome runWithEdgeAt(const vm::Image& img, Tick at, bool fastForward) {
+  vm::CostTable table = testkit::calibratedCosts();
+  table.knobs.fastForward = fastForward;
+  TestHost host;
+  host.schedule(at, Irq::Pio);
+  vm::Vm v(img, host, table);
+  EXPECT_EQ(host.runUntil(v, vm::kTicksPerSecond), vm::Stop::Halted);
+  Tick accepted = -1;
+  for (const auto& e : host.events)
+    if (e.accepted && e.irq == Irq::Pio) accepted = e.tick;
+  const auto& seen = testkit::symbol(img, "seen");
+  if (fastForward) {
+    EXPECT_GT(v.stats().fastForwarded, 0u) << "request at " << at;
+  }
+  return {static_cast<int16_t>(v.read16(static_cast<uint16_t>(seen.address))), accepted, v.now(),
+          v.stats().instructions};
+}
+
+// One pass costs 252 T-states (README, "The cycle model"); a window of 20
+// consecutive request ticks 100 passes into the loop covers boundaries
+// inside a pass and between passes.
+TEST(FastForward, EdgeAtEveryTickOfAWindowSeesTheSteppedCounter) {
+  const auto img = testkit::compileOrDie(kDelayWithHandler);
+  ASSERT_EQ(img.delayLoops.size(), 1u);
+  const Tick start = 100 * 252 + 1000;
+  for (Tick at = start; at < start + 20; ++at) {
+    const Outcome fast = runWithEdgeAt(img, at, true);
+    const Outcome stepped = runWithEdgeAt(img, at, false);
+    EXPECT_EQ(fast.seen, stepped.seen) << "request at " << at;
+    EXPECT_EQ(fast.accepted, stepped.accepted) << "request at " << at;
+    EXPECT_EQ(fast.end, stepped.end) << "request at " << at;
+    EXPECT_EQ(fast.instructions, stepped.instructions) << "request at " << at;
+    // Accepted at the first boundary at or after the request: a pass has
+    // seven, none more than 68 T-states apart (DBG with its hook).
+    EXPECT_GE(fast.accepted, at);
+    EXPECT_LT(fast.accepted, at + 68);
+    EXPECT_GT(fast.seen, 90);
+    EXPECT_LT(fast.seen, 110);
+  }
+}
+
+// Without a request, the whole loop: 700 passes of 252 T-states and the
+// final test (LDGW 29, PUSHW 22, LTW false, JZ taken) run as when stepped.
+TEST(FastForward, WholeLoopEndsWhereSteppingEnds) {
+  const auto img = testkit::compileOrDie("int z; main() { for (z = 0; z < 700; z++) ; }");
+  vm::CostTable off = testkit::calibratedCosts();
+  off.knobs.fastForward = false;
+  TestHost h1, h2;
+  vm::Vm fast(img, h1, testkit::calibratedCosts());
+  vm::Vm stepped(img, h2, off);
+  h1.runUntil(fast, vm::kTicksPerSecond);
+  h2.runUntil(stepped, vm::kTicksPerSecond);
+  const auto& z = testkit::symbol(img, "z");
+  EXPECT_EQ(fast.read16(static_cast<uint16_t>(z.address)), 700);
+  EXPECT_EQ(fast.stats().instructions, stepped.stats().instructions);
+  EXPECT_EQ(fast.now(), stepped.now());
+  // 700 passes x 7 instructions, the start-up stub (3), main's prologue and
+  // the for's statement (DBG, PUSHW, STGW), the last test (4), RET's
+  // constant and RET: the instruction count stepping gives.
+  EXPECT_GT(fast.stats().instructions, 700u * 7u);
+  // All passes but the measured one, and the one before the horizon, skipped.
+  EXPECT_GE(fast.stats().fastForwarded, 690u * 7u);
+  EXPECT_EQ(stepped.stats().fastForwarded, 0u);
+}
+
+}  // namespace
