@@ -98,6 +98,69 @@ TEST(Cost, BranchesChargeTheWayTheyGo) {
   EXPECT_EQ(delta(t, Op::LDGW, 1), 0);
 }
 
+// The 16-bit shifts: LD A,E; OR A; JR Z jumps over a DJNZ loop of n passes
+// (n = the count's low byte). Z180 table: POP DE 9; EX DE,HL 3; LD A,E 4;
+// OR A 4 = 20, then
+//   n = 0:  JR Z taken 8 = 28;
+//   n >= 1: JR Z not taken 6; LD B,A 4 = 30; n x body; DJNZ taken 9
+//           (n - 1) times and not taken 7 once.
+// SHLW's body is ADD HL,HL 7: n = 1 is 30 + 7 + 7 = 44, n = 5 is
+// 30 + 35 + 36 + 7 = 108, n = 15 is 30 + 105 + 126 + 7 = 268; each pass
+// after the first adds 7 + 9 = 16. SHRW's and SHRUW's body is SRA H (SRL
+// H) 7; RR L 7 = 14: n = 1 is 51, n = 5 is 30 + 70 + 36 + 7 = 143,
+// n = 15 is 30 + 210 + 126 + 7 = 373; each further pass 14 + 9 = 23.
+TEST(Cost, ShiftsChargeTheirLoopPerPass) {
+  const auto t = makeCostTable(uncalibratedKnobs());
+  for (Op op : {Op::SHLW, Op::SHRW, Op::SHRUW}) {
+    const bool left = op == Op::SHLW;
+    const std::string_view seq = kOpInfo[static_cast<int>(op)].z180;
+    EXPECT_EQ(sequenceCost(seq, 1).tstates, 28) << seq;  // n = 0: JR Z taken
+    EXPECT_EQ(sequenceCost(seq, 0, 1).tstates, left ? 44 : 51) << seq;
+    EXPECT_EQ(sequenceCost(seq, 0, 5).tstates, left ? 108 : 143) << seq;
+    EXPECT_EQ(sequenceCost(seq, 0, 15).tstates, left ? 268 : 373) << seq;
+    EXPECT_EQ(sequenceCost(seq).branches, 1) << seq;  // the loop's DJNZ is not a path branch
+    // The table: op[] is one pass, path 1 the skip, loopPass[] each further pass.
+    EXPECT_EQ(opCost(t, op), left ? 44u : 51u);
+    EXPECT_EQ(delta(t, op, 1), left ? 28 - 44 : 28 - 51);
+    EXPECT_EQ(t.loopPass[static_cast<int>(op)], left ? 16u : 23u);
+  }
+  // No other opcode has a loop.
+  for (int i = 0; i < kOpCount; ++i) {
+    const Op op = static_cast<Op>(i);
+    if (op == Op::SHLW || op == Op::SHRW || op == Op::SHRUW) continue;
+    EXPECT_EQ(t.loopPass[i], 0u) << kOpInfo[i].name;
+  }
+  // Calibrated refresh (2 every 20, +10 %) rounds the first pass and each
+  // further pass on its own, so the charge is linear in n: SHLW's first
+  // pass 44 + 4 = 48 (4.4 rounds down), each further pass 16 + 2 = 18
+  // (1.6 rounds up), the skip 28 + 3 = 31: 31 for n = 0, 30 + 18 n after.
+  const auto c = makeCostTable(calibratedKnobs());
+  EXPECT_EQ(opCost(c, Op::SHLW), 48u);
+  EXPECT_EQ(c.loopPass[static_cast<int>(Op::SHLW)], 18u);
+  EXPECT_EQ(opCost(c, Op::SHLW) + c.branchDelta[static_cast<int>(Op::SHLW)][1], 31u);
+}
+
+// abs (argument in HL): CALL 16; LD A,H 4; OR A 4 = 24, then
+//   not negative: JP P taken 9; RET 9 = 42;
+//   negative:     JP P not taken 6; EX DE,HL 3; LD HL,0 9; OR A 4;
+//                 SBC HL,DE 10; RET 9 = 65.
+// libCall[] is the not-taken (negative) path; libTakenDelta[] the
+// difference to the taken one. Every other routine costs the same on
+// every path, so its delta is 0.
+TEST(Cost, AbsChargesThePathOfItsArgumentsSign) {
+  const auto t = makeCostTable(uncalibratedKnobs());
+  EXPECT_EQ(libCost(t, Lib::ABS), 65u);
+  EXPECT_EQ(t.libTakenDelta[static_cast<int>(Lib::ABS)], 42 - 65);
+  for (int i = 0; i < kLibCount; ++i) {
+    if (static_cast<Lib>(i) == Lib::ABS) continue;
+    EXPECT_EQ(t.libTakenDelta[i], 0) << kLibInfo[i].name;
+    EXPECT_TRUE(pathsCostTheSame(kLibInfo[i].callSeq)) << kLibInfo[i].name;
+  }
+  EXPECT_FALSE(pathsCostTheSame(kLibInfo[static_cast<int>(Lib::ABS)].callSeq));
+  EXPECT_TRUE(libPathFromArguments(Lib::ABS));
+  EXPECT_FALSE(libPathFromArguments(Lib::FABS));
+}
+
 TEST(Cost, DebugHookIsItsSequenceWithJrNotTaken) {
   const auto t = makeCostTable(uncalibratedKnobs());
   // RST 28h 11; hook: PUSH AF 11; LD A,(nn) 12; OR A 4; JR NZ 6 (not

@@ -8,9 +8,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <variant>
 
 #include "compiler/compiler.h"
 #include "plant/plant.h"
+#include "plant/serial_link.h"
+#include "support/records.h"
 #include "support/traced.h"
 
 using namespace simbot;
@@ -381,6 +384,152 @@ TEST(Match, CostateHunterPlaysIcemanAndLatchesFrames) {
   EXPECT_EQ(a.framesRejected, 0);
   EXPECT_GT(a.shots, 0);
   EXPECT_GT(a.hits, 0);
+}
+
+// Keeps only the trace records of the kinds listed (a 180-s match writes
+// some 100,000 records; the tests below need a few hundred).
+template <class... Kinds>
+class KeepSink final : public trace::Sink {
+ public:
+  void write(const trace::Entry& e) override {
+    if ((std::holds_alternative<Kinds>(e.record) || ...)) entries.push_back(e);
+  }
+  std::vector<trace::Entry> entries;
+};
+
+// Thesis VI.D: more than event_limit (5) edge-handler entries within the
+// window (10 s) make the referee turn the robot by turn_deg (45). The
+// entries are counted at the tick their PIO interrupt is accepted
+// (Robot::interruptAccepted records it during the round, the arena applies
+// it after the round at that tick: Arena::edgeHandlerEntered rewinds the
+// plant to it). So the turn must be at the sixth acceptance's tick, not
+// at the end of the round it fell in. The program keeps interrupts off
+// most of the time, so that each request waits for an EI and is accepted
+// in the middle of a round; six edges are injected 1.2 s apart.
+TEST(Match, RefereeTurnsAtTheTickOfTheCountedHandlerEntry) {
+  const char* kEdgy = R"(#INT_VEC PIOA_VEC edge
+int z, hits;
+interrupt reti edge()
+{
+    hits++;
+}
+main()
+{
+    outport(PIOCA, 0xff);
+    outport(PIOCA, 0xff);
+    outport(PIOCA, PIOA_VEC);
+    outport(PIOCA, 0x97);
+    outport(PIOCA, 0xfc);
+    outport(PIOCA, 0x87);
+    while (1) {
+        DI();
+        for (z = 0; z < 37; z++)
+            ;
+        EI();
+    }
+}
+)";
+  auto run = [&](bool inject) {
+    auto c = matchConfig({{"A", "edgy.dc", compileSource(kEdgy)}}, 9);
+    if (inject)
+      for (int k = 1; k <= 6; ++k)
+        c.injections.push_back(
+            scheduler::parseInjection("A:edge_fore@" + std::to_string(1.2 * k) + "s", 1));
+    KeepSink<trace::rec::InterruptAccepted, trace::rec::RefereeTurn> keep;
+    c.sinks.push_back(&keep);
+    auto r = scheduler::runMatch(c);
+    return std::make_pair(r, keep.entries);
+  };
+  const auto [plain, plainTrace] = run(false);
+  const auto [turned, trace] = run(true);
+  ASSERT_EQ(matchConfig({}, 1).arena.referee.event_limit, 5);
+  const auto accepted = testkit::recordsOf<trace::rec::InterruptAccepted>(trace, 0);
+  const auto turns = testkit::recordsOf<trace::rec::RefereeTurn>(trace, 0);
+  ASSERT_EQ(accepted.size(), 6u);
+  for (size_t k = 0; k < accepted.size(); ++k) {
+    EXPECT_EQ(accepted[k].second.source, "pio_a");
+    // Mid-round: not at the injection's tick (a round's end) but at the
+    // EI that lets it in, later in the round.
+    const timebase::Tick injected = timebase::ticksFromSeconds(1.2 * static_cast<double>(k + 1));
+    EXPECT_GT(accepted[k].first - injected, 100) << k;
+    EXPECT_LT(accepted[k].first - injected, plant::kTicksPerChar) << k;
+  }
+  ASSERT_EQ(turns.size(), 1u);
+  EXPECT_EQ(turns[0].first, accepted[5].first);
+  // The robot stands still: the turn is all its heading changed by.
+  EXPECT_NEAR(turned.robots[0].finalPose.heading_deg,
+              std::fmod(plain.robots[0].finalPose.heading_deg + 45.0, 360.0), 1e-9);
+  EXPECT_TRUE(testkit::recordsOf<trace::rec::RefereeTurn>(plainTrace).empty());
+}
+
+// The 180-s ICEMAN vs fig92 match (`simbot match iceman.dc fig92.dc`:
+// default profile, seed 1, the profile's 180-s round). The counts and ticks
+// below are REGRESSION values read from the run, not an oracle: a change
+// to the cost table, the plant or the scheduler that moves them must say
+// why. Two relations are checked as an oracle:
+//
+// - ICEMAN's first send, by hand from the cost table (calibrated, the
+//   figures `simbot compile --disasm` prints; no interrupt can come before
+//   it, as nothing moves yet): CALL main 18; ser_init_z1's line DBG 68 +
+//   2 PUSHW 22 + 196 = 308; hv_enb's 68 + 50 = 118; 8 outport lines of
+//   68 + 2 x 22 + 67 = 179 each = 1432; cnt=0 and shcnt=0, 68 + 22 + 28 =
+//   118 each; read(); = DBG 68 + CALL 18 + POP 10 + read's two lines of
+//   DBG 68 + PUSHW 22 + ad_rd8 163 + the 276-T-state conversion + STGW 28
+//   = 557 and its return 68 + 22 + RET 10 = 1310; the delay loop of line 44,
+//   DBG 68 + PUSHL 44 + STGL 58 = 170, then 50,000 passes of LDGL 61 +
+//   PUSHL 44 + LTUL 94 + JZ not taken 25 + DBG 68 + INCGL 92 + JMP 10 = 394
+//   = 19,700,000, and the exit LDGL 61 + PUSHL 44 + LTUL 94 + JZ taken 29
+//   = 228; search(); DBG 68 + CALL 18; search's test x<=48 && y<=48 (both
+//   eyes at background): DBG 68 + 2 x (LDGW 29 + PUSHW 22 + LEW 56, no
+//   overflow and true + JZ not taken 25) = 332; strcpy(buf,"cfgrcfgr"):
+//   DBG 68 + 2 PUSHW 22 + strcpy 59 + 9 bytes x 34 + POP 10 = 487;
+//   platform(); DBG 68 + CALL 18; cc = sizeof(buf): 68 + 22 + STGB 29 =
+//   119; outport(ENB485,1): 179; ser_send_z1(buf,&cc): 68 + 2 x 22 + 189
+//   = 301. In all 19,705,410: the send returns (T0) at that tick.
+// - The frame latches when the NUL's stop bit ends: 8 characters and the
+//   NUL, 9 character times of kTicksPerChar = 9,600 ticks (10 bits at 9,600
+//   baud, 960 characters a second) after T0: 19,705,410 + 86,400 =
+//   19,791,810.
+TEST(Match, IcemanAgainstFig92For180SecondsPinsItsKeyFigures) {
+  auto c =
+      matchConfig({{"A", kIceman, compileFile(kIceman)}, {"B", kFig92, compileFile(kFig92)}},
+                  plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml").round_length_s);
+  ASSERT_EQ(c.seed, 1u);  // simbot match's default
+  ASSERT_EQ(c.endTick, 180 * timebase::kTicksPerSecond);
+  KeepSink<trace::rec::SerialSend, trace::rec::FrameLatched, trace::rec::SolenoidStroke,
+           trace::rec::BallLaunch>
+      keep;
+  c.sinks.push_back(&keep);
+  const auto r = scheduler::runMatch(c);
+  ASSERT_EQ(r.robots.size(), 2u);
+  // Regression values.
+  EXPECT_EQ(r.robots[0].framesLatched, 422);
+  EXPECT_EQ(r.robots[1].framesLatched, 8622);
+  EXPECT_EQ(r.robots[0].shots, 30);
+  EXPECT_EQ(r.robots[1].shots, 0);
+  EXPECT_EQ(r.robots[0].hits, 2);
+  EXPECT_EQ(r.robots[1].hits, 0);
+  EXPECT_EQ(r.winner, "A");
+  const auto sends = testkit::recordsOf<trace::rec::SerialSend>(keep.entries, 0);
+  const auto frames = testkit::recordsOf<trace::rec::FrameLatched>(keep.entries, 0);
+  const auto strokes = testkit::recordsOf<trace::rec::SolenoidStroke>(keep.entries, 0);
+  const auto launches = testkit::recordsOf<trace::rec::BallLaunch>(keep.entries, 0);
+  ASSERT_FALSE(sends.empty());
+  ASSERT_FALSE(frames.empty());
+  ASSERT_FALSE(strokes.empty());
+  ASSERT_FALSE(launches.empty());
+  EXPECT_EQ(static_cast<int>(frames.size()), r.robots[0].framesLatched);
+  EXPECT_EQ(static_cast<int>(launches.size()), r.robots[0].shots);
+  // The oracle: T0 summed by hand above, the latch 9 characters later.
+  EXPECT_EQ(sends[0].first, 19'705'410);
+  EXPECT_EQ(frames[0].first - sends[0].first, 9 * plant::kTicksPerChar);
+  EXPECT_EQ(frames[0].first, 19'791'810);
+  EXPECT_EQ(frames[0].second.bytes, "cfgrcfgr");
+  // Regression values: the first fire()'s solenoids (port B 0x30, both
+  // guns), and its launch one stroke (0.03 s = 276,480 ticks) later.
+  EXPECT_EQ(strokes[0].first, 54'265'154);
+  EXPECT_EQ(launches[0].first, 54'541'634);
+  EXPECT_EQ(launches[0].first - strokes[0].first, 276'480);
 }
 
 }  // namespace

@@ -103,6 +103,125 @@ TEST(Vm, ComparisonsChargeTheWayTheirBranchesGo) {
   }
 }
 
+// The value a two-operand instruction leaves (stored to a global) and its
+// ticks, on the table with no wait states and no refresh.
+struct Ran {
+  vm::Tick ticks;
+  uint16_t value;
+};
+Ran runBinary(Op op, uint32_t x, uint32_t y) {
+  static const vm::CostTable plain = vm::makeCostTable(vm::uncalibratedKnobs());
+  Assembler a;
+  const uint16_t out = a.data(2);
+  a.op(Op::PUSHW, x).op(Op::PUSHW, y).op(op).bind("end").op(Op::STGW, out).op(Op::HALT);
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, plain);
+  v.setBreakpoint(a.label("end"));
+  EXPECT_EQ(v.run(1'000'000), Stop::Breakpoint);
+  const vm::Tick at = v.now();
+  v.run(1'000'000);
+  return {at, v.read16(out)};
+}
+
+TEST(Vm, ShiftsChargeOneLoopPassPerCount) {
+  // PUSHW 20 x 2, then the shift (opcodes.def; sums in cost_test.cpp
+  // ShiftsChargeTheirLoopPerPass): POP DE 9; EX DE,HL 3; LD A,E 4; OR A 4;
+  // then for n = 0 JR Z taken 8 (28 in all), else JR Z not taken 6;
+  // LD B,A 4; n x body; DJNZ 9 taken n - 1 times, 7 not taken once.
+  // SHLW body ADD HL,HL 7: 28, 44, 108, 268 for n = 0, 1, 5, 15.
+  // SHRW/SHRUW body SRA/SRL H 7; RR L 7: 28, 51, 143, 373.
+  struct Case {
+    uint32_t count;
+    int shlw, shrw;
+  };
+  for (const Case c : {Case{0, 28, 28}, Case{1, 44, 51}, Case{5, 108, 143}, Case{15, 268, 373}}) {
+    const Ran l = runBinary(Op::SHLW, 0x8001, c.count);
+    EXPECT_EQ(l.ticks, 40 + c.shlw) << "SHLW " << c.count;
+    EXPECT_EQ(l.value, static_cast<uint16_t>(0x8001u << c.count)) << c.count;
+    const Ran r = runBinary(Op::SHRW, 0x8000, c.count);
+    EXPECT_EQ(r.ticks, 40 + c.shrw) << "SHRW " << c.count;
+    EXPECT_EQ(r.value, static_cast<uint16_t>(static_cast<int16_t>(-32768) >> c.count)) << c.count;
+    const Ran u = runBinary(Op::SHRUW, 0x8000, c.count);
+    EXPECT_EQ(u.ticks, 40 + c.shrw) << "SHRUW " << c.count;
+    EXPECT_EQ(u.value, static_cast<uint16_t>(0x8000u >> c.count)) << c.count;
+  }
+  // The loop count is the count's low byte: 256 skips the loop (28) and
+  // leaves the value; 40 runs 40 passes (30 + 40 x 7 + 39 x 9 + 7 = 668)
+  // and shifts every bit out.
+  EXPECT_EQ(runBinary(Op::SHLW, 0x1234, 256).ticks, 40 + 28);
+  EXPECT_EQ(runBinary(Op::SHLW, 0x1234, 256).value, 0x1234);
+  EXPECT_EQ(runBinary(Op::SHLW, 0x1234, 40).ticks, 40 + 668);
+  EXPECT_EQ(runBinary(Op::SHLW, 0x1234, 40).value, 0);
+}
+
+TEST(Vm, LongShiftIsInterruptibleAndItsTimeIsKept) {
+  // SHLW by 255 on the calibrated table: 48 + 254 x 18 = 4620 T-states
+  // after the two PUSHWs (22 each), its tail run in steps with boundaries
+  // between them; a request raised 1000 ticks in is taken before the shift
+  // ends, and the shift's time is all still charged around the handler.
+  Assembler a;
+  const uint16_t counter = a.data(2);
+  a.op(Op::EI).op(Op::PUSHW, 1).op(Op::PUSHW, 255).op(Op::SHLW).bind("end").op(Op::HALT);
+  countingHandler(a, counter);
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  v.setBreakpoint(a.label("end"));
+  EXPECT_EQ(v.run(1000), Stop::Horizon);
+  v.request(Irq::Pio, vm::kVecPIOA);
+  Stop stop;
+  while ((stop = v.run(1'000'000)) == Stop::Io) {
+  }
+  EXPECT_EQ(stop, Stop::Breakpoint);
+  EXPECT_EQ(v.read16(counter), 1u);
+  const vm::Tick shiftEnd = cost(Op::EI) + 2 * cost(Op::PUSHW) + 48 + 254 * 18;
+  ASSERT_FALSE(host.events.empty());
+  EXPECT_GE(host.events.front().tick, 1000);
+  EXPECT_LT(host.events.front().tick, 1000 + 100);  // the next step's boundary
+  const vm::Tick handler = costs().interruptAccept + cost(Op::INCGW) + cost(Op::RETI);
+  EXPECT_EQ(v.now(), shiftEnd + handler);
+}
+
+TEST(Vm, AbsChargesThePathOfItsArgumentsSign) {
+  // PUSHW 20, then abs (cost_test.cpp AbsChargesThePathOfItsArgumentsSign):
+  // CALL 16; LD A,H 4; OR A 4; JP P 9 taken; RET 9 = 42 when the argument
+  // is not negative; JP P 6 not taken; EX DE,HL 3; LD HL,0 9; OR A 4;
+  // SBC HL,DE 10; RET 9 = 65 when it is negative (-32768 included).
+  struct Case {
+    int16_t arg;
+    int tstates;
+  };
+  for (const Case c : {Case{0, 42}, Case{1234, 42}, Case{-1, 65}, Case{-32768, 65}}) {
+    Assembler a;
+    const uint16_t out = a.data(2);
+    a.op(Op::PUSHW, static_cast<uint16_t>(c.arg)).lib(vm::Lib::ABS, 1).bind("end");
+    a.op(Op::STGW, out).op(Op::HALT);
+    EXPECT_EQ(ticksTo(a, a.label("end")), 20 + c.tstates) << c.arg;
+  }
+}
+
+// --disasm shows every path's figure (calibrated knobs: +10 % refresh,
+// rounded per sequence). JZ taken 26 + 3 = 29, not taken 23 + 2 = 25;
+// LTW both taken 53 + 5 = 58, one 54 + 5 = 59, neither 55 + 6 = 61 (5.5
+// rounds up); SHLW skip 28 + 3 = 31, n passes (44 + 4) + (n - 1) x
+// (16 + 2) = 30 + 18n; abs not negative 42 + 4 = 46, negative 65 + 7 = 72;
+// LDGW 26 + 3 = 29 alone.
+TEST(Disasm, ShowsEveryPathsTstates) {
+  Assembler a;
+  a.op(Op::LDGW, vm::kDataBase).op(Op::PUSHW, 0).op(Op::LTW).jump(Op::JZ, "end");
+  a.op(Op::PUSHW, 1).op(Op::PUSHW, 2).op(Op::SHLW).lib(vm::Lib::ABS, 1);
+  a.bind("end").op(Op::HALT);
+  a.data(2);
+  const std::string text = vm::disassemble(a.finish());
+  EXPECT_NE(text.find("; addr         T-st  op       operands\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("  0000           29  LDGW     0x0100\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("  58/59/59/61  LTW"), std::string::npos) << text;
+  EXPECT_NE(text.find("        29/25  JZ       -> "), std::string::npos) << text;
+  EXPECT_NE(text.find("    31/30+18n  SHLW"), std::string::npos) << text;
+  EXPECT_NE(text.find("        46/72  LIB      abs, 1 args"), std::string::npos) << text;
+}
+
 TEST(Vm, RetPopsIxOnlyAfterEnter) {
   // CALL 16; RET 9 for a static-class function.
   {

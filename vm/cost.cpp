@@ -64,11 +64,14 @@ CostTable makeCostTable(const CostKnobs& knobs) {
     for (int p = 0; p < kOpPaths; ++p)
       t.branchDelta[i][p] =
           static_cast<int32_t>(resolve(kOpPathCost[i][p], knobs)) - static_cast<int32_t>(t.op[i]);
+    t.loopPass[i] = resolve(kOpLoopPass[i], knobs);
   }
   t.op[static_cast<int>(Op::DBG)] += resolve(kHookSeq, knobs);
   if (!knobs.epilogueEi) t.op[static_cast<int>(Op::RETI)] -= resolve(kEiSeq, knobs);
   for (int i = 0; i < kLibCount; ++i) {
     t.libCall[i] = resolve(kLibCallCost[i], knobs);
+    t.libTakenDelta[i] = static_cast<int32_t>(resolve(kLibPathCost[i][1], knobs)) -
+                         static_cast<int32_t>(t.libCall[i]);
     t.libStep[i] = resolve(kLibStepCost[i], knobs);
   }
   t.autoFrameRet = resolve(kAutoRetSeq, knobs);

@@ -38,8 +38,17 @@ struct SeqCost {
   int memCycles = 0;
   int ioCycles = 0;
   int insns = 0;
-  int branches = 0;  // conditional branches in the sequence
+  int branches = 0;  // conditional branches in the sequence (a loop's DJNZ is not one)
+  int loops = 0;     // loop groups "{...}" in the sequence
 };
+
+constexpr SeqCost operator-(SeqCost a, const SeqCost& b) {
+  a.tstates -= b.tstates;
+  a.memCycles -= b.memCycles;
+  a.ioCycles -= b.ioCycles;
+  a.insns -= b.insns;
+  return a;
+}
 
 // Branches. A sequence is the code as emitted; a conditional branch in it
 // (JP cc,nn or JR cc,e) costs the Z180's taken or not-taken figure by the
@@ -49,14 +58,23 @@ struct SeqCost {
 // of the sequence is taken; the VM picks the bits from the operands
 // (vm.cpp) and charges the difference from the all-not-taken figure.
 //
+// Loops. "{BODY; DJNZ e}" is a loop closed by DJNZ: it runs `passes` times
+// (at least once), the body each time, DJNZ taken passes - 1 times (9) and
+// not taken once (7). It may sit inside a bracket group (the 16-bit
+// shifts jump over it for a zero count); its DJNZ is not one of the
+// sequence's branches. The VM supplies `passes` from the operands.
+//
 // Sum of a "MNEMONIC; MNEMONIC; ..." sequence along the path `taken`. An
-// unknown mnemonic or a stray bracket is a compile-time error (the throw is
-// not a constant expression).
-constexpr SeqCost sequenceCost(std::string_view seq, unsigned taken = 0) {
+// unknown mnemonic, a stray bracket or brace is a compile-time error (the
+// throw is not a constant expression).
+constexpr SeqCost sequenceCost(std::string_view seq, unsigned taken = 0, int passes = 1) {
   SeqCost total;
   bool skipping = false;      // inside a bracket group jumped over
   bool inGroup = false;       // inside a bracket group
   bool groupAllowed = false;  // the previous item was a branch
+  bool inLoop = false;        // inside a loop group
+  SeqCost body;               // one pass of the loop, DJNZ not included
+  const Z180Insn* djnz = nullptr;
   while (!seq.empty()) {
     auto end = seq.find(';');
     auto item = seq.substr(0, end);
@@ -64,6 +82,7 @@ constexpr SeqCost sequenceCost(std::string_view seq, unsigned taken = 0) {
     while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
     if (!item.empty()) {
       bool closes = false;
+      bool closesLoop = false;
       if (item.front() == '[') {
         if (!groupAllowed || inGroup) throw "a bracket group must follow a conditional branch";
         item.remove_prefix(1);
@@ -71,18 +90,42 @@ constexpr SeqCost sequenceCost(std::string_view seq, unsigned taken = 0) {
       } else if (!inGroup) {
         skipping = false;
       }
+      if (!item.empty() && item.front() == '{') {
+        if (inLoop || total.loops > 0) throw "one loop group per sequence";
+        item.remove_prefix(1);
+        inLoop = true;
+        body = SeqCost{};
+        djnz = nullptr;
+        ++total.loops;
+      }
       if (!item.empty() && item.back() == ']') {
         if (!inGroup) throw "unbalanced bracket in cost sequence";
         item.remove_suffix(1);
         closes = true;
+      }
+      if (!item.empty() && item.back() == '}') {
+        if (!inLoop) throw "unbalanced brace in cost sequence";
+        item.remove_suffix(1);
+        closesLoop = true;
       }
       groupAllowed = false;
       bool found = false;
       for (const auto& z : kZ180) {
         if (z.mnemonic != item) continue;
         found = true;
-        if (skipping) break;
-        if (z.branch) {
+        const bool isDjnz = z.mnemonic == "DJNZ e";
+        if (isDjnz != (inLoop && closesLoop)) throw "DJNZ closes a loop group, and only it";
+        if (isDjnz) {
+          djnz = &z;
+        } else if (inLoop) {
+          if (z.branch) throw "a branch inside a loop group is not supported";
+          body.tstates += z.tstates;
+          body.memCycles += z.memCycles;
+          body.ioCycles += z.ioCycles;
+          ++body.insns;
+        } else if (skipping) {
+          break;
+        } else if (z.branch) {
           if (inGroup) throw "a branch inside a bracket group is not supported";
           const bool isTaken = (taken >> total.branches) & 1u;
           total.tstates += isTaken ? z.takenTstates : z.tstates;
@@ -90,16 +133,31 @@ constexpr SeqCost sequenceCost(std::string_view seq, unsigned taken = 0) {
           ++total.branches;
           groupAllowed = true;
           skipping = isTaken;  // applies to the bracket group that follows
+          ++total.insns;
         } else {
           total.tstates += z.tstates;
           total.memCycles += z.memCycles;
           total.ioCycles += z.ioCycles;
+          ++total.insns;
         }
-        ++total.insns;
         break;
       }
       if (!found) throw "unknown Z180 mnemonic in cost sequence";
+      if (closesLoop) {
+        inLoop = false;
+        if (!skipping) {
+          if (passes < 1) throw "a loop group runs at least once";
+          // passes x body, DJNZ taken passes - 1 times, not taken once.
+          total.tstates +=
+              passes * body.tstates + (passes - 1) * djnz->takenTstates + djnz->tstates;
+          total.memCycles +=
+              passes * body.memCycles + (passes - 1) * djnz->takenMemCycles + djnz->memCycles;
+          total.ioCycles += passes * body.ioCycles;
+          total.insns += passes * (body.insns + 1);
+        }
+      }
       if (closes) {
+        if (inLoop) throw "a loop group must close inside its bracket group";
         inGroup = false;
         skipping = false;
       }
@@ -108,6 +166,7 @@ constexpr SeqCost sequenceCost(std::string_view seq, unsigned taken = 0) {
     seq.remove_prefix(end + 1);
   }
   if (inGroup) throw "unbalanced bracket in cost sequence";
+  if (inLoop) throw "unbalanced brace in cost sequence";
   return total;
 }
 
@@ -131,9 +190,22 @@ inline constexpr auto kOpSeqCost = [] {
   return a;
 }();
 
-// Library call sequences are charged whole when the call starts, so every
-// path through one must cost the same (ser_*'s "JP PO; [EI]": 9 taken,
-// 6 + 3 not taken). Checked here at compile time.
+// Each pass of an opcode's loop after the first (body + DJNZ taken, less
+// nothing: the first pass and the DJNZ that falls through are in
+// kOpPathCost). Zero for an opcode without a loop.
+inline constexpr auto kOpLoopPass = [] {
+  std::array<SeqCost, kOpCount> a{};
+  for (int i = 0; i < kOpCount; ++i)
+    if (kOpPathCost[i][0].loops > 0)
+      a[i] = sequenceCost(kOpInfo[i].z180, 0, 2) - sequenceCost(kOpInfo[i].z180, 0, 1);
+  return a;
+}();
+
+// Library call sequences are charged whole when the call starts. Most must
+// cost the same on every path (ser_*'s "JP PO; [EI]": 9 taken, 6 + 3 not
+// taken); a routine whose one branch the VM decides from its argument when
+// the call starts (abs: by the argument's sign, vm.cpp libPath) may take
+// either. Checked here at compile time.
 constexpr bool pathsCostTheSame(std::string_view seq) {
   const SeqCost first = sequenceCost(seq, 0);
   for (unsigned p = 1; p < (1u << first.branches); ++p) {
@@ -145,12 +217,31 @@ constexpr bool pathsCostTheSame(std::string_view seq) {
   return true;
 }
 
+// The routines whose path the VM picks from the arguments (vm.cpp libPath).
+constexpr bool libPathFromArguments(Lib id) { return id == Lib::ABS; }
+
+// Paths through a library call: one branch at most where they differ.
+inline constexpr int kLibPaths = 2;
+
+inline constexpr auto kLibPathCost = [] {
+  std::array<std::array<SeqCost, kLibPaths>, kLibCount> a{};
+  for (int i = 0; i < kLibCount; ++i) {
+    const std::string_view seq = kLibInfo[i].callSeq;
+    if (sequenceCost(seq).loops > 0) throw "a library call sequence has no loop group (steps)";
+    if (libPathFromArguments(static_cast<Lib>(i))) {
+      if (sequenceCost(seq).branches != 1) throw "an argument-chosen path is one branch";
+    } else if (!pathsCostTheSame(seq)) {
+      throw "library call paths differ in cost";
+    }
+    for (unsigned p = 0; p < kLibPaths; ++p) a[i][p] = sequenceCost(seq, p);
+  }
+  return a;
+}();
+
+// Path 0 (every branch not taken).
 inline constexpr auto kLibCallCost = [] {
   std::array<SeqCost, kLibCount> a{};
-  for (int i = 0; i < kLibCount; ++i) {
-    if (!pathsCostTheSame(kLibInfo[i].callSeq)) throw "library call paths differ in cost";
-    a[i] = sequenceCost(kLibInfo[i].callSeq);
-  }
+  for (int i = 0; i < kLibCount; ++i) a[i] = kLibPathCost[i][0];
   return a;
 }();
 
@@ -251,6 +342,13 @@ struct CostTable {
   // Added to op[] when the instruction's branches go the way `path` says
   // (bit k: k-th branch taken); path 0 is 0 (op[] is the not-taken path).
   std::array<std::array<int32_t, kOpPaths>, kOpCount> branchDelta{};
+  // Added for each pass of an opcode's loop after the first (op[] has the
+  // first): an n-pass loop costs op[] + (n - 1) x loopPass[]. Each pass is
+  // rounded for refresh on its own, so the figure is exactly linear in n.
+  std::array<uint32_t, kOpCount> loopPass{};
+  // Added to libCall[] when a call's branch is taken (path 1); 0 but for
+  // the routines whose path comes from their argument (abs).
+  std::array<int32_t, kLibCount> libTakenDelta{};
   uint32_t autoFrameRet = 0;     // RET of a frame that ran ENTER: POP IX
   uint32_t interruptAccept = 0;  // IM2 acknowledge + handler register saves
   uint32_t serialIsr = 0;        // acceptance + library ISR body

@@ -1,5 +1,6 @@
-// Disassembler: one line per instruction (address, T-states, name, operands),
-// a label at each function and the source line above the code it produced.
+// Disassembler: one line per instruction (address, T-states by path, name,
+// operands), a label at each function and the source line above the code it
+// produced.
 // One small helper per operand shape, as in craftinginterpreters' debug.c.
 #include <fmt/format.h>
 
@@ -85,6 +86,36 @@ std::string annotate(const Image& img, Op op, uint32_t at) {
   return "";
 }
 
+// An instruction's T-states under the calibrated knobs, by path:
+//   "23"           no conditional branch;
+//   "26/23"        one branch: taken / not taken (a library call whose
+//                  path its argument picks, abs, likewise);
+//   "58/59/59/61"  two branches (the signed comparisons): both taken /
+//                  first only / second only / neither;
+//   "31/30+18n"    a loop of n passes (the 16-bit shifts): count 0, its
+//                  JR Z taken over the loop / n >= 1 passes.
+std::string costText(const CostTable& costs, Op op, const Image& img, uint32_t operandAt) {
+  const int i = static_cast<int>(op);
+  const auto path = [&](unsigned p) {
+    return static_cast<int64_t>(costs.op[i]) + costs.branchDelta[i][p];
+  };
+  if (op == Op::LIB) {
+    const int id = img.code[operandAt];
+    if (id >= kLibCount) return fmt::format("{}", costs.op[i]);
+    const int64_t call = int64_t{costs.op[i]} + costs.libCall[id];
+    if (!libPathFromArguments(static_cast<Lib>(id))) return fmt::format("{}", call);
+    return fmt::format("{}/{}", call + costs.libTakenDelta[id], call);
+  }
+  const SeqCost& seq = kOpSeqCost[i];
+  if (seq.loops > 0) {
+    const int64_t pass = costs.loopPass[i];
+    return fmt::format("{}/{}+{}n", path(1), int64_t{costs.op[i]} - pass, pass);
+  }
+  if (seq.branches == 1) return fmt::format("{}/{}", path(1), path(0));
+  if (seq.branches == 2) return fmt::format("{}/{}/{}/{}", path(3), path(1), path(2), path(0));
+  return fmt::format("{}", costs.op[i]);
+}
+
 }  // namespace
 
 std::string disassemble(const Image& img) {
@@ -98,7 +129,7 @@ std::string disassemble(const Image& img) {
                                 img.code.size(), img.data.size(), kDataBase);
   for (const auto& v : img.vectors)
     out += fmt::format("; vector 0x{:02x} -> {} at {:04x}\n", v.vector, v.handlerName, v.handler);
-  out += "; addr  T-st  op       operands\n";
+  out += fmt::format("; {:<4}  {:>11}  {:<8} {}\n", "addr", "T-st", "op", "operands");
   int lastLine = -1;
   uint32_t at = 0;
   while (at < img.code.size()) {
@@ -108,7 +139,7 @@ std::string disassemble(const Image& img) {
       const std::string text = line <= static_cast<int>(img.sourceLines.size())
                                    ? img.sourceLines[line - 1]
                                    : std::string();
-      out += fmt::format("                          ; {:>4} | {}\n", line, text);
+      out += fmt::format("{:33}; {:>4} | {}\n", "", line, text);
       lastLine = line;
     }
     const uint8_t byte = img.code[at];
@@ -126,9 +157,8 @@ std::string disassemble(const Image& img) {
     std::string operands = operandText(info(op).shape, img, at + 1);
     const std::string note = annotate(img, op, at + 1);
     if (!note.empty()) operands += fmt::format("  ({})", note);
-    uint32_t cost = costs.op[byte];
-    if (op == Op::LIB && img.code[at + 1] < kLibCount) cost += costs.libCall[img.code[at + 1]];
-    out += fmt::format("  {:04x}  {:>4}  {:<8} {}\n", at, cost, info(op).name, operands);
+    const std::string cost = costText(costs, op, img, at + 1);
+    out += fmt::format("  {:04x}  {:>11}  {:<8} {}\n", at, cost, info(op).name, operands);
     at += static_cast<uint32_t>(size);
   }
   return out;

@@ -591,7 +591,12 @@ void Vm::State::libCall(Lib id, int argc, uint32_t instructionPc) {
   lib.index = 0;
   lib.remaining = 0;
   lib.result = 0;
-  const uint32_t callCost = costs.libCall[static_cast<int>(id)];
+  uint32_t callCost = costs.libCall[static_cast<int>(id)];
+  // abs: JP P is taken (the negation skipped) when the argument is not
+  // negative (builtins.def); every other routine costs the same either way.
+  if (id == Lib::ABS && asInt16(lib.args[0]) >= 0)
+    callCost = static_cast<uint32_t>(static_cast<int32_t>(callCost) +
+                                     costs.libTakenDelta[static_cast<int>(id)]);
   // An atomic call (the serial library's DI ... restore idiom) runs its
   // whole sequence with no boundary inside; its effect happens at the next
   // boundary, before any interrupt can be accepted there.
@@ -957,6 +962,25 @@ Stop Vm::State::run(Tick until) {
     BRANCH_COST((overflow ? 0u : 1u) | (TOP == 0 ? 2u : 0u));         \
   }                                                                   \
   NEXT
+      // A shift by n: op[] is one pass; n = 0 takes the JR Z (path 1), n > 1
+      // adds n - 1 further passes, run like a long instruction's tail (in
+      // steps of at most kMaxStepTstates, interruptible between them, as
+      // the Z180 is between the loop's instructions).
+#define SHIFT(expr)                                       \
+  {                                                       \
+    const uint32_t n = POPV & 0xFF;                       \
+    const uint32_t a = TOP;                               \
+    TOP = (expr);                                         \
+    if (n == 0) {                                         \
+      BRANCH_COST(1u);                                    \
+    } else if (n > 1) {                                   \
+      const uint32_t more = (n - 1) * costs.loopPass[op]; \
+      if constexpr (kProfile) profile[opPc] += more;      \
+      burn += more;                                       \
+      burnPc = opPc;                                      \
+    }                                                     \
+  }                                                       \
+  NEXT
 #if SIMBOT_COMPUTED_GOTO
       goto* kLabels[op];
 #else
@@ -1113,11 +1137,12 @@ Stop Vm::State::run(Tick until) {
       CASE(ANDW) BINARY(a & b & 0xFFFF);
       CASE(ORW) BINARY((a | b) & 0xFFFF);
       CASE(XORW) BINARY((a ^ b) & 0xFFFF);
-      // Shift counts come from an 8-bit loop counter: 16 or more shifts
-      // leave nothing (or the sign) behind.
-      CASE(SHLW) BINARY((b & 0xFF) >= 16 ? 0u : (a << (b & 0xFF)) & 0xFFFF);
-      CASE(SHRW) BINARY(w(asInt16(a) >> std::min<uint32_t>(b & 0xFF, 15)));
-      CASE(SHRUW) BINARY((b & 0xFF) >= 16 ? 0u : (a & 0xFFFF) >> (b & 0xFF));
+      // The 16-bit shifts loop once per bit (opcodes.def): the count's low
+      // byte n is the number of passes (n = 0 takes JR Z over the loop);
+      // 16 or more passes leave nothing (or the sign) behind.
+      CASE(SHLW) SHIFT((n >= 16 ? 0u : (a << n) & 0xFFFF));
+      CASE(SHRW) SHIFT(w(asInt16(a) >> std::min<uint32_t>(n, 15)));
+      CASE(SHRUW) SHIFT((n >= 16 ? 0u : (a & 0xFFFF) >> n));
       CASE(NEGW) TOP = w(-static_cast<int32_t>(TOP));
       NEXT;
       CASE(NOTW) TOP = ~TOP & 0xFFFF;
@@ -1433,6 +1458,7 @@ Stop Vm::State::run(Tick until) {
 #undef PUSHV
 #undef BINARY
 #undef BRANCH_COST
+#undef SHIFT
 #undef COMPARE
 #undef SIGNED_COMPARE
   }
