@@ -637,7 +637,8 @@ void CodeGen::stmt(Node* n) {
 }
 
 // A counting loop with nothing in it: `for (...; v < N; v++) ;` (or <=) on
-// a static or global 16-bit integer. The VM checks the code's shape too.
+// a static or global int, unsigned, long or unsigned long. The VM checks
+// the code's shape too.
 bool CodeGen::isDelayLoop(const Node* n) const {
   const Node* body = n->then;
   const bool empty =
@@ -649,7 +650,9 @@ bool CodeGen::isDelayLoop(const Node* n) const {
     return false;
   const Obj* v = c->lhs->var;
   if (v->storage != Storage::Global && v->storage != Storage::Static) return false;
-  if (v->type->kind != TypeKind::Int && v->type->kind != TypeKind::UInt) return false;
+  const TypeKind k = v->type->kind;
+  if (k != TypeKind::Int && k != TypeKind::UInt && k != TypeKind::Long && k != TypeKind::ULong)
+    return false;
   const Node* inc = n->inc->lhs;
   return inc->kind == NodeKind::IncDec && inc->delta == 1 && inc->lhs->kind == NodeKind::Var &&
          inc->lhs->var == v;

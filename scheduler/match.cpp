@@ -159,6 +159,7 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   std::vector<uint64_t> earlierProfile;
   uint64_t earlierSerialIsrCycles = 0;
   uint64_t earlierTimerIsrCycles = 0;
+  uint64_t earlierInstructions = 0, earlierFastForwarded = 0;
   plant::SerialLink link;
   // What the serial library had still to fetch of the current send after
   // its last step: a new send while it is above zero overwrites that frame.
@@ -346,6 +347,8 @@ void Robot::reload(Tick t) {
     for (size_t a = 0; a < p.size(); ++a) earlierProfile[a] += p[a];
     earlierSerialIsrCycles += vm_->serialIsrCycles();
     earlierTimerIsrCycles += vm_->timerIsrCycles();
+    earlierInstructions += vm_->stats().instructions;
+    earlierFastForwarded += vm_->stats().fastForwarded;
   }
   powerOn(t);
   ++result.reloads;
@@ -1025,6 +1028,8 @@ void Match::finish(MatchResult& result) {
     // one instruction past the end.
     rr.cycles = static_cast<uint64_t>(rr.exited ? rr.exitTick : std::min(r->now(), result.endTick));
     rr.vmClock = static_cast<uint64_t>(r->now());
+    rr.vmInstructions = r->vm().stats().instructions + r->earlierInstructions;
+    rr.vmFastForwarded = r->vm().stats().fastForwarded + r->earlierFastForwarded;
     if (config_.profile) {
       rr.profile = r->vm().profile();
       rr.profile.resize(std::max(rr.profile.size(), r->earlierProfile.size()));

@@ -179,6 +179,10 @@ struct RobotResult {
   // instruction straddling the end and anything after main returned
   // (interrupt handlers, halted time). simbot profile adds up to this.
   uint64_t vmClock = 0;
+  // Bytecode instructions run (library steps included), and of those the
+  // ones fast-forward applied without dispatching them.
+  uint64_t vmInstructions = 0;
+  uint64_t vmFastForwarded = 0;
   std::optional<FaultInfo> fault;  // the first fault
   std::vector<FaultInfo> faults;   // every fault, in order (more than one after reloads)
   int reloads = 0;                 // MatchConfig::reloadOnFault

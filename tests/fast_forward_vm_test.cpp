@@ -95,3 +95,42 @@ TEST(FastForward, WholeLoopEndsWhereSteppingEnds) {
 }
 
 }  // namespace
+
+namespace {
+
+// ICEMAN's delay loops count an unsigned long (`for(count=0;count<1000;
+// count++);`): the 32-bit shape fast-forwards as exactly.
+TEST(FastForward, LongCountersTooAndAnEdgeSeesTheSteppedCount) {
+  const auto img = testkit::compileOrDie(R"(#INT_VEC PIOA_VEC edge
+unsigned long count, seen;
+interrupt reti edge() { seen = count; }
+main()
+{
+    for (count = 0; count < 50000; count++) ;
+}
+)");
+  ASSERT_EQ(img.delayLoops.size(), 1u);
+  const auto& seen = testkit::symbol(img, "seen");
+  for (Tick at : {Tick{1'000'000}, Tick{1'000'001}, Tick{7'777'777}}) {
+    uint32_t counts[2];
+    Tick ends[2];
+    for (int mode = 0; mode < 2; ++mode) {
+      vm::CostTable table = testkit::calibratedCosts();
+      table.knobs.fastForward = mode == 0;
+      TestHost host;
+      host.schedule(at, Irq::Pio);
+      vm::Vm v(img, host, table);
+      host.runUntil(v, 4 * vm::kTicksPerSecond);
+      counts[mode] = v.read32(static_cast<uint16_t>(seen.address));
+      ends[mode] = v.now();
+      if (mode == 0) {
+        EXPECT_GT(v.stats().fastForwarded, 0u);
+      }
+    }
+    EXPECT_EQ(counts[0], counts[1]) << "request at " << at;
+    EXPECT_EQ(ends[0], ends[1]) << "request at " << at;
+    EXPECT_GT(counts[0], 0u);
+  }
+}
+
+}  // namespace

@@ -98,9 +98,10 @@ struct Image {
   // sorted: a lastlocADDR that is not one of them is a fault.
   std::vector<uint16_t> resumePoints;
   // Delay loops the compiler marked for fast-forward (DESIGN.md, issue 13):
-  // `for (v = ...; v < N; v++) ;` on a static or global int, whose code is
-  // top: LDGW v; PUSHW N; LTW|LTUW|LEW|LEUW; JZ exit; [DBG]; INCGW v;
-  // JMP top; exit:. The VM checks that shape before trusting a mark.
+  // `for (v = ...; v < N; v++) ;` on a static or global integer, whose code
+  // is top: LDGW v; PUSHW N; LTW|LTUW|LEW|LEUW; JZ exit; [DBG]; INCGW v;
+  // JMP top; exit: (or the 32-bit LDGL, PUSHL, LTL..LEUL, INCGL). The VM
+  // checks that shape before trusting a mark.
   struct DelayLoop {
     uint16_t top;
     uint16_t exit;

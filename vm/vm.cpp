@@ -173,8 +173,9 @@ struct Vm::State {
   // ---- fast-forward of delay loops ----
   struct Loop {
     uint32_t top, exit, counter;
-    uint16_t limit;
+    uint32_t limit;
     Op compare;
+    bool wide;  // a long counter
   };
   std::vector<Loop> loops;
   std::vector<int16_t> loopAtTop;  // per code byte: index into loops, or -1
@@ -391,6 +392,8 @@ void Vm::State::findLoops() {
   const auto& code = image.code;
   auto at = [&](uint32_t a) -> int { return a < code.size() ? code[a] : -1; };
   auto u16at = [&](uint32_t a) { return static_cast<uint32_t>(code[a] | (code[a + 1] << 8)); };
+  auto u32at = [&](uint32_t a) { return u16at(a) | (u16at(a + 2) << 16); };
+  auto is = [&](uint32_t a, Op op) { return at(a) == static_cast<int>(op); };
   auto rel = [&](uint32_t operand) {
     return static_cast<uint32_t>(static_cast<int32_t>(operand + 2) +
                                  static_cast<int16_t>(u16at(operand)));
@@ -398,63 +401,73 @@ void Vm::State::findLoops() {
   for (const auto& mark : image.delayLoops) {
     uint32_t a = mark.top;
     if (mark.exit > code.size() || mark.exit <= a || mark.exit - a > kMaxLoopBytes) continue;
-    if (at(a) != static_cast<int>(Op::LDGW)) continue;
+    const bool wide = is(a, Op::LDGL);
+    if (!wide && !is(a, Op::LDGW)) continue;
     const uint32_t counter = u16at(a + 1);
     a += 3;
-    if (at(a) != static_cast<int>(Op::PUSHW)) continue;
-    const auto limit = static_cast<uint16_t>(u16at(a + 1));
-    a += 3;
+    if (!is(a, wide ? Op::PUSHL : Op::PUSHW)) continue;
+    const uint32_t limit = wide ? u32at(a + 1) : u16at(a + 1);
+    a += wide ? 5 : 3;
     const int cmp = at(a);
-    if (cmp != static_cast<int>(Op::LTW) && cmp != static_cast<int>(Op::LTUW) &&
-        cmp != static_cast<int>(Op::LEW) && cmp != static_cast<int>(Op::LEUW))
-      continue;
+    const bool compares =
+        wide ? is(a, Op::LTL) || is(a, Op::LTUL) || is(a, Op::LEL) || is(a, Op::LEUL)
+             : is(a, Op::LTW) || is(a, Op::LTUW) || is(a, Op::LEW) || is(a, Op::LEUW);
+    if (!compares) continue;
     a += 1;
-    if (at(a) != static_cast<int>(Op::JZ) || rel(a + 1) != mark.exit) continue;
+    if (!is(a, Op::JZ) || rel(a + 1) != mark.exit) continue;
     a += 3;
-    if (at(a) == static_cast<int>(Op::DBG)) a += 1;
-    if (at(a) != static_cast<int>(Op::INCGW) || u16at(a + 1) != counter) continue;
+    if (is(a, Op::DBG)) a += 1;
+    if (!is(a, wide ? Op::INCGL : Op::INCGW) || u16at(a + 1) != counter) continue;
     a += 3;
-    if (at(a) != static_cast<int>(Op::JMP) || rel(a + 1) != mark.top || a + 3 != mark.exit)
-      continue;
-    if (counter < kDataBase || counter + 1 >= kMemorySize) continue;
+    if (!is(a, Op::JMP) || rel(a + 1) != mark.top || a + 3 != mark.exit) continue;
+    if (counter < kDataBase || counter + (wide ? 3 : 1) >= kMemorySize) continue;
     if (loopAtTop.empty()) loopAtTop.assign(code.size() + 1, -1);
     if (loopAtTop[mark.top] >= 0) continue;
     loopAtTop[mark.top] = static_cast<int16_t>(loops.size());
-    loops.push_back(Loop{mark.top, mark.exit, counter, limit, static_cast<Op>(cmp)});
+    loops.push_back(Loop{mark.top, mark.exit, counter, limit, static_cast<Op>(cmp), wide});
   }
 }
 
 bool Vm::State::fastForward(Tick until) {
   const int index = loopAtTop[pc];
   const Loop& loop = loops[static_cast<size_t>(index)];
-  const uint32_t v = rd16(loop.counter);
-  const bool isSigned = loop.compare == Op::LTW || loop.compare == Op::LEW;
-  const bool inclusive = loop.compare == Op::LEW || loop.compare == Op::LEUW;
-  // Passes still to run from v, and the largest counter of the regime in
-  // which every pass costs the same (signed: no overflow in v - N when both
-  // are non-negative; the counter must not wrap).
-  auto passesLeft = [&](uint32_t from) -> int64_t {
-    const int64_t x = isSigned ? static_cast<int16_t>(from) : static_cast<int64_t>(from);
-    const int64_t n =
-        isSigned ? static_cast<int16_t>(loop.limit) : static_cast<int64_t>(loop.limit);
-    const int64_t top = isSigned ? 32767 : 65535;
-    const int64_t last = std::min(inclusive ? n : n - 1, top - 1);  // v + 1 stays in range
-    return last >= x ? last - x + 1 : 0;
+  const uint32_t v = loop.wide ? rd32(loop.counter) : rd16(loop.counter);
+  const uint32_t mask = loop.wide ? 0xFFFFFFFFu : 0xFFFFu;
+  const bool isSigned = loop.compare == Op::LTW || loop.compare == Op::LEW ||
+                        loop.compare == Op::LTL || loop.compare == Op::LEL;
+  const bool inclusive = loop.compare == Op::LEW || loop.compare == Op::LEUW ||
+                         loop.compare == Op::LEL || loop.compare == Op::LEUL;
+  // As a signed or unsigned number of the counter's width.
+  auto number = [&](uint32_t x) -> int64_t {
+    if (!isSigned) return x & mask;
+    return loop.wide ? static_cast<int32_t>(x) : static_cast<int16_t>(x);
   };
-  const bool regime =
-      !isSigned || (static_cast<int16_t>(v) >= 0 && static_cast<int16_t>(loop.limit) >= 0);
+  // Passes still to run from v while the compare holds, the counter staying
+  // below the top of its range (it never wraps here).
+  auto passesLeft = [&](uint32_t from) -> int64_t {
+    const int64_t top = isSigned ? (loop.wide ? INT32_MAX : INT16_MAX) : int64_t{mask};
+    const int64_t n = number(loop.limit);
+    const int64_t last = std::min(inclusive ? n : n - 1, top - 1);
+    return last >= number(from) ? last - number(from) + 1 : 0;
+  };
+  // The regime in which every pass costs the same: a signed compare's
+  // overflow branch is never taken when both sides are non-negative.
+  const bool regime = !isSigned || (number(v) >= 0 && number(loop.limit) >= 0);
   const bool anyBreak =
       anyBreakpoint && std::any_of(breakpoints.begin() + loop.top, breakpoints.begin() + loop.exit,
                                    [](uint8_t b) { return b != 0; });
   if (measure.loop == index && measure.accepted == acceptances &&
-      v == ((measure.counter + 1) & 0xFFFF) && regime && !anyBreak &&
-      static_cast<int16_t>(measure.counter) >= (isSigned ? 0 : INT16_MIN)) {
+      v == ((measure.counter + 1) & mask) && regime && !anyBreak &&
+      (!isSigned || number(measure.counter) >= 0)) {
     const Tick pass = now - measure.start;
     const Tick bound = std::min(until, nextTimer);
     const int64_t n =
         pass > 0 && bound > now ? std::min<int64_t>(passesLeft(v), (bound - now) / pass) : 0;
     if (n > 0) {
-      wr16(loop.counter, v + static_cast<uint32_t>(n));
+      if (loop.wide)
+        wr32(loop.counter, v + static_cast<uint32_t>(n));
+      else
+        wr16(loop.counter, v + static_cast<uint32_t>(n));
       now += n * pass;
       const uint64_t skipped =
           static_cast<uint64_t>(n) * (stats.instructions - measure.instructions);
