@@ -1,6 +1,16 @@
 // Whole-match speed: wall time of the 180-s ICEMAN vs Figure 9.2 match and
-// its real-time factor, with the integrator statistics. Reported, never
-// asserted. Run: build/bin/match_bench --benchmark_counters_tabular=true
+// its real-time factor, under the default and thesis-1997 profiles, with
+// fast-forward of delay loops on (ff) and off (noff); with the VM
+// instructions each robot ran (dispatched and fast-forwarded) and the
+// integrator statistics. Reported, never asserted. Run:
+//   build/bin/match_bench --benchmark_counters_tabular=true
+// Counters (rates are per wall second): sim_s (simulated seconds),
+// realtime_x (simulated seconds per wall second), vm_instr (instructions
+// run, both robots, fast-forwarded ones included), vm_dispatched (those
+// dispatched one by one), vm_ff (those fast-forward applied without
+// dispatch), Minstr (dispatched instructions per wall second, millions),
+// steps, rhs_evals, reinits and roots (the plant's integrator), rounds (the
+// scheduler's).
 #include <benchmark/benchmark.h>
 
 #include <stdexcept>
@@ -19,7 +29,7 @@ vm::Image compileFile(const std::string& path) {
   return std::move(*r.image);
 }
 
-void BM_IcemanVsFig92(benchmark::State& state, const char* profile) {
+void BM_IcemanVsFig92(benchmark::State& state, const char* profile, bool fastForward) {
   const std::string a = SIMBOT_SHARED_DIR "/programs/iceman.dc";
   const std::string b = SIMBOT_SHARED_DIR "/programs/fig92.dc";
   scheduler::MatchConfig config;
@@ -27,12 +37,25 @@ void BM_IcemanVsFig92(benchmark::State& state, const char* profile) {
       plant::loadProfile(std::string(SIMBOT_SOURCE_DIR "/profiles/") + profile + ".toml"), 2);
   config.robots = {{"A", a, compileFile(a)}, {"B", b, compileFile(b)}};
   config.endTick = 180 * scheduler::kTicksPerSecond;
+  config.knobs.fastForward = fastForward;
   scheduler::MatchResult last;
   for (auto _ : state) last = scheduler::runMatch(config);
   const double simSeconds = static_cast<double>(last.endTick) / scheduler::kTicksPerSecond;
+  const double iterations = static_cast<double>(state.iterations());
+  uint64_t instructions = 0, fastForwarded = 0;
+  for (const auto& robot : last.robots) {
+    instructions += robot.vmInstructions;
+    fastForwarded += robot.vmFastForwarded;
+  }
+  const double dispatched = static_cast<double>(instructions - fastForwarded);
   state.counters["sim_s"] = simSeconds;
-  state.counters["realtime_x"] = benchmark::Counter(
-      simSeconds * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["realtime_x"] =
+      benchmark::Counter(simSeconds * iterations, benchmark::Counter::kIsRate);
+  state.counters["vm_instr"] = static_cast<double>(instructions);
+  state.counters["vm_dispatched"] = dispatched;
+  state.counters["vm_ff"] = static_cast<double>(fastForwarded);
+  state.counters["Minstr"] =
+      benchmark::Counter(dispatched * iterations / 1e6, benchmark::Counter::kIsRate);
   state.counters["steps"] = static_cast<double>(last.integrator.steps);
   state.counters["rhs_evals"] = static_cast<double>(last.integrator.rhs_evals);
   state.counters["reinits"] = static_cast<double>(last.integrator.reinits);
@@ -40,8 +63,22 @@ void BM_IcemanVsFig92(benchmark::State& state, const char* profile) {
   state.counters["rounds"] = static_cast<double>(last.rounds);
 }
 
-BENCHMARK_CAPTURE(BM_IcemanVsFig92, default, "default")->Unit(benchmark::kSecond)->Iterations(1);
-BENCHMARK_CAPTURE(BM_IcemanVsFig92, thesis, "thesis-1997")->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_IcemanVsFig92, default_ff, "default", true)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_IcemanVsFig92, default_noff, "default", false)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_IcemanVsFig92, thesis_ff, "thesis-1997", true)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_IcemanVsFig92, thesis_noff, "thesis-1997", false)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 }  // namespace
 
