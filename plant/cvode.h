@@ -12,8 +12,7 @@
 #include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
-#include <sunlinsol/sunlinsol_dense.h>
-#include <sunmatrix/sunmatrix_dense.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include <stdexcept>
 #include <string>
@@ -59,36 +58,22 @@ class Vector {
   N_Vector v_;
 };
 
-class DenseMatrix {
+// Functional (fixed-point) iteration for the corrector: the right answer
+// for a non-stiff problem, with no Jacobian and no linear solve.
+class FixedPointSolver {
  public:
-  DenseMatrix(sunindextype n, SUNContext ctx) : m_(SUNDenseMatrix(n, n, ctx)) {
-    if (!m_) throw std::runtime_error("SUNDIALS: SUNDenseMatrix failed");
+  FixedPointSolver(N_Vector y, SUNContext ctx) : s_(SUNNonlinSol_FixedPoint(y, 0, ctx)) {
+    if (!s_) throw std::runtime_error("SUNDIALS: SUNNonlinSol_FixedPoint failed");
   }
-  ~DenseMatrix() {
-    if (m_) SUNMatDestroy(m_);
+  ~FixedPointSolver() {
+    if (s_) SUNNonlinSolFree(s_);
   }
-  DenseMatrix(const DenseMatrix&) = delete;
-  DenseMatrix& operator=(const DenseMatrix&) = delete;
-  SUNMatrix get() const { return m_; }
+  FixedPointSolver(const FixedPointSolver&) = delete;
+  FixedPointSolver& operator=(const FixedPointSolver&) = delete;
+  SUNNonlinearSolver get() const { return s_; }
 
  private:
-  SUNMatrix m_;
-};
-
-class DenseLinearSolver {
- public:
-  DenseLinearSolver(N_Vector y, SUNMatrix a, SUNContext ctx) : s_(SUNLinSol_Dense(y, a, ctx)) {
-    if (!s_) throw std::runtime_error("SUNDIALS: SUNLinSol_Dense failed");
-  }
-  ~DenseLinearSolver() {
-    if (s_) SUNLinSolFree(s_);
-  }
-  DenseLinearSolver(const DenseLinearSolver&) = delete;
-  DenseLinearSolver& operator=(const DenseLinearSolver&) = delete;
-  SUNLinearSolver get() const { return s_; }
-
- private:
-  SUNLinearSolver s_;
+  SUNNonlinearSolver s_;
 };
 
 class Memory {

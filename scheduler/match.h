@@ -180,7 +180,9 @@ struct RobotResult {
   // (interrupt handlers, halted time). simbot profile adds up to this.
   uint64_t vmClock = 0;
   // Bytecode instructions run (library steps included), and of those the
-  // ones fast-forward applied without dispatching them.
+  // ones fast-forward applied without dispatching them. The second depends
+  // on where the run was stopped (a trace's samples stop it more often), so
+  // it is a benchmark figure, not part of a run's result.
   uint64_t vmInstructions = 0;
   uint64_t vmFastForwarded = 0;
   std::optional<FaultInfo> fault;  // the first fault
