@@ -10,7 +10,7 @@ packages=(
   libsundials-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev
-  lua5.4 python3
+  lua5.4 python3 linux-perf     # Lua and perf for the benchmarks (bench/vs_lua.py, README)
   libjs-three                  # three.js r111, inlined in replay pages
   sigrok-cli gtkwave xvfb      # tests read --vcd output with sigrok's decoder and GTKWave
   chromium                     # the browser test (headless, software WebGL)

@@ -5,7 +5,8 @@ Usage: readme_test.py README SIMBOT WORKDIR
 
 Each ```sh block of the README runs, in order, with bash -e, in a sandbox
 laid out like the project's checkout (WORKDIR/main holding build/bin/simbot,
-programs/, scenarios/, profiles/ and tests/, beside WORKDIR/shared), so that
+programs/, scenarios/, profiles/, tests/ and bench/ and the bench binaries,
+beside WORKDIR/shared), so that
 the files a command writes land in WORKDIR and a later block can read them.
 The Quickstart block is the exception: `.ci/run` runs `scripts/test.sh` and
 `scripts/quickstart.sh` themselves on a clean clone. A desktop program
@@ -45,7 +46,12 @@ def sandbox(source, simbot, work):
         shutil.rmtree(work)
     os.makedirs(os.path.join(main, "build", "bin"))
     os.symlink(os.path.abspath(simbot), os.path.join(main, "build", "bin", "simbot"))
-    for part in ("programs", "scenarios", "profiles", "tests"):
+    # The benchmark binaries beside it, for the README's Benchmarks section.
+    for name in ("match_bench", "vm_bench"):
+        built = os.path.join(os.path.dirname(os.path.abspath(simbot)), name)
+        if os.path.exists(built):
+            os.symlink(built, os.path.join(main, "build", "bin", name))
+    for part in ("programs", "scenarios", "profiles", "tests", "bench"):
         os.symlink(os.path.join(source, part), os.path.join(main, part))
     os.symlink(os.path.abspath(os.path.join(source, "..", "shared")), os.path.join(work, "shared"))
     return main
