@@ -1,0 +1,364 @@
+// The VM's library routines: Dynamic C's built-in library (builtins.def) as
+// the VM runs it: a call's sequence charged first (in steps when longer than
+// one), its effect at the end of it, long routines (strcpy, printf...) one
+// unit per step with a boundary between steps; and the firsttime Delay
+// functions of costatements.
+#include <cstdio>
+#include <cstring>
+
+#include "vm/state.h"
+
+namespace simbot::vm {
+
+// A firsttime Delay function: a[0] the CoData, a[1] the interval.
+bool Vm::State::delayDone(const uint32_t* a, uint32_t timerAddress, uint32_t instructionPc) {
+  const uint32_t cd = a[0] & 0xFFFF;
+  if (!checkAccess(cd, kCoDataSize, instructionPc)) return false;
+  const uint32_t timer = timerAddress ? rd32(timerAddress) : 0;
+  if (rd8(cd + kCoFirstTime)) {
+    wr8(cd + kCoFirstTime, 0);
+    wr32(cd + kCoContent, timer);
+  }
+  return static_cast<int32_t>(timer - rd32(cd + kCoContent)) >= static_cast<int32_t>(a[1]);
+}
+
+// ---- library calls -------------------------------------------------------
+
+std::string Vm::State::formatPrintf(uint32_t instructionPc) {
+  std::string out;
+  uint32_t f = lib.args[0];
+  int next = 1;
+  auto arg = [&]() -> uint32_t { return next < lib.argc ? lib.args[next++] : 0; };
+  auto readString = [&](uint32_t a, size_t limit) {
+    std::string s;
+    while (s.size() < limit) {
+      if (!checkAccess(a, 1, instructionPc)) break;
+      char c = static_cast<char>(rd8(a++));
+      if (c == 0) break;
+      s.push_back(c);
+    }
+    return s;
+  };
+  const std::string format = readString(f, 4096);
+  char buf[512];
+  for (size_t i = 0; i < format.size(); ++i) {
+    char c = format[i];
+    if (c != '%') {
+      out.push_back(c);
+      continue;
+    }
+    // %[flags][width][.precision][l]conv; width and precision are read as
+    // numbers and clamped to kMaxPrintfField, as the era's library, which
+    // formatted into a small buffer, could not print more.
+    std::string spec = "%";
+    size_t j = i + 1;
+    while (j < format.size() && format[j] != '\0' && std::strchr("-0+ #", format[j]))
+      spec.push_back(format[j++]);
+    const auto number = [&]() {
+      long n = 0;
+      while (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j])))
+        n = std::min<long>(n * 10 + (format[j++] - '0'), kMaxPrintfField);
+      return n;
+    };
+    if (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j])))
+      spec += std::to_string(number());
+    if (j < format.size() && format[j] == '.') {
+      ++j;
+      spec += "." + std::to_string(number());
+    }
+    bool isLong = false;
+    if (j < format.size() && format[j] == 'l') {
+      isLong = true;
+      ++j;
+    }
+    if (j >= format.size()) {
+      out += format.substr(i);
+      break;
+    }
+    char conv = format[j];
+    i = j;
+    switch (conv) {
+      case 'd':
+      case 'i':
+        if (isLong)
+          std::snprintf(buf, sizeof buf, (spec + "ld").c_str(),
+                        static_cast<long>(static_cast<int32_t>(arg())));
+        else
+          std::snprintf(buf, sizeof buf, (spec + "d").c_str(), static_cast<int>(asInt16(arg())));
+        out += buf;
+        break;
+      case 'u':
+      case 'x':
+      case 'X':
+        if (isLong)
+          std::snprintf(buf, sizeof buf, (spec + "l" + conv).c_str(),
+                        static_cast<unsigned long>(arg()));
+        else
+          std::snprintf(buf, sizeof buf, (spec + conv).c_str(),
+                        static_cast<unsigned>(arg() & 0xFFFF));
+        out += buf;
+        break;
+      case 'c':
+        std::snprintf(buf, sizeof buf, (spec + "c").c_str(), static_cast<int>(arg() & 0xFF));
+        out += buf;
+        break;
+      case 's': {
+        std::string s = readString(arg(), 4096);
+        std::snprintf(buf, sizeof buf, (spec + "s").c_str(), s.c_str());
+        out += buf;
+        break;
+      }
+      case 'f':
+      case 'e':
+      case 'g':
+        std::snprintf(buf, sizeof buf, (spec + conv).c_str(), static_cast<double>(asFloat(arg())));
+        out += buf;
+        break;
+      case '%':
+        out.push_back('%');
+        break;
+      default:
+        out += spec;
+        out.push_back(conv);
+        break;
+    }
+  }
+  return out;
+}
+
+// LIB: the call sequence runs first (in steps when it is longer than
+// kMaxStepTstates); the routine's effect happens at the end of it.
+void Vm::State::libCall(Lib id, int argc, uint32_t instructionPc) {
+  lib.id = id;
+  lib.pc = instructionPc;
+  lib.argc = argc;
+  for (int k = argc - 1; k >= 0; --k) lib.args[k] = eval[--sp];
+  lib.index = 0;
+  lib.remaining = 0;
+  lib.result = 0;
+  uint32_t callCost = costs.libCall[static_cast<int>(id)];
+  // abs: JP P is taken (the negation skipped) when the argument is not
+  // negative (builtins.def); every other routine costs the same either way.
+  if (id == Lib::ABS && asInt16(lib.args[0]) >= 0)
+    callCost = static_cast<uint32_t>(static_cast<int32_t>(callCost) +
+                                     costs.libTakenDelta[static_cast<int>(id)]);
+  // An atomic call (the serial library's DI ... restore idiom) runs its
+  // whole sequence with no boundary inside; its effect happens at the next
+  // boundary, before any interrupt can be accepted there.
+  const uint32_t first =
+      kLibAtomic[static_cast<int>(id)] ? callCost : std::min(kMaxStepTstates, callCost);
+  now += first;
+  if (profiling) profile[instructionPc] += first;
+  lib.setup = callCost - first;
+  lib.active = true;
+  lib.awaitingBegin = lib.setup == 0;
+}
+
+void Vm::State::libBegin() {
+  lib.active = false;
+  lib.awaitingBegin = false;
+  const Lib id = lib.id;
+  const uint32_t instructionPc = lib.pc;
+  const uint32_t* a = lib.args;
+  switch (id) {
+    case Lib::AD_RD8:
+      // Sampled at the start of the conversion, which then takes its time.
+      lib.result = w(bus.adSample(now, static_cast<int>(asInt16(a[0]))));
+      lib.remaining = costs.adConversion;
+      busTouched = true;
+      lib.active = lib.remaining > 0;
+      if (!lib.active) eval[sp++] = lib.result;
+      return;
+    case Lib::OUTPORT:
+      bus.out(now, static_cast<uint16_t>(a[0]), static_cast<uint8_t>(a[1]));
+      busTouched = true;
+      return;
+    case Lib::INPORT:
+      eval[sp++] = bus.in(now, static_cast<uint16_t>(a[0]));
+      busTouched = true;
+      return;
+    case Lib::SER_INIT_Z1:
+      // The routine restores the caller's interrupt state (JP PO; EI): IFF1
+      // is as it was before the call.
+      bus.serialInit(now, asInt16(a[0]), asInt16(a[1]));
+      busTouched = true;
+      return;
+    case Lib::SER_SEND_Z1:
+      bus.serialSend(now, static_cast<uint16_t>(a[0]), static_cast<uint16_t>(a[1]));
+      busTouched = true;
+      return;
+    case Lib::HV_ENB:
+      bus.hvEnable(now);
+      busTouched = true;
+      return;
+    case Lib::ABS: {
+      int16_t v = asInt16(a[0]);
+      eval[sp++] = w(v < 0 ? -v : v);
+      return;
+    }
+    case Lib::FABS:
+      eval[sp++] = a[0] & 0x7FFFFFFFu;
+      return;
+    case Lib::DELAYMS:
+      eval[sp++] = delayDone(a, image.timer.ms, instructionPc) ? 1u : 0u;
+      return;
+    case Lib::DELAYSEC:
+      eval[sp++] = delayDone(a, image.timer.sec, instructionPc) ? 1u : 0u;
+      return;
+    case Lib::DELAYTICKS: {
+      const uint32_t args[2] = {a[0], a[1] & 0xFFFF};
+      eval[sp++] = delayDone(args, image.timer.tick, instructionPc) ? 1u : 0u;
+      return;
+    }
+    case Lib::COBEGIN:
+    case Lib::CORESET:
+    case Lib::COPAUSE:
+    case Lib::CORESUME:
+    case Lib::ISCODONE:
+    case Lib::ISCORUNNING: {
+      const uint32_t cd = a[0] & 0xFFFF;
+      if (!checkAccess(cd, kCoDataSize, instructionPc)) return;
+      const uint8_t state = rd8(cd + kCoState);
+      switch (id) {
+        case Lib::COBEGIN:
+        case Lib::CORESET:
+          costateEnd(cd, false);
+          wr8(cd + kCoFirstTime, 0);
+          wr8(cd + kCoState, id == Lib::COBEGIN ? kCoInit : kCoStopped | kCoInit);
+          return;
+        case Lib::COPAUSE:
+          wr8(cd + kCoState, state | kCoStopped);
+          return;
+        case Lib::CORESUME:
+          wr8(cd + kCoState, state & ~kCoStopped);
+          return;
+        case Lib::ISCODONE:
+          eval[sp++] = (state & (kCoStopped | kCoInit)) == (kCoStopped | kCoInit) ? 1u : 0u;
+          return;
+        default:
+          eval[sp++] = (state & kCoStopped) ? 0u : 1u;
+          return;
+      }
+    }
+    case Lib::STRCPY:
+    case Lib::MEMSET:
+    case Lib::MEMCPY:
+      lib.result = a[0] & 0xFFFF;
+      lib.active = true;
+      return;
+    case Lib::STRLEN:
+    case Lib::STRCMP:
+      lib.active = true;
+      return;
+    case Lib::PRINTF:
+      lib.text = formatPrintf(instructionPc);
+      if (fault) return;
+      lib.result = w(static_cast<int32_t>(lib.text.size()));
+      lib.remaining = static_cast<uint32_t>(lib.text.size()) * costs.printfChar;
+      lib.active = true;
+      return;
+    case Lib::Count_:
+      break;
+  }
+}
+
+void Vm::State::libFinish(bool pushResult) {
+  lib.active = false;
+  if (pushResult) eval[sp++] = lib.result;
+}
+
+// One step of a long library call: at most kMaxStepTstates T-states.
+void Vm::State::libStep() {
+  const int id = static_cast<int>(lib.id);
+  const uint32_t unit = std::max<uint32_t>(1, costs.libStep[id]);
+  const uint32_t perStep = std::max<uint32_t>(1, kMaxStepTstates / unit);
+  const uint32_t* a = lib.args;
+  ++stats.instructions;
+  if (lib.setup > 0) {
+    const uint32_t step = std::min(kMaxStepTstates, lib.setup);
+    now += step;
+    if (profiling) profile[lib.pc] += step;
+    lib.setup -= step;
+    lib.awaitingBegin = lib.setup == 0;
+    return;
+  }
+  switch (lib.id) {
+    case Lib::AD_RD8:
+    case Lib::PRINTF: {
+      const uint32_t step = std::min(kMaxStepTstates, lib.remaining);
+      now += step;
+      if (profiling) profile[lib.pc] += step;
+      lib.remaining -= step;
+      if (lib.remaining == 0) {
+        if (lib.id == Lib::PRINTF) {
+          emitConsole(lib.text);
+          lib.text.clear();
+          busTouched = true;
+        }
+        libFinish(true);
+      }
+      return;
+    }
+    default:
+      break;
+  }
+  uint32_t done = 0;
+  bool finished = false;
+  while (done < perStep && !finished) {
+    const uint32_t i = lib.index;
+    switch (lib.id) {
+      case Lib::STRCPY: {
+        if (!checkAccess(a[1] + i, 1, lib.pc) || !checkAccess(a[0] + i, 1, lib.pc)) return;
+        const uint8_t c = rd8(a[1] + i);
+        wr8(a[0] + i, c);
+        finished = c == 0;
+        break;
+      }
+      case Lib::STRLEN: {
+        if (!checkAccess(a[0] + i, 1, lib.pc)) return;
+        if (rd8(a[0] + i) == 0) {
+          lib.result = w(static_cast<int32_t>(i));
+          finished = true;
+        }
+        break;
+      }
+      case Lib::STRCMP: {
+        if (!checkAccess(a[0] + i, 1, lib.pc) || !checkAccess(a[1] + i, 1, lib.pc)) return;
+        const int x = rd8(a[0] + i), y = rd8(a[1] + i);
+        if (x != y || x == 0) {
+          lib.result = w(x - y);
+          finished = true;
+        }
+        break;
+      }
+      case Lib::MEMSET:
+      case Lib::MEMCPY: {
+        const uint32_t n = a[2] & 0xFFFF;
+        if (i >= n) {
+          finished = true;
+          continue;
+        }
+        if (!checkAccess(a[0] + i, 1, lib.pc)) return;
+        if (lib.id == Lib::MEMSET) {
+          wr8(a[0] + i, a[1]);
+        } else {
+          if (!checkAccess(a[1] + i, 1, lib.pc)) return;
+          wr8(a[0] + i, rd8(a[1] + i));
+        }
+        finished = i + 1 >= n;
+        break;
+      }
+      default:
+        finished = true;
+        break;
+    }
+    ++lib.index;
+    ++done;
+  }
+  const uint32_t cost = done * unit;
+  now += cost;
+  if (profiling) profile[lib.pc] += cost;
+  if (finished) libFinish(true);
+}
+
+}  // namespace simbot::vm

@@ -1,0 +1,256 @@
+// The VM's internal state, shared by its parts: the dispatch loop and
+// interrupt acceptance (vm.cpp), the library routines (library.cpp) and the
+// fast-forward of delay loops (fast_forward.cpp). Not part of the VM's
+// interface (vm.h): nothing outside vm/ includes it.
+#pragma once
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vm/vm.h"
+
+namespace simbot::vm {
+
+namespace detail {
+
+inline constexpr int kEvalSlots = 8192;
+// A call needs this many free slots (its own expressions, in practice).
+inline constexpr int kEvalHeadroom = 1024;
+// No instruction or library step pushes more than two slots, so checking
+// this much room at every boundary keeps any program (8,200 arguments, a
+// deep nest of calls) from writing past the expression stack.
+inline constexpr int kEvalGuard = 4;
+static_assert(kEvalHeadroom > kMaxLibArgs + kEvalGuard,
+              "a call's headroom must hold a library call's arguments");
+inline constexpr int kMaxInterruptNesting = 16;
+inline constexpr uint32_t kMaxStepTstates = 100;  // long library calls: boundary spacing
+// printf's largest field width and precision (assumption: Dynamic C's
+// printf formatted each field into a buffer of this size).
+inline constexpr long kMaxPrintfField = 127;
+// Robot stack bytes: CALL pushes the return address and IX; acceptance
+// pushes PC, AF, BC, DE, HL, IX, IY.
+inline constexpr uint32_t kCallFrameBytes = 4;
+inline constexpr uint32_t kInterruptFrameBytes = 14;
+
+struct LibCall {
+  bool active = false;
+  Lib id{};
+  uint32_t pc = 0;  // address of the LIB instruction (for traces)
+  int argc = 0;
+  uint32_t args[kMaxLibArgs]{};
+  uint32_t setup = 0;  // T-states of the call sequence still to run
+  // The call sequence has run; its effect happens at the next boundary, so
+  // that a bus access is always at a boundary that starts before the
+  // horizon (the host never sees an access past the tick it ran us to).
+  bool awaitingBegin = false;
+  uint32_t index = 0;      // bytes processed
+  uint32_t remaining = 0;  // T-states still to burn (A/D, printf)
+  uint32_t result = 0;
+  std::string text;  // printf's formatted output
+};
+
+struct CallFrame {
+  uint32_t retPc;
+  uint32_t msp;
+  uint32_t mfp;
+  bool autoFrame = false;  // ENTER ran: RET also pops IX
+};
+
+struct InterruptFrame {
+  uint32_t retPc;
+  Irq irq;
+  uint32_t msp;
+  uint32_t mfp;
+  int evalSp;
+  int callDepth;
+  bool halted;
+  uint32_t burn;
+  LibCall lib;
+};
+
+inline float asFloat(uint32_t bits) { return std::bit_cast<float>(bits); }
+inline uint32_t fromFloat(float f) { return std::bit_cast<uint32_t>(f); }
+inline int16_t asInt16(uint32_t v) { return static_cast<int16_t>(static_cast<uint16_t>(v)); }
+static_assert(Tick{kPrtTicks} * kTimerHz == kTicksPerSecond,
+              "PRT0's period must divide the clock into Dynamic C's 1,024 Hz tick");
+
+inline uint32_t w(int32_t v) { return static_cast<uint32_t>(v) & 0xFFFFu; }
+
+inline int64_t truncToRange(float f, double lo, double hi) {
+  if (std::isnan(f)) return 0;
+  double t = std::trunc(static_cast<double>(f));
+  return static_cast<int64_t>(std::clamp(t, lo, hi));
+}
+
+}  // namespace detail
+
+// The VM's parts all work inside it.
+using namespace detail;
+
+struct Vm::State {
+  State(const Image& img, Bus& b, const CostTable& c) : image(img), bus(b), costs(c) {}
+
+  const Image& image;
+  Bus& bus;
+  CostTable costs;
+  std::vector<uint8_t> mem = std::vector<uint8_t>(kMemorySize, 0);
+  std::vector<uint32_t> eval = std::vector<uint32_t>(kEvalSlots, 0);
+  int sp = 0;  // eval stack: next free slot
+  std::vector<CallFrame> calls;
+  std::vector<InterruptFrame> ints;
+  uint32_t pc = 0;
+  Tick now = 0;
+  uint32_t msp = kMemorySize;  // robot stack pointer (grows down)
+  uint32_t mfp = kMemorySize;  // auto frame pointer
+  uint32_t stackLimit = kDataBase;
+  bool iff1 = true;  // Dynamic C's BIOS runs main with interrupts enabled
+  bool iff2 = true;
+  bool eiShadow = false;
+  bool halted = false;
+  bool busTouched = false;
+  std::array<bool, kIrqCount> pend{};
+  std::array<uint8_t, kIrqCount> vec{};
+  bool anyPending = false;
+  std::array<int32_t, 256> handlerFor{};
+  std::optional<Fault> fault;
+  LibCall lib;
+  // T-states still to run of an opcode longer than kMaxStepTstates (a CALL
+  // into a run-time routine): its effect is done, its time passes in steps
+  // with an instruction boundary between them.
+  uint32_t burn = 0;
+  uint32_t burnPc = 0;
+  VmStats stats;
+  std::vector<uint8_t> breakpoints;  // one flag per code byte
+  bool anyBreakpoint = false;
+  bool resumeAtBreakpoint = false;
+  bool profiling = false;
+  std::vector<uint64_t> profile;
+  uint64_t serialIsrCycles = 0;
+  // PRT0: the next tick at which it requests the timer interrupt
+  // (kNoTimer when the service does not run).
+  static constexpr Tick kNoTimer = INT64_MAX;
+  Tick nextTimer = kNoTimer;
+  uint64_t timerIsrCycles = 0;
+  // The BIOS's counters when the program has no timer block of its own.
+  uint32_t biosTicks = 0;
+  uint8_t biosMsFraction = 0;
+  bool costateEvents = false;
+  // ---- fast-forward of delay loops ----
+  struct Loop {
+    uint32_t top, exit, counter;
+    uint32_t limit;
+    Op compare;
+    bool wide;  // a long counter
+  };
+  std::vector<Loop> loops;
+  std::vector<int16_t> loopAtTop;  // per code byte: index into loops, or -1
+  // The pass being measured: from one arrival at a loop's top to the next.
+  static constexpr uint32_t kMaxLoopBytes = 32;
+  struct Measure {
+    int loop = -1;
+    Tick start = 0;
+    uint32_t counter = 0;
+    uint64_t instructions = 0;
+    uint64_t accepted = 0;
+    std::array<uint64_t, kMaxLoopBytes> profile{};
+  } measure;
+  uint64_t acceptances = 0;  // interrupts accepted so far (a pass with one is no measure)
+  void findLoops();
+  bool fastForward(Tick until);
+  std::string consoleLine;
+  Vm* self = nullptr;
+
+  // ---- faults and memory ----
+  void raiseFault(std::string message, uint32_t atPc) {
+    if (fault) return;
+    fault = Fault{std::move(message), now, image.lineAt(atPc)};
+  }
+  // Checks a pointer access of `size` bytes; false (and a fault) if invalid.
+  bool checkAccess(uint32_t address, uint32_t size, uint32_t atPc) {
+    if (address < kNullPageEnd) {
+      raiseFault(fmt::format("null pointer access at 0x{:04x}", address), atPc);
+      return false;
+    }
+    if (address + size > kMemorySize) {
+      raiseFault(fmt::format("access outside memory at 0x{:04x} ({} bytes)", address, size), atPc);
+      return false;
+    }
+    return true;
+  }
+  uint8_t rd8(uint32_t a) const { return mem[a & 0xFFFF]; }
+  uint16_t rd16(uint32_t a) const {
+    return static_cast<uint16_t>(mem[a & 0xFFFF] | (mem[(a + 1) & 0xFFFF] << 8));
+  }
+  uint32_t rd32(uint32_t a) const { return rd16(a) | (static_cast<uint32_t>(rd16(a + 2)) << 16); }
+  void wr8(uint32_t a, uint32_t v) { mem[a & 0xFFFF] = static_cast<uint8_t>(v); }
+  void wr16(uint32_t a, uint32_t v) {
+    wr8(a, v);
+    wr8(a + 1, v >> 8);
+  }
+  void wr32(uint32_t a, uint32_t v) {
+    wr16(a, v);
+    wr16(a + 2, v >> 16);
+  }
+
+  // ---- console ----
+  void emitConsole(std::string_view text) {
+    for (char c : text) {
+      if (c == '\n') {
+        bus.console(now, consoleLine);
+        consoleLine.clear();
+      } else {
+        consoleLine.push_back(c);
+      }
+    }
+  }
+  void flushConsole() {
+    if (!consoleLine.empty()) {
+      bus.console(now, consoleLine);
+      consoleLine.clear();
+    }
+  }
+
+  // ---- interrupts ----
+  void updatePending() {
+    anyPending = std::any_of(pend.begin(), pend.end(), [](bool p) { return p; });
+  }
+  // Accepts the highest-priority pending request at the current boundary.
+  void accept();
+  // PRT0 reached nextTimer: raise its request (one flag: a tick that comes
+  // while the last one is still pending is lost) and schedule the next.
+  void timerTick() {
+    pend[static_cast<int>(Irq::Timer)] = true;
+    anyPending = true;
+    nextTimer += static_cast<Tick>((now - nextTimer) / kPrtTicks + 1) * kPrtTicks;
+  }
+  void timerService();
+  // ---- costatements ----
+  void costateEvent(uint32_t coData, Bus::CostateEvent kind, uint32_t atPc) {
+    if (costateEvents) bus.costate(now, static_cast<uint16_t>(coData), kind, image.lineAt(atPc));
+  }
+  void costateEnd(uint32_t coData, bool done) {
+    wr16(coData + kCoLastLoc, 0);
+    wr8(coData + kCoLastLocCbr, 0);
+    wr8(coData + kCoChkSum, 0);
+    if (done) wr8(coData + kCoState, kCoStopped | kCoInit);
+  }
+  bool delayDone(const uint32_t* a, uint32_t timerAddress, uint32_t instructionPc);
+  // ---- library ----
+  void libCall(Lib id, int argc, uint32_t instructionPc);
+  void libBegin();
+  void libStep();
+  void libFinish(bool pushResult);
+  std::string formatPrintf(uint32_t instructionPc);
+
+  template <bool kProfile>
+  Stop run(Tick until);
+};
+
+}  // namespace simbot::vm
