@@ -15,7 +15,9 @@ namespace simbot::vm {
 void Vm::State::findLoops() {
   const auto& code = image.code;
   auto at = [&](uint32_t a) -> int { return a < code.size() ? code[a] : -1; };
-  auto u16at = [&](uint32_t a) { return static_cast<uint32_t>(code[a] | (code[a + 1] << 8)); };
+  // Reads past the end of the code give 0 (a mark is not trusted yet).
+  auto byte = [&](uint32_t a) -> uint32_t { return a < code.size() ? code[a] : 0; };
+  auto u16at = [&](uint32_t a) { return byte(a) | (byte(a + 1) << 8); };
   auto u32at = [&](uint32_t a) { return u16at(a) | (u16at(a + 2) << 16); };
   auto is = [&](uint32_t a, Op op) { return at(a) == static_cast<int>(op); };
   auto rel = [&](uint32_t operand) {
@@ -32,7 +34,8 @@ void Vm::State::findLoops() {
     if (!is(a, wide ? Op::PUSHL : Op::PUSHW)) continue;
     const uint32_t limit = wide ? u32at(a + 1) : u16at(a + 1);
     a += wide ? 5 : 3;
-    const int cmp = at(a);
+    const bool isSigned = is(a, Op::LTW) || is(a, Op::LEW) || is(a, Op::LTL) || is(a, Op::LEL);
+    const bool inclusive = is(a, Op::LEW) || is(a, Op::LEUW) || is(a, Op::LEL) || is(a, Op::LEUL);
     const bool compares =
         wide ? is(a, Op::LTL) || is(a, Op::LTUL) || is(a, Op::LEL) || is(a, Op::LEUL)
              : is(a, Op::LTW) || is(a, Op::LTUW) || is(a, Op::LEW) || is(a, Op::LEUW);
@@ -48,7 +51,7 @@ void Vm::State::findLoops() {
     if (loopAtTop.empty()) loopAtTop.assign(code.size() + 1, -1);
     if (loopAtTop[mark.top] >= 0) continue;
     loopAtTop[mark.top] = static_cast<int16_t>(loops.size());
-    loops.push_back(Loop{mark.top, mark.exit, counter, limit, static_cast<Op>(cmp), wide});
+    loops.push_back(Loop{mark.top, mark.exit, counter, limit, wide, isSigned, inclusive});
   }
 }
 
@@ -57,10 +60,7 @@ bool Vm::State::fastForward(Tick until) {
   const Loop& loop = loops[static_cast<size_t>(index)];
   const uint32_t v = loop.wide ? rd32(loop.counter) : rd16(loop.counter);
   const uint32_t mask = loop.wide ? 0xFFFFFFFFu : 0xFFFFu;
-  const bool isSigned = loop.compare == Op::LTW || loop.compare == Op::LEW ||
-                        loop.compare == Op::LTL || loop.compare == Op::LEL;
-  const bool inclusive = loop.compare == Op::LEW || loop.compare == Op::LEUW ||
-                         loop.compare == Op::LEL || loop.compare == Op::LEUL;
+  const bool isSigned = loop.isSigned, inclusive = loop.inclusive;
   // As a signed or unsigned number of the counter's width.
   auto number = [&](uint32_t x) -> int64_t {
     if (!isSigned) return x & mask;

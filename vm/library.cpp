@@ -10,16 +10,16 @@
 
 namespace simbot::vm {
 
-// A firsttime Delay function: a[0] the CoData, a[1] the interval.
-bool Vm::State::delayDone(const uint32_t* a, uint32_t timerAddress, uint32_t instructionPc) {
-  const uint32_t cd = a[0] & 0xFFFF;
+// A firsttime Delay function on the costatement whose CoData is at cd.
+bool Vm::State::delayDone(uint32_t cd, int32_t interval, uint32_t timerAddress,
+                          uint32_t instructionPc) {
   if (!checkAccess(cd, kCoDataSize, instructionPc)) return false;
   const uint32_t timer = timerAddress ? rd32(timerAddress) : 0;
   if (rd8(cd + kCoFirstTime)) {
     wr8(cd + kCoFirstTime, 0);
     wr32(cd + kCoContent, timer);
   }
-  return static_cast<int32_t>(timer - rd32(cd + kCoContent)) >= static_cast<int32_t>(a[1]);
+  return static_cast<int32_t>(timer - rd32(cd + kCoContent)) >= interval;
 }
 
 // ---- library calls -------------------------------------------------------
@@ -200,14 +200,14 @@ void Vm::State::libBegin() {
       eval[sp++] = a[0] & 0x7FFFFFFFu;
       return;
     case Lib::DELAYMS:
-      eval[sp++] = delayDone(a, image.timer.ms, instructionPc) ? 1u : 0u;
-      return;
     case Lib::DELAYSEC:
-      eval[sp++] = delayDone(a, image.timer.sec, instructionPc) ? 1u : 0u;
-      return;
     case Lib::DELAYTICKS: {
-      const uint32_t args[2] = {a[0], a[1] & 0xFFFF};
-      eval[sp++] = delayDone(args, image.timer.tick, instructionPc) ? 1u : 0u;
+      // DelayTicks' interval is an unsigned int; the others' a long.
+      const uint32_t timer = id == Lib::DELAYMS    ? image.timer.ms
+                             : id == Lib::DELAYSEC ? image.timer.sec
+                                                   : image.timer.tick;
+      const auto interval = static_cast<int32_t>(id == Lib::DELAYTICKS ? a[1] & 0xFFFF : a[1]);
+      eval[sp++] = delayDone(a[0] & 0xFFFF, interval, timer, instructionPc) ? 1u : 0u;
       return;
     }
     case Lib::COBEGIN:

@@ -146,8 +146,9 @@ struct Vm::State {
   struct Loop {
     uint32_t top, exit, counter;
     uint32_t limit;
-    Op compare;
-    bool wide;  // a long counter
+    bool wide;       // a long counter
+    bool isSigned;   // LTW, LEW, LTL, LEL
+    bool inclusive;  // <=
   };
   std::vector<Loop> loops;
   std::vector<int16_t> loopAtTop;  // per code byte: index into loops, or -1
@@ -230,18 +231,26 @@ struct Vm::State {
     anyPending = true;
     nextTimer += static_cast<Tick>((now - nextTimer) / kPrtTicks + 1) * kPrtTicks;
   }
-  void timerService();
+  void timerService(uint32_t interruptedPc);
   // ---- costatements ----
   void costateEvent(uint32_t coData, Bus::CostateEvent kind, uint32_t atPc) {
     if (costateEvents) bus.costate(now, static_cast<uint16_t>(coData), kind, image.lineAt(atPc));
   }
-  void costateEnd(uint32_t coData, bool done) {
-    wr16(coData + kCoLastLoc, 0);
+  // CoData's ChkSum: the XOR of the resume address's three bytes.
+  static uint8_t coChecksum(uint32_t resume, uint8_t cbr) {
+    return static_cast<uint8_t>((resume & 0xFF) ^ ((resume >> 8) & 0xFF) ^ cbr);
+  }
+  // lastlocADDR := resume (0: from the top), with its CBR (0) and checksum.
+  void setResume(uint32_t coData, uint32_t resume) {
+    wr16(coData + kCoLastLoc, resume);
     wr8(coData + kCoLastLocCbr, 0);
-    wr8(coData + kCoChkSum, 0);
+    wr8(coData + kCoChkSum, coChecksum(resume, 0));
+  }
+  void costateEnd(uint32_t coData, bool done) {
+    setResume(coData, 0);
     if (done) wr8(coData + kCoState, kCoStopped | kCoInit);
   }
-  bool delayDone(const uint32_t* a, uint32_t timerAddress, uint32_t instructionPc);
+  bool delayDone(uint32_t coData, int32_t interval, uint32_t timerAddress, uint32_t instructionPc);
   // ---- library ----
   void libCall(Lib id, int argc, uint32_t instructionPc);
   void libBegin();

@@ -61,7 +61,7 @@ void Vm::State::accept() {
   ++stats.interrupts[i];
   const uint32_t interruptedPc = lib.active ? lib.pc : burn ? burnPc : pc;
   if (irq == Irq::Timer) {
-    timerService();
+    timerService(interruptedPc);
     return;
   }
   if (irq == Irq::SerialTx) {
@@ -107,8 +107,7 @@ void Vm::State::accept() {
 // The BIOS timer service (cost.h kTimerIsrSeq): atomic, like the serial
 // library's ISR: interrupts stay disabled inside it and its EI; RETI leaves
 // IFF1 set as it was at acceptance.
-void Vm::State::timerService() {
-  const uint32_t interruptedPc = lib.active ? lib.pc : burn ? burnPc : pc;
+void Vm::State::timerService(uint32_t interruptedPc) {
   bus.interruptAccepted(now, Irq::Timer, interruptedPc);
   const TimerBlock& tb = image.timer;
   const uint32_t ticks = (tb.used() ? rd32(tb.tick) : biosTicks) + 1;
@@ -230,6 +229,12 @@ Stop Vm::State::run(Tick until) {
     {
       const uint8_t* operand = code + pc + 1;
       auto u16 = [operand]() -> uint32_t { return operand[0] | (operand[1] << 8); };
+      // A CO-shape instruction's target: its REL16 after the CoData address,
+      // from the end of the instruction (pc is already past it).
+      auto coTarget = [this, operand]() -> uint32_t {
+        return static_cast<uint32_t>(static_cast<int32_t>(pc) +
+                                     static_cast<int16_t>(operand[2] | (operand[3] << 8)));
+      };
       auto i32 = [operand]() -> uint32_t {
         return operand[0] | (operand[1] << 8) | (operand[2] << 16) |
                (static_cast<uint32_t>(operand[3]) << 24);
@@ -713,8 +718,7 @@ Stop Vm::State::run(Tick until) {
       CASE(DBG) NEXT;
       CASE(COSTATE) {
         const uint32_t cd = u16();
-        const uint32_t end = static_cast<uint32_t>(
-            static_cast<int32_t>(pc) + static_cast<int16_t>(operand[2] | (operand[3] << 8)));
+        const uint32_t end = coTarget();
         if (!checkAccess(cd, kCoDataSize, opPc)) NEXT;
         const uint8_t state = rd8(cd + kCoState);
         if (state & kCoStopped) {
@@ -729,7 +733,7 @@ Stop Vm::State::run(Tick until) {
         if (resume == 0) {
           BRANCH_COST(2u);  // JR Z taken over JP (HL)
         } else {
-          if (((resume & 0xFF) ^ (resume >> 8) ^ rd8(cd + kCoLastLocCbr)) != rd8(cd + kCoChkSum)) {
+          if (coChecksum(resume, rd8(cd + kCoLastLocCbr)) != rd8(cd + kCoChkSum)) {
             raiseFault("costatement's resume address is corrupted (CoData checksum)", opPc);
             NEXT;
           }
@@ -746,12 +750,8 @@ Stop Vm::State::run(Tick until) {
       NEXT;
       CASE(COYIELD) {
         const uint32_t cd = u16();
-        const uint32_t resume = static_cast<uint32_t>(
-            static_cast<int32_t>(pc) + static_cast<int16_t>(operand[2] | (operand[3] << 8)));
         if (!checkAccess(cd, kCoDataSize, opPc)) NEXT;
-        wr16(cd + kCoLastLoc, resume);
-        wr8(cd + kCoLastLocCbr, 0);
-        wr8(cd + kCoChkSum, (resume & 0xFF) ^ (resume >> 8));
+        setResume(cd, coTarget());
         costateEvent(cd, Bus::CostateEvent::Yield, opPc);
       }
       NEXT;
