@@ -81,6 +81,7 @@ class CodeGen {
   void bind(int label);
   void jump(Op op, int label, int line);
   void coJump(Op op, int coData, int label, int line);  // CO shape
+  void rel16(int label, int line);  // a REL16 operand to `label`, fixed up later
   void pushConst(const Type* t, int64_t v, int line);
 
   // ---- data ----
@@ -101,6 +102,8 @@ class CodeGen {
   bool isDelayLoop(const Node* n) const;
   void waitfor(Node* n);
   void costateYield(Node* costate, int resumeLabel, int line);
+  void costateClose(Node* costate, int line);
+  void bindResumePoint(int label);
   void autoInitStores(const Init* init, int off, int line);
 
   // ---- expressions ----
@@ -177,18 +180,20 @@ int CodeGen::newLabel() {
 
 void CodeGen::bind(int label) { labels_[label].addr = static_cast<int>(img_.code.size()); }
 
-void CodeGen::jump(Op op, int label, int line) {
-  emit(op, line);
+void CodeGen::rel16(int label, int line) {
   labels_[label].fixups.push_back(static_cast<int>(img_.code.size()));
   emitByte(0, line);
   emitByte(0, line);
 }
 
+void CodeGen::jump(Op op, int label, int line) {
+  emit(op, line);
+  rel16(label, line);
+}
+
 void CodeGen::coJump(Op op, int coData, int label, int line) {
   emitU16(op, coData, line);
-  labels_[label].fixups.push_back(static_cast<int>(img_.code.size()));
-  emitByte(0, line);
-  emitByte(0, line);
+  rel16(label, line);
 }
 
 void CodeGen::pushConst(const Type* t, int64_t v, int line) {
@@ -623,12 +628,11 @@ void CodeGen::stmt(Node* n) {
     case NodeKind::Yield: {
       const int resume = newLabel();
       costateYield(n->costate, resume, line);
-      bind(resume);
-      img_.resumePoints.push_back(static_cast<uint16_t>(img_.code.size()));
+      bindResumePoint(resume);
       return;
     }
     case NodeKind::Abort:
-      emitU16(n->costate->ival ? Op::COEND : Op::CODONE, n->costate->var->address, line);
+      costateClose(n->costate, line);
       jump(Op::JMP, n->costate->label, line);
       return;
     default:
@@ -670,8 +674,20 @@ void CodeGen::costate(Node* n) {
   coJump(Op::COSTATE, n->var->address, end, line);
   stmt(n->then);
   const int close = n->then->endPos.line;
-  emitU16(n->ival ? Op::COEND : Op::CODONE, n->var->address, close > 0 ? close : line);
+  costateClose(n, close > 0 ? close : line);
   bind(end);
+}
+
+// The end of a costatement's pass (its closing brace or abort): the next
+// pass starts at the top, and only an always_on one runs again by itself.
+void CodeGen::costateClose(Node* costate, int line) {
+  emitU16(costate->ival ? Op::COEND : Op::CODONE, costate->var->address, line);
+}
+
+// A place a costatement resumes at; the VM refuses any other.
+void CodeGen::bindResumePoint(int label) {
+  bind(label);
+  img_.resumePoints.push_back(static_cast<uint16_t>(img_.code.size()));
 }
 
 // Gives way: lastlocADDR := resume, then leave through the costatement's end.
@@ -692,8 +708,7 @@ void CodeGen::waitfor(Node* n) {
   emitU16(Op::PUSHW, 1, line);
   emitU16(Op::STGB, cd + vm::kCoFirstTime, line);
   const int test = newLabel(), go = newLabel();
-  bind(test);
-  img_.resumePoints.push_back(static_cast<uint16_t>(img_.code.size()));
+  bindResumePoint(test);
   cond(n->cond, go, true);
   costateYield(n->costate, test, line);
   bind(go);

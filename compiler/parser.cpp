@@ -331,6 +331,7 @@ class Parser {
   Node* costateControl(NodeKind kind);
   Obj* coDataNamed(const Token& name, int initialState);
   void useTimer();
+  [[noreturn]] void notSupported(const Token& t);
 
   Preprocessor& pp_;
   const Options& options_;
@@ -770,9 +771,7 @@ void Parser::externalDeclaration() {
   VarAttr attr;
   Type* base;
   const Token& t = cur();
-  if (t.is("cofunc") || t.is("scofunc") || t.is("firsttime"))
-    fail(t.pos, "'" + t.text + "' functions (cofunctions) are not supported by simbot");
-  if (t.is("slice")) fail(t.pos, "'slice' statements are not supported by simbot");
+  if (t.is("cofunc") || t.is("scofunc") || t.is("firsttime") || t.is("slice")) notSupported(t);
   if (isDeclStart(t)) {
     base = declspec(&attr);
   } else if (t.kind == TokKind::Ident && !isKeyword(t) && peek(1).is("(")) {
@@ -1828,9 +1827,7 @@ Node* Parser::statement() {
   if (t.is("waitfor")) return waitforStatement();
   if (t.is("yield")) return costateControl(NodeKind::Yield);
   if (t.is("abort")) return costateControl(NodeKind::Abort);
-  if (t.is("wfd") || t.is("waitfordone"))
-    fail(pos, "'" + t.text + "' (cofunctions) is not supported by simbot");
-  if (t.is("slice")) fail(pos, "'slice' statements are not supported by simbot");
+  if (t.is("wfd") || t.is("waitfordone") || t.is("slice")) notSupported(t);
 
   if (t.is("{")) return compoundStatement(true);
 
@@ -2793,6 +2790,7 @@ Node* Parser::primary() {
     default:
       fail(pos, "expected expression");
   }
+  if (t.is("wfd") || t.is("waitfordone")) notSupported(t);
   if (isKeyword(t)) {
     if (isDeclStart(t)) fail(pos, "unexpected type name '" + t.text + "'");
     fail(pos, "expected expression before '" + t.text + "'");
@@ -2843,8 +2841,6 @@ Node* Parser::primary() {
                       nameTok.text + "()'; declare it before this call)");
     return funcall(nameTok, f);
   }
-  if (nameTok.text == "wfd" || nameTok.text == "waitfordone")
-    fail(pos, "'" + nameTok.text + "' (cofunctions) is not supported by simbot");
   undeclared(pos, nameTok.text, "undeclared identifier '" + nameTok.text + "'");
 }
 
@@ -3051,6 +3047,15 @@ void Parser::predefineCostateNames() {
       scopes_[0].vars[names[i]] = e;
     }
   }
+}
+
+// Dynamic C constructs simbot does not build: cofunctions (cofunc, scofunc,
+// firsttime functions, wfd / waitfordone) and slice statements.
+void Parser::notSupported(const Token& t) {
+  if (t.is("slice")) fail(t.pos, "'slice' statements are not supported by simbot");
+  if (t.is("wfd") || t.is("waitfordone"))
+    fail(t.pos, "'" + t.text + "' (cofunctions) is not supported by simbot");
+  fail(t.pos, "'" + t.text + "' functions (cofunctions) are not supported by simbot");
 }
 
 // The program uses the timer library: the BIOS's counters become data of
