@@ -197,18 +197,12 @@ main()
 
 namespace {
 
-vm::Image compileFile(const std::string& path) {
-  auto r = compiler::compileFile(path);
-  if (!r.image) throw std::runtime_error(r.errors[0].format());
-  return std::move(*r.image);
-}
-
 scheduler::MatchConfig soloConfig(const std::string& file, int timerService, double seconds) {
   auto profile = plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
   profile.robot.timer_service = timerService;
   scheduler::MatchConfig c;
   c.arena = plant::makeArenaConfig(profile, 1);
-  c.robots.push_back({"A", file, compileFile(file)});
+  c.robots.push_back({"A", file, testkit::compileFileOrDie(file)});
   c.endTick = timebase::ticksFromSeconds(seconds);
   return c;
 }

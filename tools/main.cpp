@@ -420,17 +420,14 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
   for (const auto& [name, cycles] : functions)
     std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {}\n", cycles,
                              static_cast<double>(cycles) / tps, pct(cycles), name);
-  if (robot.serialIsrCycles)
-    std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {}\n", robot.serialIsrCycles,
-                             static_cast<double>(robot.serialIsrCycles) / tps,
-                             pct(robot.serialIsrCycles), "(serial transmit interrupts)");
-  if (robot.timerIsrCycles)
-    std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {}\n", robot.timerIsrCycles,
-                             static_cast<double>(robot.timerIsrCycles) / tps,
-                             pct(robot.timerIsrCycles), "(timer service, PRT0 at 1,024 Hz)");
-  if (idle)
-    std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {}\n", idle,
-                             static_cast<double>(idle) / tps, pct(idle), "(halted)");
+  // Time spent outside the program's own code, each on a row when there is any.
+  for (const auto& [cycles, what] :
+       {std::pair{robot.serialIsrCycles, "(serial transmit interrupts)"},
+        std::pair{robot.timerIsrCycles, "(timer service, PRT0 at 1,024 Hz)"},
+        std::pair{idle, "(halted)"}})
+    if (cycles)
+      std::cout << fmt::format("{:>12} {:>9.3f} {:>6.2f}  {}\n", cycles,
+                               static_cast<double>(cycles) / tps, pct(cycles), what);
   std::cout << fmt::format("\n{:>12} {:>9} {:>6}  {:>5}  {}\n", "T-states", "seconds", "%", "line",
                            "source");
   int shown = 0;

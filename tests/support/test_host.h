@@ -115,6 +115,14 @@ inline vm::Image compileOrDie(const std::string& source, const std::string& name
   return std::move(*r.image);
 }
 
+// Compiles a program file or fails the test with the diagnostic.
+inline vm::Image compileFileOrDie(const std::string& path) {
+  auto r = compiler::compileFile(path);
+  if (!r.image)
+    throw std::runtime_error(r.errors.empty() ? "compile failed" : r.errors[0].format());
+  return std::move(*r.image);
+}
+
 inline const vm::Symbol& symbol(const vm::Image& img, const std::string& name) {
   for (const auto& s : img.symbols)
     if (s.name == name) return s;
