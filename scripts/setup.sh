@@ -15,6 +15,11 @@ packages=(
   sigrok-cli gtkwave xvfb      # tests read --vcd output with sigrok's decoder and GTKWave
   chromium                     # the browser test (headless, software WebGL)
   clang libclang-rt-14-dev     # libFuzzer (scripts/fuzz.sh)
+  libboost-math-dev            # distributions and quantiles for the statistics
+  pybind11-dev python3-dev     # the Python module
+  python3-pandas python3-matplotlib  # traces as DataFrames; docs/ plots a bench
+  python3-statsmodels          # test oracle for the survival and interval statistics
+  python3-distributed          # sweeps on a Dask cluster
 )
 # Node.js and npm drive the browser test; a machine that has them (from
 # Debian or elsewhere) keeps its own.
