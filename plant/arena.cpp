@@ -162,6 +162,7 @@ struct RobotDisc {
   std::array<bool, 2> gunOn{};
   std::array<bool, 2> gunJammed{};
   std::array<std::int64_t, 2> launchTick{-1, -1};
+  std::array<double, 2> launchFactor{1, 1};  // muzzleFactor drawn at the stroke
   std::array<int, 2> ballsLeft{};
   int shots = 0, hits = 0;
 };
@@ -735,7 +736,8 @@ struct Arena::Impl {
         const RobotParams& p = P(i);
         const Vec2 dir = geom::headingDir(heading(ys, i));
         const Vec2 muzzle = centre(ys, i) + radius(i) * dir;  // flush with the body edge (VIII.C)
-        const double speed = p.muzzle_speed_fps * ys[i * kPerRobot + (g == 0 ? G1 : G2)];
+        const double speed = p.muzzle_speed_fps * ys[i * kPerRobot + (g == 0 ? G1 : G2)] *
+                             r.launchFactor[static_cast<std::size_t>(g)];
         Ball& b = d.balls[static_cast<std::size_t>(slot)];
         b = Ball{true,
                  false,
@@ -1166,7 +1168,8 @@ bool Arena::setDrive(int robot, double leftFps, double rightFps, std::int64_t ti
   return true;
 }
 
-EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, RandomBits* gunLuck) {
+EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, RandomBits* gunLuck,
+                          RandomBits* muzzle) {
   Impl& m = *impl_;
   EventList ev;
   m.checkRobot(robot);
@@ -1206,6 +1209,7 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
       } else {
         next.launchTick[static_cast<std::size_t>(g)] =
             tick + timebase::ticksFromSeconds(p.stroke_s);
+        next.launchFactor[static_cast<std::size_t>(g)] = muzzleFactor(p, muzzle);
         scheduleChanges = true;
       }
       ev.push(e);

@@ -61,7 +61,10 @@ struct RobotParams {
   double track_ft = 0;                       // distance between the wheels
   std::array<double, 16> speed_table_fps{};  // ground speed for steps 0..f
   double left_trim = 1, right_trim = 1;      // per-wheel multiplicative trim
-  double motor_lag_s = 0;                    // first-order lag; 0 = instant
+  // Seeded, per match (drawWheelTrims): each trim times its own factor
+  // uniform in [1 - trim_spread, 1 + trim_spread]. 0 = the trims as given.
+  double trim_spread = 0;
+  double motor_lag_s = 0;  // first-order lag; 0 = instant
   // bumper reflex (hard-wired in the motor controller)
   double reflex_distance_ft = 0;
   int reflex_speed_step = 15;
@@ -77,6 +80,9 @@ struct RobotParams {
   bool gun_motors_always_on = false;  // thesis Appendix E: port B motor bits ignored
   double stroke_s = 0;                // solenoid rising edge -> launch
   double muzzle_speed_fps = 0;        // at full gun-wheel speed
+  // Seeded, per launch (muzzleFactor): the muzzle speed times a factor
+  // uniform in [1 - spread, 1 + spread]. 0 = every ball at muzzle_speed_fps.
+  double muzzle_speed_spread = 0;
   double launch_height_ft = 0;
   int balls_per_gun = 0;
   // Per stroke that would launch: the gun jams (launches nothing, now or
@@ -100,6 +106,11 @@ struct FieldParams {
   double divider_x_ft = 0, divider_south_ft = 0, divider_north_ft = 0;
   double divider_thickness_ft = 0, divider_height_ft = 0;
   std::array<Pose, 2> start{};  // A, B
+  // Robots put down by hand (placeByHand): the centre uniform in a disc of
+  // this radius around the start pose, the heading uniform within +- this
+  // many degrees of it. 0 and 0 = exactly at the start poses.
+  double placement_radius_ft = 0;
+  double placement_heading_deg = 0;
   double gravity_fps2 = 0;
   bool count_floor_skips = false;
 };
@@ -346,6 +357,32 @@ struct ArenaConfig {
 // the profile's start poses.
 ArenaConfig makeArenaConfig(const Profile& profile, int robotCount);
 
+// ---------------------------------------------------------------- seeded variation
+// DESIGN.md: the default profile's robots differ from match to match. Every
+// draw comes from the caller's generator for that purpose and robot (the
+// scheduler derives one per (seed, purpose, robot)), so one purpose's draws
+// never shift another's; a zero amount draws nothing and changes nothing.
+
+// Robots put down by hand. For each robot in order (A, then B) draws three
+// words per attempt from streams[i]: radius R sqrt(u1), direction 2 pi u2,
+// heading offset H (2 u3 - 1) (R, H: the field's placement_radius_ft and
+// placement_heading_deg). An attempt is kept if the body lies inside the
+// field, clear of the divider and of every robot placed before it;
+// otherwise the robot draws again, at most kPlacementAttempts times, and
+// after that stays exactly at its start pose. streams.size() must be
+// config.robots.size().
+inline constexpr int kPlacementAttempts = 16;
+void placeByHand(ArenaConfig& config, const std::vector<RandomBits*>& streams);
+// True if a robot of radius r centred at (x, y) lies inside the field and
+// clear of the divider (the placement test above, without other robots).
+bool placementFits(double x, double y, double r, const FieldParams& field);
+// Per-match wheel trims: left then right, one word each, each trim times
+// 1 + trim_spread (2 u - 1). No draw if trim_spread is 0.
+void drawWheelTrims(RobotParams& params, RandomBits& bits);
+// One launch's muzzle-speed factor, 1 + muzzle_speed_spread (2 u - 1) from
+// one word; exactly 1 with no draw if the spread is 0 or bits is null.
+double muzzleFactor(const RobotParams& params, RandomBits* bits);
+
 // The arena integrates all robots and balls with one CVODE instance.
 //
 // Protocol (all ticks): advance(stop) integrates from now() towards stop and
@@ -388,8 +425,9 @@ class Arena {
   // advance(). `gunLuck` draws a stroke's jam or misfire (one draw per
   // stroke that would launch, only if the robot's probabilities are not
   // both 0); null: guns never jam or misfire.
+  // `muzzle` draws each launching stroke's muzzleFactor (null: factor 1).
   EventList setPortB(int robot, std::uint8_t value, std::int64_t tick,
-                     RandomBits* gunLuck = nullptr);
+                     RandomBits* gunLuck = nullptr, RandomBits* muzzle = nullptr);
 
   // The motor controller's bumper reflex, as if that bumper switch closed
   // at `tick` (an injected bump). A reflex under way starts over. Returns

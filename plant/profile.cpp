@@ -118,6 +118,10 @@ const std::vector<KeyDef>& keyTable() {
       {"start", "b_x", Kind::Length, {-50, 50}, false, D(p.field.start[1].x_ft)},
       {"start", "b_y", Kind::Length, {-50, 50}, false, D(p.field.start[1].y_ft)},
       {"start", "b_heading", Kind::Angle, {-360, 360}, false, D(p.field.start[1].heading_deg)},
+      // Hand placement: a few inches, a few degrees (profiles/default.toml);
+      // placeByHand keeps every body inside the field whatever the radius.
+      {"start", "placement_radius", Kind::Length, {0, 2}, false, D(p.field.placement_radius_ft)},
+      {"start", "placement_heading", Kind::Angle, {0, 45}, false, D(p.field.placement_heading_deg)},
       {"robot", "body_diameter", Kind::Length, {0.1, 5}, true, D(p.robot.body_diameter_ft)},
       {"robot", "target_height", Kind::Length, {0.1, 10}, true, D(p.robot.target_height_ft)},
       {"robot",
@@ -140,6 +144,9 @@ const std::vector<KeyDef>& keyTable() {
        }},
       {"robot", "left_trim", Kind::Ratio, {0.5, 2}, true, D(p.robot.left_trim)},
       {"robot", "right_trim", Kind::Ratio, {0.5, 2}, true, D(p.robot.right_trim)},
+      // At most 0.25: a drawn trim stays within 0.75..1.25 of the given one
+      // (crossChecks keeps it within left_trim/right_trim's own range).
+      {"robot", "trim_spread", Kind::Ratio, {0, 0.25}, true, D(p.robot.trim_spread)},
       {"robot", "motor_lag", Kind::Time, {0.001, 10, true}, true, D(p.robot.motor_lag_s)},
       {"bumper", "reflex_distance", Kind::Length, {0.05, 20}, true, D(p.robot.reflex_distance_ft)},
       {"bumper", "reflex_speed_step", Kind::Step, {0, 15}, true, I(p.robot.reflex_speed_step)},
@@ -162,6 +169,8 @@ const std::vector<KeyDef>& keyTable() {
       {"gun", "motors_always_on", Kind::Bool, {0, 0}, true, B(p.robot.gun_motors_always_on)},
       {"gun", "stroke_time", Kind::Time, {0, 2}, true, D(p.robot.stroke_s)},
       {"gun", "muzzle_speed", Kind::Speed, {1, 1000}, true, D(p.robot.muzzle_speed_fps)},
+      // Below 1, so every drawn speed is positive.
+      {"gun", "muzzle_speed_spread", Kind::Ratio, {0, 0.5}, true, D(p.robot.muzzle_speed_spread)},
       {"gun", "launch_height", Kind::Length, {0.05, 10}, true, D(p.robot.launch_height_ft)},
       {"gun", "balls_per_gun", Kind::Count, {0, kMaxBallsPerGun}, true, I(p.robot.balls_per_gun)},
       {"gun", "jam_probability", Kind::Probability, {0, 1}, true, D(p.robot.jam_probability)},
@@ -532,6 +541,9 @@ void crossChecks(const Profile& p, const Checker& c, const toml::table& doc) {
     c.fail(where("gun"), fmt::format("balls_per_gun must be at most {}", kMaxBallsPerGun));
   if (p.robot.jam_probability + p.robot.misfire_probability > 1)
     c.fail(where("gun"), "jam_probability + misfire_probability must be at most 1");
+  for (const double trim : {p.robot.left_trim, p.robot.right_trim})
+    if (trim * (1 - p.robot.trim_spread) < 0.5 || trim * (1 + p.robot.trim_spread) > 2)
+      c.fail(where("robot"), "trim_spread takes a wheel's trim outside 0.5..2");
   if (p.referee.putback_ft * 2 >= p.field.size_ft - 2 * p.field.wire_inset_ft)
     c.fail(where("referee"), "putback leaves no room inside the wire");
 }
@@ -694,6 +706,11 @@ Hardware parseHardware(std::string_view text, const std::string& sourceName, Rob
     c.fail(n ? n->source() : doc.source(),
            "jam_probability + misfire_probability must be at most 1");
   }
+  for (const double trim : {p.robot.left_trim, p.robot.right_trim})
+    if (trim * (1 - p.robot.trim_spread) < 0.5 || trim * (1 + p.robot.trim_spread) > 2) {
+      const toml::node* n = doc.get("robot");
+      c.fail(n ? n->source() : doc.source(), "trim_spread takes a wheel's trim outside 0.5..2");
+    }
   params = p.robot;
   return h;
 }

@@ -42,10 +42,22 @@ struct PlantInput {
 class Match;
 
 // A robot on a scripted path follows it exactly: its wheels have no lag.
+// The arena this match plays in: the configured one with this seed's
+// variation (DESIGN.md), each purpose drawn from its own stream of (seed,
+// purpose, robot): the hand placement, then each robot's wheel trims.
 plant::ArenaConfig arenaConfigFor(const MatchConfig& config) {
   plant::ArenaConfig arena = config.arena;
   for (size_t i = 0; i < config.robots.size() && i < arena.robots.size(); ++i)
     if (!config.robots[i].path.empty()) arena.robots[i].params.motor_lag_s = 0;
+  std::vector<plant::SplitMix64> placement;
+  for (size_t i = 0; i < arena.robots.size() && i < config.robots.size(); ++i) {
+    placement.emplace_back(streamSeed(config.seed, "placement-" + config.robots[i].name));
+    plant::SplitMix64 trim(streamSeed(config.seed, "wheel-trim-" + config.robots[i].name));
+    plant::drawWheelTrims(arena.robots[i].params, trim);
+  }
+  std::vector<plant::RandomBits*> streams;
+  for (plant::SplitMix64& s : placement) streams.push_back(&s);
+  if (streams.size() == arena.robots.size()) plant::placeByHand(arena, streams);
   return arena;
 }
 
@@ -175,6 +187,7 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   Tick serialIsrAccepted = 0;
   plant::SplitMix64 noise;
   plant::SplitMix64 gunLuck;  // jams and misfires
+  plant::SplitMix64 muzzle;   // muzzle-speed spread, one draw per launching stroke
   RobotResult result;
   uint32_t mainReturn;
 };
@@ -184,7 +197,8 @@ class Match {
   explicit Match(const MatchConfig& config)
       : config_(config),
         costs_(vm::makeCostTable(config.knobs)),
-        arena_(arenaConfigFor(config)),
+        arenaConfig_(arenaConfigFor(config)),
+        arena_(arenaConfig_),
         coin_(streamSeed(config.seed, "coin")) {
     for (trace::Sink* sink : config.sinks) trace_.attach(sink);
     if (config.robots.empty() || config.robots.size() > 2)
@@ -271,7 +285,7 @@ class Match {
   }
   MatchObserver* observer() const { return config_.observer; }
   const plant::RobotParams& robotParams(int robot) const {
-    return config_.arena.robots[static_cast<size_t>(robot)].params;
+    return arenaConfig_.robots[static_cast<size_t>(robot)].params;
   }
 
  private:
@@ -287,6 +301,7 @@ class Match {
 
   const MatchConfig& config_;
   vm::CostTable costs_;
+  plant::ArenaConfig arenaConfig_;  // config_.arena with this seed's variation
   plant::Arena arena_;
   trace::Tracer trace_;
   plant::SplitMix64 coin_;
@@ -317,6 +332,7 @@ Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs_, u
       memoryFill(streamSeed(seed, "memory-fill-" + s.name)),
       noise(streamSeed(seed, "eye-noise-" + s.name)),
       gunLuck(streamSeed(seed, "gun-" + s.name)),
+      muzzle(streamSeed(seed, "muzzle-" + s.name)),
       mainReturn(s.image.entry + static_cast<uint32_t>(vm::instructionSize(vm::Op::CALL))) {
   result.name = s.name;
   result.program = s.program;
@@ -697,7 +713,7 @@ void Match::emit(Tick t, trace::Record record) {
 
 // The run's set-up: the first records of every trace.
 void Match::emitSetup() {
-  const plant::FieldParams& f = config_.arena.field;
+  const plant::FieldParams& f = arenaConfig_.field;
   emit(0,
        trace::rec::Run{"simbot-trace/1", static_cast<int64_t>(config_.seed), config_.profileName,
                        static_cast<int64_t>(robots_.size()), config_.endTick, kTicksPerSecond,
@@ -706,7 +722,7 @@ void Match::emitSetup() {
                        f.divider_thickness_ft, f.divider_height_ft, f.gravity_fps2},
        {});
   for (const auto& r : robots_) {
-    const plant::RobotSetup& setup = config_.arena.robots[static_cast<size_t>(r->index)];
+    const plant::RobotSetup& setup = arenaConfig_.robots[static_cast<size_t>(r->index)];
     const plant::RobotParams& p = setup.params;
     std::string source;
     for (const auto& line : r->spec.image.sourceLines) source += line + "\n";
@@ -804,7 +820,8 @@ void Match::applyInputs() {
     }
     sampleUpTo(w.tick);
     const plant::EventList immediate =
-        arena_.setPortB(w.robot, w.value, w.tick, &robots_[static_cast<size_t>(w.robot)]->gunLuck);
+        arena_.setPortB(w.robot, w.value, w.tick, &robots_[static_cast<size_t>(w.robot)]->gunLuck,
+                        &robots_[static_cast<size_t>(w.robot)]->muzzle);
     for (const auto& e : immediate) {
       if (config_.observer) config_.observer->onPlantEvent(w.tick, e);
       if (trace_.on()) emit(w.tick, plantRecord(e));
