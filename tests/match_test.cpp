@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <variant>
 
@@ -533,3 +534,78 @@ TEST(Match, IcemanAgainstFig92For180SecondsPinsItsKeyFigures) {
 }
 
 }  // namespace
+
+namespace {
+
+// ICEMAN vs fig92 for `seconds` under `profile` with `seed`, traced.
+testkit::TracedRun icemanFig92(const std::string& profile, uint64_t seed, double seconds) {
+  auto c = matchConfig({{"A", kIceman, compileFile(kIceman)}, {"B", kFig92, compileFile(kFig92)}},
+                       seconds, profile);
+  c.seed = seed;
+  return testkit::runTraced(c);
+}
+
+}  // namespace
+
+// Issue 14: under `default` every seed is another match (hand placement,
+// wheel trims, eye noise, muzzle speed); the same seed is the same match.
+TEST(Match, DefaultProfileGivesEachSeedItsOwnMatchAndTheSameSeedTheSameOne) {
+  std::vector<std::vector<std::string>> traces;
+  for (uint64_t seed = 1; seed <= 4; ++seed)
+    traces.push_back(icemanFig92("default", seed, 20).trace);
+  for (size_t i = 0; i < traces.size(); ++i)
+    for (size_t j = i + 1; j < traces.size(); ++j)
+      EXPECT_NE(traces[i], traces[j]) << "seeds " << i + 1 << " and " << j + 1;
+  EXPECT_EQ(icemanFig92("default", 1, 20).trace, traces[0]);
+  // The trace's set-up records give the poses the hand chose: within the
+  // profile's radius and heading spread of the marks, and not the marks.
+  const plant::Profile d = plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
+  for (const auto& trace : traces) {
+    int setups = 0;
+    for (const auto& rec : parse(trace)) {
+      if (rec.type != "robot") continue;
+      const auto& mark = d.field.start[static_cast<size_t>(setups++)];
+      const double dx = rec.json.at("x_ft").get<double>() - mark.x_ft;
+      const double dy = rec.json.at("y_ft").get<double>() - mark.y_ft;
+      double dh = rec.json.at("heading_deg").get<double>() - mark.heading_deg;
+      if (dh > 180) dh -= 360;
+      EXPECT_LE(std::hypot(dx, dy), d.field.placement_radius_ft);
+      EXPECT_GT(std::hypot(dx, dy), 0);
+      EXPECT_LE(std::abs(dh), d.field.placement_heading_deg);
+    }
+    EXPECT_EQ(setups, 2);
+  }
+}
+
+// Under thesis-1997 (no variation) the seed decides only a tied round's
+// coin: traces differ in the run record's seed and, where the coin
+// decided, the end record's winner; nothing else.
+TEST(Match, Thesis1997SeedChangesOnlyTheCoin) {
+  const auto strip = [](const testkit::TracedRun& run) {
+    std::vector<std::string> out;
+    for (auto rec : parse(run.trace)) {
+      if (rec.type == "run") rec.json.erase("seed");
+      if (rec.type == "end" && rec.json.at("tie_broken_by_coin").get<bool>())
+        rec.json.erase("winner");
+      out.push_back(rec.json.dump());
+    }
+    return out;
+  };
+  for (const double seconds : {20.0, 2.0}) {  // 20 s: ICEMAN hits; 2 s: a 0-0 tie
+    const auto first = icemanFig92("thesis-1997", 1, seconds);
+    std::set<std::string> winners{first.winner};
+    for (uint64_t seed = 2; seed <= 8; ++seed) {
+      const auto run = icemanFig92("thesis-1997", seed, seconds);
+      EXPECT_EQ(strip(run), strip(first)) << seconds << " s, seed " << seed;
+      EXPECT_EQ(run.tieBrokenByCoin, first.tieBrokenByCoin);
+      winners.insert(run.winner);
+    }
+    // The 0-0 tie goes to the coin, which both sides win over 8 seeds
+    // (all 8 flips alike: probability 2^-7, and the seeds are fixed).
+    if (first.tieBrokenByCoin)
+      EXPECT_EQ(winners.size(), 2u) << seconds;
+    else
+      EXPECT_EQ(winners.size(), 1u) << seconds;
+    EXPECT_EQ(first.tieBrokenByCoin, seconds == 2.0);
+  }
+}

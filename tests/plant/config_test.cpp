@@ -78,7 +78,7 @@ TEST(Profiles, BothShippedProfilesLoad) {
   const Profile d = defaults();
   EXPECT_EQ(d.name, "default");
   EXPECT_GT(d.robot.motor_lag_s, 0);
-  EXPECT_EQ(d.robot.noise_sigma, 0);
+  EXPECT_GT(d.robot.noise_sigma, 0);  // seeded variation (variation_test.cpp)
 }
 
 std::string shipped() {
@@ -360,3 +360,24 @@ TEST(Profile, JamAndMisfireTogetherAtMostOne) {
 }
 
 }  // namespace
+
+// The variation amounts are checked like every value: a spread that could
+// draw a trim outside 0.5..2, or a placement radius beyond its range.
+TEST(Profiles, VariationAmountsAreChecked) {
+  std::string msg = errorOf(edit("trim_spread = { value = 0.0,", "trim_spread = { value = 0.3,"));
+  EXPECT_NE(msg.find("'robot.trim_spread' must be between 0 and 0.25"), std::string::npos) << msg;
+  msg = errorOf(edit("right_trim = { value = 1.0,", "right_trim = { value = 1.9,"));
+  EXPECT_EQ(msg, "");  // 1.9 alone is fine
+  std::string text = edit("right_trim = { value = 1.0,", "right_trim = { value = 1.9,");
+  text.replace(text.find("trim_spread = { value = 0.0,"), 28, "trim_spread = { value = 0.1, ");
+  msg = errorOf(text);
+  EXPECT_NE(msg.find("trim_spread takes a wheel's trim outside 0.5..2"), std::string::npos) << msg;
+  msg = errorOf(edit("placement_radius  = { value = 0.0, unit = \"in\"",
+                     "placement_radius  = { value = 30.0, unit = \"in\""));
+  EXPECT_NE(msg.find("'start.placement_radius' must be between 0 and 2 ft"), std::string::npos)
+      << msg;
+  msg =
+      errorOf(edit("muzzle_speed_spread = { value = 0.0,", "muzzle_speed_spread = { value = 0.6,"));
+  EXPECT_NE(msg.find("'gun.muzzle_speed_spread' must be between 0 and 0.5"), std::string::npos)
+      << msg;
+}

@@ -1,0 +1,258 @@
+// The seeded variation (plant/variation.cpp, optics.cpp's noise) against
+// closed forms: each kind's draws over many seeds, with the amounts of the
+// shipped default profile, checked for their bounds and against the mean
+// (and a second moment or a probability) the uniform or Gaussian law of
+// DESIGN.md gives. Tolerances are 4.5 standard errors of the sample mean,
+// computed from the same law (a wrong amount or law moves a mean by many
+// more; a correct one fails about once in 150,000 runs, and the seeds are
+// fixed, so the outcome is the same every run).
+#include <cmath>
+#include <vector>
+
+#include "plant_support.h"
+
+using namespace plant_test;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kSe = 4.5;
+
+// Counts the words drawn through it.
+class Counting final : public RandomBits {
+ public:
+  explicit Counting(std::uint64_t seed) : inner_(seed) {}
+  std::uint64_t next() override {
+    ++count;
+    return inner_.next();
+  }
+  int count = 0;
+
+ private:
+  SplitMix64 inner_;
+};
+
+double phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+
+double wrap180(double d) {
+  d = std::fmod(d, 360.0);
+  if (d >= 180) d -= 360;
+  if (d < -180) d += 360;
+  return d;
+}
+
+TEST(Variation, ThesisHasNoneAndDefaultHasEveryKind) {
+  const Profile t = thesis(), d = defaults();
+  EXPECT_EQ(t.field.placement_radius_ft, 0);
+  EXPECT_EQ(t.field.placement_heading_deg, 0);
+  EXPECT_EQ(t.robot.trim_spread, 0);
+  EXPECT_EQ(t.robot.muzzle_speed_spread, 0);
+  EXPECT_EQ(t.robot.noise_sigma, 0);
+  EXPECT_EQ(t.robot.bad_reading_probability, 0);
+  EXPECT_DOUBLE_EQ(d.field.placement_radius_ft, 3.0 / 12);
+  EXPECT_DOUBLE_EQ(d.field.placement_heading_deg, 5);
+  EXPECT_DOUBLE_EQ(d.robot.trim_spread, 0.015);
+  EXPECT_DOUBLE_EQ(d.robot.muzzle_speed_spread, 0.1);
+  EXPECT_DOUBLE_EQ(d.robot.noise_sigma, 16);
+  EXPECT_DOUBLE_EQ(d.robot.bad_reading_probability, 0.001);
+}
+
+// Uniform over a disc of radius R: the offset's distance d = R sqrt(u) has
+// E d = 2R/3, Var d = R^2/18, E d^2 = R^2/2, Var d^2 = R^4/12; the heading
+// offset, uniform in [-H, H], has mean 0, Var H^2/3, E|dh| = H/2, Var|dh|
+// = H^2/12. Default start poses are 0.72 ft from the walls: no redraws.
+TEST(Variation, HandPlacementOver1000SeedsMatchesTheDiscAndTheHeadingSpread) {
+  const Profile d = defaults();
+  const double R = d.field.placement_radius_ft, H = d.field.placement_heading_deg;
+  const ArenaConfig nominal = makeArenaConfig(d, 2);
+  const int seeds = 1000;
+  double sumD = 0, sumD2 = 0, sumH = 0, sumAbsH = 0, sumX = 0;
+  int n = 0;
+  for (int s = 1; s <= seeds; ++s) {
+    ArenaConfig c = nominal;
+    Counting a(2 * s), b(2 * s + 1);
+    placeByHand(c, {&a, &b});
+    EXPECT_EQ(a.count, 3);
+    EXPECT_EQ(b.count, 3);
+    for (int i = 0; i < 2; ++i) {
+      const Pose& p = c.robots[static_cast<std::size_t>(i)].start;
+      const Pose& o = nominal.robots[static_cast<std::size_t>(i)].start;
+      const double dx = p.x_ft - o.x_ft, dy = p.y_ft - o.y_ft;
+      const double dist = std::hypot(dx, dy), dh = wrap180(p.heading_deg - o.heading_deg);
+      ASSERT_LE(dist, R * (1 + 1e-12));
+      ASSERT_LE(std::abs(dh), H * (1 + 1e-12));
+      ASSERT_GE(p.heading_deg, 0);
+      ASSERT_LT(p.heading_deg, 360);
+      ASSERT_TRUE(placementFits(p.x_ft, p.y_ft, d.robot.body_diameter_ft / 2, d.field));
+      sumD += dist;
+      sumD2 += dist * dist;
+      sumH += dh;
+      sumAbsH += std::abs(dh);
+      sumX += dx;
+      ++n;
+    }
+  }
+  const double N = n;
+  EXPECT_NEAR(sumD / N, 2 * R / 3, kSe * R / std::sqrt(18 * N));
+  EXPECT_NEAR(sumD2 / N, R * R / 2, kSe * R * R / std::sqrt(12 * N));
+  EXPECT_NEAR(sumX / N, 0, kSe * R / std::sqrt(4 * N));  // Var x = R^2/4
+  EXPECT_NEAR(sumH / N, 0, kSe * H / std::sqrt(3 * N));
+  EXPECT_NEAR(sumAbsH / N, H / 2, kSe * H / std::sqrt(12 * N));
+}
+
+// A mark h = 0.1 ft from where the body would touch the east wall: a draw
+// whose centre lands in the disc's segment beyond that line is redrawn.
+// The segment's share of the disc is p = (R^2 acos(h/R) - h sqrt(R^2 -
+// h^2)) / (pi R^2), so the first attempt fails with probability p.
+TEST(Variation, PlacementNearAWallRedrawsAsOftenAsTheDiscSegmentSays) {
+  const Profile d = defaults();
+  const double R = d.field.placement_radius_ft, r = d.robot.body_diameter_ft / 2;
+  const double h = 0.1;
+  ArenaConfig nominal = makeArenaConfig(d, 1);
+  nominal.robots[0].start = Pose{d.field.size_ft / 2 - r - h, 3, 90};
+  const double p = (R * R * std::acos(h / R) - h * std::sqrt(R * R - h * h)) / (kPi * R * R);
+  int redrawn = 0;
+  const int seeds = 1000;
+  for (int s = 1; s <= seeds; ++s) {
+    ArenaConfig c = nominal;
+    Counting a(s);
+    placeByHand(c, {&a});
+    const Pose& q = c.robots[0].start;
+    ASSERT_TRUE(placementFits(q.x_ft, q.y_ft, r, d.field));
+    ASSERT_EQ(a.count % 3, 0);
+    redrawn += a.count > 3;
+  }
+  EXPECT_NEAR(redrawn / double(seeds), p, kSe * std::sqrt(p * (1 - p) / seeds));
+}
+
+// B's mark on top of A's: no draw can put it clear of A, so after
+// kPlacementAttempts attempts B stays exactly on its mark.
+TEST(Variation, PlacementThatNeverFitsGivesUpAtTheMark) {
+  const Profile d = defaults();
+  ArenaConfig c = makeArenaConfig(d, 2);
+  c.robots[1].start = c.robots[0].start;
+  const Pose mark = c.robots[1].start;
+  Counting a(7), b(8);
+  placeByHand(c, {&a, &b});
+  EXPECT_EQ(a.count, 3);
+  EXPECT_EQ(b.count, 3 * kPlacementAttempts);
+  EXPECT_EQ(c.robots[1].start.x_ft, mark.x_ft);
+  EXPECT_EQ(c.robots[1].start.y_ft, mark.y_ft);
+  EXPECT_EQ(c.robots[1].start.heading_deg, mark.heading_deg);
+}
+
+// Zero amounts draw nothing and change nothing (thesis-1997).
+TEST(Variation, ZeroAmountsDrawNothing) {
+  const Profile t = thesis();
+  ArenaConfig c = makeArenaConfig(t, 2);
+  const ArenaConfig before = c;
+  Counting a(1), b(2);
+  placeByHand(c, {&a, &b});
+  RobotParams params = t.robot;
+  drawWheelTrims(params, a);
+  EXPECT_EQ(muzzleFactor(params, &a), 1.0);
+  EXPECT_EQ(a.count + b.count, 0);
+  EXPECT_EQ(params.left_trim, t.robot.left_trim);
+  EXPECT_EQ(params.right_trim, t.robot.right_trim);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(c.robots[static_cast<std::size_t>(i)].start.x_ft,
+              before.robots[static_cast<std::size_t>(i)].start.x_ft);
+    EXPECT_EQ(c.robots[static_cast<std::size_t>(i)].start.heading_deg,
+              before.robots[static_cast<std::size_t>(i)].start.heading_deg);
+  }
+  // A default robot without a stream also launches at exactly the speed.
+  EXPECT_EQ(muzzleFactor(defaults().robot, nullptr), 1.0);
+}
+
+// Uniform in [1 - s, 1 + s]: mean 1, variance s^2/3, every factor inside.
+void checkUniformFactors(const std::vector<double>& f, double s) {
+  double sum = 0, sum2 = 0;
+  for (double x : f) {
+    ASSERT_GE(x, 1 - s);
+    ASSERT_LE(x, 1 + s);
+    sum += x;
+    sum2 += (x - 1) * (x - 1);
+  }
+  const double N = static_cast<double>(f.size());
+  EXPECT_NEAR(sum / N, 1, kSe * s / std::sqrt(3 * N));
+  // Var of (x-1)^2 for x-1 uniform in [-s, s]: s^4/5 - s^4/9 = 4 s^4 / 45.
+  EXPECT_NEAR(sum2 / N, s * s / 3, kSe * s * s * std::sqrt(4.0 / 45 / N));
+}
+
+TEST(Variation, WheelTrimsOver1000SeedsAreUniformAroundTheGivenTrims) {
+  const Profile d = defaults();
+  std::vector<double> left, right;
+  for (int s = 1; s <= 1000; ++s) {
+    RobotParams p = d.robot;
+    Counting bits(s);
+    drawWheelTrims(p, bits);
+    EXPECT_EQ(bits.count, 2);
+    left.push_back(p.left_trim / d.robot.left_trim);
+    right.push_back(p.right_trim / d.robot.right_trim);
+  }
+  checkUniformFactors(left, d.robot.trim_spread);
+  checkUniformFactors(right, d.robot.trim_spread);
+}
+
+TEST(Variation, MuzzleFactorsOver1000ShotsAreUniform) {
+  const Profile d = defaults();
+  Counting bits(99);
+  std::vector<double> f;
+  for (int k = 0; k < 1000; ++k) f.push_back(muzzleFactor(d.robot, &bits));
+  EXPECT_EQ(bits.count, 1000);
+  checkUniformFactors(f, d.robot.muzzle_speed_spread);
+}
+
+// Eye readings with the default noise. At background (16, no beacon) a
+// clean reading is 16 + sigma z quantised down to a multiple of 16: 16 for
+// z < 16/sigma, 32 up to 32/sigma, at least 64 from 48/sigma on. A bad
+// reading (probability q) is 16 k, k uniform in 0..255, clamped to 16..max:
+// 16 for k <= 1, 32 for k = 2, at least 64 for k >= 4.
+TEST(Variation, EyeNoiseAtBackgroundMatchesTheProfilesSigmaAndBadReadings) {
+  const Profile d = defaults();
+  const double sigma = d.robot.noise_sigma, q = d.robot.bad_reading_probability;
+  const Pose self{-6.5, -6.5, 0};
+  SplitMix64 bits(2024);
+  const int calls = 20000;
+  int at16 = 0, at32 = 0, above48 = 0, n = 0;
+  for (int k = 0; k < calls; ++k) {
+    const EyeReadings e = computeEyes(self, nullptr, d.robot, d.field, &bits);
+    for (int v : {e.left, e.right}) {
+      ASSERT_EQ(v % 16, 0);
+      ASSERT_GE(v, 16);
+      ASSERT_LE(v, d.robot.eye_max);
+      at16 += v == 16;
+      at32 += v == 32;
+      above48 += v > 48;
+      ++n;
+    }
+  }
+  const auto check = [n](int count, double p, const char* what) {
+    EXPECT_NEAR(count / double(n), p, kSe * std::sqrt(p * (1 - p) / n)) << what;
+  };
+  check(at16, (1 - q) * phi(16 / sigma) + q * 2 / 256, "16");
+  check(at32, (1 - q) * (phi(32 / sigma) - phi(16 / sigma)) + q / 256, "32");
+  check(above48, (1 - q) * (1 - phi(48 / sigma)) + q * 252 / 256, "> 48");
+}
+
+// With the beacon saturating both eyes (4080 at 2 ft dead ahead) noise
+// cannot take a clean reading below 4000 (that is 5 sigma), so the readings
+// below 4000 are the bad ones whose k is at most 249: probability q 250/256.
+TEST(Variation, BadReadingsAtSaturationComeAtTheProfilesRate) {
+  const Profile d = defaults();
+  const double q = d.robot.bad_reading_probability;
+  const Pose self{3, 3, 0}, opp{3, 5, 0};
+  SplitMix64 bits(77);
+  int low = 0, n = 0;
+  for (int k = 0; k < 50000; ++k) {
+    const EyeReadings e = computeEyes(self, &opp, d.robot, d.field, &bits);
+    for (int v : {e.left, e.right}) {
+      low += v < 4000;
+      ++n;
+    }
+  }
+  const double p = q * 250 / 256 + (1 - q) * phi(-80 / d.robot.noise_sigma);
+  EXPECT_NEAR(low / double(n), p, kSe * std::sqrt(p * (1 - p) / n));
+}
+
+}  // namespace
