@@ -104,9 +104,12 @@ def fst_round_trip(vcd_path):
     check(timeline(a) == timeline(b), f"fst2vcd did not give back the changes of {vcd_path}")
 
 
-# ---- 1. a 20-s ICEMAN solo run: sigrok's UART decoder on TXD
+# ---- 1. a 20-s ICEMAN solo run: sigrok's UART decoder on TXD. Under
+# thesis-1997, whose eyes give no bad readings: with one, ICEMAN may restart
+# a send midway, and those bytes are on the wire but never latch.
 solo_vcd, solo_trace = OUT / "iceman-solo.vcd", OUT / "iceman-solo.jsonl"
-run("solo", ICEMAN, "--seconds", "20", "--trace", str(solo_trace), "--vcd", str(solo_vcd))
+run("solo", ICEMAN, "--seconds", "20", "--profile", "thesis-1997", "--trace", str(solo_trace),
+    "--vcd", str(solo_vcd))
 trace = read_trace(solo_trace)
 expected = []
 for r in trace:
@@ -146,7 +149,10 @@ check(picoseconds(1) == 108507 and picoseconds(9) == 976563 and picoseconds(9216
 
 # ---- 3. an injected edge: handler in service, IFF1
 inj_vcd, inj_trace = OUT / "iceman-inject.vcd", OUT / "iceman-inject.jsonl"
-run("solo", ICEMAN, "--seconds", "3", "--inject", "A:edge_fore@2s",
+# Seed 2: the default profile's hand placement there leaves no second PIO
+# request pending at the RETI (with one, as under thesis-1997, the handler
+# is accepted again at the RETI's tick and in_pio_a never falls).
+run("solo", ICEMAN, "--seconds", "3", "--seed", "2", "--inject", "A:edge_fore@2s",
     "--trace", str(inj_trace), "--vcd", str(inj_vcd))
 trace = read_trace(inj_trace)
 accepted = next(r["t"] for r in trace if r["type"] == "interrupt_accepted")

@@ -31,10 +31,11 @@ function check(ok, message) {
   }
 }
 
-// ---- the match, its trace and its page
+// ---- the match, its trace and its page (seed 15: under the default profile's
+// variation, a match in which ICEMAN meets the one-eye dead-lock)
 const tracePath = join(out, 'm180.jsonl');
 const pagePath = join(out, 'm180.html');
-execFileSync(simbot, ['match', iceman, fig92, '--seconds', '180', '--seed', '1', '--trace', tracePath,
+execFileSync(simbot, ['match', iceman, fig92, '--seconds', '180', '--seed', '15', '--trace', tracePath,
   '--replay', pagePath], { stdio: ['ignore', 'ignore', 'inherit'] });
 const samples = { A: [], B: [] };
 for (const line of readFileSync(tracePath, 'utf8').split('\n')) {
