@@ -256,3 +256,42 @@ TEST(Variation, BadReadingsAtSaturationComeAtTheProfilesRate) {
 }
 
 }  // namespace
+
+namespace {
+
+// The arena applies the muzzle factor drawn at the stroke: thesis-1997's
+// instant gun (105 ft/s, stroke 0) with a 10% spread launches gun 1's ball
+// at 105 (1 + 0.1 (2 u - 1)), u from the stream's first word, and gun 2's
+// (the next stroke) from its second; no stream: exactly 105.
+TEST(Variation, ArenaLaunchesAtTheMuzzleSpeedTimesTheDrawnFactor) {
+  Profile p = thesis();
+  p.robot.muzzle_speed_spread = 0.1;
+  SplitMix64 oracle(31);
+  const double u1 = unit53(oracle.next()), u2 = unit53(oracle.next());
+  const auto launchSpeeds = [&](RandomBits* muzzle) {
+    Arena a(config(p, {Pose{0, 3, 90}}));
+    std::vector<double> speeds;
+    const auto runTo = [&](std::int64_t stop) {
+      while (a.now() < stop)
+        for (const Event& e : a.advance(stop).events)
+          if (e.kind == EventKind::BallLaunch) speeds.push_back(std::hypot(e.vx, e.vy));
+    };
+    runTo(1000);
+    a.setPortB(0, 1u << 4, 1000, nullptr, muzzle);  // gun 1's solenoid
+    runTo(2000);
+    a.setPortB(0, (1u << 4) | (1u << 5), 2000, nullptr, muzzle);  // then gun 2's
+    runTo(ticks(0.1));
+    return speeds;
+  };
+  SplitMix64 stream(31);
+  const auto drawn = launchSpeeds(&stream);
+  ASSERT_EQ(drawn.size(), 2u);
+  EXPECT_NEAR(drawn[0], 105 * (1 + 0.1 * (2 * u1 - 1)), 1e-9);
+  EXPECT_NEAR(drawn[1], 105 * (1 + 0.1 * (2 * u2 - 1)), 1e-9);
+  const auto plain = launchSpeeds(nullptr);
+  ASSERT_EQ(plain.size(), 2u);
+  EXPECT_NEAR(plain[0], 105, 1e-9);
+  EXPECT_NEAR(plain[1], 105, 1e-9);
+}
+
+}  // namespace
