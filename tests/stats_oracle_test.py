@@ -11,6 +11,9 @@ fisher_exact and binomtest. All to 1e-9 (absolute and relative). The
 permutation test (stall_s) is Monte Carlo beyond 9999 splits: it is held to
 scipy's permutation_test on the same data within its sampling error.
 
+Also: runs.csv and the tournament's games.csv load in pandas' read_csv
+unchanged, seeds exact, with a comma and quotes in a program's file name.
+
 Debian's /usr/bin/python3 runs it (statsmodels, scipy and pandas are
 python3-statsmodels' and its dependencies).
 
@@ -185,9 +188,40 @@ def check_compare(simbot, a, b, out, seeds):
     return result
 
 
+def check_csv_files(simbot, a, b, out):
+    """runs.csv and games.csv load in pandas' read_csv unchanged (RFC 4180
+    quoting), a file name with a comma and quotes included."""
+    out.mkdir(parents=True, exist_ok=True)
+    odd = out / 'ice,man "q".dc'
+    odd.write_text(pathlib.Path(a).read_text())
+    run([simbot, "bench", str(odd), "--family", "head-to-head", "--opponent", b, "--seeds", "2",
+         "--seconds", "2", "--seed", "18446744073709551615", "--out", str(out / "bench")])
+    df = load(out / "bench" / "runs.csv")
+    if list(df["program"]) != [str(odd)] * 2 or df.shape[1] != len(open(
+            out / "bench" / "runs.csv").readline().split(",")):
+        failures.append(f"runs.csv with an odd file name: {df['program'].tolist()}")
+    if not set(df["winner"]) <= {"A", "B"}:
+        failures.append(f"runs.csv winners: {df['winner'].tolist()}")
+    run([simbot, "tournament", str(odd), b, "--rounds", "2", "--seconds", "2",
+         "--out", str(out / "tournament")])
+    games = load_games(out / "tournament" / "games.csv")
+    if len(games) != 2 or not set(games["winner"]) <= {0, 1}:
+        failures.append(f"games.csv: {games}")
+
+
+def load_games(path):
+    df = pd.read_csv(path)
+    with open(path, newline="") as f:
+        raw = [int(row["seed"]) for row in csv.DictReader(f)]
+    if not pd.api.types.is_integer_dtype(df["seed"]) or [int(s) for s in df["seed"]] != raw:
+        failures.append(f"{path}: read_csv does not load the seeds exactly")
+    return df
+
+
 def main():
     simbot, a, b, out, seeds = sys.argv[1:6]
     out = pathlib.Path(out)
+    check_csv_files(simbot, a, b, out / "csv")
     summary = check_bench(simbot, a, str(out / "bench"), int(seeds))
     check_compare(simbot, a, b, str(out / "compare"), max(8, int(seeds) // 2))
     if failures:
