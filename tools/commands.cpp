@@ -51,13 +51,13 @@ void addThresholdOptions(CLI::App& cmd, scheduler::MetricThresholds& t) {
   cmd.add_option("--seen-threshold", t.seen,
                  "eye reading above which the beacon counts as seen, both eyes for acquire_s "
                  "(default 48, ICEMAN's)")
-      ->check(CLI::Range(0, 1023));
+      ->check(CLI::Range(0, 1'000'000));
   cmd.add_option("--aim-max-diff", t.aimMaxDiff,
                  "aim_s: largest |left - right| eye difference (default 50, ICEMAN's)")
-      ->check(CLI::Range(0, 1023));
+      ->check(CLI::Range(0, 1'000'000));
   cmd.add_option("--aim-min-sum", t.aimMinSum,
                  "aim_s: smallest left + right eye sum (default 800, ICEMAN's)")
-      ->check(CLI::Range(0, 2046));
+      ->check(CLI::Range(0, 1'000'000));
 }
 
 Subcommand addBenchCommand(CLI::App& app) {
