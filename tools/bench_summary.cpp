@@ -171,12 +171,18 @@ std::vector<ProgramSummary> summarize(const BenchResult& result) {
       RobotSummary r;
       r.robot = robot == 0 ? "A" : "B";
       r.program = robot == 0 ? c.programs[p] : c.opponent;
+      // B's measured runs: those that have B's metrics (all but a
+      // malformed resumed row would).
+      std::vector<const BenchRun*> measured;
+      for (const BenchRun* run : runs)
+        if (robot == 0 || run->metricsB) measured.push_back(run);
       for (size_t m = 0; m < scheduler::metricNames().size(); ++m)
-        r.metrics.push_back(estimate(c, runs, robot == 1, m));
+        r.metrics.push_back(estimate(c, measured, robot == 1, m));
       s.robots.push_back(std::move(r));
     }
     if (headToHead) {
       for (const BenchRun* run : runs) {
+        if (run->winner.empty()) continue;
         ++s.games;
         s.winsA += run->winner == "A";
         s.coinWins += run->winner == "A" && run->coin;
