@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 namespace simbot::scheduler {
 
@@ -32,12 +31,14 @@ void MetricsObserver::onEyeRead(int robot, Tick t, int channel, int value) {
     // A pair: this right-eye read follows a left-eye read directly.
     if (pairOpen_) {
       const int l = pairLeft_, r = value;
-      if (!acquire && l > kSeenThreshold && r > kSeenThreshold) acquire = t;
-      if (!aim && std::abs(l - r) <= 50 && l + r >= 800) aim = t;
+      const MetricThresholds& th = thresholds_;
+      if (!acquire && l > th.seen && r > th.seen) acquire = t;
+      if (!aim && std::abs(l - r) <= th.aimMaxDiff && l + r >= th.aimMinSum) aim = t;
     }
     pairOpen_ = false;
   }
-  seen_ = (haveLeft_ && lastLeft_ > kSeenThreshold) || (haveRight_ && lastRight_ > kSeenThreshold);
+  seen_ =
+      (haveLeft_ && lastLeft_ > thresholds_.seen) || (haveRight_ && lastRight_ > thresholds_.seen);
 }
 
 void MetricsObserver::onInterruptAccepted(int robot, Tick t, vm::Irq irq) {
@@ -102,8 +103,9 @@ void MetricsObserver::finish(Tick endTick) {
 
 const std::vector<std::string>& metricNames() {
   static const std::vector<std::string> names = {
-      "acquire_s", "aim_s",         "first_shot_s", "first_hit_s",  "shots",           "hits",
-      "hit_ratio", "edge_accept_s", "edge_latch_s", "edge_leave_s", "frames_rejected", "stall_s"};
+      "acquire_s",    "aim_s",           "first_shot_s", "first_hit_s",   "shots",
+      "hits",         "hit_ratio",       "edge_enter_s", "edge_accept_s", "edge_latch_s",
+      "edge_leave_s", "frames_rejected", "stall_s"};
   return names;
 }
 
@@ -126,121 +128,13 @@ RunMetrics collectMetrics(const MetricsObserver& o, const RobotResult& robot) {
               static_cast<double>(robot.hits),
               robot.shots > 0 ? std::optional<double>(static_cast<double>(robot.hits) / robot.shots)
                               : std::nullopt,
+              time(o.edgeEnter),
               leg(o.edgeEnter, o.edgeAccept),
               leg(o.edgeAccept, o.edgeLatch),
               leg(o.edgeLatch, o.edgeLeave),
               static_cast<double>(o.framesRejected),
               timebase::secondsFromTicks(o.stallTicks)};
   return m;
-}
-
-// ---- statistics
-
-namespace {
-
-// Continued fraction of the incomplete beta function (modified Lentz).
-double betaContinuedFraction(double a, double b, double x) {
-  constexpr double kTiny = 1e-300, kEps = 1e-16;
-  const double qab = a + b, qap = a + 1, qam = a - 1;
-  double c = 1, d = 1 - qab * x / qap;
-  if (std::fabs(d) < kTiny) d = kTiny;
-  d = 1 / d;
-  double h = d;
-  for (int m = 1; m <= 10000; ++m) {
-    const double m2 = 2.0 * m;
-    double aa = m * (b - m) * x / ((qam + m2) * (a + m2));
-    d = 1 + aa * d;
-    if (std::fabs(d) < kTiny) d = kTiny;
-    c = 1 + aa / c;
-    if (std::fabs(c) < kTiny) c = kTiny;
-    d = 1 / d;
-    h *= d * c;
-    aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
-    d = 1 + aa * d;
-    if (std::fabs(d) < kTiny) d = kTiny;
-    c = 1 + aa / c;
-    if (std::fabs(c) < kTiny) c = kTiny;
-    d = 1 / d;
-    const double del = d * c;
-    h *= del;
-    if (std::fabs(del - 1) < kEps) break;
-  }
-  return h;
-}
-
-// Regularized incomplete beta I_x(a, b).
-double incompleteBeta(double a, double b, double x) {
-  if (x <= 0) return 0;
-  if (x >= 1) return 1;
-  const double lnFront =
-      std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x);
-  if (x < (a + 1) / (a + b + 2)) return std::exp(lnFront) * betaContinuedFraction(a, b, x) / a;
-  return 1 - std::exp(lnFront) * betaContinuedFraction(b, a, 1 - x) / b;
-}
-
-}  // namespace
-
-double studentTCdf(double t, double df) {
-  const double x = df / (df + t * t);
-  const double tail = 0.5 * incompleteBeta(df / 2, 0.5, x);  // P(T > |t|)
-  return t >= 0 ? 1 - tail : tail;
-}
-
-double studentTQuantile(double p, double df) {
-  if (!(p > 0 && p < 1) || !(df >= 1)) throw std::invalid_argument("studentTQuantile: bad input");
-  if (p == 0.5) return 0;
-  if (p < 0.5) return -studentTQuantile(1 - p, df);
-  double lo = 0, hi = 1;
-  while (studentTCdf(hi, df) < p) hi *= 2;
-  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (studentTCdf(mid, df) < p ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
-double mean(const std::vector<double>& v) {
-  double sum = 0;
-  for (double x : v) sum += x;
-  return v.empty() ? 0 : sum / static_cast<double>(v.size());
-}
-
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) throw std::invalid_argument("quantile of an empty sample");
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
-  const auto i = static_cast<size_t>(std::floor(pos));
-  if (i + 1 >= v.size()) return v.back();
-  const double frac = pos - static_cast<double>(i);
-  return v[i] + frac * (v[i + 1] - v[i]);
-}
-
-MetricSummary summarize(const std::string& name, const std::vector<std::optional<double>>& values) {
-  MetricSummary s;
-  s.name = name;
-  std::vector<double> reached;
-  for (const auto& v : values) {
-    if (v)
-      reached.push_back(*v);
-    else
-      ++s.censored;
-  }
-  s.reached = static_cast<int>(reached.size());
-  if (reached.empty()) return s;
-  const double m = mean(reached);
-  s.mean = m;
-  s.median = quantile(reached, 0.5);
-  s.p90 = quantile(reached, 0.9);
-  if (reached.size() >= 2) {
-    double ss = 0;
-    for (double x : reached) ss += (x - m) * (x - m);
-    const double n = static_cast<double>(reached.size());
-    const double sd = std::sqrt(ss / (n - 1));
-    const double half = studentTQuantile(0.975, n - 1) * sd / std::sqrt(n);
-    s.ciLow = m - half;
-    s.ciHigh = m + half;
-  }
-  return s;
 }
 
 }  // namespace simbot::scheduler

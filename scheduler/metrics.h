@@ -1,5 +1,5 @@
 // Measurements of one robot's behaviour in a run (simbot bench), taken by a
-// MatchObserver at exact ticks, and the small statistics the bench reports.
+// MatchObserver at exact ticks (the bench's statistics are in stats/).
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -10,13 +10,22 @@
 
 namespace simbot::scheduler {
 
-// Eye readings above this count as "seeing the beacon" (background is 16).
-inline constexpr int kSeenThreshold = 48;
+// What counts as acquiring and aiming at the beacon, on the eye readings of
+// one left-then-right pair. The defaults are ICEMAN's own tests (thesis
+// program: "seen" above 48, the background being 16; aimed when the eyes
+// differ by at most 50 and sum to at least 800); simbot bench takes others
+// with --seen-threshold, --aim-max-diff and --aim-min-sum.
+struct MetricThresholds {
+  int seen = 48;        // both eyes above this: acquired (and "seen" for stall_s)
+  int aimMaxDiff = 50;  // |left - right| at most this ...
+  int aimMinSum = 800;  // ... and left + right at least this: aimed
+};
 
 // Collects the raw happenings of one robot (by default A) during a run.
 class MetricsObserver final : public MatchObserver {
  public:
-  explicit MetricsObserver(int robot = 0) : robot_(robot) {}
+  explicit MetricsObserver(int robot = 0, MetricThresholds thresholds = {})
+      : robot_(robot), thresholds_(thresholds) {}
   void onEyeRead(int robot, Tick t, int channel, int value) override;
   void onInterruptAccepted(int robot, Tick t, vm::Irq irq) override;
   void onFrame(int robot, Tick t, bool latched) override;
@@ -33,6 +42,7 @@ class MetricsObserver final : public MatchObserver {
  private:
   void accumulateStall(Tick t);
   int robot_;
+  MetricThresholds thresholds_;
   // eyes: the last reading of each channel, whether the previous read was
   // channel 0 (for the left-then-right pair rule)
   int lastLeft_ = 16, lastRight_ = 16;
@@ -54,25 +64,5 @@ struct RunMetrics {
 };
 const std::vector<std::string>& metricNames();
 RunMetrics collectMetrics(const MetricsObserver& o, const RobotResult& robot);
-
-// ---- statistics
-
-// Two-sided Student-t quantile: the t with P(T <= t) = p for df degrees of
-// freedom (p in (0, 1), df >= 1). Computed from the regularized incomplete
-// beta function by bisection.
-double studentTQuantile(double p, double df);
-// CDF of Student's t.
-double studentTCdf(double t, double df);
-
-double mean(const std::vector<double>& v);
-// Linear interpolation between order statistics (R type 7); v non-empty.
-double quantile(std::vector<double> v, double q);
-
-struct MetricSummary {
-  std::string name;
-  int reached = 0, censored = 0;
-  std::optional<double> mean, median, p90, ciLow, ciHigh;  // CI needs n >= 2
-};
-MetricSummary summarize(const std::string& name, const std::vector<std::optional<double>>& values);
 
 }  // namespace simbot::scheduler

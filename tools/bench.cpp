@@ -126,10 +126,6 @@ std::string fileName(const std::string& path) {
   return std::filesystem::path(path).filename().string();
 }
 
-std::string number(const std::optional<double>& v, const char* format = "{:.4g}") {
-  return v ? fmt::format(fmt::runtime(format), *v) : "";
-}
-
 }  // namespace
 
 const std::vector<std::string>& benchFamilies() {
@@ -162,11 +158,14 @@ scheduler::MatchConfig baseConfig(const BenchConfig& config, const plant::Profil
 }  // namespace
 
 CsvRow benchHeader() {
-  CsvRow header = {"program",      "run",          "seed",
-                   "start_x_ft",   "start_y_ft",   "start_heading_deg",
-                   "b_start_x_ft", "b_start_y_ft", "b_start_heading_deg",
-                   "outcome",      "fault"};
+  CsvRow header = {"program",           "run",          "seed",
+                   "start_x_ft",        "start_y_ft",   "start_heading_deg",
+                   "b_start_x_ft",      "b_start_y_ft", "b_start_heading_deg",
+                   "outcome",           "fault",        "winner",
+                   "tie_broken_by_coin"};
   for (const auto& name : scheduler::metricNames()) header.push_back(name);
+  // Robot B's, in head-to-head (empty otherwise).
+  for (const auto& name : scheduler::metricNames()) header.push_back("b_" + name);
   return header;
 }
 
@@ -177,6 +176,10 @@ nlohmann::json benchSettings(const BenchConfig& c, const plant::Profile& profile
           {"scenario", c.scenario ? nlohmann::json(c.scenario->file) : nlohmann::json(nullptr)},
           {"opponent", c.opponent},
           {"seeds", c.seeds},
+          {"seed_key", c.seedKey},
+          {"seen_threshold", c.thresholds.seen},
+          {"aim_max_diff", c.thresholds.aimMaxDiff},
+          {"aim_min_sum", c.thresholds.aimMinSum},
           {"seconds", c.seconds},
           {"master_seed", c.masterSeed},
           {"profile", profile.name},
@@ -198,8 +201,17 @@ CsvRow benchRow(const BenchRun& run) {
                 run.startB ? poseField(run.startB->y_ft) : "",
                 run.startB ? poseField(run.startB->heading_deg) : "",
                 run.outcome,
-                run.fault};
-  for (const auto& v : run.metrics.values) row.push_back(v ? fmt::format("{}", *v) : "");
+                run.fault,
+                run.winner,
+                run.winner.empty() ? ""
+                : run.coin         ? "1"
+                                   : "0"};
+  const auto add = [&row](const std::optional<double>& v) {
+    row.push_back(v ? fmt::format("{}", *v) : "");
+  };
+  for (const auto& v : run.metrics.values) add(v);
+  for (size_t m = 0; m < scheduler::metricNames().size(); ++m)
+    add(run.metricsB ? run.metricsB->values[m] : std::nullopt);
   return row;
 }
 
@@ -215,12 +227,46 @@ BenchRun benchRunFromRow(const CsvRow& row) {
   if (!row[6].empty()) run.startB = plant::Pose{real(row[6]), real(row[7]), real(row[8])};
   run.outcome = row[9];
   run.fault = row[10];
-  run.metrics.values.resize(scheduler::metricNames().size());
-  for (size_t m = 0; m < run.metrics.values.size(); ++m)
-    if (!row[11 + m].empty()) run.metrics.values[m] = real(row[11 + m]);
+  run.winner = row[11];
+  run.coin = row[12] == "1";
+  const size_t metrics = scheduler::metricNames().size();
+  run.metrics.values.resize(metrics);
+  for (size_t m = 0; m < metrics; ++m)
+    if (!row[13 + m].empty()) run.metrics.values[m] = real(row[13 + m]);
+  // B's metrics exist exactly when the run has a winner (head-to-head).
+  if (!run.winner.empty()) {
+    run.metricsB.emplace().values.resize(metrics);
+    for (size_t m = 0; m < metrics; ++m)
+      if (!row.at(13 + metrics + m).empty()) run.metricsB->values[m] = real(row[13 + metrics + m]);
+  }
   run.done = true;
   return run;
 }
+
+// Both robots' observers on the one hook a match has.
+class ObserverPair final : public scheduler::MatchObserver {
+ public:
+  ObserverPair(scheduler::MatchObserver& a, scheduler::MatchObserver& b) : a_(a), b_(b) {}
+  void onEyeRead(int robot, scheduler::Tick t, int channel, int value) override {
+    a_.onEyeRead(robot, t, channel, value);
+    b_.onEyeRead(robot, t, channel, value);
+  }
+  void onInterruptAccepted(int robot, scheduler::Tick t, vm::Irq irq) override {
+    a_.onInterruptAccepted(robot, t, irq);
+    b_.onInterruptAccepted(robot, t, irq);
+  }
+  void onFrame(int robot, scheduler::Tick t, bool latched) override {
+    a_.onFrame(robot, t, latched);
+    b_.onFrame(robot, t, latched);
+  }
+  void onPlantEvent(scheduler::Tick t, const plant::Event& e) override {
+    a_.onPlantEvent(t, e);
+    b_.onPlantEvent(t, e);
+  }
+
+ private:
+  scheduler::MatchObserver &a_, &b_;
+};
 
 // One line on what faulted in a finished run (every robot that did, then
 // the plant), or "".
@@ -310,7 +356,9 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile, c
     run.program = config.programs[p];
     run.index = static_cast<int>(j % seeds);
     run.seed = scheduler::streamSeed(
-        config.masterSeed, fmt::format("{}/{}/{}", label, fileName(run.program), run.index));
+        config.masterSeed,
+        fmt::format("{}/{}/{}", label,
+                    config.seedKey.empty() ? fileName(run.program) : config.seedKey, run.index));
     scheduler::MatchConfig mc = bases[p];
     if (!config.family.empty()) {
       plant::SplitMix64 bits(scheduler::streamSeed(run.seed, "scenario"));
@@ -323,12 +371,22 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile, c
     mc.endTick = endTick;
     mc.seed = run.seed;
     mc.stop = io.stop;
-    scheduler::MetricsObserver observer(0);
-    mc.observer = &observer;
+    // Robot B is measured when it is a program (head-to-head), on the
+    // same thresholds.
+    const bool measureB = config.family == "head-to-head";
+    scheduler::MetricsObserver observer(0, config.thresholds), observerB(1, config.thresholds);
+    ObserverPair both(observer, observerB);
+    mc.observer = measureB ? static_cast<scheduler::MatchObserver*>(&both) : &observer;
     try {
       const scheduler::MatchResult r = scheduler::runMatch(mc);
       observer.finish(r.endTick);
       run.metrics = scheduler::collectMetrics(observer, r.robots[0]);
+      if (measureB) {
+        observerB.finish(r.endTick);
+        run.metricsB = scheduler::collectMetrics(observerB, r.robots[1]);
+        run.winner = r.winner;
+        run.coin = r.tieBrokenByCoin;
+      }
       run.fault = faultLine(r);
       run.outcome = run.fault.empty() ? "ok" : "fault";
       run.warnings = r.warnings;
@@ -399,106 +457,6 @@ std::string benchWarnings(const BenchResult& result, size_t most) {
     }
   }
   if (all > most) out += fmt::format("simbot: warning: bench: ... {} more\n", all - most);
-  return out;
-}
-
-namespace {
-
-std::vector<std::vector<scheduler::MetricSummary>> summaries(const BenchResult& result) {
-  std::vector<std::vector<scheduler::MetricSummary>> all;
-  const size_t seeds = static_cast<size_t>(result.config.seeds);
-  const auto& names = scheduler::metricNames();
-  for (size_t p = 0; p < result.config.programs.size(); ++p) {
-    std::vector<scheduler::MetricSummary> per;
-    for (size_t m = 0; m < names.size(); ++m) {
-      std::vector<std::optional<double>> values;
-      for (size_t i = 0; i < seeds; ++i) {
-        const BenchRun& run = result.runs[p * seeds + i];
-        if (run.done && run.outcome != "error") values.push_back(run.metrics.values[m]);
-      }
-      per.push_back(scheduler::summarize(names[m], values));
-    }
-    all.push_back(std::move(per));
-  }
-  return all;
-}
-
-nlohmann::json optionalJson(const std::optional<double>& v) {
-  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
-}
-
-struct Counts {
-  int done = 0, faults = 0, errors = 0;
-};
-
-Counts countsOf(const BenchResult& result, size_t program) {
-  Counts c;
-  const size_t seeds = static_cast<size_t>(result.config.seeds);
-  for (size_t i = 0; i < seeds; ++i) {
-    const BenchRun& run = result.runs[program * seeds + i];
-    if (!run.done) continue;
-    ++c.done;
-    c.faults += run.outcome == "fault";
-    c.errors += run.outcome == "error";
-  }
-  return c;
-}
-
-}  // namespace
-
-nlohmann::json summaryJson(const BenchResult& result) {
-  const auto& c = result.config;
-  nlohmann::json j = {
-      {"family", benchLabel(c)},
-      {"scenario", c.scenario ? nlohmann::json(c.scenario->file) : nlohmann::json(nullptr)},
-      {"seeds", c.seeds},
-      {"seconds", c.seconds},
-      {"master_seed", c.masterSeed},
-      {"opponent", c.opponent.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.opponent)},
-      {"programs", nlohmann::json::array()}};
-  const auto all = summaries(result);
-  for (size_t p = 0; p < c.programs.size(); ++p) {
-    nlohmann::json metrics = nlohmann::json::array();
-    for (const auto& s : all[p])
-      metrics.push_back({{"metric", s.name},
-                         {"reached", s.reached},
-                         {"censored", s.censored},
-                         {"mean", optionalJson(s.mean)},
-                         {"median", optionalJson(s.median)},
-                         {"p90", optionalJson(s.p90)},
-                         {"ci95_low", optionalJson(s.ciLow)},
-                         {"ci95_high", optionalJson(s.ciHigh)}});
-    const Counts n = countsOf(result, p);
-    j["programs"].push_back({{"program", c.programs[p]},
-                             {"runs_done", n.done},
-                             {"runs_faulted", n.faults},
-                             {"runs_failed", n.errors},
-                             {"metrics", metrics}});
-  }
-  return j;
-}
-
-std::string summaryMarkdown(const BenchResult& result) {
-  const auto& c = result.config;
-  std::string out;
-  const auto all = summaries(result);
-  for (size_t p = 0; p < c.programs.size(); ++p) {
-    const Counts n = countsOf(result, p);
-    out += fmt::format("### {}: {}, {} seeds x {} s\n\n", c.programs[p],
-                       c.family.empty() ? benchLabel(c) : "family " + c.family, c.seeds, c.seconds);
-    if (n.done < c.seeds || n.faults || n.errors)
-      out += fmt::format("{} of {} runs done; {} with a fault, {} failed (runs.csv lists them)\n\n",
-                         n.done, c.seeds, n.faults, n.errors);
-    out += "| metric | n reached | mean | median | p90 | 95% CI of mean | censored |\n";
-    out += "|---|---:|---:|---:|---:|---|---:|\n";
-    for (const auto& s : all[p]) {
-      const std::string ci =
-          s.ciLow ? fmt::format("[{:.4g}, {:.4g}]", *s.ciLow, *s.ciHigh) : std::string("");
-      out += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", s.name, s.reached,
-                         number(s.mean), number(s.median), number(s.p90), ci, s.censored);
-    }
-    out += '\n';
-  }
   return out;
 }
 

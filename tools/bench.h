@@ -10,6 +10,7 @@
 
 #include "plant/plant.h"
 #include "scheduler/metrics.h"
+#include "stats/stats.h"
 #include "tools/run_table.h"
 #include "tools/scenario.h"
 
@@ -27,6 +28,10 @@ struct BenchConfig {
   int threads = 0;       // 0: hardware concurrency
   std::string opponent;  // head-to-head: B's program
   bool progress = true;
+  scheduler::MetricThresholds thresholds;  // what counts as acquired and aimed
+  // The seeds' key in place of each program's file name (simbot compare:
+  // both sides play the very same seeded runs).
+  std::string seedKey;
 };
 
 struct BenchRun {
@@ -41,6 +46,11 @@ struct BenchRun {
   std::string outcome;
   std::string fault;  // what faulted or failed, one line; empty when ok
   scheduler::RunMetrics metrics;
+  // Head-to-head: robot B's metrics and who won ("A" or "B"; by the most
+  // hits, a tie by the seeded coin).
+  std::optional<scheduler::RunMetrics> metricsB;
+  std::string winner;
+  bool coin = false;
   // The run's warnings (injections that never fired, ...): for stderr
   // only, not kept in runs.csv (a resumed run's are not shown again).
   std::vector<std::string> warnings;
@@ -81,8 +91,48 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile,
 
 // The finished runs, in order (the final runs.csv).
 std::string runsCsv(const BenchResult& result);
+
+// The summary (tools/bench_summary.cpp): for each program, each metric with
+// the estimator that suits it (Kaplan-Meier for times to an event, Wilson
+// for the hit ratio, Garwood's exact Poisson interval for counts, a
+// bootstrap for stall_s), robot B's too and the win rate in head-to-head.
+struct MetricEstimate {
+  std::string metric;
+  std::string estimator;  // "Kaplan-Meier median", "Wilson", "exact Poisson", "bootstrap mean"
+  int n = 0;              // runs in the estimate (at risk at 0 for a time)
+  int events = 0;         // times: runs that got there; hit_ratio: hits; counts: their total
+  int64_t trials = 0;     // hit_ratio: shots
+  std::optional<double> estimate;
+  // 95%; a KM quantile's upper limit may be +infinity (past the last event).
+  std::optional<double> low, high;
+  std::optional<double> reachedBy;  // times: the KM fraction reached by reachedByS
+  double reachedByS = 0;
+};
+struct RobotSummary {
+  std::string robot, program;  // "A"/"B"
+  std::vector<MetricEstimate> metrics;
+};
+struct ProgramSummary {
+  std::string program;
+  int done = 0, faults = 0, errors = 0;
+  std::vector<RobotSummary> robots;  // A, and B in head-to-head
+  // Head-to-head: games A won of those played, and the Wilson interval.
+  int games = 0, winsA = 0, coinWins = 0;
+  std::optional<double> winRate, winLow, winHigh;
+};
+// The seconds at which times report the fraction reached: 60 or the runs'
+// length if shorter.
+double reachedByHorizon(const BenchConfig& config);
+std::vector<ProgramSummary> summarize(const BenchResult& result);
 nlohmann::json summaryJson(const BenchResult& result);
 std::string summaryMarkdown(const BenchResult& result);
+// The observations of one time metric over the runs given, censored at the
+// runs' end (a leg of the edge sequence: only runs that began it, censored
+// at the time left after it began).
+std::vector<stats::Observation> timeObservations(const std::vector<const BenchRun*>& runs,
+                                                 bool robotB, size_t metric, double seconds);
+enum class MetricKind { Time, Ratio, Count, Continuous };
+MetricKind metricKind(const std::string& name);
 // Rewrites the table in order, and writes summary.json and summary.md
 // beside it (each through a temporary file).
 void writeBenchOutputs(const BenchResult& result, RunTable& table);

@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
 #include "tools/bench.h"
+#include "tools/compare.h"
 #include "tools/json_text.h"
 #include "tools/run_table.h"
 #include "tools/runner.h"
@@ -45,15 +47,30 @@ CLI::Validator seedValidator() {
       "SEED");
 }
 
+void addThresholdOptions(CLI::App& cmd, scheduler::MetricThresholds& t) {
+  cmd.add_option("--seen-threshold", t.seen,
+                 "eye reading above which the beacon counts as seen, both eyes for acquire_s "
+                 "(default 48, ICEMAN's)")
+      ->check(CLI::Range(0, 1'000'000));
+  cmd.add_option("--aim-max-diff", t.aimMaxDiff,
+                 "aim_s: largest |left - right| eye difference (default 50, ICEMAN's)")
+      ->check(CLI::Range(0, 1'000'000));
+  cmd.add_option("--aim-min-sum", t.aimMinSum,
+                 "aim_s: smallest left + right eye sum (default 800, ICEMAN's)")
+      ->check(CLI::Range(0, 1'000'000));
+}
+
 Subcommand addBenchCommand(CLI::App& app) {
   struct Options {
     BenchConfig config;
     std::string out, profile = "default", scenario;
-    bool resume = false;
+    bool resume = false, json = false;
     CLI::Option *seconds = nullptr, *seed = nullptr, *profileOption = nullptr;
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("bench", "scenario families over many seeds, with statistics");
+  addThresholdOptions(*cmd, o->config.thresholds);
+  cmd->add_flag("--json", o->json, "print the summary as JSON (summary.json) instead of tables");
   cmd->add_option("PROGRAM", o->config.programs, "programs under test (each is robot A)")
       ->required();
   auto* family =
@@ -103,7 +120,7 @@ Subcommand addBenchCommand(CLI::App& app) {
           StopOnSignals signals;
           const BenchResult r = runBench(c, loaded, {&table, &signals.requested()});
           writeBenchOutputs(r, table);
-          std::cout << summaryMarkdown(r);
+          std::cout << (o->json ? dumpJson(summaryJson(r), 2) + "\n" : summaryMarkdown(r));
           std::cerr << benchWarnings(r) << benchFaults(r);
           const auto done = std::count_if(r.runs.begin(), r.runs.end(),
                                           [](const BenchRun& run) { return run.done; });
@@ -119,6 +136,71 @@ Subcommand addBenchCommand(CLI::App& app) {
           std::cerr << fmt::format(
               "simbot: {} runs in {:.1f} s wall; wrote {}/runs.csv, summary.json, summary.md\n",
               r.runs.size(), wall, dir);
+          return 0;
+        });
+      }};
+}
+
+Subcommand addCompareCommand(CLI::App& app) {
+  struct Options {
+    BenchConfig config;
+    std::vector<std::string> programs;
+    std::string profile = "default", profileB, out = "out/compare";
+    bool json = false;
+  };
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand(
+      "compare", "the same seeded runs for two programs (or two profiles), each metric tested");
+  cmd->add_option("PROGRAM", o->programs,
+                  "program A and program B (one program: A and B differ in --profile-b)")
+      ->required()
+      ->expected(1, 2);
+  cmd->add_option("--family", o->config.family, "stationary, circle, head-to-head or edge")
+      ->required();
+  cmd->add_option("--seeds", o->config.seeds, "runs per side")
+      ->required()
+      ->check(CLI::Range(1, 1'000'000));
+  cmd->add_option("--seconds", o->config.seconds, "simulated seconds per run (default 60)");
+  cmd->add_option("--seed", o->config.masterSeed, "master seed (default 1)")
+      ->check(seedValidator());
+  cmd->add_option("--threads", o->config.threads, "worker threads (default: all cores)")
+      ->check(CLI::Range(1, 1024));
+  cmd->add_option("--opponent", o->config.opponent, "robot B's program (head-to-head)");
+  cmd->add_option("--profile", o->profile, "A's profile name or file (default: default)");
+  cmd->add_option("--profile-b", o->profileB, "B's profile (default: A's)");
+  cmd->add_option("--out", o->out, "where runs-a.csv and runs-b.csv go (default out/compare)");
+  cmd->add_flag("--json", o->json, "print the comparison as JSON");
+  addThresholdOptions(*cmd, o->config.thresholds);
+  return {
+      cmd, [o] {
+        return guarded([&] {
+          const std::string profileB = o->profileB.empty() ? o->profile : o->profileB;
+          if (o->programs.size() == 1 && profileB == o->profile)
+            throw ToolError("simbot: compare needs two programs, or one program and --profile-b\n");
+          BenchConfig a = o->config, b = o->config;
+          a.seedKey = b.seedKey = "compare";
+          a.programs = {o->programs[0]};
+          b.programs = {o->programs.back()};
+          CompareResult r;
+          const plant::Profile pa = loadNamedProfile(o->profile);
+          const plant::Profile pb = loadNamedProfile(profileB);
+          r.profileA = pa.name;
+          r.profileB = pb.name;
+          checkBenchConfig(a);
+          std::filesystem::create_directories(o->out);
+          StopOnSignals signals;
+          r.a = runBench(a, pa, {nullptr, &signals.requested()});
+          if (!r.a.stopped) r.b = runBench(b, pb, {nullptr, &signals.requested()});
+          if (r.a.stopped || r.b.stopped) {
+            std::cerr << fmt::format("simbot: compare stopped by signal {}\n", signals.signal());
+            return 128 + signals.signal();
+          }
+          writeFileAtomically(o->out + "/runs-a.csv", runsCsv(r.a));
+          writeFileAtomically(o->out + "/runs-b.csv", runsCsv(r.b));
+          r.rows = compareRuns(r.a, r.b);
+          std::cout << (o->json ? dumpJson(compareJson(r), 2) + "\n" : compareMarkdown(r));
+          std::cerr << benchWarnings(r.a) << benchFaults(r.a) << benchWarnings(r.b)
+                    << benchFaults(r.b);
           return 0;
         });
       }};

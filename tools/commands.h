@@ -3,6 +3,8 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 
+#include "scheduler/metrics.h"
+
 namespace simbot::tools {
 
 struct Subcommand {
@@ -14,6 +16,11 @@ struct Subcommand {
 CLI::Validator seedValidator();
 
 Subcommand addBenchCommand(CLI::App& app);
+// simbot compare (tools/compare.cpp): the same seeded runs for two programs
+// or two profiles, and a test of each metric.
+Subcommand addCompareCommand(CLI::App& app);
+// --seen-threshold, --aim-max-diff, --aim-min-sum (bench and compare).
+void addThresholdOptions(CLI::App& cmd, scheduler::MetricThresholds& thresholds);
 Subcommand addTournamentCommand(CLI::App& app);
 Subcommand addExplainCommand(CLI::App& app);  // tools/explain_command.cpp
 

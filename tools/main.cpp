@@ -534,6 +534,7 @@ int main(int argc, char** argv) {
   view->add_option("-o,--output", viewOut, "the page to write (.html)")->required();
 
   const auto bench = simbot::tools::addBenchCommand(app);
+  const auto compare = simbot::tools::addCompareCommand(app);
   const auto tournament = simbot::tools::addTournamentCommand(app);
   const auto explain = simbot::tools::addExplainCommand(app);
 
@@ -557,6 +558,7 @@ int main(int argc, char** argv) {
     if (*profile) return profileCommand(profileProgram, profileOptions, profileTop);
     if (*view) return viewCommand(viewTrace, viewOut);
     if (*bench.app) return bench.run();
+    if (*compare.app) return compare.run();
     if (*tournament.app) return tournament.run();
     if (*explain.app) return explain.run();
   } catch (const tools::ToolError& e) {
