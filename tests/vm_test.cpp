@@ -482,6 +482,19 @@ void expectFault(Assembler& a, const std::string& message) {
   EXPECT_EQ(v.now(), at);
 }
 
+// The first run() faults with `message` at `tick` after `instructions`.
+void expectFaultMessageAt(Assembler& a, const std::string& message, vm::Tick tick,
+                          uint64_t instructions) {
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(v.run(1'000'000), Stop::Fault);
+  ASSERT_NE(v.fault(), nullptr);
+  EXPECT_EQ(v.fault()->message, message);
+  EXPECT_EQ(v.fault()->tick, tick);
+  EXPECT_EQ(v.stats().instructions, instructions);
+}
+
 TEST(VmFault, DivisionByZero) {
   Assembler a;
   a.op(Op::PUSHW, 1).op(Op::PUSHW, 0);
@@ -556,6 +569,112 @@ TEST(Vm, BreakpointStopsBeforeAndResumes) {
     EXPECT_EQ(v.read16(n), k);
     EXPECT_EQ(v.now(), k * static_cast<vm::Tick>(cost(Op::INCGW) + cost(Op::JMP)));
   }
+}
+
+// ---- the fast path's traps (vm.cpp "Fast path"): what decode() sends to
+// the slow boundary behaves as it did when every boundary was slow.
+
+TEST(VmFault, InvalidOpcodeFaultsWhereItIsReached) {
+  Assembler a;
+  a.op(Op::PUSHW, 1).op(Op::POP);
+  a.line = 7;
+  a.op(Op::Count_);  // the first byte value that is no opcode
+  expectFault(a, "invalid opcode");
+}
+
+TEST(VmFault, InvalidOpcodeFaultsAtTheBoundaryAfterTheLastInstruction) {
+  Assembler a;
+  a.op(Op::PUSHW, 1).op(Op::POP);
+  a.line = 7;
+  a.op(Op::Count_);
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(v.run(1'000'000), Stop::Fault);
+  EXPECT_EQ(v.fault()->message, "invalid opcode " + std::to_string(vm::kOpCount));
+  // PUSHW and POP ran; the fault is at the boundary after them.
+  EXPECT_EQ(v.fault()->tick, cost(Op::PUSHW) + cost(Op::POP));
+  EXPECT_EQ(v.stats().instructions, 2u);
+}
+
+TEST(VmFault, JumpOutsideTheCodeFaultsAfterTheJump) {
+  Assembler a;
+  a.op(Op::PUSHW, 1).op(Op::POP);
+  a.line = 7;
+  a.op(Op::JMP, 0x4000);  // 0x4000 bytes past the end
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(v.run(1'000'000), Stop::Fault);
+  // The jump ran (its cost charged) and the next boundary found its pc
+  // outside: 3 + 3 + 1 + 0x4000.
+  EXPECT_EQ(v.fault()->message, "jump outside the program (0x4007)");
+  EXPECT_EQ(v.fault()->tick, cost(Op::PUSHW) + cost(Op::POP) + cost(Op::JMP));
+  EXPECT_EQ(v.stats().instructions, 3u);
+}
+
+TEST(VmFault, CallPastTheEndAndRunningOffTheCodeFault) {
+  {
+    Assembler a;
+    a.op(Op::CALL, 0xFFF0);
+    expectFaultMessageAt(a, "jump outside the program (0xfff0)", cost(Op::CALL), 1);
+  }
+  {
+    Assembler a;  // no HALT: the instruction after PUSHW is past the end
+    a.op(Op::PUSHW, 1);
+    expectFaultMessageAt(a, "jump outside the program (0x0003)", cost(Op::PUSHW), 1);
+  }
+}
+
+TEST(Vm, ConditionalJumpWithAHostileTargetRunsOnWhenNotTaken) {
+  Assembler a;
+  const uint16_t x = a.data(2);
+  // JZ's target is far outside the code, but the 1 on the stack means it
+  // is not taken: the program goes on exactly as if the target were valid.
+  a.op(Op::PUSHW, 1).op(Op::JZ, 0x7000).op(Op::PUSHW, 5).op(Op::STGW, x).op(Op::HALT);
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(v.run(1'000'000), Stop::Halted);
+  EXPECT_EQ(v.fault(), nullptr);
+  EXPECT_EQ(v.read16(x), 5);
+  EXPECT_EQ(v.stats().instructions, 5u);
+}
+
+TEST(VmFault, ExpressionStackGuardFaultsAtTheSameBoundaryOnTheFastPath) {
+  Assembler a;
+  a.op(Op::PUSHW, 1);
+  a.line = 7;
+  a.bind("loop").op(Op::DUP).jump(Op::JMP, "loop");
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(v.run(1'000'000'000), Stop::Fault);
+  EXPECT_NE(v.fault()->message.find("expression stack overflow"), std::string::npos);
+  // sp is 1 after PUSHW and one more after each DUP; the guard (8,192
+  // slots, 4 kept free) faults at the first boundary with sp = 8,189: after
+  // the 8,188th DUP, before its JMP.
+  const int dups = 8188;
+  EXPECT_EQ(v.fault()->tick, cost(Op::PUSHW) + dups * vm::Tick{cost(Op::DUP)} +
+                                 (dups - 1) * vm::Tick{cost(Op::JMP)});
+  EXPECT_EQ(v.stats().instructions, 1u + dups + (dups - 1));
+}
+
+TEST(Vm, BreakpointSetAndClearedBetweenRuns) {
+  Assembler a;
+  const uint16_t n = a.data(2);
+  a.bind("loop").op(Op::INCGW, n).jump(Op::JMP, "loop");
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  const vm::Tick pass = cost(Op::INCGW) + cost(Op::JMP);
+  v.setBreakpoint(a.label("loop") + 3);  // the JMP
+  EXPECT_EQ(v.run(1'000'000), Stop::Breakpoint);
+  EXPECT_EQ(v.now(), vm::Tick{cost(Op::INCGW)});
+  v.setBreakpoint(a.label("loop") + 3, false);
+  EXPECT_EQ(v.run(10 * pass), Stop::Horizon);  // no stop at the JMP any more
+  EXPECT_EQ(v.now(), 10 * pass);
+  EXPECT_EQ(v.read16(n), 10);
 }
 
 }  // namespace

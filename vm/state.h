@@ -127,6 +127,18 @@ struct Vm::State {
   uint32_t burn = 0;
   uint32_t burnPc = 0;
   VmStats stats;
+  // The dispatch copy of the code (vm.cpp "Fast path"): per code address
+  // the opcode the fast path runs there, or kTrap where the slow path must
+  // look first (an invalid opcode, an instruction that runs past the end of
+  // the code or jumps outside it, one longer than kMaxStepTstates, a fast-
+  // forward loop top, a breakpoint), kCodePad kTrap bytes past the end.
+  // `padded` is the code with kCodePad zero bytes after it, for operands.
+  static constexpr uint8_t kTrap = kOpCount;
+  static constexpr uint32_t kCodePad = 8;
+  std::vector<uint8_t> dispatch;
+  std::vector<uint8_t> baseDispatch;  // without breakpoints
+  std::vector<uint8_t> padded;
+  void decode();
   std::vector<uint8_t> breakpoints;  // one flag per code byte
   bool anyBreakpoint = false;
   bool resumeAtBreakpoint = false;
