@@ -139,6 +139,24 @@ struct Vm::State {
   std::vector<uint8_t> baseDispatch;  // without breakpoints
   std::vector<uint8_t> padded;
   void decode();
+  // `dispatch` as run<kProfile> reads it: per code address the handler's
+  // label, the opcode's cost and size (0 for kTrap) and the opcode, built
+  // at the first run of each (the labels are known only inside run()).
+  struct Fast {
+    const void* label;
+    uint32_t cost;
+    uint8_t op;
+    uint8_t size;
+  };
+  std::array<std::vector<Fast>, 2> fast;
+  std::array<const void* const*, 2> fastLabels{};
+  void setFast(int k, uint32_t address) {
+    const uint8_t o = dispatch[address];
+    const bool trap = o == kTrap;
+    fast[k][address] =
+        Fast{fastLabels[k][o], trap ? 0u : costs.op[o], o,
+             trap ? uint8_t{0} : static_cast<uint8_t>(instructionSize(static_cast<Op>(o)))};
+  }
   std::vector<uint8_t> breakpoints;  // one flag per code byte
   bool anyBreakpoint = false;
   bool resumeAtBreakpoint = false;

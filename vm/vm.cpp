@@ -191,26 +191,11 @@ Stop Vm::State::run(Tick until) {
   const uint32_t* const opCost = costs.op.data();
   const int16_t* const loopTop =
       costs.knobs.fastForward && !loopAtTop.empty() ? loopAtTop.data() : nullptr;
-  // Cost and size by dispatch byte; kTrap costs nothing and stays put.
-  struct OpTable {
-    std::array<uint32_t, kOpCount + 1> cost{};
-    std::array<uint8_t, kOpCount + 1> size{};
-  };
-  static const OpTable kNoCosts = [] {
-    OpTable t;
-    for (int o = 0; o < kOpCount; ++o)
-      t.size[o] = static_cast<uint8_t>(instructionSize(static_cast<Op>(o)));
-    return t;
-  }();
-  OpTable table = kNoCosts;
-  std::copy(costs.op.begin(), costs.op.end(), table.cost.begin());
-  const uint32_t* const fastCost = table.cost.data();
-  const uint8_t* const fastSize = table.size.data();
   uint32_t* const e = eval.data();
   busTouched = false;
 
 #if SIMBOT_COMPUTED_GOTO
-  static void* const kLabels[] = {
+  static const void* const kLabels[] = {
 #define OP(name, shape, pop, push, seq) &&L_##name,
 #include "vm/opcodes.def"
 #undef OP
@@ -218,10 +203,20 @@ Stop Vm::State::run(Tick until) {
   };
 #define CASE(name) L_##name:
 #define DISPATCH() goto* kLabels[op]
+#define FAST_DISPATCH(d) goto* d.label
 #else
 #define CASE(name) case Op::name:
 #define DISPATCH() goto dispatchOp
+#define FAST_DISPATCH(d) goto dispatchOp
+  static const void* const kLabels[kOpCount + 1] = {};  // Fast::label unused
 #endif
+  constexpr int kRun = kProfile ? 1 : 0;
+  if (fast[kRun].empty()) {
+    fastLabels[kRun] = kLabels;
+    fast[kRun].resize(dispatch.size());
+    for (uint32_t a = 0; a < dispatch.size(); ++a) setFast(kRun, a);
+  }
+  const Fast* const fd = fast[kRun].data();
   Tick clk = now;
   uint32_t ip = pc;
   int esp = sp;
@@ -229,21 +224,24 @@ Stop Vm::State::run(Tick until) {
   Tick limit = 0;
 #define SAVE() (now = clk, pc = ip, sp = esp, stats.instructions = count)
 #define LOAD() (clk = now, ip = pc, esp = sp, count = stats.instructions)
-#define NEXT                                      \
-  if (__builtin_expect(clk >= limit, 0)) {        \
-    SAVE();                                       \
-    goto boundary;                                \
-  }                                               \
-  opPc = ip;                                      \
-  op = xop[ip];                                   \
-  clk += fastCost[op];                            \
-  if constexpr (kProfile) {                       \
-    if (op != kTrap) profile[opPc] += opCost[op]; \
-  }                                               \
-  ++count;                                        \
-  operand = code + ip + 1;                        \
-  ip += fastSize[op];                             \
-  DISPATCH()
+#define NEXT                                    \
+  if (__builtin_expect(clk >= limit, 0)) {      \
+    SAVE();                                     \
+    goto boundary;                              \
+  }                                             \
+  {                                             \
+    const Fast& d = fd[ip];                     \
+    opPc = ip;                                  \
+    op = d.op;                                  \
+    clk += d.cost;                              \
+    if constexpr (kProfile) {                   \
+      if (op != kTrap) profile[opPc] += d.cost; \
+    }                                           \
+    ++count;                                    \
+    operand = code + ip + 1;                    \
+    ip += d.size;                               \
+    FAST_DISPATCH(d);                           \
+  }
   // The slow boundary after a handler that has saved its state (SAVE()).
 #define SLOW goto boundary
 #define FAULT(message)         \
@@ -438,7 +436,7 @@ L_Trap_ :
       NEXT;
       CASE(PUSHF) PUSHV(I32());
       NEXT;
-      CASE(POP)-- sp;
+      CASE(POP)-- esp;
       NEXT;
       CASE(DUP) {
         const uint32_t v = TOP;
@@ -903,6 +901,7 @@ L_Trap_ :
 }
 #undef CASE
 #undef DISPATCH
+#undef FAST_DISPATCH
 #undef NEXT
 #undef SLOW
 #undef FAULT
@@ -986,6 +985,8 @@ void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
   if (codeAddress < s.breakpoints.size()) {
     s.breakpoints[codeAddress] = enabled ? 1 : 0;
     s.dispatch[codeAddress] = enabled ? State::kTrap : s.baseDispatch[codeAddress];
+    for (int k = 0; k < 2; ++k)
+      if (!s.fast[k].empty()) s.setFast(k, codeAddress);
   }
   s.anyBreakpoint =
       std::any_of(s.breakpoints.begin(), s.breakpoints.end(), [](uint8_t b) { return b != 0; });
