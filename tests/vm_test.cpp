@@ -677,4 +677,90 @@ TEST(Vm, BreakpointSetAndClearedBetweenRuns) {
   EXPECT_EQ(v.read16(n), 10);
 }
 
+// ---- superinstructions (vm.cpp SIMBOT_FUSED_PAIRS) ----
+// A counting loop whose every adjacent pair but DBG, INCGW is fused:
+// LDGW PUSHW, PUSHW LTW, LTW JZ, INCGW JMP.
+vm::Image fusedLoop(Assembler& a, uint16_t& n) {
+  n = a.data(2);
+  a.bind("top").op(Op::LDGW, n).op(Op::PUSHW, 30000).op(Op::LTW).jump(Op::JZ, "exit");
+  a.op(Op::DBG).op(Op::INCGW, n).jump(Op::JMP, "top");
+  a.bind("exit").op(Op::HALT);
+  return a.finish();
+}
+
+// One pass of the loop while n < 30000: LTW's first branch taken (no
+// overflow) and its second not (the result is 1), JZ not taken.
+vm::Tick fusedPass() {
+  return cost(Op::LDGW) + cost(Op::PUSHW) + cost(Op::LTW) +
+         costs().branchDelta[static_cast<int>(Op::LTW)][1] + cost(Op::JZ) + cost(Op::DBG) +
+         cost(Op::INCGW) + cost(Op::JMP);
+}
+
+TEST(VmFused, HorizonInsideAPairStopsBetweenItsHalves) {
+  Assembler a;
+  uint16_t n = 0;
+  const auto img = fusedLoop(a, n);
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  // The first instruction of a run() is the slow boundary's; the second
+  // pass's LDGW is dispatched by JMP as the fused pair LDGW PUSHW. The
+  // horizon at its LDGW's end stops after LDGW alone: 7 + 1 instructions.
+  const vm::Tick h = fusedPass() + cost(Op::LDGW);
+  EXPECT_EQ(v.run(h), Stop::Horizon);
+  EXPECT_EQ(v.now(), h);
+  EXPECT_EQ(v.stats().instructions, 8u);
+  EXPECT_EQ(v.pc(), 3u);  // PUSHW's address
+  EXPECT_EQ(v.read16(n), 1);
+}
+
+TEST(VmFused, EveryHorizonStopsWhereTheUnfusedRunStops) {
+  // The profiling run does not fuse: it is the oracle. For every horizon
+  // over three passes, both stop at the same tick after as many
+  // instructions with the same counter.
+  Assembler a;
+  uint16_t n = 0;
+  const auto img = fusedLoop(a, n);
+  for (vm::Tick h = 1; h < 600; ++h) {
+    TestHost h1, h2;
+    vm::Vm fused(img, h1, costs());
+    vm::Vm plain(img, h2, costs());
+    plain.enableProfile();
+    fused.run(h);
+    plain.run(h);
+    ASSERT_EQ(fused.now(), plain.now()) << "horizon " << h;
+    ASSERT_EQ(fused.stats().instructions, plain.stats().instructions) << "horizon " << h;
+    ASSERT_EQ(fused.pc(), plain.pc()) << "horizon " << h;
+    ASSERT_EQ(fused.read16(n), plain.read16(n)) << "horizon " << h;
+  }
+}
+
+TEST(VmFused, InterruptAtTheInnerBoundaryIsAcceptedThere) {
+  Assembler a;
+  uint16_t n = 0;
+  const uint16_t counter = a.data(2);
+  a.bind("top").op(Op::LDGW, 0).op(Op::PUSHW, 30000).op(Op::LTW).jump(Op::JZ, "exit");
+  a.op(Op::DBG).op(Op::INCGW, 0).jump(Op::JMP, "top");
+  a.bind("exit").op(Op::HALT);
+  countingHandler(a, counter);
+  n = a.data(2);
+  // Patch the loop's counter address (LDGW at 0, INCGW at 11).
+  a.image.code[1] = a.image.code[12] = static_cast<uint8_t>(n);
+  a.image.code[2] = a.image.code[13] = static_cast<uint8_t>(n >> 8);
+  const auto img = a.finish();
+  // The request comes exactly at the boundary between LDGW and PUSHW (the
+  // fused pair LDGW PUSHW, dispatched by JMP) of the second pass.
+  const vm::Tick at = fusedPass() + cost(Op::LDGW);
+  for (const bool profile : {false, true}) {
+    TestHost host;
+    vm::Vm v(img, host, costs());
+    if (profile) v.enableProfile();  // unfused
+    host.schedule(at, Irq::Pio);
+    host.runUntil(v, at + 1000);
+    ASSERT_FALSE(host.events.empty());
+    EXPECT_EQ(host.events.front().tick, at) << "profile " << profile;
+    EXPECT_EQ(host.events.front().pc, 3u) << "profile " << profile;  // PUSHW
+    EXPECT_EQ(v.read16(counter), 1);
+  }
+}
+
 }  // namespace

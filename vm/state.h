@@ -150,13 +150,10 @@ struct Vm::State {
   };
   std::array<std::vector<Fast>, 2> fast;
   std::array<const void* const*, 2> fastLabels{};
-  void setFast(int k, uint32_t address) {
-    const uint8_t o = dispatch[address];
-    const bool trap = o == kTrap;
-    fast[k][address] =
-        Fast{fastLabels[k][o], trap ? 0u : costs.op[o], o,
-             trap ? uint8_t{0} : static_cast<uint8_t>(instructionSize(static_cast<Op>(o)))};
-  }
+  // The superinstructions' labels (vm.cpp SIMBOT_FUSED_PAIRS), set by
+  // run<false>: its entry for a pair's first half jumps to them.
+  const void* const* fusedLabels = nullptr;
+  void setFast(int k, uint32_t address);
   std::vector<uint8_t> breakpoints;  // one flag per code byte
   bool anyBreakpoint = false;
   bool resumeAtBreakpoint = false;

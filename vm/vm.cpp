@@ -182,6 +182,53 @@ void Vm::State::decode() {
   dispatch = baseDispatch;
 }
 
+// Superinstructions: pairs (first, second) measured as the most frequent
+// adjacent opcodes of the reference, shipped, test and benchmark programs
+// (README "Speed"), whose first half cannot fault, touch the bus or leave
+// the fast path. The entry of a first half followed by its second (both
+// ordinary: no trap, no breakpoint on the second) jumps to a handler that
+// runs the first, then the boundary between them (the same compare against
+// `limit`: a horizon, PRT0 tick or trap there stops exactly there, with
+// the same count and clock), then charges the second and jumps straight to
+// its handler. Each half is counted and costs what it costs alone; the
+// only thing saved is the second's table load and indirect jump. The
+// profiling run does not fuse.
+#define SIMBOT_FUSED_PAIRS(X)                                                                      \
+  X(PUSHW, LTW)                                                                                    \
+  X(LTW, JZ) X(LDGW, LDGW) X(LDGW, PUSHW) X(LDGW, ADDW) X(ADDW, PUSHW) X(ADDW, STGW) X(INCGW, JMP) \
+      X(DBG, PUSHW) X(DBG, LDLW) X(DBG, LDGW) X(PUSHW, PUSHW) X(PUSHW, LDGW) X(PUSHW, SUBW)        \
+          X(PUSHW, ADDW) X(STGW, DBG) X(STGW, LDGW) X(POP, DBG)
+
+namespace {
+struct FusedPair {
+  Op first, second;
+};
+constexpr FusedPair kFusedPairs[] = {
+#define SIMBOT_PAIR(a, b) {Op::a, Op::b},
+    SIMBOT_FUSED_PAIRS(SIMBOT_PAIR)
+#undef SIMBOT_PAIR
+};
+int fusedIndex(uint8_t first, uint8_t second) {
+  for (size_t i = 0; i < std::size(kFusedPairs); ++i)
+    if (static_cast<uint8_t>(kFusedPairs[i].first) == first &&
+        static_cast<uint8_t>(kFusedPairs[i].second) == second)
+      return static_cast<int>(i);
+  return -1;
+}
+}  // namespace
+
+void Vm::State::setFast(int k, uint32_t address) {
+  const uint8_t o = dispatch[address];
+  const bool trap = o == kTrap;
+  const auto size = trap ? uint8_t{0} : static_cast<uint8_t>(instructionSize(static_cast<Op>(o)));
+  const void* label = fastLabels[k][o];
+  if (k == 0 && fusedLabels && !trap && address + size < dispatch.size()) {
+    const int f = fusedIndex(o, dispatch[address + size]);
+    if (f >= 0) label = fusedLabels[f];
+  }
+  fast[k][address] = Fast{label, trap ? 0u : costs.op[o], o, size};
+}
+
 template <bool kProfile>
 Stop Vm::State::run(Tick until) {
   if (fault) return Stop::Fault;
@@ -213,6 +260,14 @@ Stop Vm::State::run(Tick until) {
   constexpr int kRun = kProfile ? 1 : 0;
   if (fast[kRun].empty()) {
     fastLabels[kRun] = kLabels;
+#if SIMBOT_COMPUTED_GOTO
+    static const void* const kFused[] = {
+#define SIMBOT_PAIR(a, b) &&F_##a##_##b,
+        SIMBOT_FUSED_PAIRS(SIMBOT_PAIR)
+#undef SIMBOT_PAIR
+    };
+    if (!kProfile) fusedLabels = kFused;
+#endif
     fast[kRun].resize(dispatch.size());
     for (uint32_t a = 0; a < dispatch.size(); ++a) setFast(kRun, a);
   }
@@ -387,7 +442,7 @@ boundary:
   // Signed: first branch (JP PO) taken when the subtraction HL - DE did
   // not overflow (it jumps over the sign correction), second taken when
   // the result is 0.
-#define SIGNED_COMPARE(expr, hl, de)                                  \
+#define SIGNED_COMPARE_BODY(expr, hl, de)                             \
   {                                                                   \
     const uint32_t b = POPV;                                          \
     const uint32_t a = TOP;                                           \
@@ -395,7 +450,9 @@ boundary:
     const bool overflow = diff < -32768 || diff > 32767;              \
     TOP = (expr) ? 1u : 0u;                                           \
     BRANCH_COST((overflow ? 0u : 1u) | (TOP == 0 ? 2u : 0u));         \
-  }                                                                   \
+  }
+#define SIGNED_COMPARE(expr, hl, de) \
+  SIGNED_COMPARE_BODY(expr, hl, de)  \
   NEXT
   // A shift by n: op[] is one pass; n = 0 takes the JR Z (path 1), n > 1
   // adds n - 1 further passes, run like a long instruction's tail (in
@@ -417,6 +474,52 @@ boundary:
     }                                                     \
   }                                                       \
   NEXT
+#if SIMBOT_COMPUTED_GOTO
+  // Superinstructions (SIMBOT_FUSED_PAIRS): the first half's body, the
+  // boundary between the halves, then the second half as NEXT would
+  // dispatch it, its opcode known.
+#define FIRST_PUSHW PUSHV(U16())
+#define FIRST_LDGW PUSHV(rd16(U16()))
+#define FIRST_STGW wr16(U16(), POPV)
+#define FIRST_POP --esp
+#define FIRST_DBG
+#define FIRST_INCGW wr16(U16(), rd16(U16()) + 1u)
+#define FIRST_ADDW            \
+  {                           \
+    const uint32_t b = POPV;  \
+    TOP = (TOP + b) & 0xFFFF; \
+  }
+#define FIRST_LTW SIGNED_COMPARE_BODY(asInt16(a) < asInt16(b), a, b)
+#define NEXT_TO(second)                                     \
+  if (__builtin_expect(clk >= limit, 0)) {                  \
+    SAVE();                                                 \
+    goto boundary;                                          \
+  }                                                         \
+  opPc = ip;                                                \
+  op = static_cast<uint8_t>(Op::second);                    \
+  clk += opCost[op];                                        \
+  if constexpr (kProfile) profile[opPc] += opCost[op];      \
+  ++count;                                                  \
+  operand = code + ip + 1;                                  \
+  ip += static_cast<uint32_t>(instructionSize(Op::second)); \
+  goto L_##second;
+#define SIMBOT_PAIR(a, b) \
+  F_##a##_##b : {         \
+    FIRST_##a;            \
+    NEXT_TO(b)            \
+  }
+  SIMBOT_FUSED_PAIRS(SIMBOT_PAIR)
+#undef SIMBOT_PAIR
+#undef NEXT_TO
+#undef FIRST_PUSHW
+#undef FIRST_LDGW
+#undef FIRST_STGW
+#undef FIRST_POP
+#undef FIRST_DBG
+#undef FIRST_INCGW
+#undef FIRST_ADDW
+#undef FIRST_LTW
+#endif
 #if !SIMBOT_COMPUTED_GOTO
 dispatchOp:
   switch (static_cast<Op>(op)) {
@@ -895,6 +998,7 @@ L_Trap_ :
 #undef SHIFT
 #undef COMPARE
 #undef SIGNED_COMPARE
+#undef SIGNED_COMPARE_BODY
 #undef U16
 #undef I32
 #undef CO_TARGET
@@ -985,8 +1089,11 @@ void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
   if (codeAddress < s.breakpoints.size()) {
     s.breakpoints[codeAddress] = enabled ? 1 : 0;
     s.dispatch[codeAddress] = enabled ? State::kTrap : s.baseDispatch[codeAddress];
+    // The entries that may fuse into this address: those just before it.
+    const uint32_t from = codeAddress >= 4 ? codeAddress - 4 : 0;
     for (int k = 0; k < 2; ++k)
-      if (!s.fast[k].empty()) s.setFast(k, codeAddress);
+      if (!s.fast[k].empty())
+        for (uint32_t a = from; a <= codeAddress; ++a) s.setFast(k, a);
   }
   s.anyBreakpoint =
       std::any_of(s.breakpoints.begin(), s.breakpoints.end(), [](uint8_t b) { return b != 0; });
