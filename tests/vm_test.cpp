@@ -763,4 +763,42 @@ TEST(VmFused, InterruptAtTheInnerBoundaryIsAcceptedThere) {
   }
 }
 
+// ---- an instruction longer than 100 T-states on the fast path (L_Long_)
+// DIVW (459 T-states calibrated) has boundaries 100, 200, 300 and 400
+// T-states after its start, and its end.
+TEST(VmLong, RequestInsideTheTailIsAcceptedAtTheNextStep) {
+  Assembler a;
+  const uint16_t counter = a.data(2);
+  a.bind("loop").op(Op::PUSHW, 100).op(Op::PUSHW, 7).op(Op::DIVW).op(Op::POP);
+  a.jump(Op::JMP, "loop");
+  countingHandler(a, counter);
+  const auto img = a.finish();
+  ASSERT_GT(cost(Op::DIVW), 400u);
+  const vm::Tick pass = 2 * cost(Op::PUSHW) + cost(Op::DIVW) + cost(Op::POP) + cost(Op::JMP);
+  const vm::Tick divStart = pass + 2 * cost(Op::PUSHW);  // the second pass's DIVW
+  {
+    TestHost host;
+    vm::Vm v(img, host, costs());
+    host.schedule(divStart + 250, Irq::Pio);
+    host.runUntil(v, divStart + 2000);
+    ASSERT_FALSE(host.events.empty());
+    EXPECT_EQ(host.events.front().tick, divStart + 300);
+    EXPECT_EQ(host.events.front().pc, 6u);  // DIVW's own address: it is under way
+    EXPECT_EQ(v.read16(counter), 1);
+  }
+  {
+    TestHost host;
+    vm::Vm v(img, host, costs());
+    // The horizon inside the tail: the run stops at the first step at or
+    // after it, with DIVW counted once and its remaining time still to run.
+    EXPECT_EQ(v.run(divStart + 250), Stop::Horizon);
+    EXPECT_EQ(v.now(), divStart + 300);
+    EXPECT_EQ(v.stats().instructions, 5u + 3u);
+    EXPECT_EQ(v.pc(), 6u);
+    EXPECT_EQ(v.run(divStart + cost(Op::DIVW)), Stop::Horizon);
+    EXPECT_EQ(v.now(), divStart + cost(Op::DIVW));
+    EXPECT_EQ(v.pc(), 7u);  // POP
+  }
+}
+
 }  // namespace

@@ -130,8 +130,8 @@ struct Vm::State {
   // The dispatch copy of the code (vm.cpp "Fast path"): per code address
   // the opcode the fast path runs there, or kTrap where the slow path must
   // look first (an invalid opcode, an instruction that runs past the end of
-  // the code or jumps outside it, one longer than kMaxStepTstates, a fast-
-  // forward loop top, a breakpoint), kCodePad kTrap bytes past the end.
+  // the code or jumps outside it, a fast-forward loop top, a breakpoint),
+  // kCodePad kTrap bytes past the end.
   // `padded` is the code with kCodePad zero bytes after it, for operands.
   static constexpr uint8_t kTrap = kOpCount;
   static constexpr uint32_t kCodePad = 8;
@@ -153,6 +153,9 @@ struct Vm::State {
   // The superinstructions' labels (vm.cpp SIMBOT_FUSED_PAIRS), set by
   // run<false>: its entry for a pair's first half jumps to them.
   const void* const* fusedLabels = nullptr;
+  // The handler that starts an instruction longer than kMaxStepTstates on
+  // the fast path (null: such instructions go to the slow boundary).
+  std::array<const void*, 2> longLabels{};
   void setFast(int k, uint32_t address);
   std::vector<uint8_t> breakpoints;  // one flag per code byte
   bool anyBreakpoint = false;

@@ -146,10 +146,16 @@ void Vm::State::timerService(uint32_t interruptedPc) {
 //    requests between calls), the time of a long instruction still to burn,
 //    the eval stack past its guard: limit = 0, so the next boundary is slow;
 //  - an address whose `dispatch` byte is kTrap (decode(): invalid opcodes,
-//    instructions past the end of the code or jumping outside it, ones
-//    longer than kMaxStepTstates, fast-forward loop tops, breakpoints): the
-//    kTrap handler sends it to the slow boundary, which runs the instruction
-//    from the code itself and sets limit = 0 for the boundary after it.
+//    instructions past the end of the code or jumping outside it,
+//    fast-forward loop tops, breakpoints): the kTrap handler sends it to
+//    the slow boundary, which runs the instruction from the code itself and
+//    sets limit = 0 for the boundary after it.
+// An instruction longer than kMaxStepTstates (L_Long_) charges the first
+// kMaxStepTstates, leaves the rest in `burn` and runs its handler with
+// limit = 0; its NEXT then runs the tail's steps at `slowNext`, each after
+// the same compare against the real limit (nothing else can be due inside
+// a pure stack operation's tail), and leaves for the slow boundary at the
+// first step where something is.
 // The slow boundary (`boundary:`) is the one every instruction used to take:
 // the same tests in the same order, so every tick, count and trace is what
 // it was. Any pc the fast path can reach indexes `dispatch` safely: jumps
@@ -170,7 +176,6 @@ void Vm::State::decode() {
     if (b >= kOpCount) continue;
     const Op op = static_cast<Op>(b);
     if (a + static_cast<uint32_t>(instructionSize(op)) > size) continue;
-    if (costs.op[b] > kMaxStepTstates) continue;
     if ((op == Op::JMP || op == Op::JZ || op == Op::JNZ) && (rel(a) < 0 || rel(a) >= size))
       continue;
     if (op == Op::CALL && static_cast<uint32_t>(padded[a + 1] | (padded[a + 2] << 8)) >= size)
@@ -193,10 +198,11 @@ void Vm::State::decode() {
 // its handler. Each half is counted and costs what it costs alone; the
 // only thing saved is the second's table load and indirect jump. The
 // profiling run does not fuse.
-#define SIMBOT_FUSED_PAIRS(X)                                                                      \
-  X(PUSHW, LTW)                                                                                    \
-  X(LTW, JZ) X(LDGW, LDGW) X(LDGW, PUSHW) X(LDGW, ADDW) X(ADDW, PUSHW) X(ADDW, STGW) X(INCGW, JMP) \
-      X(DBG, PUSHW) X(DBG, LDLW) X(DBG, LDGW) X(PUSHW, PUSHW) X(PUSHW, LDGW) X(PUSHW, SUBW)        \
+#define SIMBOT_FUSED_PAIRS(X)                                                               \
+  X(PUSHW, LTW)                                                                             \
+  X(LTW, JZ)                                                                                \
+  X(LDGW, LDGW) X(LDGW, PUSHW) X(LDGW, ADDW) X(ADDW, PUSHW) X(ADDW, STGW) X(INCGW, JMP)     \
+      X(DBG, PUSHW) X(DBG, LDLW) X(DBG, LDGW) X(PUSHW, PUSHW) X(PUSHW, LDGW) X(PUSHW, SUBW) \
           X(PUSHW, ADDW) X(STGW, DBG) X(STGW, LDGW) X(POP, DBG)
 
 namespace {
@@ -218,15 +224,19 @@ int fusedIndex(uint8_t first, uint8_t second) {
 }  // namespace
 
 void Vm::State::setFast(int k, uint32_t address) {
-  const uint8_t o = dispatch[address];
+  uint8_t o = dispatch[address];
+  const bool isLong = o != kTrap && costs.op[o] > kMaxStepTstates;
+  if (isLong && !longLabels[k]) o = kTrap;
   const bool trap = o == kTrap;
   const auto size = trap ? uint8_t{0} : static_cast<uint8_t>(instructionSize(static_cast<Op>(o)));
-  const void* label = fastLabels[k][o];
-  if (k == 0 && fusedLabels && !trap && address + size < dispatch.size()) {
-    const int f = fusedIndex(o, dispatch[address + size]);
-    if (f >= 0) label = fusedLabels[f];
+  const void* label = isLong && !trap ? longLabels[k] : fastLabels[k][o];
+  if (k == 0 && fusedLabels && !trap && !isLong && address + size < dispatch.size()) {
+    const uint8_t next = dispatch[address + size];
+    const int f = fusedIndex(o, next);
+    if (f >= 0 && costs.op[next] <= kMaxStepTstates) label = fusedLabels[f];
   }
-  fast[k][address] = Fast{label, trap ? 0u : costs.op[o], o, size};
+  const uint32_t cost = trap ? 0u : isLong ? kMaxStepTstates : costs.op[o];
+  fast[k][address] = Fast{label, cost, o, size};
 }
 
 template <bool kProfile>
@@ -267,6 +277,7 @@ Stop Vm::State::run(Tick until) {
 #undef SIMBOT_PAIR
     };
     if (!kProfile) fusedLabels = kFused;
+    longLabels[kRun] = &&L_Long_;
 #endif
     fast[kRun].resize(dispatch.size());
     for (uint32_t a = 0; a < dispatch.size(); ++a) setFast(kRun, a);
@@ -277,13 +288,15 @@ Stop Vm::State::run(Tick until) {
   int esp = sp;
   uint64_t count = stats.instructions;
   Tick limit = 0;
+  Tick longLimit = -1;  // L_Long_: the limit its instruction's tail runs to
 #define SAVE() (now = clk, pc = ip, sp = esp, stats.instructions = count)
 #define LOAD() (clk = now, ip = pc, esp = sp, count = stats.instructions)
-#define NEXT                                    \
-  if (__builtin_expect(clk >= limit, 0)) {      \
-    SAVE();                                     \
-    goto boundary;                              \
-  }                                             \
+#define NEXT                               \
+  if (__builtin_expect(clk >= limit, 0)) { \
+    goto slowNext;                         \
+  }                                        \
+  DISPATCH_NEXT
+#define DISPATCH_NEXT                           \
   {                                             \
     const Fast& d = fd[ip];                     \
     opPc = ip;                                  \
@@ -519,6 +532,30 @@ boundary:
 #undef FIRST_INCGW
 #undef FIRST_ADDW
 #undef FIRST_LTW
+#endif
+slowNext:
+  if (longLimit >= 0) {  // the tail of a long instruction (L_Long_)
+    limit = longLimit;
+    longLimit = -1;
+    while (burn && clk < limit) {
+      const uint32_t step = std::min(kMaxStepTstates, burn);
+      clk += step;
+      burn -= step;
+    }
+    if (!burn && clk < limit) DISPATCH_NEXT;
+  }
+  SAVE();
+  SLOW;
+#if SIMBOT_COMPUTED_GOTO
+L_Long_ : {
+  const uint32_t rest = opCost[op] - kMaxStepTstates;
+  if constexpr (kProfile) profile[opPc] += rest;
+  burn = rest;
+  burnPc = opPc;
+  longLimit = limit;
+  limit = 0;
+  DISPATCH();
+}
 #endif
 #if !SIMBOT_COMPUTED_GOTO
 dispatchOp:
@@ -1007,6 +1044,7 @@ L_Trap_ :
 #undef DISPATCH
 #undef FAST_DISPATCH
 #undef NEXT
+#undef DISPATCH_NEXT
 #undef SLOW
 #undef FAULT
 #undef CHECK_ACCESS
