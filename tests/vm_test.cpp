@@ -763,6 +763,27 @@ TEST(VmFused, InterruptAtTheInnerBoundaryIsAcceptedThere) {
   }
 }
 
+TEST(VmFused, AFirstHalfThatFaultsFaultsAsItDoesAlone) {
+  // LDLW PUSHW is fused; LDLW at offset 0 from the initial frame pointer
+  // (0x10000) reads past the top of memory. POP's dispatch enters the pair.
+  for (const bool profile : {false, true}) {
+    Assembler a;
+    a.op(Op::PUSHW, 1).op(Op::POP);
+    a.line = 7;
+    a.op(Op::LDLW, 0).op(Op::PUSHW, 5).op(Op::HALT);
+    const auto img = a.finish();
+    TestHost host;
+    vm::Vm v(img, host, costs());
+    if (profile) v.enableProfile();  // unfused
+    EXPECT_EQ(v.run(1'000'000), Stop::Fault);
+    ASSERT_NE(v.fault(), nullptr);
+    EXPECT_EQ(v.fault()->message, "access outside memory at 0x10000 (2 bytes)");
+    EXPECT_EQ(v.fault()->tick, cost(Op::PUSHW) + cost(Op::POP) + cost(Op::LDLW));
+    EXPECT_EQ(v.fault()->line, 7);
+    EXPECT_EQ(v.stats().instructions, 3u);
+  }
+}
+
 // ---- an instruction longer than 100 T-states on the fast path (L_Long_)
 // DIVW (459 T-states calibrated) has boundaries 100, 200, 300 and 400
 // T-states after its start, and its end.
