@@ -784,6 +784,26 @@ TEST(VmFused, AFirstHalfThatFaultsFaultsAsItDoesAlone) {
   }
 }
 
+TEST(VmFused, BreakpointOnASecondHalfSetAfterRunningSplitsThePair) {
+  // INCGW JMP is fused (DBG INCGW is not, so DBG's dispatch reads INCGW's
+  // entry); after ten passes a breakpoint on the JMP must stop every later
+  // pass between the two.
+  Assembler a;
+  const uint16_t n = a.data(2);
+  a.bind("loop").op(Op::DBG).op(Op::INCGW, n).jump(Op::JMP, "loop");
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  const vm::Tick pass = cost(Op::DBG) + cost(Op::INCGW) + cost(Op::JMP);
+  EXPECT_EQ(v.run(10 * pass), Stop::Horizon);
+  v.setBreakpoint(4);
+  for (int k = 10; k < 13; ++k) {
+    EXPECT_EQ(v.run(1'000'000), Stop::Breakpoint);
+    EXPECT_EQ(v.now(), k * pass + cost(Op::DBG) + cost(Op::INCGW));
+    EXPECT_EQ(v.read16(n), k + 1);
+  }
+}
+
 // ---- an instruction longer than 100 T-states on the fast path (L_Long_)
 // DIVW (459 T-states calibrated) has boundaries 100, 200, 300 and 400
 // T-states after its start, and its end.
