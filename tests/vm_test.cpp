@@ -482,6 +482,19 @@ void expectFault(Assembler& a, const std::string& message) {
   EXPECT_EQ(v.now(), at);
 }
 
+// The first run() faults with `message` at `tick` after `instructions`.
+void expectFaultMessageAt(Assembler& a, const std::string& message, vm::Tick tick,
+                          uint64_t instructions) {
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(v.run(1'000'000), Stop::Fault);
+  ASSERT_NE(v.fault(), nullptr);
+  EXPECT_EQ(v.fault()->message, message);
+  EXPECT_EQ(v.fault()->tick, tick);
+  EXPECT_EQ(v.stats().instructions, instructions);
+}
+
 TEST(VmFault, DivisionByZero) {
   Assembler a;
   a.op(Op::PUSHW, 1).op(Op::PUSHW, 0);
@@ -555,6 +568,277 @@ TEST(Vm, BreakpointStopsBeforeAndResumes) {
     EXPECT_EQ(v.run(1'000'000), Stop::Breakpoint);
     EXPECT_EQ(v.read16(n), k);
     EXPECT_EQ(v.now(), k * static_cast<vm::Tick>(cost(Op::INCGW) + cost(Op::JMP)));
+  }
+}
+
+// ---- the fast path's traps (vm.cpp "Fast path"): what decode() sends to
+// the slow boundary behaves as it did when every boundary was slow.
+
+TEST(VmFault, InvalidOpcodeFaultsWhereItIsReached) {
+  Assembler a;
+  a.op(Op::PUSHW, 1).op(Op::POP);
+  a.line = 7;
+  a.op(Op::Count_);  // the first byte value that is no opcode
+  expectFault(a, "invalid opcode");
+}
+
+TEST(VmFault, InvalidOpcodeFaultsAtTheBoundaryAfterTheLastInstruction) {
+  Assembler a;
+  a.op(Op::PUSHW, 1).op(Op::POP);
+  a.line = 7;
+  a.op(Op::Count_);
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(v.run(1'000'000), Stop::Fault);
+  EXPECT_EQ(v.fault()->message, "invalid opcode " + std::to_string(vm::kOpCount));
+  // PUSHW and POP ran; the fault is at the boundary after them.
+  EXPECT_EQ(v.fault()->tick, cost(Op::PUSHW) + cost(Op::POP));
+  EXPECT_EQ(v.stats().instructions, 2u);
+}
+
+TEST(VmFault, JumpOutsideTheCodeFaultsAfterTheJump) {
+  Assembler a;
+  a.op(Op::PUSHW, 1).op(Op::POP);
+  a.line = 7;
+  a.op(Op::JMP, 0x4000);  // 0x4000 bytes past the end
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(v.run(1'000'000), Stop::Fault);
+  // The jump ran (its cost charged) and the next boundary found its pc
+  // outside: 3 + 3 + 1 + 0x4000.
+  EXPECT_EQ(v.fault()->message, "jump outside the program (0x4007)");
+  EXPECT_EQ(v.fault()->tick, cost(Op::PUSHW) + cost(Op::POP) + cost(Op::JMP));
+  EXPECT_EQ(v.stats().instructions, 3u);
+}
+
+TEST(VmFault, CallPastTheEndAndRunningOffTheCodeFault) {
+  {
+    Assembler a;
+    a.op(Op::CALL, 0xFFF0);
+    expectFaultMessageAt(a, "jump outside the program (0xfff0)", cost(Op::CALL), 1);
+  }
+  {
+    Assembler a;  // no HALT: the instruction after PUSHW is past the end
+    a.op(Op::PUSHW, 1);
+    expectFaultMessageAt(a, "jump outside the program (0x0003)", cost(Op::PUSHW), 1);
+  }
+}
+
+TEST(Vm, ConditionalJumpWithAHostileTargetRunsOnWhenNotTaken) {
+  Assembler a;
+  const uint16_t x = a.data(2);
+  // JZ's target is far outside the code, but the 1 on the stack means it
+  // is not taken: the program goes on exactly as if the target were valid.
+  a.op(Op::PUSHW, 1).op(Op::JZ, 0x7000).op(Op::PUSHW, 5).op(Op::STGW, x).op(Op::HALT);
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(v.run(1'000'000), Stop::Halted);
+  EXPECT_EQ(v.fault(), nullptr);
+  EXPECT_EQ(v.read16(x), 5);
+  EXPECT_EQ(v.stats().instructions, 5u);
+}
+
+TEST(VmFault, ExpressionStackGuardFaultsAtTheSameBoundaryOnTheFastPath) {
+  Assembler a;
+  a.op(Op::PUSHW, 1);
+  a.line = 7;
+  a.bind("loop").op(Op::DUP).jump(Op::JMP, "loop");
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(v.run(1'000'000'000), Stop::Fault);
+  EXPECT_NE(v.fault()->message.find("expression stack overflow"), std::string::npos);
+  // sp is 1 after PUSHW and one more after each DUP; the guard (8,192
+  // slots, 4 kept free) faults at the first boundary with sp = 8,189: after
+  // the 8,188th DUP, before its JMP.
+  const int dups = 8188;
+  EXPECT_EQ(v.fault()->tick, cost(Op::PUSHW) + dups * vm::Tick{cost(Op::DUP)} +
+                                 (dups - 1) * vm::Tick{cost(Op::JMP)});
+  EXPECT_EQ(v.stats().instructions, 1u + dups + (dups - 1));
+}
+
+TEST(Vm, BreakpointSetAndClearedBetweenRuns) {
+  Assembler a;
+  const uint16_t n = a.data(2);
+  a.bind("loop").op(Op::INCGW, n).jump(Op::JMP, "loop");
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  const vm::Tick pass = cost(Op::INCGW) + cost(Op::JMP);
+  v.setBreakpoint(a.label("loop") + 3);  // the JMP
+  EXPECT_EQ(v.run(1'000'000), Stop::Breakpoint);
+  EXPECT_EQ(v.now(), vm::Tick{cost(Op::INCGW)});
+  v.setBreakpoint(a.label("loop") + 3, false);
+  EXPECT_EQ(v.run(10 * pass), Stop::Horizon);  // no stop at the JMP any more
+  EXPECT_EQ(v.now(), 10 * pass);
+  EXPECT_EQ(v.read16(n), 10);
+}
+
+// ---- superinstructions (vm.cpp SIMBOT_FUSED_PAIRS) ----
+// A counting loop whose every adjacent pair but DBG, INCGW is fused:
+// LDGW PUSHW, PUSHW LTW, LTW JZ, INCGW JMP.
+vm::Image fusedLoop(Assembler& a, uint16_t& n) {
+  n = a.data(2);
+  a.bind("top").op(Op::LDGW, n).op(Op::PUSHW, 30000).op(Op::LTW).jump(Op::JZ, "exit");
+  a.op(Op::DBG).op(Op::INCGW, n).jump(Op::JMP, "top");
+  a.bind("exit").op(Op::HALT);
+  return a.finish();
+}
+
+// One pass of the loop while n < 30000: LTW's first branch taken (no
+// overflow) and its second not (the result is 1), JZ not taken.
+vm::Tick fusedPass() {
+  return cost(Op::LDGW) + cost(Op::PUSHW) + cost(Op::LTW) +
+         costs().branchDelta[static_cast<int>(Op::LTW)][1] + cost(Op::JZ) + cost(Op::DBG) +
+         cost(Op::INCGW) + cost(Op::JMP);
+}
+
+TEST(VmFused, HorizonInsideAPairStopsBetweenItsHalves) {
+  Assembler a;
+  uint16_t n = 0;
+  const auto img = fusedLoop(a, n);
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  // The first instruction of a run() is the slow boundary's; the second
+  // pass's LDGW is dispatched by JMP as the fused pair LDGW PUSHW. The
+  // horizon at its LDGW's end stops after LDGW alone: 7 + 1 instructions.
+  const vm::Tick h = fusedPass() + cost(Op::LDGW);
+  EXPECT_EQ(v.run(h), Stop::Horizon);
+  EXPECT_EQ(v.now(), h);
+  EXPECT_EQ(v.stats().instructions, 8u);
+  EXPECT_EQ(v.pc(), 3u);  // PUSHW's address
+  EXPECT_EQ(v.read16(n), 1);
+}
+
+TEST(VmFused, EveryHorizonStopsWhereTheUnfusedRunStops) {
+  // The profiling run does not fuse: it is the oracle. For every horizon
+  // over three passes, both stop at the same tick after as many
+  // instructions with the same counter.
+  Assembler a;
+  uint16_t n = 0;
+  const auto img = fusedLoop(a, n);
+  for (vm::Tick h = 1; h < 600; ++h) {
+    TestHost h1, h2;
+    vm::Vm fused(img, h1, costs());
+    vm::Vm plain(img, h2, costs());
+    plain.enableProfile();
+    fused.run(h);
+    plain.run(h);
+    ASSERT_EQ(fused.now(), plain.now()) << "horizon " << h;
+    ASSERT_EQ(fused.stats().instructions, plain.stats().instructions) << "horizon " << h;
+    ASSERT_EQ(fused.pc(), plain.pc()) << "horizon " << h;
+    ASSERT_EQ(fused.read16(n), plain.read16(n)) << "horizon " << h;
+  }
+}
+
+TEST(VmFused, InterruptAtTheInnerBoundaryIsAcceptedThere) {
+  Assembler a;
+  uint16_t n = 0;
+  const uint16_t counter = a.data(2);
+  a.bind("top").op(Op::LDGW, 0).op(Op::PUSHW, 30000).op(Op::LTW).jump(Op::JZ, "exit");
+  a.op(Op::DBG).op(Op::INCGW, 0).jump(Op::JMP, "top");
+  a.bind("exit").op(Op::HALT);
+  countingHandler(a, counter);
+  n = a.data(2);
+  // Patch the loop's counter address (LDGW at 0, INCGW at 11).
+  a.image.code[1] = a.image.code[12] = static_cast<uint8_t>(n);
+  a.image.code[2] = a.image.code[13] = static_cast<uint8_t>(n >> 8);
+  const auto img = a.finish();
+  // The request comes exactly at the boundary between LDGW and PUSHW (the
+  // fused pair LDGW PUSHW, dispatched by JMP) of the second pass.
+  const vm::Tick at = fusedPass() + cost(Op::LDGW);
+  for (const bool profile : {false, true}) {
+    TestHost host;
+    vm::Vm v(img, host, costs());
+    if (profile) v.enableProfile();  // unfused
+    host.schedule(at, Irq::Pio);
+    host.runUntil(v, at + 1000);
+    ASSERT_FALSE(host.events.empty());
+    EXPECT_EQ(host.events.front().tick, at) << "profile " << profile;
+    EXPECT_EQ(host.events.front().pc, 3u) << "profile " << profile;  // PUSHW
+    EXPECT_EQ(v.read16(counter), 1);
+  }
+}
+
+TEST(VmFused, AFirstHalfThatFaultsFaultsAsItDoesAlone) {
+  // LDLW PUSHW is fused; LDLW at offset 0 from the initial frame pointer
+  // (0x10000) reads past the top of memory. POP's dispatch enters the pair.
+  for (const bool profile : {false, true}) {
+    Assembler a;
+    a.op(Op::PUSHW, 1).op(Op::POP);
+    a.line = 7;
+    a.op(Op::LDLW, 0).op(Op::PUSHW, 5).op(Op::HALT);
+    const auto img = a.finish();
+    TestHost host;
+    vm::Vm v(img, host, costs());
+    if (profile) v.enableProfile();  // unfused
+    EXPECT_EQ(v.run(1'000'000), Stop::Fault);
+    ASSERT_NE(v.fault(), nullptr);
+    EXPECT_EQ(v.fault()->message, "access outside memory at 0x10000 (2 bytes)");
+    EXPECT_EQ(v.fault()->tick, cost(Op::PUSHW) + cost(Op::POP) + cost(Op::LDLW));
+    EXPECT_EQ(v.fault()->line, 7);
+    EXPECT_EQ(v.stats().instructions, 3u);
+  }
+}
+
+TEST(VmFused, BreakpointOnASecondHalfSetAfterRunningSplitsThePair) {
+  // INCGW JMP is fused (DBG INCGW is not, so DBG's dispatch reads INCGW's
+  // entry); after ten passes a breakpoint on the JMP must stop every later
+  // pass between the two.
+  Assembler a;
+  const uint16_t n = a.data(2);
+  a.bind("loop").op(Op::DBG).op(Op::INCGW, n).jump(Op::JMP, "loop");
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  const vm::Tick pass = cost(Op::DBG) + cost(Op::INCGW) + cost(Op::JMP);
+  EXPECT_EQ(v.run(10 * pass), Stop::Horizon);
+  v.setBreakpoint(4);
+  for (int k = 10; k < 13; ++k) {
+    EXPECT_EQ(v.run(1'000'000), Stop::Breakpoint);
+    EXPECT_EQ(v.now(), k * pass + cost(Op::DBG) + cost(Op::INCGW));
+    EXPECT_EQ(v.read16(n), k + 1);
+  }
+}
+
+// ---- an instruction longer than 100 T-states on the fast path (L_Long_)
+// DIVW (459 T-states calibrated) has boundaries 100, 200, 300 and 400
+// T-states after its start, and its end.
+TEST(VmLong, RequestInsideTheTailIsAcceptedAtTheNextStep) {
+  Assembler a;
+  const uint16_t counter = a.data(2);
+  a.bind("loop").op(Op::PUSHW, 100).op(Op::PUSHW, 7).op(Op::DIVW).op(Op::POP);
+  a.jump(Op::JMP, "loop");
+  countingHandler(a, counter);
+  const auto img = a.finish();
+  ASSERT_GT(cost(Op::DIVW), 400u);
+  const vm::Tick pass = 2 * cost(Op::PUSHW) + cost(Op::DIVW) + cost(Op::POP) + cost(Op::JMP);
+  const vm::Tick divStart = pass + 2 * cost(Op::PUSHW);  // the second pass's DIVW
+  {
+    TestHost host;
+    vm::Vm v(img, host, costs());
+    host.schedule(divStart + 250, Irq::Pio);
+    host.runUntil(v, divStart + 2000);
+    ASSERT_FALSE(host.events.empty());
+    EXPECT_EQ(host.events.front().tick, divStart + 300);
+    EXPECT_EQ(host.events.front().pc, 6u);  // DIVW's own address: it is under way
+    EXPECT_EQ(v.read16(counter), 1);
+  }
+  {
+    TestHost host;
+    vm::Vm v(img, host, costs());
+    // The horizon inside the tail: the run stops at the first step at or
+    // after it, with DIVW counted once and its remaining time still to run.
+    EXPECT_EQ(v.run(divStart + 250), Stop::Horizon);
+    EXPECT_EQ(v.now(), divStart + 300);
+    EXPECT_EQ(v.stats().instructions, 5u + 3u);
+    EXPECT_EQ(v.pc(), 6u);
+    EXPECT_EQ(v.run(divStart + cost(Op::DIVW)), Stop::Horizon);
+    EXPECT_EQ(v.now(), divStart + cost(Op::DIVW));
+    EXPECT_EQ(v.pc(), 7u);  // POP
   }
 }
 

@@ -127,6 +127,36 @@ struct Vm::State {
   uint32_t burn = 0;
   uint32_t burnPc = 0;
   VmStats stats;
+  // The dispatch copy of the code (vm.cpp "Fast path"): per code address
+  // the opcode the fast path runs there, or kTrap where the slow path must
+  // look first (an invalid opcode, an instruction that runs past the end of
+  // the code or jumps outside it, a fast-forward loop top, a breakpoint),
+  // kCodePad kTrap bytes past the end.
+  // `padded` is the code with kCodePad zero bytes after it, for operands.
+  static constexpr uint8_t kTrap = kOpCount;
+  static constexpr uint32_t kCodePad = 8;
+  std::vector<uint8_t> dispatch;
+  std::vector<uint8_t> baseDispatch;  // without breakpoints
+  std::vector<uint8_t> padded;
+  void decode();
+  // `dispatch` as run<kProfile> reads it: per code address the handler's
+  // label, the opcode's cost and size (0 for kTrap) and the opcode, built
+  // at the first run of each (the labels are known only inside run()).
+  struct Fast {
+    const void* label;
+    uint32_t cost;
+    uint8_t op;
+    uint8_t size;
+  };
+  std::array<std::vector<Fast>, 2> fast;
+  std::array<const void* const*, 2> fastLabels{};
+  // The superinstructions' labels (vm.cpp SIMBOT_FUSED_PAIRS), set by
+  // run<false>: its entry for a pair's first half jumps to them.
+  const void* const* fusedLabels = nullptr;
+  // The handler that starts an instruction longer than kMaxStepTstates on
+  // the fast path (null: such instructions go to the slow boundary).
+  std::array<const void*, 2> longLabels{};
+  void setFast(int k, uint32_t address);
   std::vector<uint8_t> breakpoints;  // one flag per code byte
   bool anyBreakpoint = false;
   bool resumeAtBreakpoint = false;

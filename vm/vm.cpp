@@ -131,119 +131,306 @@ void Vm::State::timerService(uint32_t interruptedPc) {
 }
 
 // ---- dispatch ---------------------------------------------------------------
+//
+// Fast path. The clock, pc, eval-stack pointer and instruction count live in
+// locals (clk, ip, esp, count) while ordinary instructions run; the State's
+// members (now, pc, sp, stats.instructions) hold them only on the slow path.
+// An ordinary instruction ends with NEXT: one compare of the clock against
+// `limit`, the load of the next opcode from `dispatch` and a jump to its
+// handler. limit is min(until, nextTimer), the first tick at which the
+// boundary has anything to do, or 0 (a trap) while anything rarer is due:
+//  - a fault, a bus access (Io), a library call, HALT, EI/DI, RETI, the
+//    costatement opcodes: their handlers go to the slow boundary themselves;
+//  - a pending request with IFF1 set (only the slow path changes IFF1, the
+//    pending flags or the EI shadow while run() runs: the host raises
+//    requests between calls), the time of a long instruction still to burn,
+//    the eval stack past its guard: limit = 0, so the next boundary is slow;
+//  - an address whose `dispatch` byte is kTrap (decode(): invalid opcodes,
+//    instructions past the end of the code or jumping outside it,
+//    fast-forward loop tops, breakpoints): the kTrap handler sends it to
+//    the slow boundary, which runs the instruction from the code itself and
+//    sets limit = 0 for the boundary after it.
+// An instruction longer than kMaxStepTstates (L_Long_) charges the first
+// kMaxStepTstates, leaves the rest in `burn` and runs its handler with
+// limit = 0; its NEXT then runs the tail's steps at `slowNext`, each after
+// the same compare against the real limit (nothing else can be due inside
+// a pure stack operation's tail), and leaves for the slow boundary at the
+// first step where something is.
+// The slow boundary (`boundary:`) is the one every instruction used to take:
+// the same tests in the same order, so every tick, count and trace is what
+// it was. Any pc the fast path can reach indexes `dispatch` safely: jumps
+// and calls out of the code are kTrap at decode, and a return address is at
+// most kCodePad - 1 past its end.
+
+void Vm::State::decode() {
+  const auto& code = image.code;
+  const auto size = static_cast<uint32_t>(code.size());
+  padded = code;
+  padded.resize(size + kCodePad, 0);
+  baseDispatch.assign(size + kCodePad, kTrap);
+  auto rel = [&](uint32_t a) {  // a REL16 instruction's target, from its start
+    return int64_t{a} + 3 + static_cast<int16_t>(padded[a + 1] | (padded[a + 2] << 8));
+  };
+  for (uint32_t a = 0; a < size; ++a) {
+    const uint8_t b = code[a];
+    if (b >= kOpCount) continue;
+    const Op op = static_cast<Op>(b);
+    if (a + static_cast<uint32_t>(instructionSize(op)) > size) continue;
+    if ((op == Op::JMP || op == Op::JZ || op == Op::JNZ) && (rel(a) < 0 || rel(a) >= size))
+      continue;
+    if (op == Op::CALL && static_cast<uint32_t>(padded[a + 1] | (padded[a + 2] << 8)) >= size)
+      continue;
+    baseDispatch[a] = b;
+  }
+  if (costs.knobs.fastForward)
+    for (const Loop& loop : loops) baseDispatch[loop.top] = kTrap;
+  dispatch = baseDispatch;
+}
+
+// Superinstructions: pairs (first, second) chosen from the most frequent
+// adjacent opcodes counted over the reference, shipped, test and benchmark
+// programs (README "Dispatch"); the first half never touches the bus or
+// charges a branch-dependent tail, and no half is longer than
+// kMaxStepTstates. The entry of a first half followed by its second (both
+// ordinary: no trap, no breakpoint on the second) jumps to a handler that
+// runs the first, then the boundary between them (the same compare against
+// `limit`: a horizon, PRT0 tick or trap there stops exactly there, with
+// the same count and clock), then charges the second and jumps straight to
+// its handler. A first half that faults leaves as it does alone (FAULT,
+// CHECK_ACCESS). Each half is counted and costs what it costs alone; what
+// is saved is the second's table load and indirect jump. The profiling run
+// does not fuse.
+// clang-format off
+#define SIMBOT_FUSED_PAIRS(X)                                                         \
+  X(PUSHW, LTW) X(LTW, JZ) X(LDGW, LDGW) X(LDGW, PUSHW) X(LDGW, ADDW) X(ADDW, PUSHW)  \
+  X(ADDW, STGW) X(INCGW, JMP) X(DBG, PUSHW) X(DBG, LDLW) X(DBG, LDGW) X(PUSHW, PUSHW) \
+  X(PUSHW, LDGW) X(PUSHW, SUBW) X(PUSHW, ADDW) X(STGW, DBG) X(STGW, LDGW) X(POP, DBG) \
+  X(LDLW, PUSHW) X(LDLW, RET) X(STLW, DBG) X(ENTER, STLW) X(SUBW, CALL) X(ADDW, RET)  \
+  X(STGW, INCGW)
+// clang-format on
+
+namespace {
+struct FusedPair {
+  Op first, second;
+};
+constexpr FusedPair kFusedPairs[] = {
+#define SIMBOT_PAIR(a, b) {Op::a, Op::b},
+    SIMBOT_FUSED_PAIRS(SIMBOT_PAIR)
+#undef SIMBOT_PAIR
+};
+int fusedIndex(uint8_t first, uint8_t second) {
+  for (size_t i = 0; i < std::size(kFusedPairs); ++i)
+    if (static_cast<uint8_t>(kFusedPairs[i].first) == first &&
+        static_cast<uint8_t>(kFusedPairs[i].second) == second)
+      return static_cast<int>(i);
+  return -1;
+}
+}  // namespace
+
+void Vm::State::setFast(int k, uint32_t address) {
+  uint8_t o = dispatch[address];
+  const bool isLong = o != kTrap && costs.op[o] > kMaxStepTstates;
+  if (isLong && !longLabels[k]) o = kTrap;
+  const bool trap = o == kTrap;
+  const auto size = trap ? uint8_t{0} : static_cast<uint8_t>(instructionSize(static_cast<Op>(o)));
+  const void* label = isLong && !trap ? longLabels[k] : fastLabels[k][o];
+  if (k == 0 && fusedLabels && !trap && !isLong && address + size < dispatch.size()) {
+    const uint8_t next = dispatch[address + size];
+    const int f = fusedIndex(o, next);
+    if (f >= 0 && costs.op[next] <= kMaxStepTstates) label = fusedLabels[f];
+  }
+  const uint32_t cost = trap ? 0u : isLong ? kMaxStepTstates : costs.op[o];
+  fast[k][address] = Fast{label, cost, o, size};
+}
 
 template <bool kProfile>
 Stop Vm::State::run(Tick until) {
   if (fault) return Stop::Fault;
-  const uint8_t* const code = image.code.data();
+  const uint8_t* const code = padded.data();
+  const uint8_t* const xop = dispatch.data();
   const uint32_t codeSize = static_cast<uint32_t>(image.code.size());
   const uint32_t* const opCost = costs.op.data();
   const int16_t* const loopTop =
       costs.knobs.fastForward && !loopAtTop.empty() ? loopAtTop.data() : nullptr;
+  uint32_t* const e = eval.data();
   busTouched = false;
 
 #if SIMBOT_COMPUTED_GOTO
-  static void* const kLabels[] = {
+  static const void* const kLabels[] = {
 #define OP(name, shape, pop, push, seq) &&L_##name,
 #include "vm/opcodes.def"
 #undef OP
+      &&L_Trap_,  // kTrap
   };
 #define CASE(name) L_##name:
+#define DISPATCH() goto* kLabels[op]
+#define FAST_DISPATCH(d) goto* d.label
 #else
 #define CASE(name) case Op::name:
+#define DISPATCH() goto dispatchOp
+#define FAST_DISPATCH(d) goto dispatchOp
+  static const void* const kLabels[kOpCount + 1] = {};  // Fast::label unused
 #endif
-#define NEXT goto boundary
+  constexpr int kRun = kProfile ? 1 : 0;
+  if (fast[kRun].empty()) {
+    fastLabels[kRun] = kLabels;
+#if SIMBOT_COMPUTED_GOTO
+    static const void* const kFused[] = {
+#define SIMBOT_PAIR(a, b) &&F_##a##_##b,
+        SIMBOT_FUSED_PAIRS(SIMBOT_PAIR)
+#undef SIMBOT_PAIR
+    };
+    if (!kProfile) fusedLabels = kFused;
+    longLabels[kRun] = &&L_Long_;
+#endif
+    fast[kRun].resize(dispatch.size());
+    for (uint32_t a = 0; a < dispatch.size(); ++a) setFast(kRun, a);
+  }
+  const Fast* const fd = fast[kRun].data();
+  Tick clk = now;
+  uint32_t ip = pc;
+  int esp = sp;
+  uint64_t count = stats.instructions;
+  Tick limit = 0;
+  Tick longLimit = -1;  // L_Long_: the limit its instruction's tail runs to
+#define SAVE() (now = clk, pc = ip, sp = esp, stats.instructions = count)
+#define LOAD() (clk = now, ip = pc, esp = sp, count = stats.instructions)
+#define NEXT                               \
+  if (__builtin_expect(clk >= limit, 0)) { \
+    goto slowNext;                         \
+  }                                        \
+  DISPATCH_NEXT
+#define DISPATCH_NEXT                           \
+  {                                             \
+    const Fast& d = fd[ip];                     \
+    opPc = ip;                                  \
+    op = d.op;                                  \
+    clk += d.cost;                              \
+    if constexpr (kProfile) {                   \
+      if (op != kTrap) profile[opPc] += d.cost; \
+    }                                           \
+    ++count;                                    \
+    operand = code + ip + 1;                    \
+    ip += d.size;                               \
+    FAST_DISPATCH(d);                           \
+  }
+  // The slow boundary after a handler that has saved its state (SAVE()).
+#define SLOW goto boundary
+#define FAULT(message)         \
+  {                            \
+    SAVE();                    \
+    raiseFault(message, opPc); \
+    SLOW;                      \
+  }
 
-  uint32_t opPc;
-  uint8_t op;
-  for (;;) {
-  boundary:
-    if (fault) return Stop::Fault;
-    if (sp > kEvalSlots - kEvalGuard) {
-      raiseFault("expression stack overflow (too many arguments or values pending)", pc);
-      continue;
-    }
-    if (busTouched) {
-      busTouched = false;
-      return Stop::Io;
-    }
-    if (now >= nextTimer) timerTick();
-    if (now >= until) return halted ? Stop::Halted : Stop::Horizon;
-    if (lib.awaitingBegin) {  // the end of a library call's sequence: no boundary
-      // (for an atomic call this also keeps interrupts out until its effect)
-      libBegin();
-      continue;
-    }
-    if (anyPending && iff1 && !eiShadow) {
-      accept();
-      continue;
-    }
-    if (burn) {
-      const uint32_t step = std::min(kMaxStepTstates, burn);
-      now += step;
-      burn -= step;
-      eiShadow = false;
-      continue;
-    }
-    if (lib.active) {
-      eiShadow = false;
-      libStep();
-      continue;
-    }
-    if (halted) {
-      // HALT: idle until the horizon, the next interrupt request from the
-      // host, or PRT0's next tick.
-      if (nextTimer < until) {
-        now = nextTimer;
-        continue;
-      }
-      now = until;
-      return Stop::Halted;
-    }
-    if (pc >= codeSize) {
-      raiseFault(fmt::format("jump outside the program (0x{:04x})", pc), pc);
-      continue;
-    }
-    if (anyBreakpoint && breakpoints[pc] && !resumeAtBreakpoint) {
-      resumeAtBreakpoint = true;
-      return Stop::Breakpoint;
-    }
-    if (loopTop && loopTop[pc] >= 0 && fastForward(until)) continue;
-    resumeAtBreakpoint = false;
-    opPc = pc;
-    op = code[pc];
-    if (op >= kOpCount) {
-      raiseFault(fmt::format("invalid opcode {}", op), pc);
-      continue;
-    }
-    if (opCost[op] <= kMaxStepTstates) {
-      now += opCost[op];
-    } else {
-      now += kMaxStepTstates;
-      burn = opCost[op] - kMaxStepTstates;
-      burnPc = opPc;
-    }
-    if constexpr (kProfile) profile[opPc] += opCost[op];
-    ++stats.instructions;
+  // checkAccess() inline: only a faulting access leaves the fast path.
+#define CHECK_ACCESS(address, bytes)                                                        \
+  if (__builtin_expect((address) < kNullPageEnd || (address) + (bytes) > kMemorySize, 0)) { \
+    SAVE();                                                                                 \
+    checkAccess(address, bytes, opPc);                                                      \
+    SLOW;                                                                                   \
+  }
+
+  uint32_t opPc = 0;
+  uint8_t op = 0;
+  const uint8_t* operand = code;
+boundary:
+  if (fault) return Stop::Fault;
+  if (sp > kEvalSlots - kEvalGuard) {
+    raiseFault("expression stack overflow (too many arguments or values pending)", pc);
+    goto boundary;
+  }
+  if (busTouched) {
+    busTouched = false;
+    return Stop::Io;
+  }
+  if (now >= nextTimer) timerTick();
+  if (now >= until) return halted ? Stop::Halted : Stop::Horizon;
+  if (lib.awaitingBegin) {  // the end of a library call's sequence: no boundary
+    // (for an atomic call this also keeps interrupts out until its effect)
+    libBegin();
+    goto boundary;
+  }
+  if (anyPending && iff1 && !eiShadow) {
+    accept();
+    goto boundary;
+  }
+  if (burn) {
+    const uint32_t step = std::min(kMaxStepTstates, burn);
+    now += step;
+    burn -= step;
     eiShadow = false;
-    {
-      const uint8_t* operand = code + pc + 1;
-      auto u16 = [operand]() -> uint32_t { return operand[0] | (operand[1] << 8); };
-      // A CO-shape instruction's target: its REL16 after the CoData address,
-      // from the end of the instruction (pc is already past it).
-      auto coTarget = [this, operand]() -> uint32_t {
-        return static_cast<uint32_t>(static_cast<int32_t>(pc) +
-                                     static_cast<int16_t>(operand[2] | (operand[3] << 8)));
-      };
-      auto i32 = [operand]() -> uint32_t {
-        return operand[0] | (operand[1] << 8) | (operand[2] << 16) |
-               (static_cast<uint32_t>(operand[3]) << 24);
-      };
-      pc += static_cast<uint32_t>(instructionSize(static_cast<Op>(op)));
-      uint32_t* const e = eval.data();
-#define TOP e[sp - 1]
-#define POPV e[--sp]
-#define PUSHV(v) e[sp++] = (v)
+    goto boundary;
+  }
+  if (lib.active) {
+    eiShadow = false;
+    libStep();
+    goto boundary;
+  }
+  if (halted) {
+    // HALT: idle until the horizon, the next interrupt request from the
+    // host, or PRT0's next tick.
+    if (nextTimer < until) {
+      now = nextTimer;
+      goto boundary;
+    }
+    now = until;
+    return Stop::Halted;
+  }
+  if (pc >= codeSize) {
+    raiseFault(fmt::format("jump outside the program (0x{:04x})", pc), pc);
+    goto boundary;
+  }
+  if (anyBreakpoint && breakpoints[pc] && !resumeAtBreakpoint) {
+    resumeAtBreakpoint = true;
+    return Stop::Breakpoint;
+  }
+  if (loopTop && loopTop[pc] >= 0 && fastForward(until)) goto boundary;
+  resumeAtBreakpoint = false;
+  opPc = pc;
+  op = code[pc];
+  if (op >= kOpCount) {
+    raiseFault(fmt::format("invalid opcode {}", op), pc);
+    goto boundary;
+  }
+  if (opCost[op] <= kMaxStepTstates) {
+    now += opCost[op];
+  } else {
+    now += kMaxStepTstates;
+    burn = opCost[op] - kMaxStepTstates;
+    burnPc = opPc;
+  }
+  if constexpr (kProfile) profile[opPc] += opCost[op];
+  ++stats.instructions;
+  eiShadow = false;
+  // The boundary after this instruction is slow too when anything rare is
+  // due there (see "Fast path").
+  limit = xop[opPc] == kTrap || burn || (anyPending && iff1) ? 0 : std::min(until, nextTimer);
+  LOAD();
+  operand = code + pc + 1;
+  ip += static_cast<uint32_t>(instructionSize(static_cast<Op>(op)));
+  DISPATCH();
+  // Operands, read from the padded code.
+#define U16() static_cast<uint32_t>(operand[0] | (operand[1] << 8))
+#define I32()                                              \
+  (static_cast<uint32_t>(operand[0] | (operand[1] << 8)) | \
+   (static_cast<uint32_t>(operand[2]) << 16) | (static_cast<uint32_t>(operand[3]) << 24))
+  // A CO-shape instruction's target: its REL16 after the CoData address,
+  // from the end of the instruction (pc is already past it; its handlers
+  // have saved their state).
+#define CO_TARGET()                                \
+  static_cast<uint32_t>(static_cast<int32_t>(pc) + \
+                        static_cast<int16_t>(operand[2] | (operand[3] << 8)))
+#define TOP e[esp - 1]
+#define POPV e[--esp]
+  // A push past the eval stack's guard makes the next boundary slow, where
+  // the guard faults as it always did (no instruction pushes more than two
+  // slots, so the array's last kEvalGuard slots are never passed).
+#define PUSHV(v)                                                       \
+  {                                                                    \
+    e[esp++] = (v);                                                    \
+    if (__builtin_expect(esp > kEvalSlots - kEvalGuard, 0)) limit = 0; \
+  }
 #define BINARY(expr)         \
   {                          \
     const uint32_t b = POPV; \
@@ -251,16 +438,16 @@ Stop Vm::State::run(Tick until) {
     TOP = (expr);            \
   }                          \
   NEXT
-      // The instruction's branches went the way `path` says (bit k: k-th
-      // branch taken): charge the difference from the not-taken figure.
+  // The instruction's branches went the way `path` says (bit k: k-th
+  // branch taken): charge the difference from the not-taken figure.
 #define BRANCH_COST(path)                                                       \
   {                                                                             \
     const int32_t d = costs.branchDelta[op][(path)];                            \
-    now += d;                                                                   \
+    clk += d;                                                                   \
     if constexpr (kProfile) profile[opPc] += static_cast<uint64_t>(int64_t{d}); \
   }
-      // A comparison that materialises 0/1: its one branch is taken when the
-      // result is 0 (it jumps over INC HL).
+  // A comparison that materialises 0/1: its one branch is taken when the
+  // result is 0 (it jumps over INC HL).
 #define COMPARE(expr)                \
   {                                  \
     const uint32_t b = POPV;         \
@@ -269,10 +456,10 @@ Stop Vm::State::run(Tick until) {
     BRANCH_COST(TOP == 0 ? 1u : 0u); \
   }                                  \
   NEXT
-      // Signed: first branch (JP PO) taken when the subtraction HL - DE did
-      // not overflow (it jumps over the sign correction), second taken when
-      // the result is 0.
-#define SIGNED_COMPARE(expr, hl, de)                                  \
+  // Signed: first branch (JP PO) taken when the subtraction HL - DE did
+  // not overflow (it jumps over the sign correction), second taken when
+  // the result is 0.
+#define SIGNED_COMPARE_BODY(expr, hl, de)                             \
   {                                                                   \
     const uint32_t b = POPV;                                          \
     const uint32_t a = TOP;                                           \
@@ -280,12 +467,14 @@ Stop Vm::State::run(Tick until) {
     const bool overflow = diff < -32768 || diff > 32767;              \
     TOP = (expr) ? 1u : 0u;                                           \
     BRANCH_COST((overflow ? 0u : 1u) | (TOP == 0 ? 2u : 0u));         \
-  }                                                                   \
+  }
+#define SIGNED_COMPARE(expr, hl, de) \
+  SIGNED_COMPARE_BODY(expr, hl, de)  \
   NEXT
-      // A shift by n: op[] is one pass; n = 0 takes the JR Z (path 1), n > 1
-      // adds n - 1 further passes, run like a long instruction's tail (in
-      // steps of at most kMaxStepTstates, interruptible between them, as
-      // the Z180 is between the loop's instructions).
+  // A shift by n: op[] is one pass; n = 0 takes the JR Z (path 1), n > 1
+  // adds n - 1 further passes, run like a long instruction's tail (in
+  // steps of at most kMaxStepTstates, interruptible between them, as
+  // the Z180 is between the loop's instructions): the slow boundary.
 #define SHIFT(expr)                                       \
   {                                                       \
     const uint32_t n = POPV & 0xFF;                       \
@@ -298,21 +487,131 @@ Stop Vm::State::run(Tick until) {
       if constexpr (kProfile) profile[opPc] += more;      \
       burn += more;                                       \
       burnPc = opPc;                                      \
+      limit = 0;                                          \
     }                                                     \
   }                                                       \
   NEXT
 #if SIMBOT_COMPUTED_GOTO
-      goto* kLabels[op];
-#else
-      switch (static_cast<Op>(op)) {
+  // Superinstructions (SIMBOT_FUSED_PAIRS): the first half's body, the
+  // boundary between the halves, then the second half as NEXT would
+  // dispatch it, its opcode known.
+#define FIRST_PUSHW PUSHV(U16())
+#define FIRST_LDGW PUSHV(rd16(U16()))
+#define FIRST_STGW wr16(U16(), POPV)
+#define FIRST_POP --esp
+#define FIRST_DBG
+#define FIRST_INCGW wr16(U16(), rd16(U16()) + 1u)
+#define FIRST_ADDW            \
+  {                           \
+    const uint32_t b = POPV;  \
+    TOP = (TOP + b) & 0xFFFF; \
+  }
+#define FIRST_LTW SIGNED_COMPARE_BODY(asInt16(a) < asInt16(b), a, b)
+#define FIRST_SUBW            \
+  {                           \
+    const uint32_t b = POPV;  \
+    TOP = (TOP - b) & 0xFFFF; \
+  }
+#define FIRST_LDLW                  \
+  {                                 \
+    const uint32_t a = mfp + U16(); \
+    CHECK_ACCESS(a, 2);             \
+    PUSHV(rd16(a));                 \
+  }
+#define FIRST_STLW                  \
+  {                                 \
+    const uint32_t a = mfp + U16(); \
+    const uint32_t v = POPV;        \
+    CHECK_ACCESS(a, 2);             \
+    wr16(a, v);                     \
+  }
+#define FIRST_ENTER                                                                  \
+  {                                                                                  \
+    const uint32_t size = U16();                                                     \
+    if (msp < stackLimit + size) FAULT("stack overflow");                            \
+    msp -= size;                                                                     \
+    mfp = msp;                                                                       \
+    if (static_cast<int>(calls.size()) > (ints.empty() ? 0 : ints.back().callDepth)) \
+      calls.back().autoFrame = true;                                                 \
+  }
+#define NEXT_TO(second)                                     \
+  if (__builtin_expect(clk >= limit, 0)) {                  \
+    SAVE();                                                 \
+    goto boundary;                                          \
+  }                                                         \
+  opPc = ip;                                                \
+  op = static_cast<uint8_t>(Op::second);                    \
+  clk += opCost[op];                                        \
+  if constexpr (kProfile) profile[opPc] += opCost[op];      \
+  ++count;                                                  \
+  operand = code + ip + 1;                                  \
+  ip += static_cast<uint32_t>(instructionSize(Op::second)); \
+  goto L_##second;
+#define SIMBOT_PAIR(a, b) \
+  F_##a##_##b : {         \
+    FIRST_##a;            \
+    NEXT_TO(b)            \
+  }
+  SIMBOT_FUSED_PAIRS(SIMBOT_PAIR)
+#undef SIMBOT_PAIR
+#undef NEXT_TO
+#undef FIRST_PUSHW
+#undef FIRST_LDGW
+#undef FIRST_STGW
+#undef FIRST_POP
+#undef FIRST_DBG
+#undef FIRST_INCGW
+#undef FIRST_ADDW
+#undef FIRST_LTW
+#undef FIRST_SUBW
+#undef FIRST_LDLW
+#undef FIRST_STLW
+#undef FIRST_ENTER
 #endif
-      CASE(PUSHW) PUSHV(u16());
+slowNext:
+  if (longLimit >= 0) {  // the tail of a long instruction (L_Long_)
+    limit = longLimit;
+    longLimit = -1;
+    while (burn && clk < limit) {
+      const uint32_t step = std::min(kMaxStepTstates, burn);
+      clk += step;
+      burn -= step;
+    }
+    if (!burn && clk < limit) DISPATCH_NEXT;
+  }
+  SAVE();
+  SLOW;
+#if SIMBOT_COMPUTED_GOTO
+L_Long_ : {
+  const uint32_t rest = opCost[op] - kMaxStepTstates;
+  if constexpr (kProfile) profile[opPc] += rest;
+  burn = rest;
+  burnPc = opPc;
+  longLimit = limit;
+  limit = 0;
+  DISPATCH();
+}
+#endif
+#if !SIMBOT_COMPUTED_GOTO
+dispatchOp:
+  switch (static_cast<Op>(op)) {
+    case Op::Count_:
+#else
+L_Trap_ :
+#endif
+    {  // the slow boundary looks first (see "Fast path")
+      --count;
+      ip = opPc;
+      SAVE();
+      SLOW;
+    }
+      CASE(PUSHW) PUSHV(U16());
       NEXT;
-      CASE(PUSHL) PUSHV(i32());
+      CASE(PUSHL) PUSHV(I32());
       NEXT;
-      CASE(PUSHF) PUSHV(i32());
+      CASE(PUSHF) PUSHV(I32());
       NEXT;
-      CASE(POP)-- sp;
+      CASE(POP)-- esp;
       NEXT;
       CASE(DUP) {
         const uint32_t v = TOP;
@@ -326,62 +625,62 @@ Stop Vm::State::run(Tick until) {
         PUSHV(b);
       }
       NEXT;
-      CASE(LDGB) PUSHV(rd8(u16()));
+      CASE(LDGB) PUSHV(rd8(U16()));
       NEXT;
-      CASE(LDGW) PUSHV(rd16(u16()));
+      CASE(LDGW) PUSHV(rd16(U16()));
       NEXT;
-      CASE(LDGL) PUSHV(rd32(u16()));
+      CASE(LDGL) PUSHV(rd32(U16()));
       NEXT;
-      CASE(STGB) wr8(u16(), POPV);
+      CASE(STGB) wr8(U16(), POPV);
       NEXT;
-      CASE(STGW) wr16(u16(), POPV);
+      CASE(STGW) wr16(U16(), POPV);
       NEXT;
-      CASE(STGL) wr32(u16(), POPV);
+      CASE(STGL) wr32(U16(), POPV);
       NEXT;
       CASE(INCGW) {
-        const uint32_t a = u16();
+        const uint32_t a = U16();
         wr16(a, rd16(a) + 1u);
       }
       NEXT;
       CASE(DECGW) {
-        const uint32_t a = u16();
+        const uint32_t a = U16();
         wr16(a, rd16(a) - 1u);
       }
       NEXT;
       CASE(INCGL) {
-        const uint32_t a = u16();
+        const uint32_t a = U16();
         wr32(a, rd32(a) + 1u);
       }
       NEXT;
       // One shape per addressing mode; the width picks rd/wr and the mask.
-#define LOAD_LOCAL(bytes, read)             \
-  {                                         \
-    const uint32_t a = mfp + u16();         \
-    if (!checkAccess(a, bytes, opPc)) NEXT; \
-    PUSHV(read(a));                         \
-  }                                         \
+#define LOAD_LOCAL(bytes, read)     \
+  {                                 \
+    const uint32_t a = mfp + U16(); \
+    CHECK_ACCESS(a, bytes);         \
+    PUSHV(read(a));                 \
+  }                                 \
   NEXT
-#define STORE_LOCAL(bytes, write)           \
-  {                                         \
-    const uint32_t a = mfp + u16();         \
-    const uint32_t v = POPV;                \
-    if (!checkAccess(a, bytes, opPc)) NEXT; \
-    write(a, v);                            \
-  }                                         \
+#define STORE_LOCAL(bytes, write)   \
+  {                                 \
+    const uint32_t a = mfp + U16(); \
+    const uint32_t v = POPV;        \
+    CHECK_ACCESS(a, bytes);         \
+    write(a, v);                    \
+  }                                 \
   NEXT
-#define LOAD_INDIRECT(bytes, read)          \
-  {                                         \
-    const uint32_t a = TOP & 0xFFFF;        \
-    if (!checkAccess(a, bytes, opPc)) NEXT; \
-    TOP = read(a);                          \
-  }                                         \
+#define LOAD_INDIRECT(bytes, read)   \
+  {                                  \
+    const uint32_t a = TOP & 0xFFFF; \
+    CHECK_ACCESS(a, bytes);          \
+    TOP = read(a);                   \
+  }                                  \
   NEXT
       // addr value -- ; or, keeping the value: addr value -- value
 #define STORE_INDIRECT(bytes, write, mask, keep)     \
   {                                                  \
     const uint32_t v = POPV;                         \
     const uint32_t a = (keep ? TOP : POPV) & 0xFFFF; \
-    if (!checkAccess(a, bytes, opPc)) NEXT;          \
+    CHECK_ACCESS(a, bytes);                          \
     write(a, v);                                     \
     if (keep) TOP = v & (mask);                      \
   }                                                  \
@@ -392,7 +691,7 @@ Stop Vm::State::run(Tick until) {
       CASE(STLB) STORE_LOCAL(1, wr8);
       CASE(STLW) STORE_LOCAL(2, wr16);
       CASE(STLL) STORE_LOCAL(4, wr32);
-      CASE(LEAL) PUSHV((mfp + u16()) & 0xFFFF);
+      CASE(LEAL) PUSHV((mfp + U16()) & 0xFFFF);
       NEXT;
       CASE(LDIB) LOAD_INDIRECT(1, rd8);
       CASE(LDIW) LOAD_INDIRECT(2, rd16);
@@ -408,9 +707,10 @@ Stop Vm::State::run(Tick until) {
 #undef LOAD_INDIRECT
 #undef STORE_INDIRECT
       CASE(COPY) {
-        const uint32_t n = u16();
+        const uint32_t n = U16();
         const uint32_t src = POPV & 0xFFFF, dst = POPV & 0xFFFF;
-        if (!checkAccess(src, n, opPc) || !checkAccess(dst, n, opPc)) NEXT;
+        CHECK_ACCESS(src, n);
+        CHECK_ACCESS(dst, n);
         std::memmove(&mem[dst], &mem[src], n);
       }
       NEXT;
@@ -421,8 +721,7 @@ Stop Vm::State::run(Tick until) {
       CASE(DIVW) {
         const int32_t b = asInt16(POPV), a = asInt16(TOP);
         if (b == 0) {
-          raiseFault("division by zero", opPc);
-          NEXT;
+          FAULT("division by zero");
         }
         TOP = w(a / b);
       }
@@ -430,8 +729,7 @@ Stop Vm::State::run(Tick until) {
       CASE(DIVUW) {
         const uint32_t b = POPV & 0xFFFF, a = TOP & 0xFFFF;
         if (b == 0) {
-          raiseFault("division by zero", opPc);
-          NEXT;
+          FAULT("division by zero");
         }
         TOP = a / b;
       }
@@ -439,8 +737,7 @@ Stop Vm::State::run(Tick until) {
       CASE(MODW) {
         const int32_t b = asInt16(POPV), a = asInt16(TOP);
         if (b == 0) {
-          raiseFault("division by zero", opPc);
-          NEXT;
+          FAULT("division by zero");
         }
         TOP = w(a % b);
       }
@@ -448,8 +745,7 @@ Stop Vm::State::run(Tick until) {
       CASE(MODUW) {
         const uint32_t b = POPV & 0xFFFF, a = TOP & 0xFFFF;
         if (b == 0) {
-          raiseFault("division by zero", opPc);
-          NEXT;
+          FAULT("division by zero");
         }
         TOP = a % b;
       }
@@ -492,8 +788,7 @@ Stop Vm::State::run(Tick until) {
       CASE(DIVL) {
         const int64_t b = static_cast<int32_t>(POPV), a = static_cast<int32_t>(TOP);
         if (b == 0) {
-          raiseFault("division by zero", opPc);
-          NEXT;
+          FAULT("division by zero");
         }
         TOP = static_cast<uint32_t>(a / b);  // INT32_MIN / -1 wraps
       }
@@ -501,8 +796,7 @@ Stop Vm::State::run(Tick until) {
       CASE(DIVUL) {
         const uint32_t b = POPV, a = TOP;
         if (b == 0) {
-          raiseFault("division by zero", opPc);
-          NEXT;
+          FAULT("division by zero");
         }
         TOP = a / b;
       }
@@ -510,8 +804,7 @@ Stop Vm::State::run(Tick until) {
       CASE(MODL) {
         const int64_t b = static_cast<int32_t>(POPV), a = static_cast<int32_t>(TOP);
         if (b == 0) {
-          raiseFault("division by zero", opPc);
-          NEXT;
+          FAULT("division by zero");
         }
         TOP = static_cast<uint32_t>(a % b);
       }
@@ -519,8 +812,7 @@ Stop Vm::State::run(Tick until) {
       CASE(MODUL) {
         const uint32_t b = POPV, a = TOP;
         if (b == 0) {
-          raiseFault("division by zero", opPc);
-          NEXT;
+          FAULT("division by zero");
         }
         TOP = a % b;
       }
@@ -558,8 +850,7 @@ Stop Vm::State::run(Tick until) {
       CASE(DIVF) {
         const float b = asFloat(POPV), a = asFloat(TOP);
         if (b == 0.0f) {
-          raiseFault("division by zero", opPc);
-          NEXT;
+          FAULT("division by zero");
         }
         TOP = fromFloat(a / b);
       }
@@ -599,43 +890,40 @@ Stop Vm::State::run(Tick until) {
       TOP = static_cast<uint32_t>(truncToRange(asFloat(TOP), -2147483648.0, 4294967295.0));
       NEXT;
 
-      CASE(JMP) pc = static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
+      CASE(JMP) ip = static_cast<uint32_t>(static_cast<int32_t>(ip) + static_cast<int16_t>(U16()));
       NEXT;
       CASE(JZ) {
         const uint32_t target =
-            static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
+            static_cast<uint32_t>(static_cast<int32_t>(ip) + static_cast<int16_t>(U16()));
         const bool taken = (POPV & 0xFFFF) == 0;
         BRANCH_COST(taken ? 1u : 0u);
-        if (taken) pc = target;
+        if (taken) ip = target;
       }
       NEXT;
       CASE(JNZ) {
         const uint32_t target =
-            static_cast<uint32_t>(static_cast<int32_t>(pc) + static_cast<int16_t>(u16()));
+            static_cast<uint32_t>(static_cast<int32_t>(ip) + static_cast<int16_t>(U16()));
         const bool taken = (POPV & 0xFFFF) != 0;
         BRANCH_COST(taken ? 1u : 0u);
-        if (taken) pc = target;
+        if (taken) ip = target;
       }
       NEXT;
       CASE(CALL) {
         if (msp < stackLimit + kCallFrameBytes) {
-          raiseFault("stack overflow", opPc);
-          NEXT;
+          FAULT("stack overflow");
         }
-        if (sp > kEvalSlots - kEvalHeadroom) {
-          raiseFault("stack overflow (expression stack)", opPc);
-          NEXT;
+        if (esp > kEvalSlots - kEvalHeadroom) {
+          FAULT("stack overflow (expression stack)");
         }
-        calls.push_back(CallFrame{pc, msp, mfp, false});
+        calls.push_back(CallFrame{ip, msp, mfp, false});
         msp -= kCallFrameBytes;
-        pc = u16();
+        ip = U16();
       }
       NEXT;
       CASE(ENTER) {
-        const uint32_t size = u16();
+        const uint32_t size = U16();
         if (msp < stackLimit + size) {
-          raiseFault("stack overflow", opPc);
-          NEXT;
+          FAULT("stack overflow");
         }
         msp -= size;
         mfp = msp;
@@ -649,29 +937,29 @@ Stop Vm::State::run(Tick until) {
       CASE(RET) {
         if (calls.empty() ||
             (!ints.empty() && static_cast<int>(calls.size()) <= ints.back().callDepth)) {
-          raiseFault("return with no caller", opPc);
-          NEXT;
+          FAULT("return with no caller");
         }
         const CallFrame f = calls.back();
         calls.pop_back();
         if (f.autoFrame) {  // POP IX: only #class auto frames set IX up
-          now += costs.autoFrameRet;
+          clk += costs.autoFrameRet;
           if constexpr (kProfile) profile[opPc] += costs.autoFrameRet;
         }
-        pc = f.retPc;
+        ip = f.retPc;
         msp = f.msp;
         mfp = f.mfp;
       }
       NEXT;
       CASE(RETI) {
+        SAVE();
         if (ints.empty() || static_cast<int>(calls.size()) != ints.back().callDepth) {
           raiseFault("RETI outside an interrupt handler", opPc);
-          NEXT;
+          SLOW;
         }
         InterruptFrame& f = ints.back();
         if (f.evalSp != sp) {
           raiseFault("internal error: stack imbalance at RETI", opPc);
-          NEXT;
+          SLOW;
         }
         pc = f.retPc;
         msp = f.msp;
@@ -687,46 +975,51 @@ Stop Vm::State::run(Tick until) {
         if (costs.knobs.epilogueEi) iff1 = iff2 = true;
         busTouched = true;
       }
-      NEXT;
+      SLOW;
       CASE(HALT) {
+        SAVE();
         pc = opPc;  // stays on HALT; an interrupt returns here
         if (!halted) flushConsole();
         halted = true;
       }
-      NEXT;
+      SLOW;
       CASE(LIB) {
+        SAVE();
         const int id = operand[0];
         const int argc = operand[1];
         if (id >= kLibCount || argc > kMaxLibArgs || argc > sp) {
           raiseFault("invalid library call", opPc);
-          NEXT;
+          SLOW;
         }
         libCall(static_cast<Lib>(id), argc, opPc);
       }
-      NEXT;
+      SLOW;
       CASE(EI) {
+        SAVE();
         if (!iff1) bus.iffChanged(now, true);
         iff1 = iff2 = true;
         eiShadow = true;
       }
-      NEXT;
+      SLOW;
       CASE(DI) {
+        SAVE();
         if (iff1) bus.iffChanged(now, false);
         iff1 = iff2 = false;
       }
-      NEXT;
+      SLOW;
       CASE(DBG) NEXT;
       CASE(COSTATE) {
-        const uint32_t cd = u16();
-        const uint32_t end = coTarget();
-        if (!checkAccess(cd, kCoDataSize, opPc)) NEXT;
+        SAVE();
+        const uint32_t cd = U16();
+        const uint32_t end = CO_TARGET();
+        if (!checkAccess(cd, kCoDataSize, opPc)) SLOW;
         const uint8_t state = rd8(cd + kCoState);
         if (state & kCoStopped) {
           now += costs.costateStoppedDelta;
           if constexpr (kProfile)
             profile[opPc] += static_cast<uint64_t>(int64_t{costs.costateStoppedDelta});
           pc = end;
-          NEXT;
+          SLOW;
         }
         wr8(cd + kCoState, state & ~kCoInit);
         const uint32_t resume = rd16(cd + kCoLastLoc);
@@ -735,39 +1028,40 @@ Stop Vm::State::run(Tick until) {
         } else {
           if (coChecksum(resume, rd8(cd + kCoLastLocCbr)) != rd8(cd + kCoChkSum)) {
             raiseFault("costatement's resume address is corrupted (CoData checksum)", opPc);
-            NEXT;
+            SLOW;
           }
           if (!std::binary_search(image.resumePoints.begin(), image.resumePoints.end(),
                                   static_cast<uint16_t>(resume))) {
             raiseFault(fmt::format("costatement resumes at 0x{:04x}, not a yield point", resume),
                        opPc);
-            NEXT;
+            SLOW;
           }
           pc = resume;
         }
         costateEvent(cd, Bus::CostateEvent::Enter, pc);
       }
-      NEXT;
+      SLOW;
       CASE(COYIELD) {
-        const uint32_t cd = u16();
-        if (!checkAccess(cd, kCoDataSize, opPc)) NEXT;
-        setResume(cd, coTarget());
+        SAVE();
+        const uint32_t cd = U16();
+        if (!checkAccess(cd, kCoDataSize, opPc)) SLOW;
+        setResume(cd, CO_TARGET());
         costateEvent(cd, Bus::CostateEvent::Yield, opPc);
       }
-      NEXT;
+      SLOW;
       CASE(COEND)
       CASE(CODONE) {
-        const uint32_t cd = u16();
-        if (!checkAccess(cd, kCoDataSize, opPc)) NEXT;
+        SAVE();
+        const uint32_t cd = U16();
+        if (!checkAccess(cd, kCoDataSize, opPc)) SLOW;
         costateEnd(cd, op == static_cast<uint8_t>(Op::CODONE));
         costateEvent(cd, Bus::CostateEvent::End, opPc);
       }
-      NEXT;
+      SLOW;
 #if !SIMBOT_COMPUTED_GOTO
-      case Op::Count_:
-        break;
-    }
+  }
 #endif
+  __builtin_unreachable();  // every handler ends in NEXT or SLOW
 #undef TOP
 #undef POPV
 #undef PUSHV
@@ -776,11 +1070,21 @@ Stop Vm::State::run(Tick until) {
 #undef SHIFT
 #undef COMPARE
 #undef SIGNED_COMPARE
-  }
+#undef SIGNED_COMPARE_BODY
+#undef U16
+#undef I32
+#undef CO_TARGET
 }
 #undef CASE
+#undef DISPATCH
+#undef FAST_DISPATCH
 #undef NEXT
-}
+#undef DISPATCH_NEXT
+#undef SLOW
+#undef FAULT
+#undef CHECK_ACCESS
+#undef SAVE
+#undef LOAD
 
 // ---- public interface ---------------------------------------------------
 
@@ -800,6 +1104,7 @@ Vm::Vm(const Image& image, Bus& bus, const CostTable& costs)
     s.nextTimer = kPrtTicks;
   s.costateEvents = bus.wantCostateEvents();
   s.findLoops();
+  s.decode();
 }
 
 Vm::~Vm() = default;
@@ -854,7 +1159,15 @@ const Image& Vm::image() const { return s_->image; }
 void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
   State& s = *s_;
   if (s.breakpoints.empty()) s.breakpoints.assign(s.image.code.size() + 1, 0);
-  if (codeAddress < s.breakpoints.size()) s.breakpoints[codeAddress] = enabled ? 1 : 0;
+  if (codeAddress < s.breakpoints.size()) {
+    s.breakpoints[codeAddress] = enabled ? 1 : 0;
+    s.dispatch[codeAddress] = enabled ? State::kTrap : s.baseDispatch[codeAddress];
+    // The entries that may fuse into this address: those just before it.
+    const uint32_t from = codeAddress >= 4 ? codeAddress - 4 : 0;
+    for (int k = 0; k < 2; ++k)
+      if (!s.fast[k].empty())
+        for (uint32_t a = from; a <= codeAddress; ++a) s.setFast(k, a);
+  }
   s.anyBreakpoint =
       std::any_of(s.breakpoints.begin(), s.breakpoints.end(), [](uint8_t b) { return b != 0; });
 }
