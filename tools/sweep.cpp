@@ -229,7 +229,13 @@ SweepSpec loadSweep(const std::string& path) {
       try {
         sweepProfile(spec, point);
       } catch (const plant::ConfigError& e) {
-        throw ToolError(sweepError(path, g->source(), e.what()));
+        // The profile checker's words, without its FILE:LINE:COL (the
+        // profile as rewritten for this point).
+        std::string what = e.what();
+        const auto at = what.find("error: ");
+        if (at != std::string::npos) what = what.substr(at + 7);
+        throw ToolError(
+            sweepError(path, g->source(), fmt::format("grid point {}: {}", point, what)));
       }
     }
   } else {
