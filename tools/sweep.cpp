@@ -288,13 +288,17 @@ CsvRow runSweepRow(const SweepSpec& spec, const SweepRun& run) {
   const BenchResult result = runBench(c, sweepProfile(spec, run.point));
   // The bench's own row, through its own CSV (one header line, one row).
   const std::string csv = runsCsv(result);
+  // Line ends may be LF or CRLF (RFC 4180's).
+  const auto chomp = [](std::string line) {
+    while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
+    return line;
+  };
   const size_t eol = csv.find('\n');
-  const CsvRow names = parseCsvLine(csv.substr(0, eol));
-  std::string body = csv.substr(eol + 1);
-  if (body.empty() || body.back() != '\n')
+  const CsvRow names = parseCsvLine(chomp(csv.substr(0, eol)));
+  const std::string body = chomp(csv.substr(eol + 1));
+  if (body.empty())
     throw std::logic_error("simbot: sweep: the bench gave no row for run " +
                            std::to_string(run.index));
-  body.pop_back();
   const CsvRow benchRow = parseCsvLine(body);
   CsvRow row = {std::to_string(run.index), run.program, run.family, run.opponent,
                 std::to_string(run.seed)};
