@@ -5,7 +5,8 @@ Usage: readme_test.py README SIMBOT WORKDIR
 
 Each ```sh block of the README runs, in order, with bash -e, in a sandbox
 laid out like the project's checkout (WORKDIR/main holding build/bin/simbot,
-programs/, scenarios/, profiles/, tests/ and bench/ and the bench binaries,
+programs/, scenarios/, profiles/, tests/, bench/, docs/, the bench binaries
+and build/python,
 beside WORKDIR/shared), so that
 the files a command writes land in WORKDIR and a later block can read them.
 The Quickstart block is the exception: `.ci/run` runs `scripts/test.sh` and
@@ -51,7 +52,11 @@ def sandbox(source, simbot, work):
         built = os.path.join(os.path.dirname(os.path.abspath(simbot)), name)
         if os.path.exists(built):
             os.symlink(built, os.path.join(main, "build", "bin", name))
-    for part in ("programs", "scenarios", "profiles", "tests", "bench"):
+    # The Python module beside it (the README's Python section).
+    module = os.path.join(os.path.dirname(os.path.abspath(simbot)), "..", "python")
+    if os.path.isdir(module):
+        os.symlink(os.path.abspath(module), os.path.join(main, "build", "python"))
+    for part in ("programs", "scenarios", "profiles", "tests", "bench", "docs"):
         os.symlink(os.path.join(source, part), os.path.join(main, part))
     os.symlink(os.path.abspath(os.path.join(source, "..", "shared")), os.path.join(work, "shared"))
     return main

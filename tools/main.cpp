@@ -20,8 +20,10 @@
 #include "timebase/tick.h"
 #include "tools/commands.h"
 #include "tools/json_text.h"
+#include "tools/play.h"
 #include "tools/runner.h"
 #include "tools/scenario.h"
+#include "tools/sweep.h"
 #include "tools/trace_jsonl.h"
 #include "tools/vcd.h"
 #include "tools/viewer.h"
@@ -31,6 +33,14 @@ namespace {
 
 using namespace simbot;
 using nlohmann::json;
+using tools::buildConfig;
+using tools::faultJson;
+using tools::faultText;
+using tools::play;
+using tools::Played;
+using tools::reportFaults;
+using tools::reportWarnings;
+using tools::RunOptions;
 
 // simbot compile FILE [--disasm] [-Wno-NAME ...] [-Werror]: the -W words
 // come through CLI11 as extras (it has no multi-letter single-dash options).
@@ -71,206 +81,30 @@ int viewCommand(const std::string& tracePath, const std::string& out) {
   return 0;
 }
 
-struct RunOptions {
-  double seconds = 0;  // not given: the profile's [match] round_length
-  uint64_t seed = 1;
-  std::string profile = "default";
-  std::vector<std::string> hw;
-  std::string trace;
-  std::string vcd;
-  std::string replay;
-  std::vector<std::string> injections;
-  std::vector<std::string> watches;
-  bool traceCostate = false;
-  bool noFastForward = false;
-  std::string scenario;
-  bool json = false;
-  bool reloadOnFault = false;
-  // Options given explicitly win over the scenario's values.
-  CLI::Option *secondsOption = nullptr, *seedOption = nullptr, *profileOption = nullptr;
-};
-
 bool given(const CLI::Option* option) { return option && option->count() > 0; }
-
-json poseJson(const plant::Pose& p) {
-  return {{"x_ft", p.x_ft}, {"y_ft", p.y_ft}, {"heading_deg", p.heading_deg}};
-}
-
-// Console lines are bytes the robot printed: one character per byte.
-json consoleJson(const std::vector<std::string>& lines) {
-  json out = json::array();
-  for (const auto& line : lines) out.push_back(tools::jsonString(line, true));
-  return out;
-}
 
 // Exit statuses (README, "Exit statuses").
 constexpr int kExitBadInput = 1;
 constexpr int kExitInternalError = 2;
 constexpr int kExitRobotFault = 3;
 
-// Findings that did not stop the run (injections that never fired, ...).
-void reportWarnings(const scheduler::MatchResult& r) {
-  for (const auto& w : r.warnings) std::cerr << "simbot: warning: " << w << '\n';
-}
-
-// A robot's fault in one line: robot, time, source line, message.
-std::string faultText(const scheduler::RobotResult& rr, const scheduler::FaultInfo& f) {
-  return fmt::format("{}:{}: fault: robot {} at {:.6f} s: {}", rr.program, f.line, rr.name, f.timeS,
-                     f.message);
-}
-
-// One loud line per fault, on stderr; true if any robot faulted.
-bool reportFaults(const scheduler::MatchResult& r) {
-  bool any = false;
-  if (r.plantFault) {
-    any = true;
-    std::cerr << fmt::format(
-        "simbot: fault: the plant's integrator failed at {:.6f} s: {}; the "
-        "run ended there\n",
-        r.plantFault->timeS, r.plantFault->message);
+// The options --seconds, --seed and --profile of a run command: given
+// explicitly, they win over a scenario's values.
+struct GivenOptions {
+  CLI::Option *seconds = nullptr, *seed = nullptr, *profile = nullptr;
+  void copyTo(tools::RunOptions& o) const {
+    o.secondsGiven = given(seconds);
+    o.seedGiven = given(seed);
+    o.profileGiven = given(profile);
   }
-  for (const auto& rr : r.robots) {
-    for (size_t k = 0; k < rr.faults.size(); ++k) {
-      any = true;
-      std::cerr << faultText(rr, rr.faults[k])
-                << (k < static_cast<size_t>(rr.reloads) ? " (reloaded)" : "") << '\n';
-    }
-  }
-  return any;
-}
-
-json faultJson(const std::optional<scheduler::FaultInfo>& f) {
-  if (!f) return nullptr;
-  return {{"message", f->message}, {"time_s", f->timeS}, {"line", f->line}};
-}
-
-json faultsJson(const std::vector<scheduler::FaultInfo>& faults) {
-  json out = json::array();
-  for (const auto& f : faults) out.push_back(faultJson(f));
-  return out;
-}
-
-// The run's configuration from the command line and the scenario: the
-// programs given (A, and B for match), then the scenario (start poses,
-// hardware, B for solo and profile, injections), then --hw and --inject.
-scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, const RunOptions& o,
-                                   tools::ScenarioUse use) {
-  std::optional<tools::Scenario> scenario;
-  if (!o.scenario.empty()) scenario = tools::loadScenario(o.scenario);
-  const plant::Profile profile = tools::loadNamedProfile(tools::preferCommandLine(
-      given(o.profileOption), scenario ? scenario->profile : std::nullopt, o.profile));
-  // Without --seconds or a scenario's, a run lasts the profile's round.
-  const double seconds = tools::preferCommandLine(
-      given(o.secondsOption), scenario ? scenario->seconds : std::nullopt,
-      given(o.secondsOption) || o.seconds > 0 ? o.seconds : profile.round_length_s);
-  if (!(seconds > 0) || seconds > 1e6)
-    throw tools::ToolError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", seconds));
-  scheduler::MatchConfig config;
-  config.arena = plant::makeArenaConfig(profile, static_cast<int>(programs.size()));
-  config.profileName = profile.name;
-  const char* names[] = {"A", "B"};
-  for (size_t i = 0; i < programs.size(); ++i)
-    config.robots.push_back({names[i], programs[i], tools::compileProgramFile(programs[i])});
-  std::array<bool, 2> hwGiven{};
-  std::vector<std::pair<int, std::string>> hwFiles;
-  for (const auto& spec : o.hw) {
-    int robot = 0;
-    std::string file = spec;
-    if (use == tools::ScenarioUse::Match) {
-      const auto eq = spec.find('=');
-      if (eq == std::string::npos || (spec.substr(0, eq) != "A" && spec.substr(0, eq) != "B"))
-        throw tools::ToolError("simbot: --hw takes A=FILE or B=FILE\n");
-      robot = spec[0] == 'A' ? 0 : 1;
-      file = spec.substr(eq + 1);
-    }
-    hwGiven[static_cast<size_t>(robot)] = true;
-    hwFiles.emplace_back(robot, file);
-  }
-  if (scenario) tools::applyScenario(*scenario, use, profile, config, hwGiven);
-  for (const auto& [robot, file] : hwFiles) {
-    auto& setup = config.arena.robots[static_cast<size_t>(robot)];
-    setup.hardware = plant::loadHardware(file, setup.params);
-  }
-  for (const auto& text : o.injections) {
-    try {
-      config.injections.push_back(
-          scheduler::parseInjection(text, static_cast<int>(config.robots.size())));
-    } catch (const std::invalid_argument& e) {
-      throw tools::ToolError(fmt::format("simbot: --inject {}\n", e.what()));
-    }
-  }
-  config.endTick = timebase::ticksFromSeconds(seconds);
-  config.seed = tools::preferCommandLine(given(o.seedOption),
-                                         scenario ? scenario->seed : std::nullopt, o.seed);
-  config.reloadOnFault = o.reloadOnFault;
-  config.reloadDelay = timebase::ticksFromSeconds(profile.reload_delay_s);
-  return config;
-}
-
-struct Played {
-  scheduler::MatchResult result;
-  double wallSeconds = 0;
-  uint64_t seed = 0;  // the one used (--seed, the scenario's, or 1)
 };
-
-Played play(const std::vector<std::string>& programs, const RunOptions& o, bool solo) {
-  // Watched values are written only into trace records.
-  if (!o.watches.empty() && o.trace.empty() && o.replay.empty())
-    throw tools::ToolError(
-        "simbot: --watch needs --trace FILE (or --replay FILE): watched values are written "
-        "only into the trace's records\n");
-  scheduler::MatchConfig config =
-      buildConfig(programs, o, solo ? tools::ScenarioUse::Solo : tools::ScenarioUse::Match);
-  config.stopWhenAllExited = solo;
-  config.watches = o.watches;
-  if (o.traceCostate && o.trace.empty() && o.replay.empty())
-    throw tools::ToolError("simbot: --trace-costate needs --trace FILE (or --replay FILE)\n");
-  config.traceCostate = o.traceCostate;
-  if (o.noFastForward) config.knobs.fastForward = false;
-  // Sinks open their files before the run: a bad path costs nothing.
-  std::optional<tools::JsonlSink> jsonl;
-  std::optional<tools::VcdSink> vcd;
-  std::optional<tools::ReplaySink> replay;
-  if (!o.trace.empty()) config.sinks.push_back(&jsonl.emplace(o.trace));
-  if (!o.vcd.empty()) config.sinks.push_back(&vcd.emplace(o.vcd));
-  if (!o.replay.empty()) config.sinks.push_back(&replay.emplace(o.replay));
-  Played played;
-  played.seed = config.seed;
-  const auto start = std::chrono::steady_clock::now();
-  try {
-    played.result = scheduler::runMatch(config);
-  } catch (const std::invalid_argument& e) {
-    throw tools::ToolError(fmt::format("simbot: {}\n", e.what()));
-  }
-  played.wallSeconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return played;
-}
 
 int soloCommand(const std::string& program, const RunOptions& o) {
   const Played played = play({program}, o, true);
   const auto& r = played.result;
-  const double wall = played.wallSeconds;
   const auto& a = r.robots[0];
-  json j = {
-      {"exited", a.exited},
-      {"exit_time_s", a.exited ? json(timebase::secondsFromTicks(a.exitTick)) : json(nullptr)},
-      {"cycles", a.cycles},
-      {"vm_instructions", a.vmInstructions},
-      {"sim_seconds", timebase::secondsFromTicks(r.endTick)},
-      {"wall_seconds", wall},
-      {"console", consoleJson(a.console)},
-      {"fault", faultJson(a.fault)},
-      {"faults", faultsJson(a.faults)},
-      {"reloads", a.reloads},
-      {"plant_fault", faultJson(r.plantFault)},
-      {"motor_frames_latched", a.framesLatched},
-      {"motor_frames_rejected", a.framesRejected},
-      {"motor_frames_overwritten", a.framesOverwritten},
-      {"interrupts", a.interrupts},
-      {"final_pose", poseJson(a.finalPose)}};
   if (o.json) {
-    std::cout << tools::dumpJson(j, 2) << '\n';
+    std::cout << tools::dumpJson(tools::soloJson(played), 2) << '\n';
   } else {
     for (const auto& line : a.console) std::cout << line << '\n';
     std::cerr << fmt::format(
@@ -290,37 +124,8 @@ int matchCommand(const std::string& a, const std::string& b, const RunOptions& o
   const Played played = play({a, b}, o, false);
   const auto& r = played.result;
   const double wall = played.wallSeconds;
-  json robots = json::array();
-  for (const auto& rr : r.robots)
-    robots.push_back({{"name", rr.name},
-                      {"program", rr.program},
-                      {"hits", rr.hits},
-                      {"shots", rr.shots},
-                      {"motor_frames_latched", rr.framesLatched},
-                      {"motor_frames_rejected", rr.framesRejected},
-                      {"motor_frames_overwritten", rr.framesOverwritten},
-                      {"interrupts", rr.interrupts},
-                      {"cycles", rr.cycles},
-                      {"vm_instructions", rr.vmInstructions},
-                      {"fault", faultJson(rr.fault)},
-                      {"faults", faultsJson(rr.faults)},
-                      {"reloads", rr.reloads},
-                      {"final_pose", poseJson(rr.finalPose)},
-                      {"console_lines", rr.console.size()}});
-  json j = {{"sim_seconds", timebase::secondsFromTicks(r.endTick)},
-            {"wall_seconds", wall},
-            {"seed", played.seed},
-            {"winner", r.winner},
-            {"tie_broken_by_coin", r.tieBrokenByCoin},
-            {"plant_fault", faultJson(r.plantFault)},
-            {"integrator",
-             {{"steps", r.integrator.steps},
-              {"rhs_evals", r.integrator.rhs_evals},
-              {"reinits", r.integrator.reinits},
-              {"roots", r.integrator.roots}}},
-            {"robots", robots}};
   if (o.json) {
-    std::cout << tools::dumpJson(j, 2) << '\n';
+    std::cout << tools::dumpJson(tools::matchJson(played), 2) << '\n';
   } else {
     for (const auto& rr : r.robots) {
       std::cout << fmt::format(
@@ -442,13 +247,12 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
   return status;
 }
 
-void addRunOptions(CLI::App* cmd, RunOptions& o, bool solo) {
-  o.secondsOption = cmd->add_option("--seconds", o.seconds,
-                                    "simulated seconds (default: the profile's round_length)");
-  o.seedOption =
+void addRunOptions(CLI::App* cmd, RunOptions& o, GivenOptions& g, bool solo) {
+  g.seconds = cmd->add_option("--seconds", o.seconds,
+                              "simulated seconds (default: the profile's round_length)");
+  g.seed =
       cmd->add_option("--seed", o.seed, "master seed (default 1)")->check(tools::seedValidator());
-  o.profileOption =
-      cmd->add_option("--profile", o.profile, "profile name or file (default: default)");
+  g.profile = cmd->add_option("--profile", o.profile, "profile name or file (default: default)");
   cmd->add_option("--scenario", o.scenario,
                   "scenario file (TOML): start poses, profile, hardware, injections, robot B");
   cmd->add_option("--hw", o.hw,
@@ -495,32 +299,34 @@ int main(int argc, char** argv) {
       "for the names).");
 
   RunOptions soloOptions;
+  GivenOptions soloGiven;
   std::string soloProgram;
   auto* solo = app.add_subcommand("solo", "run one robot alone in the arena");
   solo->add_option("FILE", soloProgram, "program (.dc)")->required();
-  addRunOptions(solo, soloOptions, true);
+  addRunOptions(solo, soloOptions, soloGiven, true);
 
   RunOptions matchOptions;
+  GivenOptions matchGiven;
   std::string programA, programB;
   auto* match = app.add_subcommand("match", "play a match between two programs");
   match->add_option("A", programA, "robot A's program")->required();
   match->add_option("B", programB, "robot B's program")->required();
-  addRunOptions(match, matchOptions, false);
+  addRunOptions(match, matchOptions, matchGiven, false);
 
   RunOptions profileOptions;
+  GivenOptions profileGiven;
   profileOptions.seconds = 60;
   std::string profileProgram;
   int profileTop = 20;
   auto* profile =
       app.add_subcommand("profile", "cycles and time per source line and function of a solo run");
   profile->add_option("FILE", profileProgram, "program (.dc)")->required();
-  profileOptions.secondsOption =
+  profileGiven.seconds =
       profile->add_option("--seconds", profileOptions.seconds, "simulated seconds (default 60)");
-  profileOptions.seedOption =
-      profile->add_option("--seed", profileOptions.seed, "master seed (default 1)")
-          ->check(tools::seedValidator());
-  profileOptions.profileOption = profile->add_option("--profile", profileOptions.profile,
-                                                     "physical profile (default: default)");
+  profileGiven.seed = profile->add_option("--seed", profileOptions.seed, "master seed (default 1)")
+                          ->check(tools::seedValidator());
+  profileGiven.profile = profile->add_option("--profile", profileOptions.profile,
+                                             "physical profile (default: default)");
   profile->add_option("--scenario", profileOptions.scenario,
                       "scenario file (TOML): start pose, profile, hardware, injections, robot B");
   profile->add_option("--inject", profileOptions.injections, "as for solo (repeatable)");
@@ -537,6 +343,7 @@ int main(int argc, char** argv) {
   const auto compare = simbot::tools::addCompareCommand(app);
   const auto tournament = simbot::tools::addTournamentCommand(app);
   const auto explain = simbot::tools::addExplainCommand(app);
+  const auto sweep = simbot::tools::addSweepCommand(app);
 
   try {
     app.parse(argc, argv);
@@ -551,6 +358,9 @@ int main(int argc, char** argv) {
     std::cerr << "simbot: " << message << " (simbot --help lists the options)\n";
     return kExitBadInput;
   }
+  soloGiven.copyTo(soloOptions);
+  matchGiven.copyTo(matchOptions);
+  profileGiven.copyTo(profileOptions);
   try {
     if (*compile) return compileCommand(compileFile, disasm, compile->remaining());
     if (*solo) return soloCommand(soloProgram, soloOptions);
@@ -561,6 +371,7 @@ int main(int argc, char** argv) {
     if (*compare.app) return compare.run();
     if (*tournament.app) return tournament.run();
     if (*explain.app) return explain.run();
+    if (*sweep.app) return sweep.run();
   } catch (const tools::ToolError& e) {
     std::cerr << e.what();
     return kExitBadInput;

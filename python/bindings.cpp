@@ -1,0 +1,157 @@
+// _simbot: the C++ side of the Python module `simbot` (python/simbot/).
+// Every entry point is the CLI's own code (tools/play.h for solo and match,
+// tools/bench.h, tools/sweep.h), so a result here is the CLI's result:
+// simbot.match(A, B) is `simbot match A B --json`, parsed. JSON and CSV
+// cross as text and are parsed on the Python side. Runs release the GIL,
+// so Python threads (a Dask worker's) run them in parallel.
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "compiler/compiler.h"
+#include "tools/bench.h"
+#include "tools/json_text.h"
+#include "tools/play.h"
+#include "tools/runner.h"
+#include "tools/sweep.h"
+#include "tools/trace_jsonl.h"
+#include "vm/vm.h"
+
+namespace py = pybind11;
+using namespace simbot;
+
+namespace {
+
+std::string withoutNewline(std::string text) {
+  while (!text.empty() && text.back() == '\n') text.pop_back();
+  return text;
+}
+
+py::dict compileProgram(const std::string& path, bool disasm) {
+  const auto result = compiler::compileFile(path);
+  std::vector<compiler::Diagnostic> all = result.warnings;
+  all.insert(all.end(), result.errors.begin(), result.errors.end());
+  std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
+    return a.line != b.line ? a.line < b.line : a.column < b.column;
+  });
+  std::vector<std::string> diagnostics;
+  for (const auto& d : all) diagnostics.push_back(withoutNewline(d.format()));
+  py::dict out;
+  out["ok"] = result.image.has_value();
+  out["diagnostics"] = diagnostics;
+  out["disasm"] = result.image && disasm ? py::cast(vm::disassemble(*result.image)) : py::none();
+  return out;
+}
+
+// solo (one program) or match (two): the CLI's JSON, the trace's JSONL
+// lines when asked for, and the run's warnings.
+py::tuple playRun(const std::vector<std::string>& programs, std::optional<double> seconds,
+                  std::optional<uint64_t> seed, std::optional<std::string> profile,
+                  const std::string& scenario, const std::vector<std::string>& hw,
+                  const std::vector<std::string>& inject, const std::vector<std::string>& watch,
+                  const std::string& tracePath, const std::string& vcd, const std::string& replay,
+                  bool traceCostate, bool noFastForward, bool reloadOnFault, bool keepTrace) {
+  tools::RunOptions o;
+  if (seconds) o.seconds = *seconds;
+  if (seed) o.seed = *seed;
+  if (profile) o.profile = *profile;
+  o.secondsGiven = seconds.has_value();
+  o.seedGiven = seed.has_value();
+  o.profileGiven = profile.has_value();
+  o.scenario = scenario;
+  o.hw = hw;
+  o.injections = inject;
+  o.watches = watch;
+  o.trace = tracePath;
+  o.vcd = vcd;
+  o.replay = replay;
+  o.traceCostate = traceCostate;
+  o.noFastForward = noFastForward;
+  o.reloadOnFault = reloadOnFault;
+  tools::JsonlLines lines;
+  if (keepTrace) o.sinks.push_back(&lines);
+  const bool solo = programs.size() == 1;
+  std::string json;
+  std::vector<std::string> warnings;
+  {
+    py::gil_scoped_release release;
+    const tools::Played played = tools::play(programs, o, solo);
+    json = tools::dumpJson(solo ? tools::soloJson(played) : tools::matchJson(played), 2);
+    warnings = played.result.warnings;
+  }
+  return py::make_tuple(json, lines.lines, warnings);
+}
+
+py::tuple benchRuns(const std::vector<std::string>& programs, const std::string& family, int seeds,
+                    double seconds, uint64_t seed, const std::string& profile,
+                    const std::string& opponent, int threads) {
+  py::gil_scoped_release release;
+  tools::BenchConfig c;
+  c.programs = programs;
+  c.family = family;
+  c.seeds = seeds;
+  c.seconds = seconds;
+  c.masterSeed = seed;
+  c.opponent = opponent;
+  c.threads = threads;
+  c.progress = false;
+  const plant::Profile loaded = tools::loadNamedProfile(profile);
+  const tools::BenchResult r = tools::runBench(c, loaded);
+  py::gil_scoped_acquire acquire;
+  return py::make_tuple(tools::dumpJson(tools::summaryJson(r), 2), tools::runsCsv(r));
+}
+
+struct Sweep {
+  tools::SweepSpec spec;
+  std::vector<tools::SweepRun> runs;
+  explicit Sweep(const std::string& path)
+      : spec(tools::loadSweep(path)), runs(tools::expandSweep(spec)) {}
+  tools::CsvRow row(size_t index) const {
+    if (index >= runs.size()) throw py::index_error("no run " + std::to_string(index));
+    py::gil_scoped_release release;
+    return tools::runSweepRow(spec, runs[index]);
+  }
+};
+
+}  // namespace
+
+PYBIND11_MODULE(_simbot, m) {
+  m.doc() = "simbot's C++ core (use the package `simbot`)";
+  static py::exception<std::runtime_error> error(m, "Error", PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const tools::ToolError& e) {
+      error(withoutNewline(e.what()).c_str());
+    } catch (const plant::ConfigError& e) {
+      error(withoutNewline(e.what()).c_str());
+    }
+  });
+  m.def("compile", &compileProgram, py::arg("path"), py::arg("disasm") = false);
+  m.def("play", &playRun, py::arg("programs"), py::arg("seconds"), py::arg("seed"),
+        py::arg("profile"), py::arg("scenario"), py::arg("hw"), py::arg("inject"), py::arg("watch"),
+        py::arg("trace"), py::arg("vcd"), py::arg("replay"), py::arg("trace_costate"),
+        py::arg("no_fast_forward"), py::arg("reload_on_fault"), py::arg("keep_trace"));
+  m.def("bench", &benchRuns, py::arg("programs"), py::arg("family"), py::arg("seeds"),
+        py::arg("seconds"), py::arg("seed"), py::arg("profile"), py::arg("opponent"),
+        py::arg("threads"));
+  py::class_<Sweep>(m, "Sweep")
+      .def(py::init<const std::string&>(), py::arg("path"))
+      .def("__len__", [](const Sweep& s) { return s.runs.size(); })
+      .def("header", [](const Sweep& s) { return tools::sweepHeader(s.spec); })
+      .def("row", &Sweep::row, py::arg("index"));
+  m.def("parse_shard", &tools::parseShard, py::arg("text"));
+  m.def("shard_range", &tools::shardRange, py::arg("runs"), py::arg("k"), py::arg("n"));
+  py::class_<tools::SweepWriter>(m, "SweepWriter")
+      .def(py::init<const std::string&, const tools::CsvRow&, bool, size_t, size_t, bool>(),
+           py::arg("path"), py::arg("header"), py::arg("write_header"), py::arg("begin"),
+           py::arg("end"), py::arg("resume"))
+      .def("next", &tools::SweepWriter::next)
+      .def("put", &tools::SweepWriter::put, py::arg("index"), py::arg("row"))
+      .def("pending", &tools::SweepWriter::pending)
+      .def("finish", &tools::SweepWriter::finish);
+}
