@@ -194,6 +194,10 @@ struct Arena::Impl {
   std::array<std::array<double, 2>, 2> wheelTarget{};
   std::array<std::array<double, 2>, 2> gunTarget{};
   bool pending = false;
+  // The prediction came from a root (its crossing directions in
+  // pendingFound), not from a scheduled launch; retreat() holds it again.
+  bool pendingFromRoot = false;
+  std::vector<int> pendingFound;
   std::int64_t pendingTick = 0;
   double pendingTime = 0;
   Discrete pendingD;
@@ -253,6 +257,7 @@ struct Arena::Impl {
     qtmp.assign(static_cast<std::size_t>(n), 0.0);
     rootsFound.assign(kMaxRoots, 0);
     heldFound.assign(kMaxRoots, 0);
+    pendingFound.assign(kMaxRoots, 0);
     recs.reserve(1024);
     coef.reserve(static_cast<std::size_t>(1024 * 13 * n));
 
@@ -982,10 +987,11 @@ struct Arena::Impl {
         if (lt >= 0 && lt <= T) return true;
     return false;
   }
-  std::int64_t nextLaunch() const {
+  std::int64_t nextLaunch() const { return nextLaunchIn(D); }
+  std::int64_t nextLaunchIn(const Discrete& d) const {
     std::int64_t best = -1;
     for (int i = 0; i < nR; ++i)
-      for (std::int64_t lt : D.r[static_cast<std::size_t>(i)].launchTick)
+      for (std::int64_t lt : d.r[static_cast<std::size_t>(i)].launchTick)
         if (lt >= 0 && (best < 0 || lt < best)) best = lt;
     return best;
   }
@@ -1035,10 +1041,30 @@ struct Arena::Impl {
   bool predict(std::int64_t T, double te, const int* found, EventList& ev) {
     if (!eventsAt(T, te, found, ev)) return false;
     pending = true;
+    pendingFromRoot = found != nullptr;
+    if (found) std::copy(found, found + kMaxRoots, pendingFound.begin());
     pendingTick = T;
     pendingTime = te;
     now = T;
     return true;
+  }
+
+  // Back to `tick` (>= the last re-initialisation, < now): the caller stops
+  // there instead. A prediction from a root is held
+  // again, exactly as if advance() had been given `tick` as its stop (its
+  // root lay beyond it); one from a launch is predicted again by the
+  // advance() whose stop reaches the launch. No CVODE call: the steps
+  // taken stay, as they would after an advance() that overshot.
+  void retreat(std::int64_t tick) {
+    if (tick >= now || tick < segTick) return;
+    if (pending && pendingFromRoot) {
+      held = true;
+      heldTick = pendingTick;
+      heldTime = pendingTime;
+      heldFound = pendingFound;
+    }
+    pending = false;
+    now = tick;
   }
 
   AdvanceResult advance(std::int64_t stopTick) {
@@ -1284,6 +1310,18 @@ EventList Arena::edgeHandlerEntered(int robot, std::int64_t tick) {
 }
 
 AdvanceResult Arena::advance(std::int64_t stopTick) { return impl_->advance(stopTick); }
+void Arena::retreat(std::int64_t tick) { impl_->retreat(tick); }
+
+bool Arena::ballsInFlight() const {
+  const Impl& m = *impl_;
+  for (const Discrete* d : {&m.D, &m.pendingD}) {
+    if (d == &m.pendingD && !m.pending) break;
+    for (const Ball& b : d->balls)
+      if (b.active) return true;
+    if (m.nextLaunchIn(*d) >= 0) return true;
+  }
+  return false;
+}
 
 RobotState Arena::state(int robot, std::int64_t tick) const {
   const Impl& m = *impl_;

@@ -435,6 +435,16 @@ class Arena {
   EventList triggerReflex(int robot, Bumper side, std::int64_t tick);
 
   AdvanceResult advance(std::int64_t stopTick);
+  // The caller stops at `tick` (in [lastReinitTick(), now()]) after all:
+  // now() becomes `tick`, the events the last advance() returned at a later
+  // tick are dropped, and the advance() whose stop reaches their tick
+  // reports them again, as if the last advance() had been given `tick` as
+  // its stop. The integrator's steps stay (as after an advance() whose last
+  // step overshot its stop).
+  void retreat(std::int64_t tick);
+  // A ball is in flight or a launch is scheduled (at now(), after any
+  // pending events).
+  bool ballsInFlight() const;
 
   Pose pose(int robot, std::int64_t tick) const;
   RobotState state(int robot, std::int64_t tick) const;

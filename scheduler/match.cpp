@@ -1,5 +1,46 @@
 // One match: the round loop described in match.h, the robots' buses (ports,
 // A/D, serial library hooks, interrupt notifications) and the trace.
+//
+// Larger rounds. A round is a run of sub-rounds, each exactly one round of
+// the one-character protocol of match.h: from t_k = the earliest VM clock,
+// every VM runs to h_k = min(next queued event, t_k + 9,600, the plant's
+// next event). What a round saves is the plant's round trip: the plant is
+// advanced once, to P = min(next queued event, t + 8 x 9,600) (only to the
+// first sub-round's horizon while a ball is in flight or a launch is
+// scheduled), and a sub-round ends the round when
+//   (a) its VMs made a plant input (port B write, injected bump, edge
+//       handler entry): inputs are applied at the end of the sub-round, as
+//       at the end of a one-character round;
+//   (b) a queued event is due at its horizon, or the plant's event is (h_k
+//       is the plant's stop P or its event tick);
+//   (c) (solo runs) every robot has exited or faulted.
+// Claim: a run gives the same VM instructions, bus accesses, events and
+// trace records, at the same ticks, as with one plant advance per round.
+// Proof, by the sub-rounds of one round, which have no (a) or (b) before
+// the last: (1) the horizons are the same: h_k uses the same queue and VM
+// clocks, and the plant's event tick is the same because advance() is
+// independent of how time is chopped (plant.h: the same steps, roots and
+// held roots whatever the stops), so the first root at or before P is the
+// one the per-sub-round advances would have reported, at the same tick,
+// and none lies before it. (2) What a VM sees is the same: eye readings
+// come from dense output at their tick, which the chopping does not change
+// either, and port A and the interrupt requests change only at events (at
+// horizons, none inside). (3) Nothing a sub-round could do between rounds
+// is skipped: with no input, no queued event due and no plant event, the
+// end of a one-character round only takes samples up to h_k, done here
+// before the next sub-round so that records keep their order. (4) When a
+// round ends at h_k < P (by (a) or (c), or a new queued event earlier than
+// P), Arena::retreat(h_k) puts the plant where advance(h_k) would have: its
+// clock at h_k, a predicted event past h_k held for the advance() that
+// reaches its tick; inputs then re-initialise at their ticks <= h_k as
+// before. The only difference is work: steps taken past an input's tick
+// are thrown away at the re-initialisation, so IntegratorStats' steps and
+// rhs_evals can be higher (by at most the steps of 8 characters per
+// input); no state, event or record depends on them. A ball in flight
+// keeps the plant to one sub-round because a root with no event (a ball's
+// closest approach) updates the ball's closest distance when the plant
+// reaches it, and one past an input's tick would not be found on the
+// re-initialised trajectory.
 #include "scheduler/match.h"
 
 #include <fmt/format.h>
@@ -20,6 +61,10 @@ namespace simbot::scheduler {
 namespace {
 
 constexpr Tick kLookahead = plant::kTicksPerChar;
+// How far the plant integrates ahead in one round (header comment, "Larger
+// rounds"): eight character times. Integration past an input's tick is
+// thrown away at the input, so this bounds the work wasted per input.
+constexpr Tick kRoundLookahead = 8 * plant::kTicksPerChar;
 
 // Queued events; the plant's own events come from Arena::advance.
 struct QueuedEvent {
@@ -290,6 +335,11 @@ class Match {
 
  private:
   Tick earliestClock() const;
+  bool allExited() const {
+    return std::all_of(robots_.begin(), robots_.end(), [](const auto& r) {
+      return (r->result.exited || r->vm().fault()) && !r->reloadPending;
+    });
+  }
   void applyInputs();
   bool advancePlantTo(Tick t, plant::AdvanceResult& step);
   void resolveWatches();
@@ -319,6 +369,7 @@ class Match {
   bool betweenRounds_ = false;
   Tick nextSample_ = 0;
   uint64_t rounds_ = 0;
+  uint64_t subRounds_ = 0;  // sub-rounds after the first of each round
 };
 
 // ---- robot ------------------------------------------------------------------
@@ -956,9 +1007,28 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
     roundStart = t;
     if (trace_.on()) trace_.flushBefore(std::min(t, arena_.now()));
     Tick horizon = std::min(queue_.nextTick(), t + kLookahead);
-    plant::AdvanceResult step = arena_.advance(horizon);
-    horizon = step.tick;
-    for (auto& r : robots_) r->runTo(horizon);
+    // The plant goes further than the first sub-round when no ball is in
+    // flight (header comment: "Larger rounds").
+    const Tick plantStop =
+        arena_.ballsInFlight() ? horizon : std::min(queue_.nextTick(), t + kRoundLookahead);
+    plant::AdvanceResult step = arena_.advance(plantStop);
+    for (;;) {
+      horizon = std::min(horizon, step.tick);
+      for (auto& r : robots_) r->runTo(horizon);
+      if (horizon == step.tick || !inputs_.empty() || queue_.nextTick() == horizon ||
+          (config_.stopWhenAllExited && allExited()))
+        break;
+      sampleUpTo(horizon);  // before the next sub-round's records, as between rounds
+      ++subRounds_;
+      horizon = std::min(queue_.nextTick(), earliestClock() + kLookahead);
+    }
+    if (horizon < step.tick) {
+      // The round ends before the plant's stop: it goes back to the horizon
+      // (a prediction is kept for later), as if it had stopped there.
+      arena_.retreat(horizon);
+      step.tick = horizon;
+      step.events.clear();
+    }
     if (!inputs_.empty()) {
       applyInputs();
       // A re-initialisation discarded the plant's prediction: find it again.
@@ -998,11 +1068,7 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
       }
     }
     betweenRounds_ = false;
-    if (config_.stopWhenAllExited && std::all_of(robots_.begin(), robots_.end(), [](const auto& r) {
-          return (r->result.exited || r->vm().fault()) && !r->reloadPending;
-        })) {
-      over = true;
-    }
+    if (config_.stopWhenAllExited && allExited()) over = true;
     if (over) {
       result.endTick = horizon;
       sampleUpTo(horizon);

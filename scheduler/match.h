@@ -10,6 +10,9 @@
 //      register, at least 9,600 ticks after the byte entered it; so no event
 //      another VM could observe is created inside a round.
 //   2. The plant integrates ahead to h; its first root, if earlier, caps h.
+//      (Several such rounds share one plant advance when nothing happens
+//      between them: match.cpp, "Larger rounds"; MatchResult::rounds counts
+//      the plant's rounds.)
 //   3. Each VM runs to h (every instruction starting before h; bus accesses
 //      happen at boundaries before h). Port reads see device state as of the
 //      last processed event; eye readings come from dense output at their

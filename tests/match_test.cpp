@@ -328,6 +328,22 @@ TEST(Match, CyclesAreTheClockAtMainsReturnOrTheEnd) {
   EXPECT_EQ(r.robots[0].cycles, 396'288u);
 }
 
+// Larger rounds (match.cpp, "Larger rounds"): with no ball in flight and
+// no queued event before the end, a round lets the plant run eight
+// character times (76,800 ticks) ahead, and ends there unless a robot acts
+// on the plant. A program whose main returns at once idles from then on
+// (its clock stands at each horizon), so the 1-s run (9,216,000 ticks) is
+// 9,216,000 / 76,800 = 120 rounds, where one-character rounds took
+// 9,216,000 / 9,600 = 960: each round holds eight sub-rounds, and only the
+// last of the 120 ends at the end-of-run event.
+TEST(Match, AnIdleRobotsSecondIsOneHundredTwentyRounds) {
+  const auto r =
+      scheduler::runMatch(matchConfig({{"A", "idle.dc", compileSource("main()\n{\n}\n")}}, 1.0));
+  ASSERT_TRUE(r.robots[0].exited);
+  EXPECT_EQ(r.endTick, 9'216'000);
+  EXPECT_EQ(r.rounds, 120u);
+}
+
 TEST(Match, AFaultedRobotLosesATiedRound) {
   const char* kFaults = "int *p;\nmain()\n{\n    *p = 1;\n}\n";  // null pointer at once
   for (uint64_t seed = 1; seed <= 8; ++seed) {
