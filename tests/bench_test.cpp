@@ -9,6 +9,7 @@
 #include "scheduler/metrics.h"
 #include "stats/stats.h"
 #include "support/traced.h"
+#include "tools/run_table.h"
 #include "tools/runner.h"
 #include "tools/tournament.h"
 
@@ -21,6 +22,22 @@ using namespace simbot;
 // se(1) = 0.8 sqrt(1/20), se(3) = S(3) sqrt(1/20 + 2/3). The median is the
 // first time with S < 0.5: 3. Its cloglog interval: r(1) = -1.131 and
 // r(3) = 1.008 both within 1.96, so [1, inf) (3 is the last event time).
+// RFC 4180, section 2: records end in CRLF; a field holding a comma, a quote
+// or a line break is quoted, its quotes doubled.
+TEST(RunTable, RecordsFollowRfc4180) {
+  EXPECT_EQ(tools::csvRecord({"a,b", "say \"hi\"", "x"}), "\"a,b\",\"say \"\"hi\"\"\",x\r\n");
+  // Two records, the second with a line break inside quotes, then a third
+  // cut short by a kill (no line end): the third is not a record yet.
+  const std::string text = "h1,h2\r\n\"two\r\nlines\",2\r\n3,3";
+  const auto records = tools::csvRecords(text);
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_EQ(records[0], "h1,h2");
+  EXPECT_EQ(records[1], "\"two\r\nlines\",2");
+  EXPECT_EQ(tools::parseCsvLine(records[1]), (tools::CsvRow{"two\r\nlines", "2"}));
+  // LF line ends (tables written before CRLF) still read.
+  EXPECT_EQ(tools::csvRecords("a\nb\n"), (std::vector<std::string>{"a", "b"}));
+}
+
 TEST(Stats, KaplanMeierByHand) {
   const auto km = stats::kaplanMeier({{1, true}, {2, false}, {3, true}, {3, true}, {4, false}});
   ASSERT_EQ(km.times, (std::vector<double>{1, 3}));

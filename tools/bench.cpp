@@ -425,8 +425,8 @@ std::vector<CsvRow> doneRows(const BenchResult& result) {
 }  // namespace
 
 std::string runsCsv(const BenchResult& result) {
-  std::string out = csvLine(benchHeader()) + "\n";
-  for (const auto& row : doneRows(result)) out += csvLine(row) + "\n";
+  std::string out = csvRecord(benchHeader());
+  for (const auto& row : doneRows(result)) out += csvRecord(row);
   return out;
 }
 

@@ -36,6 +36,23 @@ std::string csvLine(const CsvRow& fields) {
   return line;
 }
 
+std::string csvRecord(const CsvRow& fields) { return csvLine(fields) + "\r\n"; }
+
+std::vector<std::string> csvRecords(const std::string& text) {
+  std::vector<std::string> records;
+  bool quoted = false;
+  size_t start = 0;
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '"') quoted = !quoted;
+    if (text[i] == '\n' && !quoted) {
+      const size_t end = i > start && text[i - 1] == '\r' ? i - 1 : i;
+      records.push_back(text.substr(start, end - start));
+      start = i + 1;
+    }
+  }
+  return records;
+}
+
 CsvRow parseCsvLine(const std::string& line) {
   CsvRow fields(1);
   bool quoted = false;
@@ -115,13 +132,9 @@ RunTable::RunTable(const std::string& dir, const std::string& file, const CsvRow
           "simbot: --resume: the batch in '{}' was run with other settings ({}); run it again "
           "with those, or choose another --out\n",
           dir, dumpJson(earlier)));
-    const std::string text = readAll(path_);
-    size_t start = 0, number = 0;
-    while (start < text.size()) {
-      const size_t end = text.find('\n', start);
-      if (end == std::string::npos) break;  // cut short by a kill: that run is done again
-      const std::string line = text.substr(start, end - start);
-      start = end + 1;
+    size_t number = 0;
+    // A last line cut short by a kill is left out: that run is done again.
+    for (const std::string& line : csvRecords(readAll(path_))) {
       CsvRow row;
       try {
         row = parseCsvLine(line);
@@ -144,7 +157,7 @@ RunTable::RunTable(const std::string& dir, const std::string& file, const CsvRow
     rewrite(keep);
   } else {
     writeFileAtomically(settingsPath, dumpJson(settings, 2) + "\n");
-    writeFileAtomically(path_, csvLine(header) + "\n");
+    writeFileAtomically(path_, csvRecord(header));
   }
   file_ = std::fopen(path_.c_str(), "ab");
   if (!file_)
@@ -156,15 +169,15 @@ RunTable::~RunTable() {
 }
 
 void RunTable::append(const CsvRow& row) {
-  const std::string line = csvLine(row) + "\n";
+  const std::string line = csvRecord(row);
   std::lock_guard lock(mutex_);
   if (std::fwrite(line.data(), 1, line.size(), file_) != line.size() || std::fflush(file_) != 0)
     throw ToolError(fmt::format("simbot: writing '{}': {}\n", path_, std::strerror(errno)));
 }
 
 void RunTable::rewrite(const std::vector<CsvRow>& rows) {
-  std::string text = csvLine(header_) + "\n";
-  for (const auto& row : rows) text += csvLine(row) + "\n";
+  std::string text = csvRecord(header_);
+  for (const auto& row : rows) text += csvRecord(row);
   std::lock_guard lock(mutex_);
   if (file_) {
     std::fclose(file_);

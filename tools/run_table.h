@@ -24,7 +24,15 @@ using CsvRow = std::vector<std::string>;
 // A CSV field (RFC 4180): quoted when it holds a comma, a quote or a line
 // break, with quotes doubled.
 std::string csvField(const std::string& text);
+// The fields joined by commas, without a line end.
 std::string csvLine(const CsvRow& fields);
+// One record of a table: the line and RFC 4180's CRLF line end.
+std::string csvRecord(const CsvRow& fields);
+// The complete records of a table's text, without their line ends: a record
+// ends at CRLF or LF outside quotes (a line break inside a quoted field
+// belongs to the field); a last record with no line end (cut short by a
+// kill) is left out.
+std::vector<std::string> csvRecords(const std::string& text);
 // One line back into fields; throws std::invalid_argument if malformed.
 CsvRow parseCsvLine(const std::string& line);
 

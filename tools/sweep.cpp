@@ -331,20 +331,6 @@ namespace {
 
 // A CSV file's records (a quoted field may hold a line break); a last
 // record without its line end is left out (cut short by a kill).
-std::vector<std::string> csvRecords(const std::string& text) {
-  std::vector<std::string> records;
-  bool quoted = false;
-  size_t start = 0;
-  for (size_t i = 0; i < text.size(); ++i) {
-    if (text[i] == '"') quoted = !quoted;
-    if (text[i] == '\n' && !quoted) {
-      records.push_back(text.substr(start, i - start));
-      start = i + 1;
-    }
-  }
-  return records;
-}
-
 }  // namespace
 
 SweepWriter::SweepWriter(const std::string& path, const CsvRow& header, bool writeHeader,
@@ -365,7 +351,7 @@ SweepWriter::SweepWriter(const std::string& path, const CsvRow& header, bool wri
           throw ToolError(fmt::format(
               "{}:1: error: --resume: not this sweep's table (its header differs)\n", path));
       } else {
-        kept += records[r++] + "\n";
+        kept += records[r++] + "\r\n";
       }
     }
     if (!writeHeader || !kept.empty()) {
@@ -380,7 +366,7 @@ SweepWriter::SweepWriter(const std::string& path, const CsvRow& header, bool wri
           throw ToolError(
               fmt::format("{}: error: --resume: row {} is not run {} of this sweep (or shard)\n",
                           path, r + 1, next_));
-        kept += records[r] + "\n";
+        kept += records[r] + "\r\n";
         ++next_;
       }
     }
@@ -388,7 +374,7 @@ SweepWriter::SweepWriter(const std::string& path, const CsvRow& header, bool wri
     file_ = std::fopen(path.c_str(), "ab");
   } else {
     file_ = std::fopen(path.c_str(), "wb");
-    if (file_ && writeHeader) writeLocked(csvLine(header) + "\n");
+    if (file_ && writeHeader) writeLocked(csvRecord(header));
   }
   if (!file_)
     throw ToolError(fmt::format("simbot: cannot write '{}': {}\n", path, std::strerror(errno)));
@@ -409,7 +395,7 @@ void SweepWriter::put(size_t index, const CsvRow& row) {
     throw std::logic_error(fmt::format("simbot: sweep: run {} is not awaited", index));
   const auto at = std::lower_bound(waiting_.begin(), waiting_.end(), index,
                                    [](const auto& w, size_t i) { return w.first < i; });
-  waiting_.insert(at, {index, csvLine(row) + "\n"});
+  waiting_.insert(at, {index, csvRecord(row)});
   std::string ready;
   size_t n = 0;
   while (n < waiting_.size() && waiting_[n].first == next_) {
