@@ -70,6 +70,7 @@
 // boundary a convex function the ball starts inside of.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include "plant/cvode.h"
@@ -207,6 +208,12 @@ struct Arena::Impl {
   std::int64_t now = 0;      // tick reached
   std::int64_t segTick = 0;  // tick of the last (re)initialisation
   double segT0 = 0;          // its time in seconds
+  // What the last (re)initialisation gave CVODE, and whether CVode has been
+  // called since: a re-initialisation at the same tick with the same state
+  // and dynamics before any step would leave CVODE exactly as it is.
+  bool fresh = false;
+  std::vector<double> segY;
+  std::array<std::array<double, 2>, 2> segWheel{}, segGun{};
 
   // ---- the integrator's own position (see "Stepping" above)
   double tOut = 0;               // tout for CVode: segT0 + kFirstStepHorizon
@@ -255,6 +262,7 @@ struct Arena::Impl {
     pendingY.assign(static_cast<std::size_t>(n), 0.0);
     tmp.assign(static_cast<std::size_t>(n), 0.0);
     qtmp.assign(static_cast<std::size_t>(n), 0.0);
+    segY.assign(static_cast<std::size_t>(n), 0.0);
     rootsFound.assign(kMaxRoots, 0);
     heldFound.assign(kMaxRoots, 0);
     pendingFound.assign(kMaxRoots, 0);
@@ -565,11 +573,23 @@ struct Arena::Impl {
     computeTargets(D);
     applyJumps(y);
     std::copy(y.begin(), y.end(), yv.data());
-    if (!first) {
+    // An input at the tick of the last re-initialisation, before any step,
+    // that leaves the state and everything the right-hand side reads as
+    // they were: CVODE is already exactly where CVodeReInit would put it
+    // (no step, no RHS evaluation since), so it is not called. The root set
+    // and stop time are rebuilt below as always.
+    const bool same = fresh && tick == segTick && t0 == segT0 && wheelTarget == segWheel &&
+                      gunTarget == segGun &&
+                      std::memcmp(y.data(), segY.data(), y.size() * sizeof(double)) == 0;
+    if (!first && !same) {
       accumulateStats();
       cv::check(CVodeReInit(mem.get(), t0, yv.get()), "CVodeReInit");
       ++acc.reinits;
     }
+    fresh = true;
+    std::copy(y.begin(), y.end(), segY.begin());
+    segWheel = wheelTarget;
+    segGun = gunTarget;
     buildRoots();
     if (nRoots != nRootsRegistered) {
       cv::check(CVodeRootInit(mem.get(), nRoots, nRoots > 0 ? &Impl::rootThunk : nullptr),
@@ -1094,6 +1114,7 @@ struct Arena::Impl {
       // ticks <= stop lie before the first time CVODE returns past tStop.
       if (tReturned >= tStop) break;
       double tret = 0;
+      fresh = false;
       const int flag = CVode(mem.get(), tOut, yv.get(), &tret, CV_ONE_STEP);
       cv::check(flag, "CVode");
       recordStep(tret);
@@ -1351,12 +1372,13 @@ bool Arena::edgeDetectorLow(int robot, Detector d, std::int64_t tick) const {
   return m.discreteAt(tick).r[static_cast<std::size_t>(robot)].edgeLow[static_cast<std::size_t>(d)];
 }
 
-EyeReadings Arena::eyeReadings(int robot, std::int64_t tick, RandomBits* noise) const {
+EyeReadings Arena::eyeReadings(int robot, std::int64_t tick, RandomBits* noise,
+                               EyeChannels channels) const {
   const Impl& m = *impl_;
   const Pose self = pose(robot, tick);
-  if (m.nR < 2) return computeEyes(self, nullptr, m.P(robot), m.cfg.field, noise);
+  if (m.nR < 2) return computeEyes(self, nullptr, m.P(robot), m.cfg.field, noise, channels);
   const Pose other = pose(1 - robot, tick);
-  return computeEyes(self, &other, m.P(robot), m.cfg.field, noise);
+  return computeEyes(self, &other, m.P(robot), m.cfg.field, noise, channels);
 }
 
 std::vector<BallView> Arena::balls(std::int64_t tick) const {

@@ -227,6 +227,9 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   uint8_t edgeLines = 0xFF;
   int enb485 = -1;  // never written
   std::array<int64_t, 2> adReads{};
+  // Interrupts accepted per source (vm::Irq), over the whole run; put into
+  // the result's map by name at the end, so counting one allocates nothing.
+  std::array<uint64_t, vm::kIrqCount> interruptCounts{};
   std::array<int, 2> lastAdValue{-1, -1};
   Tick serialEventAt = -1;
   Tick serialIsrAccepted = 0;
@@ -523,7 +526,11 @@ uint8_t Robot::in(Tick, uint16_t port) {
 }
 
 int Robot::adSample(Tick t, int channel) {
-  const plant::EyeReadings e = match.arena().eyeReadings(index, t, &noise);
+  // Only the eye asked for is computed; the noise stream advances as for both.
+  const plant::EyeChannels asked = channel == 0   ? plant::EyeChannels::Left
+                                   : channel == 1 ? plant::EyeChannels::Right
+                                                  : plant::EyeChannels::Both;
+  const plant::EyeReadings e = match.arena().eyeReadings(index, t, &noise, asked);
   const int value = channel == 0 ? e.left : channel == 1 ? e.right : 0;
   if (match.observer()) match.observer()->onEyeRead(index, t, channel, value);
   if (channel == 0 || channel == 1) {
@@ -669,7 +676,7 @@ std::string Robot::handlerName() const {
 }
 
 void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
-  ++result.interrupts[std::string(vm::irqName(irq))];
+  ++interruptCounts[static_cast<size_t>(irq)];
   if (match.observer()) match.observer()->onInterruptAccepted(index, t, irq);
   if (irq == vm::Irq::Pio) {
     pio.accepted();
@@ -849,8 +856,13 @@ bool Match::advancePlantTo(Tick t, plant::AdvanceResult& step) {
 }
 
 void Match::applyInputs() {
-  std::stable_sort(inputs_.begin(), inputs_.end(),
-                   [](const PlantInput& a, const PlantInput& b) { return a.tick < b.tick; });
+  // Stable by tick, in place: std::stable_sort would allocate a buffer every
+  // round with inputs; a round has a handful, mostly in order already.
+  for (auto it = inputs_.begin(); it != inputs_.end(); ++it)
+    std::rotate(
+        std::upper_bound(inputs_.begin(), it, *it,
+                         [](const PlantInput& a, const PlantInput& b) { return a.tick < b.tick; }),
+        it, it + 1);
   for (const auto& w : inputs_) {
     // An earlier input of this round may have re-initialised the plant at
     // its tick: integrate up to this one. Plant events at this tick come
@@ -1121,7 +1133,7 @@ void Match::finish(MatchResult& result) {
       rr.timerIsrCycles = r->vm().timerIsrCycles() + r->earlierTimerIsrCycles;
     }
     for (vm::Irq irq : {vm::Irq::Pio, vm::Irq::Timer, vm::Irq::SerialTx})
-      rr.interrupts.emplace(std::string(vm::irqName(irq)), 0);
+      rr.interrupts[std::string(vm::irqName(irq))] += r->interruptCounts[static_cast<size_t>(irq)];
     // After a plant fault the plant answers only from its last re-initialisation.
     rr.finalPose =
         arena_.pose(r->index, std::clamp(result.endTick, arena_.lastReinitTick(), arena_.now()));
