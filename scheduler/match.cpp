@@ -55,6 +55,7 @@
 #include "plant/pio.h"
 #include "plant/serial_link.h"
 #include "scheduler/event_queue.h"
+#include "scheduler/part_clock.h"
 
 namespace simbot::scheduler {
 
@@ -247,7 +248,8 @@ class Match {
         costs_(vm::makeCostTable(config.knobs)),
         arenaConfig_(arenaConfigFor(config)),
         arena_(arenaConfig_),
-        coin_(streamSeed(config.seed, "coin")) {
+        coin_(streamSeed(config.seed, "coin")),
+        clock_(config.timeParts) {
     for (trace::Sink* sink : config.sinks) trace_.attach(sink);
     if (config.robots.empty() || config.robots.size() > 2)
       throw std::invalid_argument("a match needs one or two robots");
@@ -306,6 +308,7 @@ class Match {
   void rounds(MatchResult& result, Tick& roundStart);
 
   plant::Arena& arena() { return arena_; }
+  PartClock& clock() { return clock_; }
   bool tracing() const { return trace_.on(); }
   bool profiling() const { return config_.profile; }
   bool tracingCostates() const { return config_.traceCostate && trace_.on(); }
@@ -373,6 +376,7 @@ class Match {
   Tick nextSample_ = 0;
   uint64_t rounds_ = 0;
   uint64_t subRounds_ = 0;  // sub-rounds after the first of each round
+  PartClock clock_;
 };
 
 // ---- robot ------------------------------------------------------------------
@@ -530,7 +534,10 @@ int Robot::adSample(Tick t, int channel) {
   const plant::EyeChannels asked = channel == 0   ? plant::EyeChannels::Left
                                    : channel == 1 ? plant::EyeChannels::Right
                                                   : plant::EyeChannels::Both;
-  const plant::EyeReadings e = match.arena().eyeReadings(index, t, &noise, asked);
+  const plant::EyeReadings e = [&] {
+    const PartScope plant(match.clock(), PartClock::Plant);
+    return match.arena().eyeReadings(index, t, &noise, asked);
+  }();
   const int value = channel == 0 ? e.left : channel == 1 ? e.right : 0;
   if (match.observer()) match.observer()->onEyeRead(index, t, channel, value);
   if (channel == 0 || channel == 1) {
@@ -587,6 +594,7 @@ void Robot::byteDone(Tick t) {
     if (match.observer()) match.observer()->onFrame(index, t, frame->command.has_value());
     if (frame->command) {
       ++result.framesLatched;
+      const PartScope plant(match.clock(), PartClock::Plant);
       match.arena().setWheels(index, *frame->command, t);
     } else {
       ++result.framesRejected;
@@ -818,7 +826,11 @@ void Match::emitSetup() {
 
 void Match::applyReflex(Tick t, int robot, plant::Bumper side) {
   sampleUpTo(t);
-  handlePlantEvents(t, arena_.triggerReflex(robot, side, t));
+  const plant::EventList events = [&] {
+    const PartScope plant(clock_, PartClock::Plant);
+    return arena_.triggerReflex(robot, side, t);
+  }();
+  handlePlantEvents(t, events);
 }
 
 // Leg `leg` of a robot's scripted path starts at t; leg == path size is
@@ -830,7 +842,10 @@ void Match::startLeg(Tick t, int robot, int leg) {
   const bool stop = leg == static_cast<int>(path.size());
   const DriveLeg drive = stop ? DriveLeg{} : path[static_cast<size_t>(leg)];
   sampleUpTo(t);
-  arena_.setDrive(robot, drive.leftFps, drive.rightFps, t);
+  {
+    const PartScope plant(clock_, PartClock::Plant);
+    arena_.setDrive(robot, drive.leftFps, drive.rightFps, t);
+  }
   if (trace_.on())
     emit(t, trace::rec::PathLeg{robot, stop ? std::nullopt : std::optional<int64_t>(leg),
                                 drive.leftFps, drive.rightFps});
@@ -846,7 +861,10 @@ void Match::startLeg(Tick t, int robot, int leg) {
 bool Match::advancePlantTo(Tick t, plant::AdvanceResult& step) {
   if (arena_.now() >= t) return false;
   while (arena_.now() < t) {
-    step = arena_.advance(t);
+    {
+      const PartScope plant(clock_, PartClock::Plant);
+      step = arena_.advance(t);
+    }
     if (step.tick < t) {
       sampleUpTo(step.tick);
       handlePlantEvents(step.tick, step.events);
@@ -878,13 +896,20 @@ void Match::applyInputs() {
     }
     if (w.kind == PlantInput::Kind::EdgeHandler) {
       sampleUpTo(w.tick);
-      handlePlantEvents(w.tick, arena_.edgeHandlerEntered(w.robot, w.tick));
+      const plant::EventList events = [&] {
+        const PartScope plant(clock_, PartClock::Plant);
+        return arena_.edgeHandlerEntered(w.robot, w.tick);
+      }();
+      handlePlantEvents(w.tick, events);
       continue;
     }
     sampleUpTo(w.tick);
-    const plant::EventList immediate =
-        arena_.setPortB(w.robot, w.value, w.tick, &robots_[static_cast<size_t>(w.robot)]->gunLuck,
-                        &robots_[static_cast<size_t>(w.robot)]->muzzle);
+    const plant::EventList immediate = [&] {
+      const PartScope plant(clock_, PartClock::Plant);
+      return arena_.setPortB(w.robot, w.value, w.tick,
+                             &robots_[static_cast<size_t>(w.robot)]->gunLuck,
+                             &robots_[static_cast<size_t>(w.robot)]->muzzle);
+    }();
     for (const auto& e : immediate) {
       if (config_.observer) config_.observer->onPlantEvent(w.tick, e);
       if (trace_.on()) emit(w.tick, plantRecord(e));
@@ -997,6 +1022,7 @@ MatchResult Match::run() {
   MatchResult result;
   if (trace_.on()) emitSetup();
   Tick roundStart = 0;
+  clock_.start();
   try {
     rounds(result, roundStart);
   } catch (const plant::SolverError& e) {
@@ -1006,6 +1032,8 @@ MatchResult Match::run() {
     result.endTick = roundStart;
     if (trace_.on()) emit(roundStart, trace::rec::PlantFault{e.what()}, {});
   }
+  clock_.stop();
+  result.parts = clock_.times();
   finish(result);
   return result;
 }
@@ -1023,10 +1051,17 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
     // flight (header comment: "Larger rounds").
     const Tick plantStop =
         arena_.ballsInFlight() ? horizon : std::min(queue_.nextTick(), t + kRoundLookahead);
-    plant::AdvanceResult step = arena_.advance(plantStop);
+    // (Lambdas, here and below, so that the results are built in place.)
+    plant::AdvanceResult step = [&] {
+      const PartScope plant(clock_, PartClock::Plant);
+      return arena_.advance(plantStop);
+    }();
     for (;;) {
       horizon = std::min(horizon, step.tick);
-      for (auto& r : robots_) r->runTo(horizon);
+      {
+        const PartScope vms(clock_, PartClock::Vm);
+        for (auto& r : robots_) r->runTo(horizon);
+      }
       if (horizon == step.tick || !inputs_.empty() || queue_.nextTick() == horizon ||
           (config_.stopWhenAllExited && allExited()))
         break;
@@ -1037,6 +1072,7 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
     if (horizon < step.tick) {
       // The round ends before the plant's stop: it goes back to the horizon
       // (a prediction is kept for later), as if it had stopped there.
+      const PartScope plant(clock_, PartClock::Plant);
       arena_.retreat(horizon);
       step.tick = horizon;
       step.events.clear();
