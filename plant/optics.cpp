@@ -17,7 +17,10 @@
 // numbers here, never with std::*_distribution, whose output differs
 // between library versions. Draw order per call: left eye then right; per
 // eye two words for the Gaussian (if sigma > 0), then one for the bad-reading
-// test and one more for the bad value (if the probability > 0).
+// test and one more for the bad value (if the probability > 0). A read of
+// one eye (an A/D read of one channel) computes only that eye but draws the
+// other eye's words all the same, so the stream never depends on which
+// channel a program reads.
 #include <cmath>
 
 #include "plant/geometry.h"
@@ -52,6 +55,18 @@ double addNoise(double s, const RobotParams& p, RandomBits* rng, bool& bad, int&
     }
   }
   return s;
+}
+
+// The draws addNoise makes for an eye nobody asked for, without the
+// arithmetic: the same words, in the same order, so the stream stays where
+// a read of both eyes would leave it.
+void skipNoise(const RobotParams& p, RandomBits* rng) {
+  if (!rng) return;
+  if (p.noise_sigma > 0) {
+    rng->next();
+    rng->next();
+  }
+  if (p.bad_reading_probability > 0 && unit53(rng->next()) < p.bad_reading_probability) rng->next();
 }
 
 }  // namespace
@@ -97,7 +112,7 @@ EyeGeometry eyeGeometry(const Pose& self, const Pose& opp, const RobotParams& p,
 }
 
 EyeReadings computeEyes(const Pose& self, const Pose* opponent, const RobotParams& p,
-                        const FieldParams& field, RandomBits* noise) {
+                        const FieldParams& field, RandomBits* noise, EyeChannels channels) {
   double sLeft = p.eye_background, sRight = p.eye_background;
   if (opponent) {
     const EyeGeometry g = eyeGeometry(self, *opponent, p, field);
@@ -118,10 +133,18 @@ EyeReadings computeEyes(const Pose& self, const Pose* opponent, const RobotParam
   EyeReadings r;
   bool bad = false;
   int badValue = 0;
-  double s = addNoise(sLeft, p, noise, bad, badValue);
-  r.left = bad ? quantise(badValue, p) : quantise(s, p);
-  s = addNoise(sRight, p, noise, bad, badValue);
-  r.right = bad ? quantise(badValue, p) : quantise(s, p);
+  if (channels != EyeChannels::Right) {
+    const double s = addNoise(sLeft, p, noise, bad, badValue);
+    r.left = bad ? quantise(badValue, p) : quantise(s, p);
+  } else {
+    skipNoise(p, noise);
+  }
+  if (channels != EyeChannels::Left) {
+    const double s = addNoise(sRight, p, noise, bad, badValue);
+    r.right = bad ? quantise(badValue, p) : quantise(s, p);
+  } else {
+    skipNoise(p, noise);
+  }
   return r;
 }
 

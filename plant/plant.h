@@ -221,8 +221,12 @@ class SplitMix64 final : public RandomBits {
 
 // The eye model of DESIGN.md (thesis VII.C, Appendix C). `opponent` null:
 // no beacon in the arena (background on both eyes).
+// `channels` selects the eyes computed; the other one reads as the default
+// 16 but its noise words are drawn all the same (optics.cpp).
+enum class EyeChannels : std::uint8_t { Both, Left, Right };
 EyeReadings computeEyes(const Pose& self, const Pose* opponent, const RobotParams& eyes,
-                        const FieldParams& field, RandomBits* noise = nullptr);
+                        const FieldParams& field, RandomBits* noise = nullptr,
+                        EyeChannels channels = EyeChannels::Both);
 // Unquantised signal S of the near eye and the far-eye fraction f; exposed
 // for tests and the viewer. seen=false when out of view or blocked.
 struct EyeGeometry {
@@ -449,7 +453,8 @@ class Arena {
   Pose pose(int robot, std::int64_t tick) const;
   RobotState state(int robot, std::int64_t tick) const;
   bool edgeDetectorLow(int robot, Detector d, std::int64_t tick) const;
-  EyeReadings eyeReadings(int robot, std::int64_t tick, RandomBits* noise = nullptr) const;
+  EyeReadings eyeReadings(int robot, std::int64_t tick, RandomBits* noise = nullptr,
+                          EyeChannels channels = EyeChannels::Both) const;
   std::vector<BallView> balls(std::int64_t tick) const;
 
   bool inReflex(int robot) const;  // at now(), after any pending events

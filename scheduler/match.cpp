@@ -1,5 +1,6 @@
-// One match: the round loop described in match.h, the robots' buses (ports,
-// A/D, serial library hooks, interrupt notifications) and the trace.
+// One match: the round loop described in match.h, the robots' VMs and the
+// trace. The robots' buses (ports, A/D, serial library hooks, interrupt
+// notifications) are in robot_bus.cpp; the classes in match_impl.h.
 //
 // Larger rounds. A round is a run of sub-rounds, each exactly one round of
 // the one-character protocol of match.h: from t_k = the earliest VM clock,
@@ -52,39 +53,11 @@
 #include <deque>
 #include <stdexcept>
 
-#include "plant/pio.h"
-#include "plant/serial_link.h"
-#include "scheduler/event_queue.h"
+#include "scheduler/match_impl.h"
 
 namespace simbot::scheduler {
 
-namespace {
-
-constexpr Tick kLookahead = plant::kTicksPerChar;
-// How far the plant integrates ahead in one round (header comment, "Larger
-// rounds"): eight character times. Integration past an input's tick is
-// thrown away at the input, so this bounds the work wasted per input.
-constexpr Tick kRoundLookahead = 8 * plant::kTicksPerChar;
-
-// Queued events; the plant's own events come from Arena::advance.
-struct QueuedEvent {
-  enum class Kind : uint8_t { SerialByte, DriveLeg, Inject, ReleaseEdge, Reload, EndOfRound } kind;
-  int robot = 0;
-  int index = 0;  // injection number, path leg, or the detector bit to release
-};
-
-// A plant input made by a robot during a round: a port B write, a bump
-// injected at a program point, or the entry into its PIO (edge) handler,
-// which the referee counts. Applied after the round, in tick order.
-struct PlantInput {
-  Tick tick;
-  int robot;
-  enum class Kind : uint8_t { PortB, Reflex, EdgeHandler } kind;
-  uint8_t value;  // port B
-  plant::Bumper bumper;
-};
-
-class Match;
+namespace detail {
 
 // A robot on a scripted path follows it exactly: its wheels have no lag.
 // The arena this match plays in: the configured one with this seed's
@@ -105,272 +78,6 @@ plant::ArenaConfig arenaConfigFor(const MatchConfig& config) {
   if (streams.size() == arena.robots.size()) plant::placeByHand(arena, streams);
   return arena;
 }
-
-// A VM's clock starts at 0 when it is made; a VM made for a reload starts
-// at tick `base` of the match, so every tick it reports is moved by `base`.
-class ShiftedBus : public vm::Bus {
- public:
-  explicit ShiftedBus(vm::Bus& to) : to_(to) {}
-  Tick base = 0;
-  void out(Tick t, uint16_t port, uint8_t value) override { to_.out(t + base, port, value); }
-  uint8_t in(Tick t, uint16_t port) override { return to_.in(t + base, port); }
-  int adSample(Tick t, int channel) override { return to_.adSample(t + base, channel); }
-  void hvEnable(Tick t) override { to_.hvEnable(t + base); }
-  void serialInit(Tick t, int mode, int divisor) override {
-    to_.serialInit(t + base, mode, divisor);
-  }
-  void serialSend(Tick t, uint16_t buf, uint16_t cc) override { to_.serialSend(t + base, buf, cc); }
-  void serialTxService(Tick t, vm::Vm& v) override { to_.serialTxService(t + base, v); }
-  void console(Tick t, std::string_view line) override { to_.console(t + base, line); }
-  void interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) override {
-    to_.interruptAccepted(t + base, irq, pc);
-  }
-  void interruptReturned(Tick t, vm::Irq irq) override { to_.interruptReturned(t + base, irq); }
-  void iffChanged(Tick t, bool iff1) override { to_.iffChanged(t + base, iff1); }
-  bool wantCostateEvents() const override { return to_.wantCostateEvents(); }
-  void costate(Tick t, uint16_t coData, CostateEvent e, int line) override {
-    to_.costate(t + base, coData, e, line);
-  }
-
- private:
-  vm::Bus& to_;
-};
-
-// One robot: its VM, the devices its program talks to, and its counters.
-class Robot : public vm::Bus, public plant::RobotMemory {
- public:
-  Robot(Match& match, int index, const RobotSpec& spec, const vm::CostTable& costs, uint64_t seed);
-
-  // The robot's clock (match ticks) and its program's VM.
-  Tick now() const { return bus.base + vm_->now(); }
-  vm::Vm& vm() { return *vm_; }
-  const vm::Vm& vm() const { return *vm_; }
-  // A VM as at load, its clock at t: fresh memory (with the profile's
-  // power-on fill), the breakpoints the match needs.
-  void powerOn(Tick t);
-  // --reload-on-fault: the faulted program starts again at t.
-  void reload(Tick t);
-  bool reloadPending = false;
-  bool faultSeen = false;  // this VM's fault is recorded
-
-  // vm::Bus
-  void out(Tick t, uint16_t port, uint8_t value) override;
-  uint8_t in(Tick t, uint16_t port) override;
-  int adSample(Tick t, int channel) override;
-  void serialSend(Tick t, uint16_t buf, uint16_t cc) override;
-  void serialTxService(Tick t, vm::Vm& v) override;
-  void console(Tick t, std::string_view line) override;
-  void interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) override;
-  void interruptReturned(Tick t, vm::Irq irq) override;
-  void iffChanged(Tick t, bool iff1) override;
-  bool wantCostateEvents() const override;
-  void costate(Tick t, uint16_t coData, CostateEvent e, int line) override;
-  // plant::RobotMemory
-  uint8_t read8(uint16_t a) const override { return vm_->read8(a); }
-  void write8(uint16_t a, uint8_t v) override { vm_->write8(a, v); }
-
-  // Runs the VM to `horizon` (its clock ends at or after it).
-  void runTo(Tick horizon);
-  void byteDone(Tick t);
-  // Port A's edge lines: low while the plant says so or an injection holds.
-  void updateEdgeLines(Tick t);
-  void inject(Tick t, const Injection& injection);
-  uint8_t plantLow = 0, injectedLow = 0;
-  std::map<uint32_t, std::vector<int>> lineInjections;  // code address -> injections
-  // Executions of each injection point, over the whole run (a reload does
-  // not restart the count).
-  std::map<uint32_t, int> lineHits;
-  struct Watch {
-    std::string name;
-    uint16_t address;
-    std::string type;
-  };
-  std::vector<Watch> watches;
-  trace::Watch watchedValues() const;
-  void scheduleSerial(Tick t);
-  void updateSerialRequest();
-
-  // Where the program was at each sample tick (traced runs): taken at the
-  // VM's first instruction boundary at or after the tick.
-  struct Snapshot {
-    Tick tick;
-    int line;
-    const vm::Symbol* function;
-    bool inHandler;
-    trace::Watch watch;
-  };
-  std::deque<Snapshot> snapshots;
-  Tick nextSnapshot = 0;
-  void takeSnapshots();
-  Snapshot snapshotFor(Tick t);
-  std::string handlerName() const;
-
-  const RobotSpec& spec;
-  int index;
-  Match& match;
-  const vm::CostTable& costs;
-  ShiftedBus bus;
-  std::unique_ptr<vm::Vm> vm_;
-  plant::SplitMix64 memoryFill;  // power-on RAM (profile random_memory)
-  // T-states of earlier VMs of this robot (reloads), for profiles.
-  std::vector<uint64_t> earlierProfile;
-  uint64_t earlierSerialIsrCycles = 0;
-  uint64_t earlierTimerIsrCycles = 0;
-  uint64_t earlierInstructions = 0, earlierFastForwarded = 0;
-  plant::SerialLink link;
-  // What the serial library had still to fetch of the current send after
-  // its last step: a new send while it is above zero overwrites that frame.
-  // (Read back after each step, since the program may rewrite *cc itself.)
-  uint16_t sendCcAddress = 0;
-  int sendUnfetched = 0;
-  plant::PioPortA pio;
-  uint8_t edgeLines = 0xFF;
-  int enb485 = -1;  // never written
-  std::array<int64_t, 2> adReads{};
-  std::array<int, 2> lastAdValue{-1, -1};
-  Tick serialEventAt = -1;
-  Tick serialIsrAccepted = 0;
-  plant::SplitMix64 noise;
-  plant::SplitMix64 gunLuck;  // jams and misfires
-  plant::SplitMix64 muzzle;   // muzzle-speed spread, one draw per launching stroke
-  RobotResult result;
-  uint32_t mainReturn;
-};
-
-class Match {
- public:
-  explicit Match(const MatchConfig& config)
-      : config_(config),
-        costs_(vm::makeCostTable(config.knobs)),
-        arenaConfig_(arenaConfigFor(config)),
-        arena_(arenaConfig_),
-        coin_(streamSeed(config.seed, "coin")) {
-    for (trace::Sink* sink : config.sinks) trace_.attach(sink);
-    if (config.robots.empty() || config.robots.size() > 2)
-      throw std::invalid_argument("a match needs one or two robots");
-    for (size_t i = 0; i < config.robots.size(); ++i)
-      robots_.push_back(std::make_unique<Robot>(*this, static_cast<int>(i), config.robots[i],
-                                                costs_, config.seed));
-    if (config.reloadOnFault && config.reloadDelay < kMinReloadDelay)
-      throw std::invalid_argument(
-          fmt::format("a reload must wait at least {} ticks (the serial port's two characters)",
-                      kMinReloadDelay));
-    resolveWatches();
-    queue_.schedule(config.endTick, EventClass::EndOfRound, {QueuedEvent::Kind::EndOfRound, 0, 0});
-    for (size_t i = 0; i < config.robots.size(); ++i) {
-      for (const DriveLeg& leg : config.robots[i].path)
-        if (leg.duration <= 0) throw std::invalid_argument("a path leg must last at least a tick");
-      if (!config.robots[i].path.empty())
-        queue_.schedule(0, EventClass::MotorLatch,
-                        {QueuedEvent::Kind::DriveLeg, static_cast<int>(i), 0});
-    }
-    for (size_t k = 0; k < config.injections.size(); ++k) {
-      const Injection& in = config.injections[k];
-      if (in.robot < 0 || in.robot >= static_cast<int>(robots_.size()))
-        throw std::invalid_argument("injection for a robot that is not in this run: " + in.text);
-      Robot& r = *robots_[static_cast<size_t>(in.robot)];
-      if (in.line > 0) {
-        const auto& lines = r.spec.image.lines;
-        const auto at = std::find(lines.begin(), lines.end(), in.line);
-        if (at == lines.end())
-          throw std::invalid_argument(
-              fmt::format("{}: line {} of {} has no code", in.text, in.line, r.spec.program));
-        const std::optional<uint32_t> head = loopHead(r.spec.image, in.line);
-        if (in.pass && !head)
-          throw std::invalid_argument(fmt::format(
-              "{}: line {} of {} holds no whole loop (pass:N#K counts the passes of a loop "
-              "written on one line; line:N#K counts entries into a line)",
-              in.text, in.line, r.spec.program));
-        if (!in.pass && head)
-          warnings_.push_back(fmt::format(
-              "--inject {}: line {} of {} holds a whole loop; line:N#K counts entries into "
-              "the line (runs of its first instruction, once before each run of the loop), "
-              "not passes of the loop; for pass {} of the loop write pass:{}#{}",
-              in.text, in.line, r.spec.program, in.count, in.line, in.count));
-        const auto address = in.pass ? *head : static_cast<uint32_t>(at - lines.begin());
-        r.lineInjections[address].push_back(static_cast<int>(k));
-        injectionAddress_[k] = address;
-        r.vm().setBreakpoint(address);
-      } else {
-        queue_.schedule(in.tick, EventClass::Injection,
-                        {QueuedEvent::Kind::Inject, in.robot, static_cast<int>(k)});
-      }
-    }
-  }
-
-  MatchResult run();
-  // The round loop; `roundStart` is the tick the current round began at.
-  void rounds(MatchResult& result, Tick& roundStart);
-
-  plant::Arena& arena() { return arena_; }
-  bool tracing() const { return trace_.on(); }
-  bool profiling() const { return config_.profile; }
-  bool tracingCostates() const { return config_.traceCostate && trace_.on(); }
-  // Robot `robot` faulted at t: its reload, if the run asks for one.
-  void faulted(int robot, Tick t);
-  // Injection `injection` (one of config_.injections) fired.
-  void fired(const Injection& injection) {
-    fired_[static_cast<size_t>(&injection - config_.injections.data())] = true;
-  }
-  Tick sampleInterval() const { return config_.sampleInterval; }
-  // A record at tick t, with the watched variables of its robot as they are
-  // now in that robot's memory.
-  void emit(Tick t, trace::Record record);
-  void emit(Tick t, trace::Record record, trace::Watch watch) {
-    trace_.emit(t, std::move(record), std::move(watch));
-  }
-  EventQueue<QueuedEvent>& queue() { return queue_; }
-  std::vector<PlantInput>& inputs() { return inputs_; }
-  bool betweenRounds() const { return betweenRounds_; }
-  void applyReflex(Tick t, int robot, plant::Bumper side);
-  void startLeg(Tick t, int robot, int leg);
-  const Injection& injection(int k) const { return config_.injections[static_cast<size_t>(k)]; }
-  const std::string& name(int robot) const {
-    return config_.robots[static_cast<size_t>(robot)].name;
-  }
-  MatchObserver* observer() const { return config_.observer; }
-  const plant::RobotParams& robotParams(int robot) const {
-    return arenaConfig_.robots[static_cast<size_t>(robot)].params;
-  }
-
- private:
-  Tick earliestClock() const;
-  bool allExited() const {
-    return std::all_of(robots_.begin(), robots_.end(), [](const auto& r) {
-      return (r->result.exited || r->vm().fault()) && !r->reloadPending;
-    });
-  }
-  void applyInputs();
-  bool advancePlantTo(Tick t, plant::AdvanceResult& step);
-  void resolveWatches();
-  void emitSetup();
-  trace::Record plantRecord(const plant::Event& e) const;
-  void handlePlantEvents(Tick t, const plant::EventList& events);
-  void sampleUpTo(Tick t);
-  void finish(MatchResult& result);
-
-  const MatchConfig& config_;
-  vm::CostTable costs_;
-  plant::ArenaConfig arenaConfig_;  // config_.arena with this seed's variation
-  plant::Arena arena_;
-  trace::Tracer trace_;
-  plant::SplitMix64 coin_;
-  EventQueue<QueuedEvent> queue_;
-  std::vector<std::unique_ptr<Robot>> robots_;
-  std::vector<PlantInput> inputs_;
-  std::vector<std::string> warnings_;
-  std::vector<bool> fired_ = std::vector<bool>(config_.injections.size());
-  std::vector<uint32_t> injectionAddress_ = std::vector<uint32_t>(config_.injections.size());
-  int hitsAt(const Injection& in, uint32_t address) const {
-    const auto& hits = robots_[static_cast<size_t>(in.robot)]->lineHits;
-    const auto it = hits.find(address);
-    return it == hits.end() ? 0 : it->second;
-  }
-  bool betweenRounds_ = false;
-  Tick nextSample_ = 0;
-  uint64_t rounds_ = 0;
-  uint64_t subRounds_ = 0;  // sub-rounds after the first of each round
-};
 
 // ---- robot ------------------------------------------------------------------
 
@@ -496,228 +203,6 @@ Robot::Snapshot Robot::snapshotFor(Tick t) {
                   spec.image.functionAt(pc), false, watchedValues()};
 }
 
-void Robot::out(Tick t, uint16_t port, uint8_t value) {
-  switch (port) {
-    case vm::kPortPIOCA:
-      pio.control(value);
-      return;
-    case vm::kPortPIODA:
-      pio.writeData(value);
-      return;
-    case vm::kPortPIODB:
-      match.inputs().push_back({t, index, PlantInput::Kind::PortB, value, plant::Bumper::Front});
-      if (match.tracing()) match.emit(t, trace::rec::PortB{index, value});
-      return;
-    case vm::kPortENB485:
-      if (match.tracing() && value != enb485) match.emit(t, trace::rec::Rs485{index, value});
-      enb485 = value;
-      return;
-    default:
-      return;  // PIOCB set-up and unknown ports have no effect here
-  }
-}
-
-uint8_t Robot::in(Tick, uint16_t port) {
-  if (port == vm::kPortPIODA) return pio.read();
-  return 0xFF;
-}
-
-int Robot::adSample(Tick t, int channel) {
-  const plant::EyeReadings e = match.arena().eyeReadings(index, t, &noise);
-  const int value = channel == 0 ? e.left : channel == 1 ? e.right : 0;
-  if (match.observer()) match.observer()->onEyeRead(index, t, channel, value);
-  if (channel == 0 || channel == 1) {
-    // Traced as a step when it differs: a search loop reads thousands a second.
-    const auto c = static_cast<size_t>(channel);
-    ++adReads[c];
-    if (match.tracing() && value != lastAdValue[c])
-      match.emit(t, trace::rec::AdRead{index, channel, value, adReads[c]});
-    lastAdValue[c] = value;
-  }
-  return value;
-}
-
-void Robot::serialSend(Tick t, uint16_t buf, uint16_t cc) {
-  if (match.tracing()) match.emit(t, trace::rec::SerialSend{index, vm_->read8(cc)});
-  if (sendUnfetched > 0) ++result.framesOverwritten;
-  link.send(t, buf, cc, *this);
-  sendCcAddress = cc;
-  sendUnfetched = vm_->read8(cc);
-  scheduleSerial(t);
-  updateSerialRequest();
-}
-
-void Robot::serialTxService(Tick t, vm::Vm&) {
-  link.service(t, *this);
-  sendUnfetched = vm_->read8(sendCcAddress);
-  scheduleSerial(t);
-  updateSerialRequest();
-}
-
-// A byte that entered the shift register is on the wire for one character
-// time, ending at nextByteDone().
-void Robot::scheduleSerial(Tick) {
-  const auto done = link.nextByteDone();
-  if (done && *done != serialEventAt) {
-    serialEventAt = *done;
-    if (match.tracing())
-      match.emit(*done - plant::kTicksPerChar, trace::rec::SerialByte{index, link.shifting()});
-    match.queue().schedule(*done, EventClass::SerialByte,
-                           {QueuedEvent::Kind::SerialByte, index, 0});
-  }
-}
-
-void Robot::updateSerialRequest() {
-  if (link.requestingInterrupt())
-    vm_->request(vm::Irq::SerialTx);
-  else
-    vm_->cancelRequest(vm::Irq::SerialTx);
-}
-
-void Robot::byteDone(Tick t) {
-  serialEventAt = -1;
-  if (auto frame = link.byteDone(t)) {
-    if (match.observer()) match.observer()->onFrame(index, t, frame->command.has_value());
-    if (frame->command) {
-      ++result.framesLatched;
-      match.arena().setWheels(index, *frame->command, t);
-    } else {
-      ++result.framesRejected;
-    }
-    if (match.tracing()) {
-      if (frame->command)
-        match.emit(t, trace::rec::FrameLatched{index, frame->bytes});
-      else
-        match.emit(t, trace::rec::FrameRejected{index, frame->bytes});
-    }
-  }
-  scheduleSerial(t);
-  updateSerialRequest();
-}
-
-// Each watched variable's value as its C type reads it.
-trace::Watch Robot::watchedValues() const {
-  trace::Watch values;
-  for (const auto& w : watches) {
-    const bool isUnsigned = w.type.find("unsigned") != std::string::npos;
-    trace::WatchValue v;
-    if (w.type.find('*') != std::string::npos) {
-      v = std::int64_t{vm_->read16(w.address)};
-    } else if (w.type.find("float") != std::string::npos ||
-               w.type.find("double") != std::string::npos) {
-      v = static_cast<double>(std::bit_cast<float>(vm_->read32(w.address)));
-    } else if (w.type.find("long") != std::string::npos) {
-      const uint32_t raw = vm_->read32(w.address);
-      v = isUnsigned ? std::int64_t{raw} : std::int64_t{static_cast<int32_t>(raw)};
-    } else if (w.type.find("char") != std::string::npos) {
-      v = std::int64_t{vm_->read8(w.address)};
-    } else {
-      const uint16_t raw = vm_->read16(w.address);
-      v = isUnsigned ? std::int64_t{raw} : std::int64_t{static_cast<int16_t>(raw)};
-    }
-    values.emplace_back(w.name, v);
-  }
-  return values;
-}
-
-void Robot::updateEdgeLines(Tick t) {
-  const auto lines = static_cast<uint8_t>(~(plantLow | injectedLow));
-  if (lines != edgeLines && match.tracing()) match.emit(t, trace::rec::PortA{index, lines});
-  edgeLines = lines;
-  if (pio.setInputs(edgeLines)) vm_->request(vm::Irq::Pio, pio.vector());
-}
-
-void Robot::inject(Tick t, const Injection& injection) {
-  match.fired(injection);
-  if (match.tracing()) match.emit(t, trace::rec::Injection{index, injection.text, vm_->line()});
-  switch (injection.source) {
-    case InjectSource::EdgeFore:
-    case InjectSource::EdgeAft: {
-      const uint8_t bit = injection.source == InjectSource::EdgeFore ? 0x02 : 0x01;
-      injectedLow |= bit;
-      updateEdgeLines(t);
-      match.queue().schedule(t + kInjectedEdgePulse, EventClass::Injection,
-                             {QueuedEvent::Kind::ReleaseEdge, index, bit});
-      return;
-    }
-    case InjectSource::BumperFront:
-    case InjectSource::BumperBack: {
-      const plant::Bumper side = injection.source == InjectSource::BumperFront
-                                     ? plant::Bumper::Front
-                                     : plant::Bumper::Back;
-      // Between rounds (a time or tick) the plant takes it at once; at a
-      // program point it waits for the end of the round with port B writes.
-      if (match.betweenRounds())
-        match.applyReflex(t, index, side);
-      else
-        match.inputs().push_back({t, index, PlantInput::Kind::Reflex, 0, side});
-      return;
-    }
-  }
-}
-
-void Robot::console(Tick t, std::string_view line) {
-  result.console.emplace_back(line);
-  if (match.tracing()) match.emit(t, trace::rec::Console{index, std::string(line)});
-}
-
-// The #INT_VEC handler the PIO's vector selects.
-std::string Robot::handlerName() const {
-  for (const auto& v : spec.image.vectors)
-    if (v.vector == pio.vector()) return v.handlerName;
-  return "";
-}
-
-void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
-  ++result.interrupts[std::string(vm::irqName(irq))];
-  if (match.observer()) match.observer()->onInterruptAccepted(index, t, irq);
-  if (irq == vm::Irq::Pio) {
-    pio.accepted();
-    match.inputs().push_back({t, index, PlantInput::Kind::EdgeHandler, 0, plant::Bumper::Front});
-  }
-  // The BIOS timer service (1,024 a second) is counted, not traced.
-  if (!match.tracing() || irq == vm::Irq::Timer) return;
-  if (irq == vm::Irq::SerialTx) {
-    serialIsrAccepted = t;  // traced as one span when it returns
-    return;
-  }
-  const vm::Symbol* fn = spec.image.functionAt(pc);
-  match.emit(t, trace::rec::InterruptAccepted{index, std::string(vm::irqName(irq)),
-                                              spec.image.lineAt(pc), fn ? fn->name : "",
-                                              irq == vm::Irq::Pio ? handlerName() : ""});
-}
-
-void Robot::interruptReturned(Tick t, vm::Irq irq) {
-  if (irq == vm::Irq::SerialTx) {
-    if (match.tracing()) match.emit(serialIsrAccepted, trace::rec::SerialIsr{index, t});
-    return;
-  }
-  if (irq != vm::Irq::Pio) return;
-  if (match.tracing())
-    match.emit(t, trace::rec::InterruptReturned{index, std::string(vm::irqName(irq))});
-  if (pio.returned()) vm_->request(vm::Irq::Pio, pio.vector());
-}
-
-void Robot::iffChanged(Tick t, bool iff1) {
-  if (match.tracing()) match.emit(t, trace::rec::Iff1{index, iff1});
-}
-
-bool Robot::wantCostateEvents() const { return match.tracingCostates(); }
-
-// The costatement is named by its CoData's symbol: the name a named one
-// was given, "costate@LINE" for an unnamed one (FUNCTION.costate@LINE).
-void Robot::costate(Tick t, uint16_t coData, CostateEvent e, int line) {
-  std::string name = fmt::format("0x{:04x}", coData);
-  for (const auto& s : spec.image.symbols)
-    if (s.address == coData && s.size == vm::kCoDataSize &&
-        (s.kind == vm::Symbol::Kind::Global || s.kind == vm::Symbol::Kind::Static)) {
-      name = s.name.substr(s.name.find('.') + 1);
-      break;
-    }
-  static constexpr const char* kEvent[] = {"enter", "yield", "end"};
-  match.emit(t, trace::rec::Costate{index, name, kEvent[static_cast<int>(e)], line});
-}
-
 // ---- match ------------------------------------------------------------------
 
 Tick Match::earliestClock() const {
@@ -811,7 +296,11 @@ void Match::emitSetup() {
 
 void Match::applyReflex(Tick t, int robot, plant::Bumper side) {
   sampleUpTo(t);
-  handlePlantEvents(t, arena_.triggerReflex(robot, side, t));
+  const plant::EventList events = [&] {
+    const PartScope plant(clock_, PartClock::Plant);
+    return arena_.triggerReflex(robot, side, t);
+  }();
+  handlePlantEvents(t, events);
 }
 
 // Leg `leg` of a robot's scripted path starts at t; leg == path size is
@@ -823,7 +312,10 @@ void Match::startLeg(Tick t, int robot, int leg) {
   const bool stop = leg == static_cast<int>(path.size());
   const DriveLeg drive = stop ? DriveLeg{} : path[static_cast<size_t>(leg)];
   sampleUpTo(t);
-  arena_.setDrive(robot, drive.leftFps, drive.rightFps, t);
+  {
+    const PartScope plant(clock_, PartClock::Plant);
+    arena_.setDrive(robot, drive.leftFps, drive.rightFps, t);
+  }
   if (trace_.on())
     emit(t, trace::rec::PathLeg{robot, stop ? std::nullopt : std::optional<int64_t>(leg),
                                 drive.leftFps, drive.rightFps});
@@ -839,7 +331,10 @@ void Match::startLeg(Tick t, int robot, int leg) {
 bool Match::advancePlantTo(Tick t, plant::AdvanceResult& step) {
   if (arena_.now() >= t) return false;
   while (arena_.now() < t) {
-    step = arena_.advance(t);
+    {
+      const PartScope plant(clock_, PartClock::Plant);
+      step = arena_.advance(t);
+    }
     if (step.tick < t) {
       sampleUpTo(step.tick);
       handlePlantEvents(step.tick, step.events);
@@ -849,8 +344,13 @@ bool Match::advancePlantTo(Tick t, plant::AdvanceResult& step) {
 }
 
 void Match::applyInputs() {
-  std::stable_sort(inputs_.begin(), inputs_.end(),
-                   [](const PlantInput& a, const PlantInput& b) { return a.tick < b.tick; });
+  // Stable by tick, in place: std::stable_sort would allocate a buffer every
+  // round with inputs; a round has a handful, mostly in order already.
+  for (auto it = inputs_.begin(); it != inputs_.end(); ++it)
+    std::rotate(
+        std::upper_bound(inputs_.begin(), it, *it,
+                         [](const PlantInput& a, const PlantInput& b) { return a.tick < b.tick; }),
+        it, it + 1);
   for (const auto& w : inputs_) {
     // An earlier input of this round may have re-initialised the plant at
     // its tick: integrate up to this one. Plant events at this tick come
@@ -866,13 +366,20 @@ void Match::applyInputs() {
     }
     if (w.kind == PlantInput::Kind::EdgeHandler) {
       sampleUpTo(w.tick);
-      handlePlantEvents(w.tick, arena_.edgeHandlerEntered(w.robot, w.tick));
+      const plant::EventList events = [&] {
+        const PartScope plant(clock_, PartClock::Plant);
+        return arena_.edgeHandlerEntered(w.robot, w.tick);
+      }();
+      handlePlantEvents(w.tick, events);
       continue;
     }
     sampleUpTo(w.tick);
-    const plant::EventList immediate =
-        arena_.setPortB(w.robot, w.value, w.tick, &robots_[static_cast<size_t>(w.robot)]->gunLuck,
-                        &robots_[static_cast<size_t>(w.robot)]->muzzle);
+    const plant::EventList immediate = [&] {
+      const PartScope plant(clock_, PartClock::Plant);
+      return arena_.setPortB(w.robot, w.value, w.tick,
+                             &robots_[static_cast<size_t>(w.robot)]->gunLuck,
+                             &robots_[static_cast<size_t>(w.robot)]->muzzle);
+    }();
     for (const auto& e : immediate) {
       if (config_.observer) config_.observer->onPlantEvent(w.tick, e);
       if (trace_.on()) emit(w.tick, plantRecord(e));
@@ -985,6 +492,7 @@ MatchResult Match::run() {
   MatchResult result;
   if (trace_.on()) emitSetup();
   Tick roundStart = 0;
+  clock_.start();
   try {
     rounds(result, roundStart);
   } catch (const plant::SolverError& e) {
@@ -994,6 +502,8 @@ MatchResult Match::run() {
     result.endTick = roundStart;
     if (trace_.on()) emit(roundStart, trace::rec::PlantFault{e.what()}, {});
   }
+  clock_.stop();
+  result.parts = clock_.times();
   finish(result);
   return result;
 }
@@ -1011,10 +521,17 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
     // flight (header comment: "Larger rounds").
     const Tick plantStop =
         arena_.ballsInFlight() ? horizon : std::min(queue_.nextTick(), t + kRoundLookahead);
-    plant::AdvanceResult step = arena_.advance(plantStop);
+    // (Lambdas, here and below, so that the results are built in place.)
+    plant::AdvanceResult step = [&] {
+      const PartScope plant(clock_, PartClock::Plant);
+      return arena_.advance(plantStop);
+    }();
     for (;;) {
       horizon = std::min(horizon, step.tick);
-      for (auto& r : robots_) r->runTo(horizon);
+      {
+        const PartScope vms(clock_, PartClock::Vm);
+        for (auto& r : robots_) r->runTo(horizon);
+      }
       if (horizon == step.tick || !inputs_.empty() || queue_.nextTick() == horizon ||
           (config_.stopWhenAllExited && allExited()))
         break;
@@ -1025,6 +542,7 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
     if (horizon < step.tick) {
       // The round ends before the plant's stop: it goes back to the horizon
       // (a prediction is kept for later), as if it had stopped there.
+      const PartScope plant(clock_, PartClock::Plant);
       arena_.retreat(horizon);
       step.tick = horizon;
       step.events.clear();
@@ -1121,7 +639,7 @@ void Match::finish(MatchResult& result) {
       rr.timerIsrCycles = r->vm().timerIsrCycles() + r->earlierTimerIsrCycles;
     }
     for (vm::Irq irq : {vm::Irq::Pio, vm::Irq::Timer, vm::Irq::SerialTx})
-      rr.interrupts.emplace(std::string(vm::irqName(irq)), 0);
+      rr.interrupts[std::string(vm::irqName(irq))] += r->interruptCounts[static_cast<size_t>(irq)];
     // After a plant fault the plant answers only from its last re-initialisation.
     rr.finalPose =
         arena_.pose(r->index, std::clamp(result.endTick, arena_.lastReinitTick(), arena_.now()));
@@ -1154,7 +672,7 @@ void Match::finish(MatchResult& result) {
   trace_.close();
 }
 
-}  // namespace
+}  // namespace detail
 
 namespace {
 
@@ -1275,7 +793,7 @@ uint64_t streamSeed(uint64_t seed, const std::string& purpose) {
 }
 
 MatchResult runMatch(const MatchConfig& config) {
-  Match match(config);
+  detail::Match match(config);
   return match.run();
 }
 

@@ -151,6 +151,9 @@ struct MatchConfig {
   // last latched command meanwhile. No reload is done at or after the end.
   bool reloadOnFault = false;
   Tick reloadDelay = 0;  // at least kMinReloadDelay
+  // Measure the wall time spent in the VMs, the plant and the scheduler
+  // (MatchResult::parts; bench/match_bench). Off: no clock is read.
+  bool timeParts = false;
 };
 
 // A reload waits at least this long, so that the bytes a faulted robot's
@@ -203,6 +206,14 @@ struct RobotResult {
   uint64_t timerIsrCycles = 0;  // the BIOS timer service (PRT0)
 };
 
+// Wall seconds of a run by part (MatchConfig::timeParts): the VMs running
+// (without the plant queries they make), the plant (integration, inputs,
+// eye readings), and the scheduler (everything else: round loop, queue,
+// trace). Zero when not measured.
+struct PartTimes {
+  double vm_s = 0, plant_s = 0, scheduler_s = 0;
+};
+
 struct MatchResult {
   Tick endTick = 0;
   std::vector<RobotResult> robots;
@@ -217,6 +228,7 @@ struct MatchResult {
   // never fired, a line:N#K on a line that holds a whole loop), one line
   // each, for the tools to print as warnings.
   std::vector<std::string> warnings;
+  PartTimes parts;
 };
 
 MatchResult runMatch(const MatchConfig& config);

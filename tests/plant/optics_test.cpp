@@ -136,6 +136,27 @@ TEST(Optics, SeededNoiseIsReproducibleAndChangesReadings) {
   EXPECT_LT(bad, 120);
 }
 
+// A read of one eye gives that eye's value of a read of both, and leaves the
+// noise stream where a read of both leaves it (same words, same order), so
+// a program's channel choice never shifts later reads.
+TEST(Optics, OneChannelReadMatchesBothAndDrawsTheSameWords) {
+  Profile p = thesis();
+  p.robot.noise_sigma = 40;
+  p.robot.bad_reading_probability = 0.1;
+  const Pose self{0, 0, 0}, opp{1, 7, 0};
+  SplitMix64 both(7), left(7), right(7);
+  for (int i = 0; i < 500; ++i) {
+    const EyeReadings b = computeEyes(self, &opp, p.robot, p.field, &both);
+    const EyeReadings l = computeEyes(self, &opp, p.robot, p.field, &left, EyeChannels::Left);
+    const EyeReadings r = computeEyes(self, &opp, p.robot, p.field, &right, EyeChannels::Right);
+    EXPECT_EQ(l.left, b.left);
+    EXPECT_EQ(r.right, b.right);
+  }
+  const std::uint64_t next = both.next();
+  EXPECT_EQ(left.next(), next);
+  EXPECT_EQ(right.next(), next);
+}
+
 TEST(Optics, ArenaEyesFollowThePoses) {
   const Profile p = thesis();
   Arena a(makeArenaConfig(p, 2));

@@ -1,0 +1,292 @@
+// plant/arena_events.cpp -- the arena's event rules.
+//
+// What happens at an event's tick, in the fixed order process() documents:
+// ball launches and outcomes, referee put-backs and turns, reflexes,
+// contacts and edge detectors, each listed as an Event for the scheduler.
+// The rules change a copy of the discrete state and the continuous state
+// at the tick; the integrator (arena_integrator.cpp) makes them pending,
+// applies them and re-initialises.
+#include "plant/arena_impl.h"
+
+namespace simbot::plant {
+
+// ------------------------------------------------------------ event processing
+Bumper Arena::Impl::sideOf(double headingRad, const Vec2& towards) {
+  return geom::headingDir(headingRad).dot(towards) >= 0 ? Bumper::Front : Bumper::Back;
+}
+
+void Arena::Impl::startReflex(Discrete& d, const std::vector<double>& y, int i, Bumper side,
+                              std::int64_t T, EventList& ev) {
+  RobotDisc& r = d.r[static_cast<std::size_t>(i)];
+  r.reflex = true;
+  r.reflexSide = side;
+  r.reflexS0 = y[static_cast<std::size_t>(i * kPerRobot + S)];
+  r.reflexTicks.push(T);
+  r.eventTicks.push(T);
+  Event e{EventKind::ReflexStart};
+  e.robot = static_cast<std::int8_t>(i);
+  e.bumper = side;
+  ev.push(e);
+}
+
+// Finds the reported crossing direction of a root, 0 if not reported.
+int Arena::Impl::reported(const int* found, RootKind k, int who) const {
+  if (!found) return 0;
+  for (int j = 0; j < nRoots; ++j)
+    if (roots[static_cast<std::size_t>(j)].kind == k &&
+        roots[static_cast<std::size_t>(j)].robot == who)
+      return found[j];
+  return 0;
+}
+
+// Applies everything that happens at tick T (time te) to (d, y) and lists
+// the events, in this fixed order: ball launches; ball outcomes (floor,
+// divider, hit, leaving the field -- the floor first, so a ball reaching
+// floor and robot together is a miss, thesis VIII.H); per robot: referee
+// put-back, reflex end; contacts (robot-robot, divider, wall) and the
+// reflexes they start; edge detectors; the referee's turn. A put-back or a
+// turn moves a robot, so contacts and edges are reconciled again after it.
+void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<double>& y,
+                          const int* found, EventList& ev) {
+  double* ys = y.data();
+  // -- launches
+  for (int i = 0; i < nR; ++i) {
+    RobotDisc& r = d.r[static_cast<std::size_t>(i)];
+    for (int g = 0; g < 2; ++g) {
+      if (r.launchTick[static_cast<std::size_t>(g)] < 0 ||
+          r.launchTick[static_cast<std::size_t>(g)] > T)
+        continue;
+      r.launchTick[static_cast<std::size_t>(g)] = -1;
+      if (r.ballsLeft[static_cast<std::size_t>(g)] <= 0) continue;
+      int slot = -1;
+      for (int b = 0; b < kMaxBalls && slot < 0; ++b)
+        if (!d.balls[static_cast<std::size_t>(b)].active) slot = b;
+      if (slot < 0) throw std::logic_error("plant: the ball table is full (see kMaxBalls)");
+      r.ballsLeft[static_cast<std::size_t>(g)]--;
+      r.shots++;
+      const RobotParams& p = P(i);
+      const Vec2 dir = geom::headingDir(heading(ys, i));
+      const Vec2 muzzle = centre(ys, i) + radius(i) * dir;  // flush with the body edge (VIII.C)
+      const double speed = p.muzzle_speed_fps * ys[i * kPerRobot + (g == 0 ? G1 : G2)] *
+                           r.launchFactor[static_cast<std::size_t>(g)];
+      Ball& b = d.balls[static_cast<std::size_t>(slot)];
+      b = Ball{true,
+               false,
+               i,
+               g,
+               te,
+               muzzle.x(),
+               muzzle.y(),
+               p.launch_height_ft,
+               speed * dir.x(),
+               speed * dir.y()};
+      Event e{EventKind::BallLaunch};
+      e.robot = static_cast<std::int8_t>(i);
+      e.gun = static_cast<std::int8_t>(g);
+      e.ball = static_cast<std::int8_t>(slot);
+      e.x = b.x0;
+      e.y = b.y0;
+      e.z = b.z0;
+      e.vx = b.vx;
+      e.vy = b.vy;
+      ev.push(e);
+    }
+  }
+  // -- balls
+  for (int s = 0; s < kMaxBalls; ++s) {
+    Ball& b = d.balls[static_cast<std::size_t>(s)];
+    if (!b.active) continue;
+    double x, yy, z;
+    ballAt(b, te, x, yy, z);
+    if (nR == 2) b.closest = std::min(b.closest, ballGap(b, te, ys));
+    Event e{EventKind::BallMiss};
+    e.robot = static_cast<std::int8_t>(b.shooter);
+    e.gun = static_cast<std::int8_t>(b.gun);
+    e.ball = static_cast<std::int8_t>(s);
+    e.x = x;
+    e.y = yy;
+    e.z = z;
+    e.closest_ft = nR == 2 ? b.closest : -1;
+    if (!b.rolling && (reported(found, RootKind::BallFloor, s) < 0 || z <= 0)) {
+      if (cfg.field.count_floor_skips) {
+        // Appendix A counts skips: the ball goes on along the floor
+        // (assumption) and can still hit.
+        const double dt = std::sqrt(2 * b.z0 / cfg.field.gravity_fps2);
+        b.x0 += b.vx * dt;
+        b.y0 += b.vy * dt;
+        b.t0 += dt;
+        b.rolling = true;
+        z = 0;
+        Event skip = e;
+        skip.kind = EventKind::BallSkip;
+        skip.x = b.x0;
+        skip.y = b.y0;
+        skip.z = 0;
+        ev.push(skip);
+      } else {
+        e.miss = MissReason::Floor;
+        ev.push(e);
+        b.active = false;
+        continue;
+      }
+    }
+    const bool inSlab =
+        std::abs(x - cfg.field.divider_x_ft) <= cfg.field.divider_thickness_ft / 2 ||
+        reported(found, RootKind::BallDivider, s) > 0;
+    if (inSlab && yy >= cfg.field.divider_south_ft && yy <= cfg.field.divider_north_ft &&
+        z <= cfg.field.divider_height_ft) {
+      e.miss = MissReason::Divider;
+      ev.push(e);
+      b.active = false;
+      continue;
+    }
+    if (nR == 2) {
+      double p2, d2;
+      ballHitG(b, te, ys, p2, d2);
+      const int tgt = 1 - b.shooter;
+      const double R = radius(tgt);
+      const bool crossed = reported(found, RootKind::BallHit, s) > 0 && p2 <= R * R;
+      if ((crossed || d2 <= R * R) && z <= P(tgt).target_height_ft) {
+        Event h = e;
+        h.kind = EventKind::BallHit;
+        h.other = static_cast<std::int8_t>(tgt);
+        ev.push(h);
+        d.r[static_cast<std::size_t>(b.shooter)].hits++;
+        b.active = false;
+        continue;
+      }
+    }
+    if (reported(found, RootKind::BallOut, s) < 0 || ballOutG(b, te) < 0) {
+      e.miss = MissReason::LeftField;
+      ev.push(e);
+      b.active = false;
+    }
+  }
+  // -- robots
+  bool moved = false;
+  for (int i = 0; i < nR; ++i) {
+    RobotDisc& r = d.r[static_cast<std::size_t>(i)];
+    double* ry = ys + i * kPerRobot;
+    if (reported(found, RootKind::OutOfField, i) < 0 || outG(ys, i) < 0) {
+      const double hb = wireHalf - cfg.referee.putback_ft;
+      ry[X] = std::clamp(ry[X], -hb, hb);
+      ry[Y] = std::clamp(ry[Y], -hb, hb);
+      Event e{EventKind::RefereePutBack};
+      e.robot = static_cast<std::int8_t>(i);
+      ev.push(e);
+      moved = true;
+    }
+    if (r.reflex && (reported(found, RootKind::ReflexEnd, i) > 0 || reflexG(ys, i, d) >= 0)) {
+      r.reflex = false;
+      Event e{EventKind::ReflexEnd};
+      e.robot = static_cast<std::int8_t>(i);
+      e.bumper = r.reflexSide;
+      ev.push(e);
+    }
+  }
+  for (int pass = 0; pass < 3; ++pass) {
+    const int* f = pass == 0 ? found : nullptr;
+    contacts(T, d, y, f, ev);
+    edges(d, y, f, ev);
+    bool turned = false;
+    for (int i = 0; i < nR; ++i) turned = refereeTurn(T, d, y, i, ev) || turned;
+    if (!turned && !(moved && pass == 0)) break;
+    moved = false;
+  }
+}
+
+// Thesis VI.D auto_ref: more than reflex_limit bumper reflexes, or more
+// than event_limit reflexes and edge-handler entries, within the window
+// turn the robot by turn_deg and start the count again.
+bool Arena::Impl::refereeDue(const RobotDisc& r, std::int64_t T) const {
+  const std::int64_t from = T - timebase::ticksFromSeconds(cfg.referee.window_s);
+  return r.reflexTicks.countSince(from) > cfg.referee.reflex_limit ||
+         r.eventTicks.countSince(from) > cfg.referee.event_limit;
+}
+
+bool Arena::Impl::refereeTurn(std::int64_t T, Discrete& d, std::vector<double>& y, int i,
+                              EventList& ev) {
+  RobotDisc& r = d.r[static_cast<std::size_t>(i)];
+  if (!refereeDue(r, T)) return false;
+  y[static_cast<std::size_t>(i * kPerRobot + H)] += geom::degToRad(cfg.referee.turn_deg);
+  r.reflexTicks.n = 0;
+  r.eventTicks.n = 0;
+  Event e{EventKind::RefereeTurn};
+  e.robot = static_cast<std::int8_t>(i);
+  ev.push(e);
+  return true;
+}
+
+void Arena::Impl::contacts(std::int64_t T, Discrete& d, std::vector<double>& y, const int* found,
+                           EventList& ev) {
+  const double* ys = y.data();
+  auto contactEvent = [&](EventKind k, int i, Bumper b, ContactWith w, int other) {
+    Event e{k};
+    e.robot = static_cast<std::int8_t>(i);
+    e.bumper = b;
+    e.with = w;
+    e.other = static_cast<std::int8_t>(other);
+    ev.push(e);
+  };
+  if (nR == 2) {
+    const int rep = reported(found, RootKind::RobotRobot, 0);
+    const bool c = rep != 0 ? rep < 0 : robotG(ys) < 0;
+    if (c && !d.robotContact) {
+      for (int i = 0; i < 2; ++i) {
+        const Bumper side = sideOf(heading(ys, i), centre(ys, 1 - i) - centre(ys, i));
+        contactEvent(EventKind::Contact, i, side, ContactWith::Robot, 1 - i);
+        startReflex(d, y, i, side, T, ev);
+      }
+    } else if (!c && d.robotContact) {
+      for (int i = 0; i < 2; ++i)
+        contactEvent(EventKind::ContactEnd, i, Bumper::Front, ContactWith::Robot, 1 - i);
+    }
+    d.robotContact = c;
+  }
+  // A robot against a fixed obstacle: contact starts (the bumper on the
+  // side facing `towards`, and its reflex) or ends where g changes sign.
+  auto obstacle = [&](int i, RootKind k, double g, bool& touching, ContactWith with,
+                      const Vec2& towards) {
+    const int rep = reported(found, k, i);
+    const bool c = rep != 0 ? rep < 0 : g < 0;
+    if (c && !touching) {
+      const Bumper side = sideOf(heading(ys, i), towards);
+      contactEvent(EventKind::Contact, i, side, with, -1);
+      startReflex(d, y, i, side, T, ev);
+    } else if (!c && touching) {
+      contactEvent(EventKind::ContactEnd, i, Bumper::Front, with, -1);
+    }
+    touching = c;
+  };
+  for (int i = 0; i < nR; ++i) {
+    RobotDisc& r = d.r[static_cast<std::size_t>(i)];
+    const Vec2 cc = centre(ys, i);
+    obstacle(i, RootKind::Divider, dividerG(ys, i), r.dividerContact, ContactWith::Divider,
+             geom::closestPointOnRect(cc, geom::dividerRect(cfg.field)) - cc);
+    if (cfg.field.field_walls) {
+      const Vec2 normal = std::abs(cc.x()) >= std::abs(cc.y()) ? Vec2(cc.x() >= 0 ? 1 : -1, 0)
+                                                               : Vec2(0, cc.y() >= 0 ? 1 : -1);
+      obstacle(i, RootKind::Wall, wallG(ys, i), r.wallContact, ContactWith::Wall, normal);
+    }
+  }
+}
+
+void Arena::Impl::edges(Discrete& d, std::vector<double>& y, const int* found, EventList& ev) {
+  for (int i = 0; i < nR; ++i) {
+    RobotDisc& r = d.r[static_cast<std::size_t>(i)];
+    for (int k = 0; k < 2; ++k) {
+      const int rep = reported(found, k == 0 ? RootKind::EdgeFore : RootKind::EdgeAft, i);
+      const bool low = rep != 0 ? rep < 0 : edgeG(y.data(), i, k) < 0;
+      if (low == r.edgeLow[static_cast<std::size_t>(k)]) continue;
+      r.edgeLow[static_cast<std::size_t>(k)] = low;
+      Event e{low ? EventKind::EdgeEnter : EventKind::EdgeLeave};
+      e.robot = static_cast<std::int8_t>(i);
+      e.detector = k == 0 ? Detector::Fore : Detector::Aft;
+      ev.push(e);
+      // Not counted for the referee: a crossing counts only when the
+      // program's edge handler is entered (edgeHandlerEntered).
+    }
+  }
+}
+
+}  // namespace simbot::plant

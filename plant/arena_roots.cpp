@@ -1,0 +1,191 @@
+// plant/arena_roots.cpp -- the arena's root functions.
+//
+// Every discrete change of the arena is the zero of one of these functions
+// of time and state (arena.cpp, "Events"): edge detectors, walls, divider,
+// field, reflex end, robot-robot contact and the balls' closed-form
+// flights. buildRoots() lists the ones the current discrete state needs;
+// CVODE evaluates them through rootThunk; crossedTick() decides the tick of
+// a crossing CVODE reported. They only read the state: the rules that act
+// on a crossing are in arena_events.cpp.
+#include "plant/arena_impl.h"
+
+namespace simbot::plant {
+
+Vec2 Arena::Impl::detector(const double* y, int i, int k) const {
+  const double off = radius(i) - P(i).edge_detector_inset_ft;
+  const Vec2 dir = geom::headingDir(heading(y, i));
+  return k == 0 ? Vec2(centre(y, i) + off * dir) : Vec2(centre(y, i) - off * dir);
+}
+
+double Arena::Impl::edgeG(const double* y, int i, int k) const {
+  return geom::squareRingDistance(detector(y, i, k), wireHalf) - cfg.field.wire_sensitivity_ft;
+}
+
+double Arena::Impl::outG(const double* y, int i) const {
+  const Vec2 c = centre(y, i);
+  return half - std::max(std::abs(c.x()), std::abs(c.y()));
+}
+
+double Arena::Impl::dividerG(const double* y, int i) const {
+  const Vec2 c = centre(y, i);
+  return dividerClearance(c.x(), c.y(), radius(i), cfg.field);
+}
+
+double Arena::Impl::robotG(const double* y) const {
+  return (centre(y, 0) - centre(y, 1)).norm() - radius(0) - radius(1);
+}
+
+double Arena::Impl::reflexG(const double* y, int i, const Discrete& d) const {
+  const RobotDisc& r = d.r[static_cast<std::size_t>(i)];
+  const double sign = r.reflexSide == Bumper::Front ? -1.0 : 1.0;
+  return sign * (y[i * kPerRobot + S] - r.reflexS0) - P(i).reflex_distance_ft;
+}
+
+// Ball position at time t (closed form).
+void Arena::Impl::ballAt(const Ball& b, double t, double& x, double& yy, double& z) const {
+  const double dt = t - b.t0;
+  x = b.x0 + b.vx * dt;
+  yy = b.y0 + b.vy * dt;
+  z = b.rolling ? 0.0 : b.z0 - 0.5 * cfg.field.gravity_fps2 * dt * dt;
+}
+
+// The non-grazing hit function: along-track offset plus half-chord.
+double Arena::Impl::ballHitG(const Ball& b, double t, const double* y, double& perp2,
+                             double& dist2) const {
+  double x, yy, z;
+  ballAt(b, t, x, yy, z);
+  const int tgt = 1 - b.shooter;
+  const Vec2 rel = Vec2(x, yy) - centre(y, tgt);
+  const double R = radius(tgt);
+  dist2 = rel.squaredNorm();
+  const double sp = std::sqrt(b.vx * b.vx + b.vy * b.vy);
+  if (sp == 0.0) {
+    perp2 = dist2;
+    return R - std::sqrt(dist2);
+  }
+  const Vec2 u(b.vx / sp, b.vy / sp);
+  const double a = rel.dot(u);
+  perp2 = std::max(dist2 - a * a, 0.0);
+  return a + std::sqrt(std::max(R * R - perp2, 0.0));
+}
+
+// Distance from the ball to the other robot's body, a cylinder of the
+// target height (0 when inside it).
+double Arena::Impl::ballGap(const Ball& b, double t, const double* y) const {
+  double x, yy, z;
+  ballAt(b, t, x, yy, z);
+  const int tgt = 1 - b.shooter;
+  const double across = std::max((Vec2(x, yy) - centre(y, tgt)).norm() - radius(tgt), 0.0);
+  const double above = std::max(z - P(tgt).target_height_ft, 0.0);
+  return std::hypot(across, above);
+}
+
+// The field walls stop a ball (DESIGN.md: a ball reaching a field wall
+// is a miss), at the field's edge.
+double Arena::Impl::ballOutG(const Ball& b, double t) const {
+  double x, yy, z;
+  ballAt(b, t, x, yy, z);
+  return half - std::max(std::abs(x), std::abs(yy));
+}
+
+// Signed distance past the divider's near face along the ball's x
+// travel: linear in t, so a thin wall cannot be stepped over unnoticed.
+double Arena::Impl::ballDividerG(const Ball& b, double t) const {
+  double x, yy, z;
+  ballAt(b, t, x, yy, z);
+  const double dir = b.vx > 0 ? 1.0 : b.vx < 0 ? -1.0 : 0.0;
+  if (dir == 0.0) return 1.0;
+  return dir * (x - cfg.field.divider_x_ft) + cfg.field.divider_thickness_ft / 2;
+}
+
+double Arena::Impl::rootValue(const RootDesc& rd, double t, const double* y) const {
+  switch (rd.kind) {
+    case RootKind::EdgeFore:
+      return edgeG(y, rd.robot, 0);
+    case RootKind::EdgeAft:
+      return edgeG(y, rd.robot, 1);
+    case RootKind::OutOfField:
+      return outG(y, rd.robot);
+    case RootKind::Wall:
+      return wallG(y, rd.robot);
+    case RootKind::Divider:
+      return dividerG(y, rd.robot);
+    case RootKind::ReflexEnd:
+      return reflexG(y, rd.robot, D);
+    case RootKind::RobotRobot:
+      return robotG(y);
+    case RootKind::BallFloor: {
+      double x, yy, z;
+      ballAt(D.balls[static_cast<std::size_t>(rd.robot)], t, x, yy, z);
+      return z;
+    }
+    case RootKind::BallHit: {
+      double p2, d2;
+      return ballHitG(D.balls[static_cast<std::size_t>(rd.robot)], t, y, p2, d2);
+    }
+    case RootKind::BallOut:
+      return ballOutG(D.balls[static_cast<std::size_t>(rd.robot)], t);
+    case RootKind::BallDivider:
+      return ballDividerG(D.balls[static_cast<std::size_t>(rd.robot)], t);
+  }
+  return 1.0;
+}
+
+int Arena::Impl::rootThunk(sunrealtype t, N_Vector y, sunrealtype* g, void* user) {
+  const Impl* self = static_cast<const Impl*>(user);
+  const double* yy = N_VGetArrayPointer(y);
+  for (int i = 0; i < self->nRoots; ++i)
+    g[i] = self->rootValue(self->roots[static_cast<std::size_t>(i)], t, yy);
+  return 0;
+}
+
+void Arena::Impl::buildRoots() {
+  nRoots = 0;
+  auto add = [&](RootKind k, int who) {
+    roots[static_cast<std::size_t>(nRoots++)] = RootDesc{k, who};
+  };
+  for (int i = 0; i < nR; ++i) {
+    add(RootKind::EdgeFore, i);
+    add(RootKind::EdgeAft, i);
+    add(RootKind::OutOfField, i);
+    if (cfg.field.field_walls) add(RootKind::Wall, i);
+    add(RootKind::Divider, i);
+    if (D.r[static_cast<std::size_t>(i)].reflex) add(RootKind::ReflexEnd, i);
+  }
+  if (nR == 2) add(RootKind::RobotRobot, 0);
+  for (int b = 0; b < kMaxBalls; ++b) {
+    const Ball& ball = D.balls[static_cast<std::size_t>(b)];
+    if (!ball.active) continue;
+    if (!ball.rolling) add(RootKind::BallFloor, b);
+    if (nR == 2) add(RootKind::BallHit, b);
+    add(RootKind::BallOut, b);
+    add(RootKind::BallDivider, b);
+  }
+}
+
+// DESIGN.md: an event happens at the first integer tick at which its root
+// function has crossed. CVODE returns the right end of its root bracket,
+// a hair past the crossing, so T0 = ceil(tret) is one tick late when the
+// crossing falls exactly on tick T0 - 1 (a contact at constant speed, a
+// reflex of exactly 1.5 ft at 1.5 ft/s). Decide from dense output at the
+// two neighbouring ticks: T0 - 1 if a reported root function is already
+// on its new side there, or within kOnTickFraction of a tick of it
+// (linearly between the ticks), which round-off cannot tell from zero.
+std::int64_t Arena::Impl::crossedTick(std::int64_t T0) {
+  const std::int64_t k = T0 - 1;
+  if (k <= segTick) return T0;  // the segment's first tick is not a crossing
+  const double tk = secondsFromTick(k), tT = secondsFromTick(T0);
+  evalAt(tk, tmp);
+  evalAt(tT, qtmp);
+  for (int j = 0; j < nRoots; ++j) {
+    const int dir = rootsFound[static_cast<std::size_t>(j)];
+    if (dir == 0) continue;
+    const RootDesc& rd = roots[static_cast<std::size_t>(j)];
+    const double gk = rootValue(rd, tk, tmp.data());
+    const double gT = rootValue(rd, tT, qtmp.data());
+    if (dir * gk >= 0 || std::abs(gk) <= kOnTickFraction * std::abs(gT - gk)) return k;
+  }
+  return T0;
+}
+
+}  // namespace simbot::plant

@@ -1,0 +1,334 @@
+// scheduler/match_impl.h -- internal: the classes of one match.
+//
+// A match is its round loop (Match, match.cpp) and its robots, each a VM
+// with the devices its program talks to (Robot). The robot's bus -- how a
+// VM's port writes, A/D reads, serial library calls and interrupt
+// notifications become plant inputs, queued events and trace records -- is
+// in robot_bus.cpp, apart from the round loop; both see these classes, in
+// namespace detail. Nothing outside scheduler/ includes this header.
+#pragma once
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <deque>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "plant/pio.h"
+#include "plant/serial_link.h"
+#include "scheduler/event_queue.h"
+#include "scheduler/match.h"
+#include "scheduler/part_clock.h"
+
+namespace simbot::scheduler::detail {
+
+constexpr Tick kLookahead = plant::kTicksPerChar;
+// How far the plant integrates ahead in one round (header comment, "Larger
+// rounds"): eight character times. Integration past an input's tick is
+// thrown away at the input, so this bounds the work wasted per input.
+constexpr Tick kRoundLookahead = 8 * plant::kTicksPerChar;
+
+// Queued events; the plant's own events come from Arena::advance.
+struct QueuedEvent {
+  enum class Kind : uint8_t { SerialByte, DriveLeg, Inject, ReleaseEdge, Reload, EndOfRound } kind;
+  int robot = 0;
+  int index = 0;  // injection number, path leg, or the detector bit to release
+};
+
+// A plant input made by a robot during a round: a port B write, a bump
+// injected at a program point, or the entry into its PIO (edge) handler,
+// which the referee counts. Applied after the round, in tick order.
+struct PlantInput {
+  Tick tick;
+  int robot;
+  enum class Kind : uint8_t { PortB, Reflex, EdgeHandler } kind;
+  uint8_t value;  // port B
+  plant::Bumper bumper;
+};
+
+class Match;
+
+// A robot on a scripted path follows it exactly: its wheels have no lag.
+// The arena this match plays in: the configured one with this seed's
+// variation (DESIGN.md), each purpose drawn from its own stream of (seed,
+// purpose, robot): the hand placement, then each robot's wheel trims.
+plant::ArenaConfig arenaConfigFor(const MatchConfig& config);
+
+// A VM's clock starts at 0 when it is made; a VM made for a reload starts
+// at tick `base` of the match, so every tick it reports is moved by `base`.
+class ShiftedBus : public vm::Bus {
+ public:
+  explicit ShiftedBus(vm::Bus& to) : to_(to) {}
+  Tick base = 0;
+  void out(Tick t, uint16_t port, uint8_t value) override { to_.out(t + base, port, value); }
+  uint8_t in(Tick t, uint16_t port) override { return to_.in(t + base, port); }
+  int adSample(Tick t, int channel) override { return to_.adSample(t + base, channel); }
+  void hvEnable(Tick t) override { to_.hvEnable(t + base); }
+  void serialInit(Tick t, int mode, int divisor) override {
+    to_.serialInit(t + base, mode, divisor);
+  }
+  void serialSend(Tick t, uint16_t buf, uint16_t cc) override { to_.serialSend(t + base, buf, cc); }
+  void serialTxService(Tick t, vm::Vm& v) override { to_.serialTxService(t + base, v); }
+  void console(Tick t, std::string_view line) override { to_.console(t + base, line); }
+  void interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) override {
+    to_.interruptAccepted(t + base, irq, pc);
+  }
+  void interruptReturned(Tick t, vm::Irq irq) override { to_.interruptReturned(t + base, irq); }
+  void iffChanged(Tick t, bool iff1) override { to_.iffChanged(t + base, iff1); }
+  bool wantCostateEvents() const override { return to_.wantCostateEvents(); }
+  void costate(Tick t, uint16_t coData, CostateEvent e, int line) override {
+    to_.costate(t + base, coData, e, line);
+  }
+
+ private:
+  vm::Bus& to_;
+};
+
+// One robot: its VM, the devices its program talks to, and its counters.
+class Robot : public vm::Bus, public plant::RobotMemory {
+ public:
+  Robot(Match& match, int index, const RobotSpec& spec, const vm::CostTable& costs, uint64_t seed);
+
+  // The robot's clock (match ticks) and its program's VM.
+  Tick now() const { return bus.base + vm_->now(); }
+  vm::Vm& vm() { return *vm_; }
+  const vm::Vm& vm() const { return *vm_; }
+  // A VM as at load, its clock at t: fresh memory (with the profile's
+  // power-on fill), the breakpoints the match needs.
+  void powerOn(Tick t);
+  // --reload-on-fault: the faulted program starts again at t.
+  void reload(Tick t);
+  bool reloadPending = false;
+  bool faultSeen = false;  // this VM's fault is recorded
+
+  // vm::Bus
+  void out(Tick t, uint16_t port, uint8_t value) override;
+  uint8_t in(Tick t, uint16_t port) override;
+  int adSample(Tick t, int channel) override;
+  void serialSend(Tick t, uint16_t buf, uint16_t cc) override;
+  void serialTxService(Tick t, vm::Vm& v) override;
+  void console(Tick t, std::string_view line) override;
+  void interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) override;
+  void interruptReturned(Tick t, vm::Irq irq) override;
+  void iffChanged(Tick t, bool iff1) override;
+  bool wantCostateEvents() const override;
+  void costate(Tick t, uint16_t coData, CostateEvent e, int line) override;
+  // plant::RobotMemory
+  uint8_t read8(uint16_t a) const override { return vm_->read8(a); }
+  void write8(uint16_t a, uint8_t v) override { vm_->write8(a, v); }
+
+  // Runs the VM to `horizon` (its clock ends at or after it).
+  void runTo(Tick horizon);
+  void byteDone(Tick t);
+  // Port A's edge lines: low while the plant says so or an injection holds.
+  void updateEdgeLines(Tick t);
+  void inject(Tick t, const Injection& injection);
+  uint8_t plantLow = 0, injectedLow = 0;
+  std::map<uint32_t, std::vector<int>> lineInjections;  // code address -> injections
+  // Executions of each injection point, over the whole run (a reload does
+  // not restart the count).
+  std::map<uint32_t, int> lineHits;
+  struct Watch {
+    std::string name;
+    uint16_t address;
+    std::string type;
+  };
+  std::vector<Watch> watches;
+  trace::Watch watchedValues() const;
+  void scheduleSerial(Tick t);
+  void updateSerialRequest();
+
+  // Where the program was at each sample tick (traced runs): taken at the
+  // VM's first instruction boundary at or after the tick.
+  struct Snapshot {
+    Tick tick;
+    int line;
+    const vm::Symbol* function;
+    bool inHandler;
+    trace::Watch watch;
+  };
+  std::deque<Snapshot> snapshots;
+  Tick nextSnapshot = 0;
+  void takeSnapshots();
+  Snapshot snapshotFor(Tick t);
+  std::string handlerName() const;
+
+  const RobotSpec& spec;
+  int index;
+  Match& match;
+  const vm::CostTable& costs;
+  ShiftedBus bus;
+  std::unique_ptr<vm::Vm> vm_;
+  plant::SplitMix64 memoryFill;  // power-on RAM (profile random_memory)
+  // T-states of earlier VMs of this robot (reloads), for profiles.
+  std::vector<uint64_t> earlierProfile;
+  uint64_t earlierSerialIsrCycles = 0;
+  uint64_t earlierTimerIsrCycles = 0;
+  uint64_t earlierInstructions = 0, earlierFastForwarded = 0;
+  plant::SerialLink link;
+  // What the serial library had still to fetch of the current send after
+  // its last step: a new send while it is above zero overwrites that frame.
+  // (Read back after each step, since the program may rewrite *cc itself.)
+  uint16_t sendCcAddress = 0;
+  int sendUnfetched = 0;
+  plant::PioPortA pio;
+  uint8_t edgeLines = 0xFF;
+  int enb485 = -1;  // never written
+  std::array<int64_t, 2> adReads{};
+  // Interrupts accepted per source (vm::Irq), over the whole run; put into
+  // the result's map by name at the end, so counting one allocates nothing.
+  std::array<uint64_t, vm::kIrqCount> interruptCounts{};
+  std::array<int, 2> lastAdValue{-1, -1};
+  Tick serialEventAt = -1;
+  Tick serialIsrAccepted = 0;
+  plant::SplitMix64 noise;
+  plant::SplitMix64 gunLuck;  // jams and misfires
+  plant::SplitMix64 muzzle;   // muzzle-speed spread, one draw per launching stroke
+  RobotResult result;
+  uint32_t mainReturn;
+};
+
+class Match {
+ public:
+  explicit Match(const MatchConfig& config)
+      : config_(config),
+        costs_(vm::makeCostTable(config.knobs)),
+        arenaConfig_(arenaConfigFor(config)),
+        arena_(arenaConfig_),
+        coin_(streamSeed(config.seed, "coin")),
+        clock_(config.timeParts) {
+    for (trace::Sink* sink : config.sinks) trace_.attach(sink);
+    if (config.robots.empty() || config.robots.size() > 2)
+      throw std::invalid_argument("a match needs one or two robots");
+    for (size_t i = 0; i < config.robots.size(); ++i)
+      robots_.push_back(std::make_unique<Robot>(*this, static_cast<int>(i), config.robots[i],
+                                                costs_, config.seed));
+    if (config.reloadOnFault && config.reloadDelay < kMinReloadDelay)
+      throw std::invalid_argument(
+          fmt::format("a reload must wait at least {} ticks (the serial port's two characters)",
+                      kMinReloadDelay));
+    resolveWatches();
+    queue_.schedule(config.endTick, EventClass::EndOfRound, {QueuedEvent::Kind::EndOfRound, 0, 0});
+    for (size_t i = 0; i < config.robots.size(); ++i) {
+      for (const DriveLeg& leg : config.robots[i].path)
+        if (leg.duration <= 0) throw std::invalid_argument("a path leg must last at least a tick");
+      if (!config.robots[i].path.empty())
+        queue_.schedule(0, EventClass::MotorLatch,
+                        {QueuedEvent::Kind::DriveLeg, static_cast<int>(i), 0});
+    }
+    for (size_t k = 0; k < config.injections.size(); ++k) {
+      const Injection& in = config.injections[k];
+      if (in.robot < 0 || in.robot >= static_cast<int>(robots_.size()))
+        throw std::invalid_argument("injection for a robot that is not in this run: " + in.text);
+      Robot& r = *robots_[static_cast<size_t>(in.robot)];
+      if (in.line > 0) {
+        const auto& lines = r.spec.image.lines;
+        const auto at = std::find(lines.begin(), lines.end(), in.line);
+        if (at == lines.end())
+          throw std::invalid_argument(
+              fmt::format("{}: line {} of {} has no code", in.text, in.line, r.spec.program));
+        const std::optional<uint32_t> head = loopHead(r.spec.image, in.line);
+        if (in.pass && !head)
+          throw std::invalid_argument(fmt::format(
+              "{}: line {} of {} holds no whole loop (pass:N#K counts the passes of a loop "
+              "written on one line; line:N#K counts entries into a line)",
+              in.text, in.line, r.spec.program));
+        if (!in.pass && head)
+          warnings_.push_back(fmt::format(
+              "--inject {}: line {} of {} holds a whole loop; line:N#K counts entries into "
+              "the line (runs of its first instruction, once before each run of the loop), "
+              "not passes of the loop; for pass {} of the loop write pass:{}#{}",
+              in.text, in.line, r.spec.program, in.count, in.line, in.count));
+        const auto address = in.pass ? *head : static_cast<uint32_t>(at - lines.begin());
+        r.lineInjections[address].push_back(static_cast<int>(k));
+        injectionAddress_[k] = address;
+        r.vm().setBreakpoint(address);
+      } else {
+        queue_.schedule(in.tick, EventClass::Injection,
+                        {QueuedEvent::Kind::Inject, in.robot, static_cast<int>(k)});
+      }
+    }
+  }
+
+  MatchResult run();
+  // The round loop; `roundStart` is the tick the current round began at.
+  void rounds(MatchResult& result, Tick& roundStart);
+
+  plant::Arena& arena() { return arena_; }
+  PartClock& clock() { return clock_; }
+  bool tracing() const { return trace_.on(); }
+  bool profiling() const { return config_.profile; }
+  bool tracingCostates() const { return config_.traceCostate && trace_.on(); }
+  // Robot `robot` faulted at t: its reload, if the run asks for one.
+  void faulted(int robot, Tick t);
+  // Injection `injection` (one of config_.injections) fired.
+  void fired(const Injection& injection) {
+    fired_[static_cast<size_t>(&injection - config_.injections.data())] = true;
+  }
+  Tick sampleInterval() const { return config_.sampleInterval; }
+  // A record at tick t, with the watched variables of its robot as they are
+  // now in that robot's memory.
+  void emit(Tick t, trace::Record record);
+  void emit(Tick t, trace::Record record, trace::Watch watch) {
+    trace_.emit(t, std::move(record), std::move(watch));
+  }
+  EventQueue<QueuedEvent>& queue() { return queue_; }
+  std::vector<PlantInput>& inputs() { return inputs_; }
+  bool betweenRounds() const { return betweenRounds_; }
+  void applyReflex(Tick t, int robot, plant::Bumper side);
+  void startLeg(Tick t, int robot, int leg);
+  const Injection& injection(int k) const { return config_.injections[static_cast<size_t>(k)]; }
+  const std::string& name(int robot) const {
+    return config_.robots[static_cast<size_t>(robot)].name;
+  }
+  MatchObserver* observer() const { return config_.observer; }
+  const plant::RobotParams& robotParams(int robot) const {
+    return arenaConfig_.robots[static_cast<size_t>(robot)].params;
+  }
+
+ private:
+  Tick earliestClock() const;
+  bool allExited() const {
+    return std::all_of(robots_.begin(), robots_.end(), [](const auto& r) {
+      return (r->result.exited || r->vm().fault()) && !r->reloadPending;
+    });
+  }
+  void applyInputs();
+  bool advancePlantTo(Tick t, plant::AdvanceResult& step);
+  void resolveWatches();
+  void emitSetup();
+  trace::Record plantRecord(const plant::Event& e) const;
+  void handlePlantEvents(Tick t, const plant::EventList& events);
+  void sampleUpTo(Tick t);
+  void finish(MatchResult& result);
+
+  const MatchConfig& config_;
+  vm::CostTable costs_;
+  plant::ArenaConfig arenaConfig_;  // config_.arena with this seed's variation
+  plant::Arena arena_;
+  trace::Tracer trace_;
+  plant::SplitMix64 coin_;
+  EventQueue<QueuedEvent> queue_;
+  std::vector<std::unique_ptr<Robot>> robots_;
+  std::vector<PlantInput> inputs_;
+  std::vector<std::string> warnings_;
+  std::vector<bool> fired_ = std::vector<bool>(config_.injections.size());
+  std::vector<uint32_t> injectionAddress_ = std::vector<uint32_t>(config_.injections.size());
+  int hitsAt(const Injection& in, uint32_t address) const {
+    const auto& hits = robots_[static_cast<size_t>(in.robot)]->lineHits;
+    const auto it = hits.find(address);
+    return it == hits.end() ? 0 : it->second;
+  }
+  bool betweenRounds_ = false;
+  Tick nextSample_ = 0;
+  uint64_t rounds_ = 0;
+  uint64_t subRounds_ = 0;  // sub-rounds after the first of each round
+  PartClock clock_;
+};
+
+}  // namespace simbot::scheduler::detail

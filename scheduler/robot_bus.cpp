@@ -1,0 +1,247 @@
+// scheduler/robot_bus.cpp -- a robot's bus: what its VM's accesses do.
+//
+// The VM calls these at the exact tick of each access (vm::Bus): port B
+// writes and PIO handler entries become plant inputs applied after the
+// round, A/D reads the plant's eye readings at their tick, the serial
+// library's calls drive the robot's serial link to the motor controller
+// (a latched frame sets the wheels), PIO port A follows the edge lines, and
+// each leaves its trace record. The round loop that runs the VMs and
+// applies the inputs is in match.cpp.
+#include <bit>
+#include <string>
+
+#include "scheduler/match_impl.h"
+
+namespace simbot::scheduler::detail {
+
+void Robot::out(Tick t, uint16_t port, uint8_t value) {
+  switch (port) {
+    case vm::kPortPIOCA:
+      pio.control(value);
+      return;
+    case vm::kPortPIODA:
+      pio.writeData(value);
+      return;
+    case vm::kPortPIODB:
+      match.inputs().push_back({t, index, PlantInput::Kind::PortB, value, plant::Bumper::Front});
+      if (match.tracing()) match.emit(t, trace::rec::PortB{index, value});
+      return;
+    case vm::kPortENB485:
+      if (match.tracing() && value != enb485) match.emit(t, trace::rec::Rs485{index, value});
+      enb485 = value;
+      return;
+    default:
+      return;  // PIOCB set-up and unknown ports have no effect here
+  }
+}
+
+uint8_t Robot::in(Tick, uint16_t port) {
+  if (port == vm::kPortPIODA) return pio.read();
+  return 0xFF;
+}
+
+int Robot::adSample(Tick t, int channel) {
+  // Only the eye asked for is computed; the noise stream advances as for both.
+  const plant::EyeChannels asked = channel == 0   ? plant::EyeChannels::Left
+                                   : channel == 1 ? plant::EyeChannels::Right
+                                                  : plant::EyeChannels::Both;
+  const plant::EyeReadings e = [&] {
+    const PartScope plant(match.clock(), PartClock::Plant);
+    return match.arena().eyeReadings(index, t, &noise, asked);
+  }();
+  const int value = channel == 0 ? e.left : channel == 1 ? e.right : 0;
+  if (match.observer()) match.observer()->onEyeRead(index, t, channel, value);
+  if (channel == 0 || channel == 1) {
+    // Traced as a step when it differs: a search loop reads thousands a second.
+    const auto c = static_cast<size_t>(channel);
+    ++adReads[c];
+    if (match.tracing() && value != lastAdValue[c])
+      match.emit(t, trace::rec::AdRead{index, channel, value, adReads[c]});
+    lastAdValue[c] = value;
+  }
+  return value;
+}
+
+void Robot::serialSend(Tick t, uint16_t buf, uint16_t cc) {
+  if (match.tracing()) match.emit(t, trace::rec::SerialSend{index, vm_->read8(cc)});
+  if (sendUnfetched > 0) ++result.framesOverwritten;
+  link.send(t, buf, cc, *this);
+  sendCcAddress = cc;
+  sendUnfetched = vm_->read8(cc);
+  scheduleSerial(t);
+  updateSerialRequest();
+}
+
+void Robot::serialTxService(Tick t, vm::Vm&) {
+  link.service(t, *this);
+  sendUnfetched = vm_->read8(sendCcAddress);
+  scheduleSerial(t);
+  updateSerialRequest();
+}
+
+// A byte that entered the shift register is on the wire for one character
+// time, ending at nextByteDone().
+void Robot::scheduleSerial(Tick) {
+  const auto done = link.nextByteDone();
+  if (done && *done != serialEventAt) {
+    serialEventAt = *done;
+    if (match.tracing())
+      match.emit(*done - plant::kTicksPerChar, trace::rec::SerialByte{index, link.shifting()});
+    match.queue().schedule(*done, EventClass::SerialByte,
+                           {QueuedEvent::Kind::SerialByte, index, 0});
+  }
+}
+
+void Robot::updateSerialRequest() {
+  if (link.requestingInterrupt())
+    vm_->request(vm::Irq::SerialTx);
+  else
+    vm_->cancelRequest(vm::Irq::SerialTx);
+}
+
+void Robot::byteDone(Tick t) {
+  serialEventAt = -1;
+  if (auto frame = link.byteDone(t)) {
+    if (match.observer()) match.observer()->onFrame(index, t, frame->command.has_value());
+    if (frame->command) {
+      ++result.framesLatched;
+      const PartScope plant(match.clock(), PartClock::Plant);
+      match.arena().setWheels(index, *frame->command, t);
+    } else {
+      ++result.framesRejected;
+    }
+    if (match.tracing()) {
+      if (frame->command)
+        match.emit(t, trace::rec::FrameLatched{index, frame->bytes});
+      else
+        match.emit(t, trace::rec::FrameRejected{index, frame->bytes});
+    }
+  }
+  scheduleSerial(t);
+  updateSerialRequest();
+}
+
+// Each watched variable's value as its C type reads it.
+trace::Watch Robot::watchedValues() const {
+  trace::Watch values;
+  for (const auto& w : watches) {
+    const bool isUnsigned = w.type.find("unsigned") != std::string::npos;
+    trace::WatchValue v;
+    if (w.type.find('*') != std::string::npos) {
+      v = std::int64_t{vm_->read16(w.address)};
+    } else if (w.type.find("float") != std::string::npos ||
+               w.type.find("double") != std::string::npos) {
+      v = static_cast<double>(std::bit_cast<float>(vm_->read32(w.address)));
+    } else if (w.type.find("long") != std::string::npos) {
+      const uint32_t raw = vm_->read32(w.address);
+      v = isUnsigned ? std::int64_t{raw} : std::int64_t{static_cast<int32_t>(raw)};
+    } else if (w.type.find("char") != std::string::npos) {
+      v = std::int64_t{vm_->read8(w.address)};
+    } else {
+      const uint16_t raw = vm_->read16(w.address);
+      v = isUnsigned ? std::int64_t{raw} : std::int64_t{static_cast<int16_t>(raw)};
+    }
+    values.emplace_back(w.name, v);
+  }
+  return values;
+}
+
+void Robot::updateEdgeLines(Tick t) {
+  const auto lines = static_cast<uint8_t>(~(plantLow | injectedLow));
+  if (lines != edgeLines && match.tracing()) match.emit(t, trace::rec::PortA{index, lines});
+  edgeLines = lines;
+  if (pio.setInputs(edgeLines)) vm_->request(vm::Irq::Pio, pio.vector());
+}
+
+void Robot::inject(Tick t, const Injection& injection) {
+  match.fired(injection);
+  if (match.tracing()) match.emit(t, trace::rec::Injection{index, injection.text, vm_->line()});
+  switch (injection.source) {
+    case InjectSource::EdgeFore:
+    case InjectSource::EdgeAft: {
+      const uint8_t bit = injection.source == InjectSource::EdgeFore ? 0x02 : 0x01;
+      injectedLow |= bit;
+      updateEdgeLines(t);
+      match.queue().schedule(t + kInjectedEdgePulse, EventClass::Injection,
+                             {QueuedEvent::Kind::ReleaseEdge, index, bit});
+      return;
+    }
+    case InjectSource::BumperFront:
+    case InjectSource::BumperBack: {
+      const plant::Bumper side = injection.source == InjectSource::BumperFront
+                                     ? plant::Bumper::Front
+                                     : plant::Bumper::Back;
+      // Between rounds (a time or tick) the plant takes it at once; at a
+      // program point it waits for the end of the round with port B writes.
+      if (match.betweenRounds())
+        match.applyReflex(t, index, side);
+      else
+        match.inputs().push_back({t, index, PlantInput::Kind::Reflex, 0, side});
+      return;
+    }
+  }
+}
+
+void Robot::console(Tick t, std::string_view line) {
+  result.console.emplace_back(line);
+  if (match.tracing()) match.emit(t, trace::rec::Console{index, std::string(line)});
+}
+
+// The #INT_VEC handler the PIO's vector selects.
+std::string Robot::handlerName() const {
+  for (const auto& v : spec.image.vectors)
+    if (v.vector == pio.vector()) return v.handlerName;
+  return "";
+}
+
+void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
+  ++interruptCounts[static_cast<size_t>(irq)];
+  if (match.observer()) match.observer()->onInterruptAccepted(index, t, irq);
+  if (irq == vm::Irq::Pio) {
+    pio.accepted();
+    match.inputs().push_back({t, index, PlantInput::Kind::EdgeHandler, 0, plant::Bumper::Front});
+  }
+  // The BIOS timer service (1,024 a second) is counted, not traced.
+  if (!match.tracing() || irq == vm::Irq::Timer) return;
+  if (irq == vm::Irq::SerialTx) {
+    serialIsrAccepted = t;  // traced as one span when it returns
+    return;
+  }
+  const vm::Symbol* fn = spec.image.functionAt(pc);
+  match.emit(t, trace::rec::InterruptAccepted{index, std::string(vm::irqName(irq)),
+                                              spec.image.lineAt(pc), fn ? fn->name : "",
+                                              irq == vm::Irq::Pio ? handlerName() : ""});
+}
+
+void Robot::interruptReturned(Tick t, vm::Irq irq) {
+  if (irq == vm::Irq::SerialTx) {
+    if (match.tracing()) match.emit(serialIsrAccepted, trace::rec::SerialIsr{index, t});
+    return;
+  }
+  if (irq != vm::Irq::Pio) return;
+  if (match.tracing())
+    match.emit(t, trace::rec::InterruptReturned{index, std::string(vm::irqName(irq))});
+  if (pio.returned()) vm_->request(vm::Irq::Pio, pio.vector());
+}
+
+void Robot::iffChanged(Tick t, bool iff1) {
+  if (match.tracing()) match.emit(t, trace::rec::Iff1{index, iff1});
+}
+
+bool Robot::wantCostateEvents() const { return match.tracingCostates(); }
+
+// The costatement is named by its CoData's symbol: the name a named one
+// was given, "costate@LINE" for an unnamed one (FUNCTION.costate@LINE).
+void Robot::costate(Tick t, uint16_t coData, CostateEvent e, int line) {
+  std::string name = fmt::format("0x{:04x}", coData);
+  for (const auto& s : spec.image.symbols)
+    if (s.address == coData && s.size == vm::kCoDataSize &&
+        (s.kind == vm::Symbol::Kind::Global || s.kind == vm::Symbol::Kind::Static)) {
+      name = s.name.substr(s.name.find('.') + 1);
+      break;
+    }
+  static constexpr const char* kEvent[] = {"enter", "yield", "end"};
+  match.emit(t, trace::rec::Costate{index, name, kEvent[static_cast<int>(e)], line});
+}
+
+}  // namespace simbot::scheduler::detail
