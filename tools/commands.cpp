@@ -18,8 +18,6 @@
 
 namespace simbot::tools {
 
-namespace {
-
 int guarded(const std::function<int()>& body) {
   try {
     return body();
@@ -32,7 +30,7 @@ int guarded(const std::function<int()>& body) {
   }
 }
 
-}  // namespace
+namespace {}  // namespace
 
 CLI::Validator seedValidator() {
   return CLI::Validator(

@@ -12,6 +12,10 @@ struct Subcommand {
   std::function<int()> run;  // prints its own errors; returns the exit status
 };
 
+// Runs a subcommand's body: a ToolError or a profile's ConfigError is
+// printed on stderr and gives exit status 1.
+int guarded(const std::function<int()>& body);
+
 // A seed: a decimal integer from 0 to 2^64 - 1 (not wrapped, not signed).
 CLI::Validator seedValidator();
 

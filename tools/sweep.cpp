@@ -519,17 +519,7 @@ Subcommand addSweepCommand(CLI::App& app) {
   cmd->add_option("--dask", o->dask,
                   "run on a Dask cluster through the Python module: tcp://HOST:PORT, or "
                   "local:N for a local cluster of N worker processes");
-  return {cmd, [o] {
-            try {
-              return runSweepCommand(*o);
-            } catch (const ToolError& e) {
-              std::cerr << e.what();
-              return 1;
-            } catch (const plant::ConfigError& e) {
-              std::cerr << e.what() << '\n';
-              return 1;
-            }
-          }};
+  return {cmd, [o] { return guarded([&] { return runSweepCommand(*o); }); }};
 }
 
 }  // namespace simbot::tools
