@@ -63,6 +63,14 @@ class SerialLink {
     return tsrBusy_ ? std::optional<Tick>(tsrDoneAt_) : std::nullopt;
   }
   bool idle() const { return !tsrBusy_ && !tdrFull_; }
+  // When a NUL already in the port finishes (the only byte that can latch a
+  // frame): the TSR's, or else the TDR's, which follows it. Nullopt when
+  // neither holds a NUL: any later one finishes after the next byte done.
+  std::optional<Tick> nulDone() const {
+    if (tsrBusy_ && tsr_ == 0) return tsrDoneAt_;
+    if (tsrBusy_ && tdrFull_ && tdr_ == 0) return tsrDoneAt_ + kTicksPerChar;
+    return std::nullopt;
+  }
   // The byte in the TSR (on the wire until nextByteDone()).
   uint8_t shifting() const { return tsr_; }
   uint64_t bytesSent() const { return bytesSent_; }

@@ -9,8 +9,8 @@
 // whatever the heap does with equal elements. Causality is asserted: an
 // event may not be scheduled before the tick of the last event taken.
 #pragma once
+#include <algorithm>
 #include <cstdint>
-#include <queue>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -67,17 +67,27 @@ class EventQueue {
     if (tick < now_)
       throw CausalityError("event scheduled at tick " + std::to_string(tick) + " before now (" +
                            std::to_string(now_) + ")");
-    heap_.push(Entry{EventKey{tick, cls, nextSeq_++}, std::move(payload)});
+    heap_.push_back(Entry{EventKey{tick, cls, nextSeq_++}, std::move(payload)});
+    std::push_heap(heap_.begin(), heap_.end(), Later{});
   }
   bool empty() const { return heap_.empty(); }
   size_t size() const { return heap_.size(); }
-  Tick nextTick() const { return heap_.top().key.tick; }
-  const Entry& top() const { return heap_.top(); }
+  Tick nextTick() const { return heap_.front().key.tick; }
+  const Entry& top() const { return heap_.front(); }
   Entry pop() {
-    Entry e = heap_.top();
-    heap_.pop();
+    std::pop_heap(heap_.begin(), heap_.end(), Later{});
+    Entry e = std::move(heap_.back());
+    heap_.pop_back();
     now_ = e.key.tick;
     return e;
+  }
+  // The tick of the earliest event of any class but `cls`, or `none` if
+  // there is none. A scan: the queue holds a handful of events.
+  Tick nextTickExcept(EventClass cls, Tick none) const {
+    Tick best = none;
+    for (const Entry& e : heap_)
+      if (e.key.cls != cls && e.key.tick < best) best = e.key.tick;
+    return best;
   }
   Tick now() const { return now_; }
 
@@ -85,7 +95,7 @@ class EventQueue {
   struct Later {
     bool operator()(const Entry& a, const Entry& b) const { return b.key < a.key; }
   };
-  std::priority_queue<Entry, std::vector<Entry>, Later> heap_;
+  std::vector<Entry> heap_;  // a binary heap under Later: top at front()
   uint64_t nextSeq_ = 0;
   Tick now_ = 0;
 };

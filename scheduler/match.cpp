@@ -6,15 +6,20 @@
 // the one-character protocol of match.h: from t_k = the earliest VM clock,
 // every VM runs to h_k = min(next queued event, t_k + 9,600, the plant's
 // next event). What a round saves is the plant's round trip: the plant is
-// advanced once, to P = min(next queued event, t + 8 x 9,600) (only to the
-// first sub-round's horizon while a ball is in flight or a launch is
+// advanced once, to P = min(next queued event that is not a serial byte,
+// the finish of a NUL already in a serial port, t + 8 x 9,600) (only to
+// the first sub-round's horizon while a ball is in flight or a launch is
 // scheduled), and a sub-round ends the round when
 //   (a) its VMs made a plant input (port B write, injected bump, edge
 //       handler entry): inputs are applied at the end of the sub-round, as
 //       at the end of a one-character round;
 //   (b) a queued event is due at its horizon, or the plant's event is (h_k
-//       is the plant's stop P or its event tick);
-//   (c) (solo runs) every robot has exited or faulted.
+//       is the plant's stop P or its event tick), but see (d);
+//   (c) (solo runs) every robot has exited or faulted;
+//   (d) serial bytes due at h_k (and nothing else) are taken between the
+//       sub-rounds, as at the end of a round, and the round goes on unless
+//       a byte latched a frame with new wheel speeds (that re-initialises
+//       the plant at h_k, as an input would).
 // Claim: a run gives the same VM instructions, bus accesses, events and
 // trace records, at the same ticks, as with one plant advance per round.
 // Proof, by the sub-rounds of one round, which have no (a) or (b) before
@@ -42,6 +47,25 @@
 // closest approach) updates the ball's closest distance when the plant
 // reaches it, and one past an input's tick would not be found on the
 // re-initialised trajectory.
+// (5) Rule (d): a byte done only changes its robot's link, port and
+// interrupt request (no VM runs, so nothing else sees it before h_k) and,
+// when it completes a frame, the latched command. A latch that keeps the
+// wheel speeds changes neither the state nor the right-hand side, so the
+// prediction holds (Arena::setWheels keeps it, as it does between rounds);
+// one that changes them re-initialises the plant at h_k, leaving it where
+// retreat(h_k) and the same input would have, and the round ends there
+// (only a NUL latches; P stops at one already in a port because the steps
+// past it would mostly be thrown away, which cost what the rounds save). The
+// byte's records and samples come in the order the end of a round gives
+// them (samples up to h_k, then the byte), and before the next sub-round
+// the horizon is min(queue, earliest VM clock + 9,600, plant event), which
+// is what the next round would have computed, by (1), except that the
+// plant's stop is still this round's P: a sub-round may end at P where the
+// next round would have gone on. A VM's run does not depend on where its
+// time is cut when nothing reaches it in between (runTo already cuts it at
+// every trace snapshot, and JSON with and without --trace is the same), so
+// only the split of instructions between fast-forwarded and dispatched can
+// differ.
 #include "scheduler/match.h"
 
 #include <fmt/format.h>
@@ -518,9 +542,15 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
     if (trace_.on()) trace_.flushBefore(std::min(t, arena_.now()));
     Tick horizon = std::min(queue_.nextTick(), t + kLookahead);
     // The plant goes further than the first sub-round when no ball is in
-    // flight (header comment: "Larger rounds").
-    const Tick plantStop =
-        arena_.ballsInFlight() ? horizon : std::min(queue_.nextTick(), t + kRoundLookahead);
+    // flight, past serial bytes (header comment: "Larger rounds", (d)).
+    Tick plantStop = horizon;
+    if (!arena_.ballsInFlight()) {
+      plantStop = queue_.nextTickExcept(EventClass::SerialByte, t + kRoundLookahead);
+      // Not past a NUL that may latch new wheel speeds: the steps beyond it
+      // would be thrown away (measured: they cost what the rounds save).
+      for (const auto& r : robots_)
+        if (const auto nul = r->link.nulDone()) plantStop = std::min(plantStop, *nul);
+    }
     // (Lambdas, here and below, so that the results are built in place.)
     plant::AdvanceResult step = [&] {
       const PartScope plant(clock_, PartClock::Plant);
@@ -532,10 +562,10 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
         const PartScope vms(clock_, PartClock::Vm);
         for (auto& r : robots_) r->runTo(horizon);
       }
-      if (horizon == step.tick || !inputs_.empty() || queue_.nextTick() == horizon ||
-          (config_.stopWhenAllExited && allExited()))
+      if (horizon == step.tick || !inputs_.empty() || (config_.stopWhenAllExited && allExited()))
         break;
       sampleUpTo(horizon);  // before the next sub-round's records, as between rounds
+      if (queue_.nextTick() == horizon && !serialBytesInRound(horizon)) break;
       ++subRounds_;
       horizon = std::min(queue_.nextTick(), earliestClock() + kLookahead);
     }
@@ -592,6 +622,21 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
       sampleUpTo(horizon);
     }
   }
+}
+
+// Rule (d) of "Larger rounds": the serial bytes due at the horizon of a
+// sub-round, taken inside the round. False when the round must end there
+// instead: another kind of queued event is due at the horizon, or a frame
+// latched with new wheel speeds re-initialised the plant at the horizon
+// (then the plant's prediction is gone and the round ends as it would
+// have after an input).
+bool Match::serialBytesInRound(Tick horizon) {
+  while (!queue_.empty() && queue_.nextTick() == horizon &&
+         queue_.top().payload.kind == QueuedEvent::Kind::SerialByte) {
+    const auto entry = queue_.pop();
+    robots_[static_cast<size_t>(entry.payload.robot)]->byteDone(horizon);
+  }
+  return arena_.now() > horizon && (queue_.empty() || queue_.nextTick() != horizon);
 }
 
 void Match::faulted(int robot, Tick t) {

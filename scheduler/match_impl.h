@@ -258,6 +258,7 @@ class Match {
   MatchResult run();
   // The round loop; `roundStart` is the tick the current round began at.
   void rounds(MatchResult& result, Tick& roundStart);
+  bool serialBytesInRound(Tick horizon);
 
   plant::Arena& arena() { return arena_; }
   PartClock& clock() { return clock_; }

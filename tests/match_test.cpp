@@ -344,6 +344,33 @@ TEST(Match, AnIdleRobotsSecondIsOneHundredTwentyRounds) {
   EXPECT_EQ(r.rounds, 120u);
 }
 
+// Larger rounds, rule (d) (match.cpp): a frame's bytes are taken inside
+// a round, and only a NUL already in the port (the one byte that can latch
+// new wheel speeds) stops the plant. The robot sends one 9-byte string at
+// T0 (a few hundred ticks in) and returns; byte k finishes at
+// T0 + 9,600 (k + 1), the NUL (k = 8) at the latch L = T0 + 86,400.
+// Round 1 is [0, 76,800): no NUL is in the port at 0, and bytes 0-6 finish
+// inside it without ending it. By 76,800 byte 7 is shifting and the NUL
+// waits in the TDR, so round 2 is [76,800, L]. From L the robot is idle and
+// rounds are 76,800 ticks long again up to the end at 9,216,000:
+// 2 + ceil((9,216,000 - L) / 76,800) rounds (121). Before rule (d), when
+// every byte ended its round, the same run took 128 (at d73b409).
+TEST(Match, AFramesBytesDoNotCutRoundsOnlyItsLatchDoes) {
+  const char* kSendOnce =
+      "char buf[9];\nchar cc;\n"
+      "main()\n{\n    ser_init_z1(0,9600/1200);\n    strcpy(buf,\"8fgr8fgr\");\n"
+      "    cc = sizeof(buf);\n    ser_send_z1(buf,&cc);\n}\n";
+  const auto r = testkit::runTraced(matchConfig({{"A", "send.dc", compileSource(kSendOnce)}}, 1.0));
+  ASSERT_EQ(r.robots[0].framesLatched, 1);
+  long long latch = -1;
+  for (const auto& rec : parse(r.trace))
+    if (rec.type == "frame_latched") latch = rec.t;
+  ASSERT_GT(latch, 86'400);
+  ASSERT_LT(latch, 76'800 + 86'400);  // T0 < 76,800: the NUL finishes in round 2
+  EXPECT_EQ(r.endTick, 9'216'000);
+  EXPECT_EQ(r.rounds, static_cast<uint64_t>(2 + (9'216'000 - latch + 76'800 - 1) / 76'800));
+}
+
 TEST(Match, AFaultedRobotLosesATiedRound) {
   const char* kFaults = "int *p;\nmain()\n{\n    *p = 1;\n}\n";  // null pointer at once
   for (uint64_t seed = 1; seed <= 8; ++seed) {
