@@ -1,0 +1,46 @@
+// The decoder's side of the idioms (idioms.h): which one starts at an
+// address, and what its pieces cost under this VM's cost table.
+#include <algorithm>
+
+#include "vm/state.h"
+
+namespace simbot::vm {
+
+void Vm::State::setIdiomCosts() {
+  for (int i = 0; i < kIdiomCount; ++i) {
+    const IdiomShape& shape = kIdiomShapes[i];
+    IdiomCost c;
+    for (int k = 1; k < shape.n; ++k) {
+      const auto o = static_cast<int>(shape.pieces[k]);
+      c.base += costs.op[o];
+      // The last piece ends at the next NEXT, unless it is longer than
+      // kMaxStepTstates: then its steps' boundaries (L_Long_) must all
+      // come before `limit` too, its end included.
+      if (k == shape.n - 1 && costs.op[o] <= kMaxStepTstates) continue;
+      // Its slowest path: unused path slots hold 0, which only errs high.
+      const int32_t slowest =
+          *std::max_element(costs.branchDelta[o].begin(), costs.branchDelta[o].end());
+      c.span += costs.op[o] + static_cast<uint32_t>(std::max(slowest, 0));
+    }
+    idiomCosts[i] = c;
+  }
+}
+
+int Vm::State::idiomAt(uint32_t address) const {
+  const auto end = static_cast<uint32_t>(dispatch.size());
+  for (int i = 0; i < kIdiomCount; ++i) {
+    const IdiomShape& shape = kIdiomShapes[i];
+    uint32_t a = address;
+    int k = 0;
+    for (; k < shape.n; ++k) {
+      const auto o = static_cast<uint8_t>(shape.pieces[k]);
+      // The first piece is dispatched as usual: it must be an ordinary one.
+      if (a >= end || dispatch[a] != o || (k == 0 && costs.op[o] > kMaxStepTstates)) break;
+      a += static_cast<uint32_t>(instructionSize(shape.pieces[k]));
+    }
+    if (k == shape.n) return i;
+  }
+  return -1;
+}
+
+}  // namespace simbot::vm
