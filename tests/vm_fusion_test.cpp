@@ -53,7 +53,10 @@ constexpr uint16_t kDataBytes = 80;  // x, y, r, hits, i, ints, then the byte ar
 // idiom's value, if it leaves one, goes to r; a branch taken skips
 // INCGW hits. The PIO handler counts into ints.
 // First, `dbgs` DBG and `pairs` PUSHW POP (PrtTicksLandingInside...).
-vm::Image idiomProgram(const IdiomShape& s, Variant v, bool dbg, int dbgs = 0, int pairs = 0) {
+// An idiom that ends in RET is a function's end: the loop calls it.
+// `start` receives the idiom's first piece's address.
+vm::Image idiomProgram(const IdiomShape& s, Variant v, bool dbg, int dbgs = 0, int pairs = 0,
+                       uint32_t* start = nullptr) {
   Assembler a;
   const uint16_t x = a.data(2), y = a.data(2), r = a.data(2), hits = a.data(2), i = a.data(2),
                  ints = a.data(2), arg = a.data(2), arr = a.data(kDataBytes - 14);
@@ -78,40 +81,50 @@ vm::Image idiomProgram(const IdiomShape& s, Variant v, bool dbg, int dbgs = 0, i
     depth += vm::info(s.pieces[k]).push;
   }
   for (int k = 0; k < -lowest; ++k) a.op(Op::LDGW, y);
-  a.line = 10;
-  if (dbg) a.op(Op::DBG);
   uint32_t callAt = 0;
-  for (int k = 0; k < s.n; ++k) {
-    const Op o = s.pieces[k];
-    switch (o) {
-      case Op::LDGW:
-        a.op(o, k == 0 ? x : s.pieces[0] == Op::PUSHW ? i : y);
-        break;
-      case Op::LDLW:
-        a.op(o, v == Variant::Fault ? 3u : 0u);  // FP + 3: 0xFFFF, past the end
-        break;
-      case Op::PUSHW:
-        if (k == 0)
-          a.op(o, v == Variant::Fault ? 0x10u : arr);  // a byte array's base
-        else
-          a.op(o, k == 1 ? 0x7FFFu : 0xA5C3u);  // a constant; a byte to store
-        break;
-      case Op::STGW:
-        a.op(o, r);
-        break;
-      case Op::JZ:
-      case Op::JNZ:
-      case Op::JMP:
-        a.jump(o, "next");
-        break;
-      case Op::CALL:
-        callAt = a.here() + 1;
-        a.op(o, 0);
-        break;
-      default:
-        a.op(o);
-    }
+  const bool isFunction = s.pieces[s.n - 1] == Op::RET;
+  uint32_t callIdiomAt = 0;
+  if (isFunction) {
+    callIdiomAt = a.here() + 1;
+    a.op(Op::CALL, 0);
   }
+  auto emitIdiom = [&] {
+    a.line = 10;
+    if (dbg) a.op(Op::DBG);
+    if (start) *start = a.here();
+    for (int k = 0; k < s.n; ++k) {
+      const Op o = s.pieces[k];
+      switch (o) {
+        case Op::LDGW:
+          a.op(o, k == 0 ? x : s.pieces[0] == Op::PUSHW ? i : y);
+          break;
+        case Op::LDLW:
+          a.op(o, v == Variant::Fault ? 3u : 0u);  // FP + 3: 0xFFFF, past the end
+          break;
+        case Op::PUSHW:
+          if (k == 0)
+            a.op(o, v == Variant::Fault ? 0x10u : arr);  // a byte array's base
+          else
+            a.op(o, k == 1 ? 0x7FFFu : 0xA5C3u);  // a constant; a byte to store
+          break;
+        case Op::STGW:
+          a.op(o, r);
+          break;
+        case Op::JZ:
+        case Op::JNZ:
+        case Op::JMP:
+          a.jump(o, "next");
+          break;
+        case Op::CALL:
+          callAt = a.here() + 1;
+          a.op(o, 0);
+          break;
+        default:
+          a.op(o);
+      }
+    }
+  };
+  if (!isFunction) emitIdiom();
   a.line = 11;
   if (leavesValue(s)) a.op(Op::STGW, r);
   a.op(Op::INCGW, hits);
@@ -129,26 +142,24 @@ vm::Image idiomProgram(const IdiomShape& s, Variant v, bool dbg, int dbgs = 0, i
     a.image.code[callAt] = static_cast<uint8_t>(fn);
     a.image.code[callAt + 1] = static_cast<uint8_t>(fn >> 8);
   }
+  if (isFunction) {
+    const uint32_t f = a.here();
+    emitIdiom();
+    a.image.code[callIdiomAt] = static_cast<uint8_t>(f);
+    a.image.code[callIdiomAt + 1] = static_cast<uint8_t>(f >> 8);
+  }
   a.line = 20;
   a.bind("handler").op(Op::INCGW, ints).op(Op::RETI);
   a.image.vectors.push_back({vm::kVecPIOA, static_cast<uint16_t>(a.label("handler")), "handler"});
   return a.finish();
 }
 
-// Where the idiom starts and where each of its pieces does.
-std::vector<uint32_t> pieceAddresses(const IdiomShape& s, bool dbg) {
+// Where each of the idiom's pieces starts.
+std::vector<uint32_t> pieceAddresses(const IdiomShape& s, uint32_t start) {
   std::vector<uint32_t> at;
-  int depth = 0, lowest = 0;
   for (int k = 0; k < s.n; ++k) {
-    depth -= vm::info(s.pieces[k]).pop;
-    lowest = std::min(lowest, depth);
-    depth += vm::info(s.pieces[k]).push;
-  }
-  // ENTER, PUSHW, STLW, the values below, DBG
-  uint32_t a = 3 + 3 + 3 + 3 * static_cast<uint32_t>(-lowest) + (dbg ? 1 : 0);
-  for (int k = 0; k < s.n; ++k) {
-    at.push_back(a);
-    a += static_cast<uint32_t>(vm::instructionSize(s.pieces[k]));
+    at.push_back(start);
+    start += static_cast<uint32_t>(vm::instructionSize(s.pieces[k]));
   }
   return at;
 }
@@ -304,8 +315,9 @@ TEST(VmIdiom, ABreakpointOnAnyPieceStopsThereEveryPass) {
   // Set before the first run, and set after some passes have run fused.
   for (const IdiomShape& s : kIdiomShapes)
     for (const bool dbg : {false, true}) {
-      const auto img = idiomProgram(s, Variant::Plain, dbg);
-      const auto at = pieceAddresses(s, dbg);
+      uint32_t start = 0;
+      const auto img = idiomProgram(s, Variant::Plain, dbg, 0, 0, &start);
+      const auto at = pieceAddresses(s, start);
       for (int k = 1; k < s.n; ++k)
         for (const vm::Tick before : {vm::Tick{0}, vm::Tick{1000}}) {
           TestHost h1, h2;

@@ -22,6 +22,15 @@ void Vm::State::setIdiomCosts() {
           *std::max_element(costs.branchDelta[o].begin(), costs.branchDelta[o].end());
       c.span += costs.op[o] + static_cast<uint32_t>(std::max(slowest, 0));
     }
+    const Op last = shape.pieces[shape.n - 1];
+    if (shape.n == 4 && (last == Op::JZ || last == Op::JNZ)) {
+      const auto& compare = costs.branchDelta[static_cast<int>(shape.pieces[2])];
+      const auto& branch = costs.branchDelta[static_cast<int>(last)];
+      for (int p = 0; p < 4; ++p)
+        for (int t = 0; t < 2; ++t)
+          c.path[p * 2 + t] =
+              static_cast<uint32_t>(static_cast<int32_t>(c.base) + compare[p] + branch[t]);
+    }
     idiomCosts[i] = c;
   }
 }

@@ -39,7 +39,7 @@ namespace simbot::vm::detail {
   X(StoreByte, PUSHW) X(ByteJZ, PUSHW) X(ByteJNZ, PUSHW) X(Byte, PUSHW)       \
   SIMBOT_IDIOMS_CB(X##_CB) SIMBOT_IDIOMS_BS(X##_BSJ) SIMBOT_IDIOMS_BS(X##_BS) \
   SIMBOT_IDIOMS_LK(X##_LKC) SIMBOT_IDIOMS_LK(X##_LK) X(MulAdd, LDGW)          \
-  X(Mul, LDGW) SIMBOT_IDIOMS_KS(X##_KS) X(StoreConst, PUSHW)
+  X(Mul, LDGW) SIMBOT_IDIOMS_KS(X##_KS) X(StoreConst, PUSHW) X(LoadRet, LDLW)
 // clang-format on
 
 // Every idiom's pieces, longest first where one idiom is a prefix of
@@ -50,18 +50,23 @@ namespace simbot::vm::detail {
 #define SIMBOT_IDIOM_LKC_SHAPE(l, o) {{Op::l, Op::PUSHW, Op::o, Op::CALL}, 4},
 #define SIMBOT_IDIOM_LK_SHAPE(l, o) {{Op::l, Op::PUSHW, Op::o}, 3},
 #define SIMBOT_IDIOM_KS_SHAPE(o) {{Op::PUSHW, Op::o, Op::STGW}, 3},
-#define SIMBOT_IDIOM_SHAPES                                                                     \
-  {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::PUSHW, Op::STIB}, 5},                                    \
-      {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::LDIB, Op::JZ}, 5},                                   \
-      {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::LDIB, Op::JNZ}, 5},                                  \
-      {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::LDIB}, 4},                                           \
-      SIMBOT_IDIOMS_CB(SIMBOT_IDIOM_CB_SHAPE) SIMBOT_IDIOMS_BS(SIMBOT_IDIOM_BSJ_SHAPE)          \
-          SIMBOT_IDIOMS_BS(SIMBOT_IDIOM_BS_SHAPE) SIMBOT_IDIOMS_LK(SIMBOT_IDIOM_LKC_SHAPE)      \
-              SIMBOT_IDIOMS_LK(SIMBOT_IDIOM_LK_SHAPE){{Op::LDGW, Op::LDGW, Op::MULW, Op::ADDW}, \
-                                                      4},                                       \
-      {{Op::LDGW, Op::LDGW, Op::MULW}, 3}, SIMBOT_IDIOMS_KS(SIMBOT_IDIOM_KS_SHAPE) {            \
-    {Op::PUSHW, Op::STGW}, 2                                                                    \
-  }
+// clang-format off
+#define SIMBOT_IDIOM_SHAPES                                                      \
+  {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::PUSHW, Op::STIB}, 5},                     \
+  {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::LDIB, Op::JZ}, 5},                        \
+  {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::LDIB, Op::JNZ}, 5},                       \
+  {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::LDIB}, 4},                                \
+  SIMBOT_IDIOMS_CB(SIMBOT_IDIOM_CB_SHAPE)                                        \
+  SIMBOT_IDIOMS_BS(SIMBOT_IDIOM_BSJ_SHAPE)                                       \
+  SIMBOT_IDIOMS_BS(SIMBOT_IDIOM_BS_SHAPE)                                        \
+  SIMBOT_IDIOMS_LK(SIMBOT_IDIOM_LKC_SHAPE)                                       \
+  SIMBOT_IDIOMS_LK(SIMBOT_IDIOM_LK_SHAPE)                                        \
+  {{Op::LDGW, Op::LDGW, Op::MULW, Op::ADDW}, 4},                                 \
+  {{Op::LDGW, Op::LDGW, Op::MULW}, 3},                                           \
+  SIMBOT_IDIOMS_KS(SIMBOT_IDIOM_KS_SHAPE)                                        \
+  {{Op::PUSHW, Op::STGW}, 2},                                                    \
+  {{Op::LDLW, Op::RET}, 2}
+// clang-format on
 
 struct IdiomShape {
   Op pieces[5];
@@ -102,9 +107,12 @@ inline constexpr uint32_t kMaxIdiomReach = 11;
 // pieces but the first and the last can take (each at its slowest
 // branch path), and `base`, what its pieces but the first cost with every
 // branch not taken (the handler adds the paths' deltas).
+// `path`: a compare-and-branch's whole cost by its compare's path p and
+// its branch (taken t), at [p * 2 + t].
 struct IdiomCost {
   uint32_t span = 0;
   uint32_t base = 0;
+  uint32_t path[8]{};
 };
 
 }  // namespace simbot::vm::detail

@@ -294,6 +294,9 @@ Stop Vm::State::run(Tick until) {
   const int16_t* const loopTop =
       costs.knobs.fastForward && !loopAtTop.empty() ? loopAtTop.data() : nullptr;
   uint32_t* const e = eval.data();
+  // The idioms' memory, in a register: a byte store through `mem` would
+  // make the compiler reload its data pointer.
+  uint8_t* const m = mem.data();
   busTouched = false;
 
 #if SIMBOT_COMPUTED_GOTO
@@ -657,30 +660,40 @@ boundary:
   // actual costs and counts them; otherwise, and where a piece would
   // fault, the first piece runs alone and the rest are dispatched one by
   // one. Operands are read at their offsets from the first's.
+// As rd16, rd8, wr16 and wr8, on m.
+#define M_RD8(a) static_cast<uint32_t>(m[(a)&0xFFFF])
+#define M_RD16(a) (M_RD8(a) | (M_RD8((a) + 1) << 8))
+#define M_WR8(a, v) (m[(a)&0xFFFF] = static_cast<uint8_t>(v))
+#define M_WR16(a, v)                   \
+  {                                    \
+    const uint32_t wa = (a), wv = (v); \
+    M_WR8(wa, wv);                     \
+    M_WR8(wa + 1, wv >> 8);            \
+  }
 #define OPND16(off) static_cast<uint32_t>(operand[off] | (operand[(off) + 1] << 8))
 #define IDIOM_ENTER(kind, first, peak)                                                       \
   const IdiomCost& ic = idiomCosts[kind];                                                    \
   if (__builtin_expect(clk + ic.span >= limit || esp > kEvalSlots - kEvalGuard - (peak), 0)) \
     goto L_##first;
-#define IDIOM_LOAD_LDGW(x) const uint32_t x = rd16(OPND16(0));
+#define IDIOM_LOAD_LDGW(x) const uint32_t x = M_RD16(OPND16(0));
 #define IDIOM_LOAD_LDLW(x)                                                                         \
   const uint32_t x##Address = mfp + OPND16(0);                                                     \
   if (__builtin_expect(x##Address < kNullPageEnd || x##Address + 2 > kMemorySize, 0)) goto L_LDLW; \
-  const uint32_t x = rd16(x##Address);
-#define IDIOM_SRC_LDGW(v) rd16(v)
+  const uint32_t x = M_RD16(x##Address);
+#define IDIOM_SRC_LDGW(v) M_RD16(v)
 #define IDIOM_SRC_PUSHW(v) (v)
 #define IDIOM_OP_ADDW(x, y) (((x) + (y)) & 0xFFFF)
 #define IDIOM_OP_SUBW(x, y) (((x) - (y)) & 0xFFFF)
 #define IDIOM_TARGET(ip, off) \
   static_cast<uint32_t>(static_cast<int32_t>(ip) + static_cast<int16_t>(OPND16(off)))
   // PUSHW base; LDGW i; ADDW; ...: the byte at base + i.
-#define IDIOM_BYTE_ADDRESS(first)                            \
-  const uint32_t a = (OPND16(0) + rd16(OPND16(3))) & 0xFFFF; \
+#define IDIOM_BYTE_ADDRESS(first)                              \
+  const uint32_t a = (OPND16(0) + M_RD16(OPND16(3))) & 0xFFFF; \
   if (__builtin_expect(a < kNullPageEnd || a + 1 > kMemorySize, 0)) goto L_##first;
 I_StoreByte : {  // PUSHW base; LDGW i; ADDW; PUSHW v; STIB
   IDIOM_ENTER(kIdiomStoreByte, PUSHW, 2)
   IDIOM_BYTE_ADDRESS(PUSHW)
-  wr8(a, OPND16(7));
+  M_WR8(a, OPND16(7));
   clk += ic.base;
   count += 4;
   ip = opPc + 11;
@@ -689,7 +702,7 @@ I_StoreByte : {  // PUSHW base; LDGW i; ADDW; PUSHW v; STIB
 I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
   IDIOM_ENTER(kIdiomByte, PUSHW, 2)
   IDIOM_BYTE_ADDRESS(PUSHW)
-  e[esp++] = rd8(a);
+  e[esp++] = M_RD8(a);
   clk += ic.base;
   count += 3;
   ip = opPc + 8;
@@ -699,7 +712,7 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
   I_##name : { /* PUSHW base; LDGW i; ADDW; LDIB; br t */                              \
     IDIOM_ENTER(kIdiom##name, PUSHW, 2)                                                \
     IDIOM_BYTE_ADDRESS(PUSHW)                                                          \
-    const uint32_t v = rd8(a);                                                         \
+    const uint32_t v = M_RD8(a);                                                       \
     const bool taken = (takenIf);                                                      \
     clk += Tick{ic.base} + costs.branchDelta[static_cast<int>(Op::br)][taken ? 1 : 0]; \
     count += 4;                                                                        \
@@ -708,26 +721,25 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
   NEXT;
   IDIOM_BYTE_BRANCH(ByteJZ, JZ, v == 0)
   IDIOM_BYTE_BRANCH(ByteJNZ, JNZ, v != 0)
-#define SIMBOT_IDIOM(l, c, b)                                                 \
-  I_CB_##l##_##c##_##b : { /* l x; PUSHW k; c; b t */                         \
-    IDIOM_ENTER(kIdiomCb_##l##_##c##_##b, l, 2)                               \
-    IDIOM_LOAD_##l(x) unsigned path = 0;                                      \
-    const bool r = compare16<Op::c>(x, OPND16(3), path);                      \
-    const bool taken = Op::b == Op::JZ ? !r : r;                              \
-    clk += Tick{ic.base} + costs.branchDelta[static_cast<int>(Op::c)][path] + \
-           costs.branchDelta[static_cast<int>(Op::b)][taken ? 1 : 0];         \
-    count += 3;                                                               \
-    ip = taken ? IDIOM_TARGET(opPc + 10, 7) : opPc + 10;                      \
-  }                                                                           \
+#define SIMBOT_IDIOM(l, c, b)                            \
+  I_CB_##l##_##c##_##b : { /* l x; PUSHW k; c; b t */    \
+    IDIOM_ENTER(kIdiomCb_##l##_##c##_##b, l, 2)          \
+    IDIOM_LOAD_##l(x) unsigned path = 0;                 \
+    const bool r = compare16<Op::c>(x, OPND16(3), path); \
+    const bool taken = Op::b == Op::JZ ? !r : r;         \
+    clk += ic.path[path * 2 + (taken ? 1 : 0)];          \
+    count += 3;                                          \
+    ip = taken ? IDIOM_TARGET(opPc + 10, 7) : opPc + 10; \
+  }                                                      \
   NEXT;
   SIMBOT_IDIOMS_CB(SIMBOT_IDIOM)
 #undef SIMBOT_IDIOM
 #define SIMBOT_IDIOM(s, o)                        \
   I_BS_##s##_##o : { /* LDGW a; s b; o; STGW c */ \
     IDIOM_ENTER(kIdiomBs_##s##_##o, LDGW, 2)      \
-    const uint32_t x = rd16(OPND16(0));           \
+    const uint32_t x = M_RD16(OPND16(0));         \
     const uint32_t y = IDIOM_SRC_##s(OPND16(3));  \
-    wr16(OPND16(7), IDIOM_OP_##o(x, y));          \
+    M_WR16(OPND16(7), IDIOM_OP_##o(x, y));        \
     clk += ic.base;                               \
     count += 3;                                   \
     ip = opPc + 10;                               \
@@ -749,9 +761,9 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
 #define SIMBOT_IDIOM(s, o)                                \
   I_BSJ_##s##_##o : { /* LDGW a; s b; o; STGW c; JMP t */ \
     IDIOM_ENTER(kIdiomBsj_##s##_##o, LDGW, 2)             \
-    const uint32_t x = rd16(OPND16(0));                   \
+    const uint32_t x = M_RD16(OPND16(0));                 \
     const uint32_t y = IDIOM_SRC_##s(OPND16(3));          \
-    wr16(OPND16(7), IDIOM_OP_##o(x, y));                  \
+    M_WR16(OPND16(7), IDIOM_OP_##o(x, y));                \
     clk += ic.base;                                       \
     count += 4;                                           \
     ip = IDIOM_TARGET(opPc + 13, 10);                     \
@@ -778,7 +790,7 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
 // A long MULW inside: its steps' boundaries are all inside the span.
 I_MulAdd : { /* LDGW a; LDGW b; MULW; ADDW */
   IDIOM_ENTER(kIdiomMulAdd, LDGW, 2)
-  const uint32_t p = (rd16(OPND16(0)) * rd16(OPND16(3))) & 0xFFFF;
+  const uint32_t p = (M_RD16(OPND16(0)) * M_RD16(OPND16(3))) & 0xFFFF;
   e[esp - 1] = (e[esp - 1] + p) & 0xFFFF;
   clk += ic.base;
   count += 3;
@@ -787,30 +799,48 @@ I_MulAdd : { /* LDGW a; LDGW b; MULW; ADDW */
   NEXT;
 I_Mul : { /* LDGW a; LDGW b; MULW */
   IDIOM_ENTER(kIdiomMul, LDGW, 2)
-  e[esp++] = (rd16(OPND16(0)) * rd16(OPND16(3))) & 0xFFFF;
+  e[esp++] = (M_RD16(OPND16(0)) * M_RD16(OPND16(3))) & 0xFFFF;
   clk += ic.base;
   count += 2;
   ip = opPc + 7;
 }
   NEXT;
-#define SIMBOT_IDIOM(o)                          \
-  I_KS_##o : { /* PUSHW k; o; STGW a */          \
-    IDIOM_ENTER(kIdiomKs_##o, PUSHW, 1)          \
-    const uint32_t v = e[--esp];                 \
-    wr16(OPND16(4), IDIOM_OP_##o(v, OPND16(0))); \
-    clk += ic.base;                              \
-    count += 2;                                  \
-    ip = opPc + 7;                               \
-  }                                              \
+#define SIMBOT_IDIOM(o)                            \
+  I_KS_##o : { /* PUSHW k; o; STGW a */            \
+    IDIOM_ENTER(kIdiomKs_##o, PUSHW, 1)            \
+    const uint32_t v = e[--esp];                   \
+    M_WR16(OPND16(4), IDIOM_OP_##o(v, OPND16(0))); \
+    clk += ic.base;                                \
+    count += 2;                                    \
+    ip = opPc + 7;                                 \
+  }                                                \
   NEXT;
   SIMBOT_IDIOMS_KS(SIMBOT_IDIOM)
 #undef SIMBOT_IDIOM
 I_StoreConst : { /* PUSHW k; STGW a */
   IDIOM_ENTER(kIdiomStoreConst, PUSHW, 1)
-  wr16(OPND16(3), OPND16(0));
+  M_WR16(OPND16(3), OPND16(0));
   clk += ic.base;
   count += 1;
   ip = opPc + 6;
+}
+  NEXT;
+I_LoadRet : { /* LDLW x; RET: RET's fault leaves it to run alone */
+  IDIOM_ENTER(kIdiomLoadRet, LDLW, 1)
+  IDIOM_LOAD_LDLW(x)
+  if (__builtin_expect(calls.empty() || (!ints.empty() &&
+                                         static_cast<int>(calls.size()) <= ints.back().callDepth),
+                       0))
+    goto L_LDLW;
+  e[esp++] = x;
+  const CallFrame f = calls.back();
+  calls.pop_back();
+  clk += ic.base;
+  if (f.autoFrame) clk += costs.autoFrameRet;  // as RET: POP IX
+  count += 1;
+  ip = f.retPc;
+  msp = f.msp;
+  mfp = f.mfp;
 }
   NEXT;
   // DBG, then the idiom after it: the boundary between them, then the
@@ -844,6 +874,10 @@ I_StoreConst : { /* PUSHW k; STGW a */
 #undef SIMBOT_IDIOM_LK
 #undef SIMBOT_IDIOM_KS
 #undef DBG_THEN
+#undef M_RD8
+#undef M_RD16
+#undef M_WR8
+#undef M_WR16
 #undef OPND16
 #undef IDIOM_ENTER
 #undef IDIOM_LOAD_LDGW
