@@ -294,9 +294,11 @@ Stop Vm::State::run(Tick until) {
   const int16_t* const loopTop =
       costs.knobs.fastForward && !loopAtTop.empty() ? loopAtTop.data() : nullptr;
   uint32_t* const e = eval.data();
+#if SIMBOT_COMPUTED_GOTO
   // The idioms' memory, in a register: a byte store through `mem` would
   // make the compiler reload its data pointer.
   uint8_t* const m = mem.data();
+#endif
   busTouched = false;
 
 #if SIMBOT_COMPUTED_GOTO
