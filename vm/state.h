@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "vm/idioms.h"
 #include "vm/vm.h"
 
 namespace simbot::vm {
@@ -153,6 +154,15 @@ struct Vm::State {
   // The superinstructions' labels (vm.cpp SIMBOT_FUSED_PAIRS), set by
   // run<false>: its entry for a pair's first half jumps to them.
   const void* const* fusedLabels = nullptr;
+  // The idioms' labels (idioms.h), set by run<false>, and their pieces'
+  // costs (idioms.cpp).
+  const void* const* idiomLabels = nullptr;
+  const void* const* dbgIdiomLabels = nullptr;  // DBG, then the idiom
+  std::array<IdiomCost, kIdiomCount> idiomCosts{};
+  void setIdiomCosts();
+  // The idiom whose pieces start at `address` (all ordinary and none a trap
+  // in `dispatch`), or -1.
+  int idiomAt(uint32_t address) const;
   // The handler that starts an instruction longer than kMaxStepTstates on
   // the fast path (null: such instructions go to the slow boundary).
   std::array<const void*, 2> longLabels{};

@@ -225,6 +225,37 @@ int fusedIndex(uint8_t first, uint8_t second) {
       return static_cast<int>(i);
   return -1;
 }
+
+// A 16-bit comparison as its handler does it (COMPARE, SIGNED_COMPARE in
+// run()): the result and the path its branches take.
+template <Op C>
+bool compare16(uint32_t a, uint32_t b, unsigned& path) {
+  if constexpr (C == Op::LTW || C == Op::LEW || C == Op::GTW || C == Op::GEW) {
+    // LTW and GEW compute a - b (HL = a); LEW and GTW b - a.
+    constexpr bool kAFirst = C == Op::LTW || C == Op::GEW;
+    const uint32_t hl = kAFirst ? a : b, de = kAFirst ? b : a;
+    const int32_t diff = int32_t{asInt16(hl)} - int32_t{asInt16(de)};
+    const bool overflow = diff < -32768 || diff > 32767;
+    bool r = false;
+    if constexpr (C == Op::LTW) r = asInt16(a) < asInt16(b);
+    if constexpr (C == Op::LEW) r = asInt16(a) <= asInt16(b);
+    if constexpr (C == Op::GTW) r = asInt16(a) > asInt16(b);
+    if constexpr (C == Op::GEW) r = asInt16(a) >= asInt16(b);
+    path = (overflow ? 0u : 1u) | (r ? 0u : 2u);
+    return r;
+  } else {
+    const uint32_t x = a & 0xFFFF, y = b & 0xFFFF;
+    bool r = false;
+    if constexpr (C == Op::EQW) r = x == y;
+    if constexpr (C == Op::NEW) r = x != y;
+    if constexpr (C == Op::LTUW) r = x < y;
+    if constexpr (C == Op::LEUW) r = x <= y;
+    if constexpr (C == Op::GTUW) r = x > y;
+    if constexpr (C == Op::GEUW) r = x >= y;
+    path = r ? 0u : 1u;
+    return r;
+  }
+}
 }  // namespace
 
 void Vm::State::setFast(int k, uint32_t address) {
@@ -237,7 +268,17 @@ void Vm::State::setFast(int k, uint32_t address) {
   if (k == 0 && fusedLabels && !trap && !isLong && address + size < dispatch.size()) {
     const uint8_t next = dispatch[address + size];
     const int f = fusedIndex(o, next);
-    if (f >= 0 && costs.op[next] <= kMaxStepTstates) label = fusedLabels[f];
+    // A pair would run its second half unfused: an idiom there is worth more.
+    if (f >= 0 && costs.op[next] <= kMaxStepTstates &&
+        !(idiomLabels && idiomAt(address + size) >= 0))
+      label = fusedLabels[f];
+  }
+  if (k == 0 && idiomLabels && !trap && !isLong) {
+    int i = idiomAt(address);
+    if (i >= 0)
+      label = idiomLabels[i];
+    else if (o == static_cast<uint8_t>(Op::DBG) && (i = idiomAt(address + 1)) >= 0)
+      label = dbgIdiomLabels[i];
   }
   const uint32_t cost = trap ? 0u : isLong ? kMaxStepTstates : costs.op[o];
   fast[k][address] = Fast{label, cost, o, size};
@@ -253,6 +294,11 @@ Stop Vm::State::run(Tick until) {
   const int16_t* const loopTop =
       costs.knobs.fastForward && !loopAtTop.empty() ? loopAtTop.data() : nullptr;
   uint32_t* const e = eval.data();
+#if SIMBOT_COMPUTED_GOTO
+  // The idioms' memory, in a register: a byte store through `mem` would
+  // make the compiler reload its data pointer.
+  uint8_t* const m = mem.data();
+#endif
   busTouched = false;
 
 #if SIMBOT_COMPUTED_GOTO
@@ -281,6 +327,46 @@ Stop Vm::State::run(Tick until) {
 #undef SIMBOT_PAIR
     };
     if (!kProfile) fusedLabels = kFused;
+      // In the order of kIdiomShapes (idioms.h).
+      // In the order of kIdiomShapes (idioms.h): the idioms, and DBG followed
+      // by each (the DBG that starts most statements).
+#define SIMBOT_IDIOM(name, first) &&I_##name,
+#define SIMBOT_IDIOM_CB(l, c, b) &&I_CB_##l##_##c##_##b,
+#define SIMBOT_IDIOM_BSJ(s, o) &&I_BSJ_##s##_##o,
+#define SIMBOT_IDIOM_BS(s, o) &&I_BS_##s##_##o,
+#define SIMBOT_IDIOM_LKC(l, o) &&I_LKC_##l##_##o,
+#define SIMBOT_IDIOM_LK(l, o) &&I_LK_##l##_##o,
+#define SIMBOT_IDIOM_KS(o) &&I_KS_##o,
+    static const void* const kIdioms[] = {SIMBOT_IDIOM_LIST(SIMBOT_IDIOM)};
+#undef SIMBOT_IDIOM
+#undef SIMBOT_IDIOM_CB
+#undef SIMBOT_IDIOM_BSJ
+#undef SIMBOT_IDIOM_BS
+#undef SIMBOT_IDIOM_LKC
+#undef SIMBOT_IDIOM_LK
+#undef SIMBOT_IDIOM_KS
+#define SIMBOT_IDIOM(name, first) &&D_##name,
+#define SIMBOT_IDIOM_CB(l, c, b) &&D_CB_##l##_##c##_##b,
+#define SIMBOT_IDIOM_BSJ(s, o) &&D_BSJ_##s##_##o,
+#define SIMBOT_IDIOM_BS(s, o) &&D_BS_##s##_##o,
+#define SIMBOT_IDIOM_LKC(l, o) &&D_LKC_##l##_##o,
+#define SIMBOT_IDIOM_LK(l, o) &&D_LK_##l##_##o,
+#define SIMBOT_IDIOM_KS(o) &&D_KS_##o,
+    static const void* const kDbgIdioms[] = {SIMBOT_IDIOM_LIST(SIMBOT_IDIOM)};
+#undef SIMBOT_IDIOM
+#undef SIMBOT_IDIOM_CB
+#undef SIMBOT_IDIOM_BSJ
+#undef SIMBOT_IDIOM_BS
+#undef SIMBOT_IDIOM_LKC
+#undef SIMBOT_IDIOM_LK
+#undef SIMBOT_IDIOM_KS
+    static_assert(std::size(kDbgIdioms) == kIdiomCount);
+    static_assert(std::size(kIdioms) == kIdiomCount);
+    if (!kProfile) {
+      setIdiomCosts();
+      idiomLabels = kIdioms;
+      dbgIdiomLabels = kDbgIdioms;
+    }
     longLabels[kRun] = &&L_Long_;
 #endif
     fast[kRun].resize(dispatch.size());
@@ -567,6 +653,244 @@ boundary:
 #undef FIRST_LDLW
 #undef FIRST_STLW
 #undef FIRST_ENTER
+
+  // Idioms (idioms.h): the first piece has been dispatched (charged and
+  // counted) as usual. If the boundaries inside the idiom all come before
+  // `limit` even at the pieces' slowest paths, and its pushes stay inside
+  // the expression stack's guard, nothing can happen at them (see "Fast
+  // path"), so the idiom does the pieces' work at once, charges their
+  // actual costs and counts them; otherwise, and where a piece would
+  // fault, the first piece runs alone and the rest are dispatched one by
+  // one. Operands are read at their offsets from the first's.
+// As rd16, rd8, wr16 and wr8, on m.
+#define M_RD8(a) static_cast<uint32_t>(m[(a)&0xFFFF])
+#define M_RD16(a) (M_RD8(a) | (M_RD8((a) + 1) << 8))
+#define M_WR8(a, v) (m[(a)&0xFFFF] = static_cast<uint8_t>(v))
+#define M_WR16(a, v)                   \
+  {                                    \
+    const uint32_t wa = (a), wv = (v); \
+    M_WR8(wa, wv);                     \
+    M_WR8(wa + 1, wv >> 8);            \
+  }
+#define OPND16(off) static_cast<uint32_t>(operand[off] | (operand[(off) + 1] << 8))
+#define IDIOM_ENTER(kind, first, peak)                                                       \
+  const IdiomCost& ic = idiomCosts[kind];                                                    \
+  if (__builtin_expect(clk + ic.span >= limit || esp > kEvalSlots - kEvalGuard - (peak), 0)) \
+    goto L_##first;
+#define IDIOM_LOAD_LDGW(x) const uint32_t x = M_RD16(OPND16(0));
+#define IDIOM_LOAD_LDLW(x)                                                                         \
+  const uint32_t x##Address = mfp + OPND16(0);                                                     \
+  if (__builtin_expect(x##Address < kNullPageEnd || x##Address + 2 > kMemorySize, 0)) goto L_LDLW; \
+  const uint32_t x = M_RD16(x##Address);
+#define IDIOM_SRC_LDGW(v) M_RD16(v)
+#define IDIOM_SRC_PUSHW(v) (v)
+#define IDIOM_OP_ADDW(x, y) (((x) + (y)) & 0xFFFF)
+#define IDIOM_OP_SUBW(x, y) (((x) - (y)) & 0xFFFF)
+#define IDIOM_TARGET(ip, off) \
+  static_cast<uint32_t>(static_cast<int32_t>(ip) + static_cast<int16_t>(OPND16(off)))
+  // PUSHW base; LDGW i; ADDW; ...: the byte at base + i.
+#define IDIOM_BYTE_ADDRESS(first)                              \
+  const uint32_t a = (OPND16(0) + M_RD16(OPND16(3))) & 0xFFFF; \
+  if (__builtin_expect(a < kNullPageEnd || a + 1 > kMemorySize, 0)) goto L_##first;
+I_StoreByte : {  // PUSHW base; LDGW i; ADDW; PUSHW v; STIB
+  IDIOM_ENTER(kIdiomStoreByte, PUSHW, 2)
+  IDIOM_BYTE_ADDRESS(PUSHW)
+  M_WR8(a, OPND16(7));
+  clk += ic.base;
+  count += 4;
+  ip = opPc + 11;
+}
+  NEXT;
+I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
+  IDIOM_ENTER(kIdiomByte, PUSHW, 2)
+  IDIOM_BYTE_ADDRESS(PUSHW)
+  e[esp++] = M_RD8(a);
+  clk += ic.base;
+  count += 3;
+  ip = opPc + 8;
+}
+  NEXT;
+#define IDIOM_BYTE_BRANCH(name, br, takenIf)                                           \
+  I_##name : { /* PUSHW base; LDGW i; ADDW; LDIB; br t */                              \
+    IDIOM_ENTER(kIdiom##name, PUSHW, 2)                                                \
+    IDIOM_BYTE_ADDRESS(PUSHW)                                                          \
+    const uint32_t v = M_RD8(a);                                                       \
+    const bool taken = (takenIf);                                                      \
+    clk += Tick{ic.base} + costs.branchDelta[static_cast<int>(Op::br)][taken ? 1 : 0]; \
+    count += 4;                                                                        \
+    ip = taken ? IDIOM_TARGET(opPc + 11, 8) : opPc + 11;                               \
+  }                                                                                    \
+  NEXT;
+  IDIOM_BYTE_BRANCH(ByteJZ, JZ, v == 0)
+  IDIOM_BYTE_BRANCH(ByteJNZ, JNZ, v != 0)
+#define SIMBOT_IDIOM(l, c, b)                            \
+  I_CB_##l##_##c##_##b : { /* l x; PUSHW k; c; b t */    \
+    IDIOM_ENTER(kIdiomCb_##l##_##c##_##b, l, 2)          \
+    IDIOM_LOAD_##l(x) unsigned path = 0;                 \
+    const bool r = compare16<Op::c>(x, OPND16(3), path); \
+    const bool taken = Op::b == Op::JZ ? !r : r;         \
+    clk += ic.path[path * 2 + (taken ? 1 : 0)];          \
+    count += 3;                                          \
+    ip = taken ? IDIOM_TARGET(opPc + 10, 7) : opPc + 10; \
+  }                                                      \
+  NEXT;
+  SIMBOT_IDIOMS_CB(SIMBOT_IDIOM)
+#undef SIMBOT_IDIOM
+#define SIMBOT_IDIOM(s, o)                        \
+  I_BS_##s##_##o : { /* LDGW a; s b; o; STGW c */ \
+    IDIOM_ENTER(kIdiomBs_##s##_##o, LDGW, 2)      \
+    const uint32_t x = M_RD16(OPND16(0));         \
+    const uint32_t y = IDIOM_SRC_##s(OPND16(3));  \
+    M_WR16(OPND16(7), IDIOM_OP_##o(x, y));        \
+    clk += ic.base;                               \
+    count += 3;                                   \
+    ip = opPc + 10;                               \
+  }                                               \
+  NEXT;
+  SIMBOT_IDIOMS_BS(SIMBOT_IDIOM)
+#undef SIMBOT_IDIOM
+#define SIMBOT_IDIOM(l, o)                                   \
+  I_LK_##l##_##o : { /* l x; PUSHW k; o */                   \
+    IDIOM_ENTER(kIdiomLk_##l##_##o, l, 2)                    \
+    IDIOM_LOAD_##l(x) e[esp++] = IDIOM_OP_##o(x, OPND16(3)); \
+    clk += ic.base;                                          \
+    count += 2;                                              \
+    ip = opPc + 7;                                           \
+  }                                                          \
+  NEXT;
+  SIMBOT_IDIOMS_LK(SIMBOT_IDIOM)
+#undef SIMBOT_IDIOM
+#define SIMBOT_IDIOM(s, o)                                \
+  I_BSJ_##s##_##o : { /* LDGW a; s b; o; STGW c; JMP t */ \
+    IDIOM_ENTER(kIdiomBsj_##s##_##o, LDGW, 2)             \
+    const uint32_t x = M_RD16(OPND16(0));                 \
+    const uint32_t y = IDIOM_SRC_##s(OPND16(3));          \
+    M_WR16(OPND16(7), IDIOM_OP_##o(x, y));                \
+    clk += ic.base;                                       \
+    count += 4;                                           \
+    ip = IDIOM_TARGET(opPc + 13, 10);                     \
+  }                                                       \
+  NEXT;
+  SIMBOT_IDIOMS_BS(SIMBOT_IDIOM)
+#undef SIMBOT_IDIOM
+  // CALL's own faults (stack overflow, no headroom) leave it to run alone.
+#define SIMBOT_IDIOM(l, o)                                                  \
+  I_LKC_##l##_##o : { /* l x; PUSHW k; o; CALL f */                         \
+    IDIOM_ENTER(kIdiomLkc_##l##_##o, l, 2)                                  \
+    IDIOM_LOAD_##l(x) if (msp < stackLimit + kCallFrameBytes ||             \
+                          esp + 1 > kEvalSlots - kEvalHeadroom) goto L_##l; \
+    e[esp++] = IDIOM_OP_##o(x, OPND16(3));                                  \
+    calls.push_back(CallFrame{opPc + 10, msp, mfp, false});                 \
+    msp -= kCallFrameBytes;                                                 \
+    clk += ic.base;                                                         \
+    count += 3;                                                             \
+    ip = OPND16(7);                                                         \
+  }                                                                         \
+  NEXT;
+  SIMBOT_IDIOMS_LK(SIMBOT_IDIOM)
+#undef SIMBOT_IDIOM
+// A long MULW inside: its steps' boundaries are all inside the span.
+I_MulAdd : { /* LDGW a; LDGW b; MULW; ADDW */
+  IDIOM_ENTER(kIdiomMulAdd, LDGW, 2)
+  const uint32_t p = (M_RD16(OPND16(0)) * M_RD16(OPND16(3))) & 0xFFFF;
+  e[esp - 1] = (e[esp - 1] + p) & 0xFFFF;
+  clk += ic.base;
+  count += 3;
+  ip = opPc + 8;
+}
+  NEXT;
+I_Mul : { /* LDGW a; LDGW b; MULW */
+  IDIOM_ENTER(kIdiomMul, LDGW, 2)
+  e[esp++] = (M_RD16(OPND16(0)) * M_RD16(OPND16(3))) & 0xFFFF;
+  clk += ic.base;
+  count += 2;
+  ip = opPc + 7;
+}
+  NEXT;
+#define SIMBOT_IDIOM(o)                            \
+  I_KS_##o : { /* PUSHW k; o; STGW a */            \
+    IDIOM_ENTER(kIdiomKs_##o, PUSHW, 1)            \
+    const uint32_t v = e[--esp];                   \
+    M_WR16(OPND16(4), IDIOM_OP_##o(v, OPND16(0))); \
+    clk += ic.base;                                \
+    count += 2;                                    \
+    ip = opPc + 7;                                 \
+  }                                                \
+  NEXT;
+  SIMBOT_IDIOMS_KS(SIMBOT_IDIOM)
+#undef SIMBOT_IDIOM
+I_StoreConst : { /* PUSHW k; STGW a */
+  IDIOM_ENTER(kIdiomStoreConst, PUSHW, 1)
+  M_WR16(OPND16(3), OPND16(0));
+  clk += ic.base;
+  count += 1;
+  ip = opPc + 6;
+}
+  NEXT;
+I_LoadRet : { /* LDLW x; RET: RET's fault leaves it to run alone */
+  IDIOM_ENTER(kIdiomLoadRet, LDLW, 1)
+  IDIOM_LOAD_LDLW(x)
+  if (__builtin_expect(calls.empty() || (!ints.empty() &&
+                                         static_cast<int>(calls.size()) <= ints.back().callDepth),
+                       0))
+    goto L_LDLW;
+  e[esp++] = x;
+  const CallFrame f = calls.back();
+  calls.pop_back();
+  clk += ic.base;
+  if (f.autoFrame) clk += costs.autoFrameRet;  // as RET: POP IX
+  count += 1;
+  ip = f.retPc;
+  msp = f.msp;
+  mfp = f.mfp;
+}
+  NEXT;
+  // DBG, then the idiom after it: the boundary between them, then the
+  // idiom's first piece charged as NEXT would, without the table load.
+#define DBG_THEN(name, first)                                \
+  D_##name : {                                               \
+    if (__builtin_expect(clk >= limit, 0)) {                 \
+      SAVE();                                                \
+      goto boundary;                                         \
+    }                                                        \
+    opPc = ip;                                               \
+    clk += opCost[static_cast<int>(Op::first)];              \
+    ++count;                                                 \
+    operand = code + ip + 1;                                 \
+    ip += static_cast<uint32_t>(instructionSize(Op::first)); \
+    goto I_##name;                                           \
+  }
+#define SIMBOT_IDIOM(name, first) DBG_THEN(name, first)
+#define SIMBOT_IDIOM_CB(l, c, b) DBG_THEN(CB_##l##_##c##_##b, l)
+#define SIMBOT_IDIOM_BSJ(s, o) DBG_THEN(BSJ_##s##_##o, LDGW)
+#define SIMBOT_IDIOM_BS(s, o) DBG_THEN(BS_##s##_##o, LDGW)
+#define SIMBOT_IDIOM_LKC(l, o) DBG_THEN(LKC_##l##_##o, l)
+#define SIMBOT_IDIOM_LK(l, o) DBG_THEN(LK_##l##_##o, l)
+#define SIMBOT_IDIOM_KS(o) DBG_THEN(KS_##o, PUSHW)
+  SIMBOT_IDIOM_LIST(SIMBOT_IDIOM)
+#undef SIMBOT_IDIOM
+#undef SIMBOT_IDIOM_CB
+#undef SIMBOT_IDIOM_BSJ
+#undef SIMBOT_IDIOM_BS
+#undef SIMBOT_IDIOM_LKC
+#undef SIMBOT_IDIOM_LK
+#undef SIMBOT_IDIOM_KS
+#undef DBG_THEN
+#undef M_RD8
+#undef M_RD16
+#undef M_WR8
+#undef M_WR16
+#undef OPND16
+#undef IDIOM_ENTER
+#undef IDIOM_LOAD_LDGW
+#undef IDIOM_LOAD_LDLW
+#undef IDIOM_SRC_LDGW
+#undef IDIOM_SRC_PUSHW
+#undef IDIOM_OP_ADDW
+#undef IDIOM_OP_SUBW
+#undef IDIOM_TARGET
+#undef IDIOM_BYTE_ADDRESS
+#undef IDIOM_BYTE_BRANCH
 #endif
 slowNext:
   if (longLimit >= 0) {  // the tail of a long instruction (L_Long_)
@@ -1162,8 +1486,9 @@ void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
   if (codeAddress < s.breakpoints.size()) {
     s.breakpoints[codeAddress] = enabled ? 1 : 0;
     s.dispatch[codeAddress] = enabled ? State::kTrap : s.baseDispatch[codeAddress];
-    // The entries that may fuse into this address: those just before it.
-    const uint32_t from = codeAddress >= 4 ? codeAddress - 4 : 0;
+    // The entries that may fuse into this address: those just before it
+    // (an idiom's last piece starts at most kMaxIdiomReach after them).
+    const uint32_t from = codeAddress >= kMaxIdiomReach ? codeAddress - kMaxIdiomReach : 0;
     for (int k = 0; k < 2; ++k)
       if (!s.fast[k].empty())
         for (uint32_t a = from; a <= codeAddress; ++a) s.setFast(k, a);

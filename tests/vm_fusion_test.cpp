@@ -1,0 +1,345 @@
+// The idioms (vm/idioms.h) against the unfused run as the oracle: the
+// profiling run never fuses, so a profiled VM steps every piece one by one.
+// For every idiom a loop built around it must stop at every horizon, accept
+// an interrupt requested at every tick, take PRT0's ticks, fault, overflow
+// the expression stack and stop at breakpoints exactly where, when and
+// with what state the unfused run does.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+
+#include "support/assembler.h"
+#include "support/test_host.h"
+#include "vm/idioms.h"
+
+using namespace simbot;
+using simbot::testkit::Assembler;
+using simbot::testkit::TestHost;
+using vm::Irq;
+using vm::Op;
+using vm::Stop;
+using vm::detail::IdiomShape;
+using vm::detail::kIdiomShapes;
+
+namespace {
+
+const vm::CostTable& costs() { return testkit::calibratedCosts(); }
+
+enum class Variant {
+  Plain,   // operands in range
+  Fault,   // the byte address in the null page, the auto past memory's end
+  Growing  // each pass leaves a value on the expression stack
+};
+
+std::string nameOf(const IdiomShape& s) {
+  std::string n;
+  for (int k = 0; k < s.n; ++k) n += std::string(vm::info(s.pieces[k]).name) + " ";
+  return n;
+}
+
+bool leavesValue(const IdiomShape& s) {
+  const Op last = s.pieces[s.n - 1];
+  return last != Op::STIB && last != Op::STGW && last != Op::JZ && last != Op::JNZ &&
+         last != Op::JMP;
+}
+
+constexpr uint16_t kDataBytes = 80;  // x, y, r, hits, i, ints, then the byte array
+
+// A loop around the idiom: its variable x (a global, or the auto at
+// offset 0) starts at 0x7FFC and counts up past 0x8000 against the
+// constant 0x7FFF, so that the comparisons go both ways, signed ones with
+// and without overflow; the byte array holds zeros and non-zeros; the
+// idiom's value, if it leaves one, goes to r; a branch taken skips
+// INCGW hits. The PIO handler counts into ints.
+// First, `dbgs` DBG and `pairs` PUSHW POP (PrtTicksLandingInside...).
+// An idiom that ends in RET is a function's end: the loop calls it.
+// `start` receives the idiom's first piece's address.
+vm::Image idiomProgram(const IdiomShape& s, Variant v, bool dbg, int dbgs = 0, int pairs = 0,
+                       uint32_t* start = nullptr) {
+  Assembler a;
+  const uint16_t x = a.data(2), y = a.data(2), r = a.data(2), hits = a.data(2), i = a.data(2),
+                 ints = a.data(2), arg = a.data(2), arr = a.data(kDataBytes - 14);
+  auto set16 = [&](uint16_t at, uint16_t value) {
+    a.image.data[at - vm::kDataBase] = static_cast<uint8_t>(value);
+    a.image.data[at - vm::kDataBase + 1] = static_cast<uint8_t>(value >> 8);
+  };
+  set16(x, 0x7FFC);
+  set16(y, 0x0123);
+  for (uint16_t j = 0; j < kDataBytes - 14; ++j)
+    a.image.data[arr - vm::kDataBase + j] = static_cast<uint8_t>(j % 3 == 0 ? 0 : j);
+  for (int k = 0; k < dbgs; ++k) a.op(Op::DBG);
+  for (int k = 0; k < pairs; ++k) a.op(Op::PUSHW, 0).op(Op::POP);
+  a.op(Op::ENTER, 4).op(Op::PUSHW, 0x7FFC).op(Op::STLW, 0);
+  a.bind("top");
+  // An idiom that takes values from below its own (ADDW after MULW,
+  // KS's ADDW) finds y there.
+  int depth = 0, lowest = 0;
+  for (int k = 0; k < s.n; ++k) {
+    depth -= vm::info(s.pieces[k]).pop;
+    lowest = std::min(lowest, depth);
+    depth += vm::info(s.pieces[k]).push;
+  }
+  for (int k = 0; k < -lowest; ++k) a.op(Op::LDGW, y);
+  uint32_t callAt = 0;
+  const bool isFunction = s.pieces[s.n - 1] == Op::RET;
+  uint32_t callIdiomAt = 0;
+  if (isFunction) {
+    callIdiomAt = a.here() + 1;
+    a.op(Op::CALL, 0);
+  }
+  auto emitIdiom = [&] {
+    a.line = 10;
+    if (dbg) a.op(Op::DBG);
+    if (start) *start = a.here();
+    for (int k = 0; k < s.n; ++k) {
+      const Op o = s.pieces[k];
+      switch (o) {
+        case Op::LDGW:
+          a.op(o, k == 0 ? x : s.pieces[0] == Op::PUSHW ? i : y);
+          break;
+        case Op::LDLW:
+          a.op(o, v == Variant::Fault ? 3u : 0u);  // FP + 3: 0xFFFF, past the end
+          break;
+        case Op::PUSHW:
+          if (k == 0)
+            a.op(o, v == Variant::Fault ? 0x10u : arr);  // a byte array's base
+          else
+            a.op(o, k == 1 ? 0x7FFFu : 0xA5C3u);  // a constant; a byte to store
+          break;
+        case Op::STGW:
+          a.op(o, r);
+          break;
+        case Op::JZ:
+        case Op::JNZ:
+        case Op::JMP:
+          a.jump(o, "next");
+          break;
+        case Op::CALL:
+          callAt = a.here() + 1;
+          a.op(o, 0);
+          break;
+        default:
+          a.op(o);
+      }
+    }
+  };
+  if (!isFunction) emitIdiom();
+  a.line = 11;
+  if (leavesValue(s)) a.op(Op::STGW, r);
+  a.op(Op::INCGW, hits);
+  a.bind("next");
+  a.line = 12;
+  a.op(Op::INCGW, x).op(Op::INCGW, i);
+  a.op(Op::LDLW, 0).op(Op::PUSHW, 1).op(Op::ADDW).op(Op::STLW, 0);
+  if (v == Variant::Growing) a.op(Op::PUSHW, 7);
+  a.jump(Op::JMP, "top");
+  // The function a CALL piece calls: it keeps its argument and returns 0x55.
+  a.line = 30;
+  const uint32_t fn = a.here();
+  a.op(Op::STGW, arg).op(Op::PUSHW, 0x55).op(Op::RET);
+  if (callAt) {
+    a.image.code[callAt] = static_cast<uint8_t>(fn);
+    a.image.code[callAt + 1] = static_cast<uint8_t>(fn >> 8);
+  }
+  if (isFunction) {
+    const uint32_t f = a.here();
+    emitIdiom();
+    a.image.code[callIdiomAt] = static_cast<uint8_t>(f);
+    a.image.code[callIdiomAt + 1] = static_cast<uint8_t>(f >> 8);
+  }
+  a.line = 20;
+  a.bind("handler").op(Op::INCGW, ints).op(Op::RETI);
+  a.image.vectors.push_back({vm::kVecPIOA, static_cast<uint16_t>(a.label("handler")), "handler"});
+  return a.finish();
+}
+
+// Where each of the idiom's pieces starts.
+std::vector<uint32_t> pieceAddresses(const IdiomShape& s, uint32_t start) {
+  std::vector<uint32_t> at;
+  for (int k = 0; k < s.n; ++k) {
+    at.push_back(start);
+    start += static_cast<uint32_t>(vm::instructionSize(s.pieces[k]));
+  }
+  return at;
+}
+
+// Everything a run leaves that the idiom could change.
+void expectSame(const vm::Vm& f, const vm::Vm& p, const std::string& what) {
+  ASSERT_EQ(f.now(), p.now()) << what;
+  ASSERT_EQ(f.stats().instructions, p.stats().instructions) << what;
+  ASSERT_EQ(f.pc(), p.pc()) << what;
+  ASSERT_EQ(f.halted(), p.halted()) << what;
+  ASSERT_EQ(f.interruptDepth(), p.interruptDepth()) << what;
+  ASSERT_EQ(f.stats().interrupts, p.stats().interrupts) << what;
+  ASSERT_EQ(f.fault() != nullptr, p.fault() != nullptr) << what;
+  if (f.fault()) {
+    EXPECT_EQ(f.fault()->message, p.fault()->message) << what;
+    EXPECT_EQ(f.fault()->tick, p.fault()->tick) << what;
+    EXPECT_EQ(f.fault()->line, p.fault()->line) << what;
+  }
+  for (uint32_t a = vm::kDataBase; a < vm::kDataBase + kDataBytes + 96u; ++a)
+    ASSERT_EQ(f.read8(static_cast<uint16_t>(a)), p.read8(static_cast<uint16_t>(a)))
+        << what << " at 0x" << std::hex << a;
+  for (uint32_t a = 0xFFF0; a <= 0xFFFF; ++a)
+    ASSERT_EQ(f.read8(static_cast<uint16_t>(a)), p.read8(static_cast<uint16_t>(a)))
+        << what << " at 0x" << std::hex << a;
+}
+
+// One pass of any of these loops is under 700 T-states: the sweeps cover
+// at least three passes.
+constexpr vm::Tick kSweep = 2100;
+
+TEST(VmIdiom, EveryHorizonStopsWhereTheUnfusedRunStops) {
+  for (const IdiomShape& s : kIdiomShapes)
+    for (const bool dbg : {false, true}) {
+      const auto img = idiomProgram(s, Variant::Plain, dbg);
+      for (vm::Tick h = 1; h <= kSweep; ++h) {
+        TestHost h1, h2;
+        vm::Vm fused(img, h1, costs());
+        vm::Vm plain(img, h2, costs());
+        plain.enableProfile();
+        ASSERT_EQ(fused.run(h), plain.run(h)) << nameOf(s) << h;
+        expectSame(fused, plain, nameOf(s) + "horizon " + std::to_string(h));
+        if (HasFatalFailure()) return;
+        // Resuming from there runs on as the unfused run does.
+        ASSERT_EQ(fused.run(h + 1000), plain.run(h + 1000)) << nameOf(s) << h;
+        expectSame(fused, plain, nameOf(s) + "resumed from " + std::to_string(h));
+        if (HasFatalFailure()) return;
+      }
+    }
+}
+
+TEST(VmIdiom, AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused) {
+  for (const IdiomShape& s : kIdiomShapes)
+    for (const bool dbg : {false, true}) {
+      const auto img = idiomProgram(s, Variant::Plain, dbg);
+      for (vm::Tick at = 1; at <= kSweep; ++at) {
+        TestHost h1, h2;
+        vm::Vm fused(img, h1, costs());
+        vm::Vm plain(img, h2, costs());
+        plain.enableProfile();
+        h1.schedule(at, Irq::Pio);
+        h2.schedule(at, Irq::Pio);
+        h1.runUntil(fused, at + 1500);
+        h2.runUntil(plain, at + 1500);
+        const std::string what = nameOf(s) + "request at " + std::to_string(at);
+        ASSERT_EQ(h1.events.size(), h2.events.size()) << what;
+        ASSERT_FALSE(h1.events.empty()) << what;
+        for (size_t k = 0; k < h1.events.size(); ++k) {
+          EXPECT_EQ(h1.events[k].tick, h2.events[k].tick) << what;
+          EXPECT_EQ(h1.events[k].pc, h2.events[k].pc) << what;
+        }
+        expectSame(fused, plain, what);
+        if (HasFatalFailure()) return;
+      }
+    }
+}
+
+TEST(VmIdiom, PrtTicksLandingInsideAreTakenWhereTheyAreUnfused) {
+  // The BIOS timer service on: PRT0 ticks every kPrtTicks. A prefix of p
+  // DBG (62 T-states) and q PUSHW POP (29) moves the loop against the
+  // ticks, so that they land at every offset into the idiom's pieces.
+  vm::CostKnobs knobs = vm::calibratedKnobs();
+  knobs.timerService = vm::TimerService::Always;
+  const vm::CostTable timed = vm::makeCostTable(knobs);
+  for (const IdiomShape& s : kIdiomShapes)
+    for (const bool dbg : {false, true}) {
+      for (int p = 0; p < 12; ++p)
+        for (int q = 0; q < 3; ++q) {
+          const vm::Image img = idiomProgram(s, Variant::Plain, dbg, p, q);
+          TestHost h1, h2;
+          vm::Vm fused(img, h1, timed);
+          vm::Vm plain(img, h2, timed);
+          plain.enableProfile();
+          const vm::Tick end = 3 * vm::kPrtTicks + 500;
+          ASSERT_EQ(fused.run(end), plain.run(end));
+          const std::string what =
+              nameOf(s) + "prefix " + std::to_string(p) + "," + std::to_string(q);
+          ASSERT_EQ(fused.timerIsrCycles(), plain.timerIsrCycles()) << what;
+          ASSERT_EQ(fused.stats().interrupts[static_cast<int>(Irq::Timer)], 3u) << what;
+          expectSame(fused, plain, what);
+          if (HasFatalFailure()) return;
+        }
+    }
+}
+
+TEST(VmIdiom, APieceThatFaultsFaultsAsItDoesAlone) {
+  // The byte idioms address the null page (0x10 + i), the auto ones read
+  // FP + 3 = 0xFFFF: the unfused run faults in STIB, LDIB or LDLW.
+  int faulting = 0;
+  for (const IdiomShape& s : kIdiomShapes)
+    for (const bool dbg : {false, true}) {
+      const auto img = idiomProgram(s, Variant::Fault, dbg);
+      TestHost h1, h2;
+      vm::Vm fused(img, h1, costs());
+      vm::Vm plain(img, h2, costs());
+      plain.enableProfile();
+      const Stop stop = plain.run(1'000'000);
+      ASSERT_EQ(fused.run(1'000'000), stop) << nameOf(s);
+      expectSame(fused, plain, nameOf(s) + "fault");
+      if (HasFatalFailure()) return;
+      if (stop == Stop::Fault) {
+        ++faulting;
+        EXPECT_EQ(plain.fault()->line, 10) << nameOf(s);  // inside the idiom
+      }
+    }
+  // Every idiom with a byte access or an auto, with and without DBG.
+  int expected = 0;
+  for (const IdiomShape& s : kIdiomShapes) {
+    bool faults = s.pieces[0] == Op::LDLW;
+    for (int k = 0; k < s.n; ++k) faults |= s.pieces[k] == Op::LDIB || s.pieces[k] == Op::STIB;
+    expected += faults ? 2 : 0;
+  }
+  EXPECT_EQ(faulting, expected);
+}
+
+TEST(VmIdiom, TheExpressionStackGuardStopsWhereItDoesUnfused) {
+  // Each pass leaves one value more; some pass's pushes inside the idiom
+  // reach the guard, and the boundary after that push faults.
+  for (const IdiomShape& s : kIdiomShapes)
+    for (const bool dbg : {false, true}) {
+      const auto img = idiomProgram(s, Variant::Growing, dbg);
+      TestHost h1, h2;
+      vm::Vm fused(img, h1, costs());
+      vm::Vm plain(img, h2, costs());
+      plain.enableProfile();
+      ASSERT_EQ(plain.run(100'000'000), Stop::Fault) << nameOf(s);
+      ASSERT_EQ(fused.run(100'000'000), Stop::Fault) << nameOf(s);
+      expectSame(fused, plain, nameOf(s) + "guard");
+      if (HasFatalFailure()) return;
+    }
+}
+
+TEST(VmIdiom, ABreakpointOnAnyPieceStopsThereEveryPass) {
+  // Set before the first run, and set after some passes have run fused.
+  for (const IdiomShape& s : kIdiomShapes)
+    for (const bool dbg : {false, true}) {
+      uint32_t start = 0;
+      const auto img = idiomProgram(s, Variant::Plain, dbg, 0, 0, &start);
+      const auto at = pieceAddresses(s, start);
+      for (int k = 1; k < s.n; ++k)
+        for (const vm::Tick before : {vm::Tick{0}, vm::Tick{1000}}) {
+          TestHost h1, h2;
+          vm::Vm fused(img, h1, costs());
+          vm::Vm plain(img, h2, costs());
+          plain.enableProfile();
+          if (before) {
+            ASSERT_EQ(fused.run(before), plain.run(before));
+          }
+          fused.setBreakpoint(at[k]);
+          plain.setBreakpoint(at[k]);
+          for (int pass = 0; pass < 4; ++pass) {
+            const Stop stop = plain.run(1'000'000);
+            ASSERT_EQ(fused.run(1'000'000), stop) << nameOf(s) << k;
+            const std::string what = nameOf(s) + "piece " + std::to_string(k);
+            expectSame(fused, plain, what);
+            if (HasFatalFailure()) return;
+            if (stop != Stop::Breakpoint) break;  // a branch went round it
+            EXPECT_EQ(plain.pc(), at[k]) << what;
+          }
+        }
+    }
+}
+
+}  // namespace

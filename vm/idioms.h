@@ -1,0 +1,118 @@
+// Semantic superinstructions (idioms): runs of 3-5 ordinary instructions
+// that the fast path executes as one dispatch, with no expression-stack
+// traffic for their intermediates. Chosen from the most frequent n-grams
+// counted over the reference, shipped, test and benchmark programs (README
+// "Dispatch"). The list is shared by the decoder (idioms.cpp: which idiom
+// starts at an address, and what its pieces cost) and the handlers
+// (vm.cpp, one label per idiom, in the same order).
+#pragma once
+#include <cstdint>
+#include <iterator>
+
+#include "vm/bytecode.h"
+
+namespace simbot::vm::detail {
+
+// Compare-and-branch: LOAD x; PUSHW k; CMP; BR t, for every 16-bit
+// comparison, a global or auto LOAD and JZ or JNZ.
+// clang-format off
+#define SIMBOT_IDIOM_COMPARES(X, load, br)                              \
+  X(load, LTW, br) X(load, LEW, br) X(load, GTW, br) X(load, GEW, br)   \
+  X(load, EQW, br) X(load, NEW, br) X(load, LTUW, br) X(load, LEUW, br) \
+  X(load, GTUW, br) X(load, GEUW, br)
+#define SIMBOT_IDIOMS_CB(X)                                                    \
+  SIMBOT_IDIOM_COMPARES(X, LDGW, JZ) SIMBOT_IDIOM_COMPARES(X, LDGW, JNZ)       \
+  SIMBOT_IDIOM_COMPARES(X, LDLW, JZ) SIMBOT_IDIOM_COMPARES(X, LDLW, JNZ)
+// Load-op-store on globals: LDGW a; SRC b; OP; STGW c (c = a OP b), alone
+// (BS) and closing a loop (BSJ: then JMP).
+#define SIMBOT_IDIOMS_BS(X) X(LDGW, ADDW) X(LDGW, SUBW) X(PUSHW, ADDW) X(PUSHW, SUBW)
+// An operand and an immediate: LOAD x; PUSHW k; OP (pushes x OP k), alone
+// (LK) and as a call's last argument (LKC: then CALL f).
+#define SIMBOT_IDIOMS_LK(X) \
+  X(LDLW, ADDW) X(LDLW, SUBW) X(LDGW, ADDW) X(LDGW, SUBW)
+
+// An expression's end stored: PUSHW k; OP; STGW a (a = top OP k).
+#define SIMBOT_IDIOMS_KS(X) X(ADDW) X(SUBW)
+
+// Every idiom as X(name, first piece), in the order of kIdiomShapes.
+#define SIMBOT_IDIOM_LIST(X)                                                   \
+  X(StoreByte, PUSHW) X(ByteJZ, PUSHW) X(ByteJNZ, PUSHW) X(Byte, PUSHW)       \
+  SIMBOT_IDIOMS_CB(X##_CB) SIMBOT_IDIOMS_BS(X##_BSJ) SIMBOT_IDIOMS_BS(X##_BS) \
+  SIMBOT_IDIOMS_LK(X##_LKC) SIMBOT_IDIOMS_LK(X##_LK) X(MulAdd, LDGW)          \
+  X(Mul, LDGW) SIMBOT_IDIOMS_KS(X##_KS) X(StoreConst, PUSHW) X(LoadRet, LDLW)
+// clang-format on
+
+// Every idiom's pieces, longest first where one idiom is a prefix of
+// another (the decoder takes the first that matches).
+#define SIMBOT_IDIOM_CB_SHAPE(l, c, b) {{Op::l, Op::PUSHW, Op::c, Op::b}, 4},
+#define SIMBOT_IDIOM_BSJ_SHAPE(s, o) {{Op::LDGW, Op::s, Op::o, Op::STGW, Op::JMP}, 5},
+#define SIMBOT_IDIOM_BS_SHAPE(s, o) {{Op::LDGW, Op::s, Op::o, Op::STGW}, 4},
+#define SIMBOT_IDIOM_LKC_SHAPE(l, o) {{Op::l, Op::PUSHW, Op::o, Op::CALL}, 4},
+#define SIMBOT_IDIOM_LK_SHAPE(l, o) {{Op::l, Op::PUSHW, Op::o}, 3},
+#define SIMBOT_IDIOM_KS_SHAPE(o) {{Op::PUSHW, Op::o, Op::STGW}, 3},
+// clang-format off
+#define SIMBOT_IDIOM_SHAPES                                                      \
+  {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::PUSHW, Op::STIB}, 5},                     \
+  {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::LDIB, Op::JZ}, 5},                        \
+  {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::LDIB, Op::JNZ}, 5},                       \
+  {{Op::PUSHW, Op::LDGW, Op::ADDW, Op::LDIB}, 4},                                \
+  SIMBOT_IDIOMS_CB(SIMBOT_IDIOM_CB_SHAPE)                                        \
+  SIMBOT_IDIOMS_BS(SIMBOT_IDIOM_BSJ_SHAPE)                                       \
+  SIMBOT_IDIOMS_BS(SIMBOT_IDIOM_BS_SHAPE)                                        \
+  SIMBOT_IDIOMS_LK(SIMBOT_IDIOM_LKC_SHAPE)                                       \
+  SIMBOT_IDIOMS_LK(SIMBOT_IDIOM_LK_SHAPE)                                        \
+  {{Op::LDGW, Op::LDGW, Op::MULW, Op::ADDW}, 4},                                 \
+  {{Op::LDGW, Op::LDGW, Op::MULW}, 3},                                           \
+  SIMBOT_IDIOMS_KS(SIMBOT_IDIOM_KS_SHAPE)                                        \
+  {{Op::PUSHW, Op::STGW}, 2},                                                    \
+  {{Op::LDLW, Op::RET}, 2}
+// clang-format on
+
+struct IdiomShape {
+  Op pieces[5];
+  int n;
+};
+
+inline constexpr IdiomShape kIdiomShapes[] = {SIMBOT_IDIOM_SHAPES};
+inline constexpr int kIdiomCount = static_cast<int>(std::size(kIdiomShapes));
+
+// Their indices, in the same order (the handlers' names in vm.cpp).
+enum IdiomKind : int {
+#define SIMBOT_IDIOM_KIND(name, first) kIdiom##name,
+#define SIMBOT_IDIOM_KIND_CB(l, c, b) kIdiomCb_##l##_##c##_##b,
+#define SIMBOT_IDIOM_KIND_BSJ(s, o) kIdiomBsj_##s##_##o,
+#define SIMBOT_IDIOM_KIND_BS(s, o) kIdiomBs_##s##_##o,
+#define SIMBOT_IDIOM_KIND_LKC(l, o) kIdiomLkc_##l##_##o,
+#define SIMBOT_IDIOM_KIND_LK(l, o) kIdiomLk_##l##_##o,
+#define SIMBOT_IDIOM_KIND_KS(o) kIdiomKs_##o,
+  SIMBOT_IDIOM_LIST(SIMBOT_IDIOM_KIND)
+#undef SIMBOT_IDIOM_KIND
+#undef SIMBOT_IDIOM_KIND_CB
+#undef SIMBOT_IDIOM_KIND_BSJ
+#undef SIMBOT_IDIOM_KIND_BS
+#undef SIMBOT_IDIOM_KIND_LKC
+#undef SIMBOT_IDIOM_KIND_LK
+#undef SIMBOT_IDIOM_KIND_KS
+      kIdiomEnd
+};
+static_assert(kIdiomEnd == kIdiomCount, "one kind per shape");
+
+// The farthest an entry that fuses pieces can be before the last of them
+// (DBG, then PUSHW base; LDGW i; ADDW; PUSHW v; STIB or LDGW a; LDGW b;
+// ADDW; STGW c; JMP t): a breakpoint set at an address re-decodes the
+// entries this far before it.
+inline constexpr uint32_t kMaxIdiomReach = 11;
+
+// An idiom's pieces' costs, from the cost table: `span`, the most its
+// pieces but the first and the last can take (each at its slowest
+// branch path), and `base`, what its pieces but the first cost with every
+// branch not taken (the handler adds the paths' deltas).
+// `path`: a compare-and-branch's whole cost by its compare's path p and
+// its branch (taken t), at [p * 2 + t].
+struct IdiomCost {
+  uint32_t span = 0;
+  uint32_t base = 0;
+  uint32_t path[8]{};
+};
+
+}  // namespace simbot::vm::detail
