@@ -201,6 +201,8 @@ struct Arena::Impl {
   double radius(int i) const { return P(i).body_diameter_ft / 2; }
 
   double maxStep() const;
+  bool atRest(const std::vector<double>& y) const;
+  double maxStepSet = -1;  // the value last given to CVodeSetMaxStep
 
   // ------------------------------------------------------------ geometry on a
   // state

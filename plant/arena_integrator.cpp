@@ -65,7 +65,6 @@ Arena::Impl::Impl(const ArenaConfig& c)
   // CVODE's own messages would go to stderr: a failure is reported as the
   // run's plant fault instead (SolverError).
   cv::check(CVodeSetErrFile(mem.get(), nullptr), "CVodeSetErrFile");
-  cv::check(CVodeSetMaxStep(mem.get(), maxStep()), "CVodeSetMaxStep");
   std::copy(y, y + n, tmp.begin());
   reinit(0, 0.0, tmp, /*first=*/true);
 }
@@ -82,6 +81,21 @@ double Arena::Impl::maxStep() const {
   }
   if (pointSpeed <= 0) return 0.0;  // nothing moves: no limit
   return (1.0 / 12.0) / (nR * pointSpeed);
+}
+
+// Every wheel and its target at rest and no ball in flight: the state and
+// every root function are then constant until the next re-initialisation
+// (nothing changes the right-hand side without one), so no crossing can
+// hide inside a step and maxStep() need not bound it.
+bool Arena::Impl::atRest(const std::vector<double>& y) const {
+  for (const Ball& b : D.balls)
+    if (b.active) return false;
+  for (int i = 0; i < nR; ++i) {
+    const double* r = y.data() + i * kPerRobot;
+    const auto& wt = wheelTarget[static_cast<std::size_t>(i)];
+    if (r[VL] != 0 || r[VR] != 0 || wt[0] != 0 || wt[1] != 0) return false;
+  }
+  return true;
 }
 
 void Arena::Impl::rhs(double, const double* y, double* f) const {
@@ -185,6 +199,14 @@ void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, b
     accumulateStats();
     cv::check(CVodeReInit(mem.get(), t0, yv.get()), "CVodeReInit");
     ++acc.reinits;
+  }
+  // At rest the steps grow as fast as CVODE allows (a solo program that
+  // never drives: a few steps instead of one per maxStep()); the dense
+  // output is the same constant state either way.
+  const double hmax = atRest(y) ? 0.0 : maxStep();  // 0: no bound
+  if (hmax != maxStepSet) {
+    cv::check(CVodeSetMaxStep(mem.get(), hmax), "CVodeSetMaxStep");
+    maxStepSet = hmax;
   }
   fresh = true;
   std::copy(y.begin(), y.end(), segY.begin());

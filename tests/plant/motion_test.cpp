@@ -125,6 +125,32 @@ TEST(Motion, WheelLagStepResponse) {
   }
 }
 
+// maxStep() bounds a step to 1/12 ft of the fastest point's travel so that
+// no root crossing hides inside it: a robot of the default profile, alone
+// (top speed v = 1.45 ft/s, track 0.75 ft, body 12.75 in: radius 0.53125 ft)
+// has a point speed of v + (2 v / 0.75) 0.53125 = 3.5042 ft/s, so a step of
+// at most 0.023781 s and at least ceil(1 / 0.023781) = 43 steps for each
+// second it moves. At rest (wheels and targets 0, no ball) nothing can
+// cross, the bound is off, and CVODE's steps grow as fast as it allows: far
+// fewer than 100 s / 0.023781 = 4,205 steps for 100 s, and the pose is
+// exactly the start.
+TEST(Motion, AtRestTheStepIsUnboundedAndMovingItIsBoundAgain) {
+  Profile p = defaults();
+  p.robot.left_trim = p.robot.right_trim = 1.0;
+  Arena a(config(p, {Pose{1, 1, 10}}));
+  const auto rest = ticks(100.0);
+  a.advance(rest);
+  const IntegratorStats atRest = a.stats();
+  EXPECT_LT(atRest.steps, 100);
+  const Pose q = a.pose(0, rest);
+  EXPECT_EQ(q.x_ft, 1.0);
+  EXPECT_EQ(q.y_ft, 1.0);
+  EXPECT_EQ(q.heading_deg, 10.0);
+  ASSERT_TRUE(a.setWheels(0, frame("cfg0crg0"), rest));  // spin in place, far from walls
+  a.advance(rest + ticks(1.0));
+  EXPECT_GE(a.stats().steps - atRest.steps, 43);
+}
+
 TEST(Motion, ForeDetectorEntersWireRangeAtClosedFormTick) {
   const Profile p = thesis();
   Arena a(config(p, {Pose{-6.5, -6.5, 0}}));
