@@ -17,13 +17,16 @@ ctest --test-dir build --output-on-failure --parallel "$jobs" --timeout 900
   -DSIMBOT_WERROR=ON
 # Left out under the sanitizers, to keep the suite under 20 minutes: checks
 # that repeat whole 180-s CLI matches for determinism, drive the replay page
-# in Chromium, or compare numbers with statsmodels. The code they run is
-# exercised under the sanitizers by the gtest suites (Match.*, Stats.*) and
-# hostile.inputs (which also writes replay pages), and the checks
-# themselves ran in the normal build above.
+# in Chromium, compare numbers with statsmodels, or run every idiom of the
+# VM against its unfused run at each of 2,100 horizons and interrupt ticks
+# (75 s each under ASan). The code they run is exercised under the
+# sanitizers by the gtest suites (Match.*, Stats.*, the other VmIdiom.*
+# checks: faulting pieces, the stack guard, breakpoints) and hostile.inputs
+# (which also writes replay pages), and the checks themselves ran in the
+# normal build above.
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-asan --output-on-failure --parallel "$jobs" --timeout 1800 \
-  -E '^(cli\.match\.deterministic|browser\.viewer|stats\.oracle)$'
+  -E '^(cli\.match\.deterministic|browser\.viewer|stats\.oracle|VmIdiom\.EveryHorizonStopsWhereTheUnfusedRunStops|VmIdiom\.AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused)$'
 # ThreadSanitizer: only the suite that runs work on several threads.
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSIMBOT_TSAN=ON \
   -DSIMBOT_BENCHMARKS=OFF -DSIMBOT_WERROR=ON > build-tsan.configure.log 2>&1 ||
