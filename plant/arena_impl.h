@@ -174,6 +174,14 @@ struct Arena::Impl {
 
   // ---- roots
   std::array<RootDesc, kMaxRoots> roots{};
+  // The root functions whose crossings were events at tick firedTick (over
+  // every re-initialisation at that tick): crossedTick() never puts
+  // another crossing of one of them there.
+  std::int64_t firedTick = -1;
+  std::array<RootDesc, kMaxRoots> fired{};
+  int nFired = 0;
+  void noteFired(std::int64_t tick, const int* found);
+  bool firedAt(std::int64_t tick, const RootDesc& rd) const;
   int nRoots = 0;
   int nRootsRegistered = -1;
   std::vector<int> rootsFound;

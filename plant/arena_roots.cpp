@@ -171,9 +171,15 @@ void Arena::Impl::buildRoots() {
 // two neighbouring ticks: T0 - 1 if a reported root function is already
 // on its new side there, or within kOnTickFraction of a tick of it
 // (linearly between the ticks), which round-off cannot tell from zero.
+// At the segment's first tick only the round-off case counts, and only for
+// a function that has not fired there already: two crossings exactly on
+// one tick (both reflexes of a head-on contact ending) are found in one
+// step, or, as the steps fall, the second in the segment that the first
+// one's re-initialisation starts; both are events of that tick.
 std::int64_t Arena::Impl::crossedTick(std::int64_t T0) {
   const std::int64_t k = T0 - 1;
-  if (k <= segTick) return T0;  // the segment's first tick is not a crossing
+  if (k < segTick) return T0;
+  const bool first = k == segTick;
   const double tk = secondsFromTick(k), tT = secondsFromTick(T0);
   evalAt(tk, tmp);
   evalAt(tT, qtmp);
@@ -181,11 +187,33 @@ std::int64_t Arena::Impl::crossedTick(std::int64_t T0) {
     const int dir = rootsFound[static_cast<std::size_t>(j)];
     if (dir == 0) continue;
     const RootDesc& rd = roots[static_cast<std::size_t>(j)];
+    if (first && firedAt(k, rd)) continue;
     const double gk = rootValue(rd, tk, tmp.data());
     const double gT = rootValue(rd, tT, qtmp.data());
-    if (dir * gk >= 0 || std::abs(gk) <= kOnTickFraction * std::abs(gT - gk)) return k;
+    if ((!first && dir * gk >= 0) || std::abs(gk) <= kOnTickFraction * std::abs(gT - gk)) return k;
   }
   return T0;
+}
+
+// Each root function at most once per tick through crossedTick()'s first
+// tick rule, over any number of re-initialisations there.
+void Arena::Impl::noteFired(std::int64_t tick, const int* found) {
+  if (tick != firedTick) {
+    firedTick = tick;
+    nFired = 0;
+  }
+  for (int j = 0; j < nRoots; ++j)
+    if (found[j] != 0 && !firedAt(tick, roots[static_cast<std::size_t>(j)]) && nFired < kMaxRoots)
+      fired[static_cast<std::size_t>(nFired++)] = roots[static_cast<std::size_t>(j)];
+}
+
+bool Arena::Impl::firedAt(std::int64_t tick, const RootDesc& rd) const {
+  if (tick != firedTick) return false;
+  for (int i = 0; i < nFired; ++i) {
+    const RootDesc& f = fired[static_cast<std::size_t>(i)];
+    if (f.kind == rd.kind && f.robot == rd.robot) return true;
+  }
+  return false;
 }
 
 }  // namespace simbot::plant
