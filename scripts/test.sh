@@ -3,7 +3,7 @@
 # (clang-format), the normal build with warnings as errors, the same suite
 # built with AddressSanitizer and UndefinedBehaviorSanitizer, the threaded
 # bench and tournament built with ThreadSanitizer, and a short campaign
-# (60 s) of each libFuzzer target.
+# (45 s) of each libFuzzer target.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
@@ -16,17 +16,17 @@ ctest --test-dir build --output-on-failure --parallel "$jobs" --timeout 900
 ./scripts/build.sh build-asan -DSIMBOT_SANITIZE=ON -DSIMBOT_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=Debug \
   -DSIMBOT_WERROR=ON
 # Left out under the sanitizers, to keep the suite under 20 minutes: checks
-# that repeat whole 180-s CLI matches for determinism, drive the replay page
-# in Chromium, compare numbers with statsmodels, or run every idiom of the
-# VM against its unfused run at each of 2,100 horizons and interrupt ticks
-# (75 s each under ASan). The code they run is exercised under the
-# sanitizers by the gtest suites (Match.*, Stats.*, the other VmIdiom.*
-# checks: faulting pieces, the stack guard, breakpoints) and hostile.inputs
-# (which also writes replay pages), and the checks themselves ran in the
-# normal build above.
+# that repeat whole 180-s CLI matches for determinism, kill and resume batch
+# runs from Python, drive the replay page in Chromium, compare numbers with
+# statsmodels, or run every idiom of the VM against its unfused run at each
+# of 2,100 horizons and interrupt ticks (75 s each under ASan). The code
+# they run is exercised under the sanitizers by the gtest suites (Match.*,
+# Stats.*, the other VmIdiom.* checks: faulting pieces, the stack guard,
+# breakpoints) and hostile.inputs (which also writes replay pages), and the
+# checks themselves ran in the normal build above.
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-asan --output-on-failure --parallel "$jobs" --timeout 1800 \
-  -E '^(cli\.match\.deterministic|browser\.viewer|stats\.oracle|VmIdiom\.EveryHorizonStopsWhereTheUnfusedRunStops|VmIdiom\.AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused)$'
+  -E '^(cli\.match\.deterministic|batch\.kill_and_resume|browser\.viewer|stats\.oracle|VmIdiom\.EveryHorizonStopsWhereTheUnfusedRunStops|VmIdiom\.AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused)$'
 # ThreadSanitizer: only the suite that runs work on several threads.
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSIMBOT_TSAN=ON \
   -DSIMBOT_BENCHMARKS=OFF -DSIMBOT_WERROR=ON > build-tsan.configure.log 2>&1 ||
@@ -34,4 +34,4 @@ cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSIMBOT_TSA
 cmake --build build-tsan --parallel "$jobs" --target bench_test
 TSAN_OPTIONS=halt_on_error=1 \
   ctest --test-dir build-tsan -R '^(Bench|Tournament)\.' --output-on-failure --parallel "$jobs"
-./scripts/fuzz.sh 60
+./scripts/fuzz.sh 45
