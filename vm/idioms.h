@@ -42,6 +42,19 @@ namespace simbot::vm::detail {
   X(Mul, LDGW) SIMBOT_IDIOMS_KS(X##_KS) X(StoreConst, PUSHW) X(LoadRet, LDLW)
 // clang-format on
 
+// Every idiom as SIMBOT_IDIOM_NAMED(name, first piece), in the same order,
+// each family's name spelled out (CB_LDGW_LTW_JZ, BSJ_LDGW_ADDW, ...): the
+// enum below, the handlers' label tables and the DBG entries in vm.cpp
+// define SIMBOT_IDIOM_NAMED and expand SIMBOT_IDIOM_NAMES.
+#define SIMBOT_IDIOM_N(name, first) SIMBOT_IDIOM_NAMED(name, first)
+#define SIMBOT_IDIOM_N_CB(l, c, b) SIMBOT_IDIOM_NAMED(CB_##l##_##c##_##b, l)
+#define SIMBOT_IDIOM_N_BSJ(s, o) SIMBOT_IDIOM_NAMED(BSJ_##s##_##o, LDGW)
+#define SIMBOT_IDIOM_N_BS(s, o) SIMBOT_IDIOM_NAMED(BS_##s##_##o, LDGW)
+#define SIMBOT_IDIOM_N_LKC(l, o) SIMBOT_IDIOM_NAMED(LKC_##l##_##o, l)
+#define SIMBOT_IDIOM_N_LK(l, o) SIMBOT_IDIOM_NAMED(LK_##l##_##o, l)
+#define SIMBOT_IDIOM_N_KS(o) SIMBOT_IDIOM_NAMED(KS_##o, PUSHW)
+#define SIMBOT_IDIOM_NAMES SIMBOT_IDIOM_LIST(SIMBOT_IDIOM_N)
+
 // Every idiom's pieces, longest first where one idiom is a prefix of
 // another (the decoder takes the first that matches).
 #define SIMBOT_IDIOM_CB_SHAPE(l, c, b) {{Op::l, Op::PUSHW, Op::c, Op::b}, 4},
@@ -78,21 +91,9 @@ inline constexpr int kIdiomCount = static_cast<int>(std::size(kIdiomShapes));
 
 // Their indices, in the same order (the handlers' names in vm.cpp).
 enum IdiomKind : int {
-#define SIMBOT_IDIOM_KIND(name, first) kIdiom##name,
-#define SIMBOT_IDIOM_KIND_CB(l, c, b) kIdiomCb_##l##_##c##_##b,
-#define SIMBOT_IDIOM_KIND_BSJ(s, o) kIdiomBsj_##s##_##o,
-#define SIMBOT_IDIOM_KIND_BS(s, o) kIdiomBs_##s##_##o,
-#define SIMBOT_IDIOM_KIND_LKC(l, o) kIdiomLkc_##l##_##o,
-#define SIMBOT_IDIOM_KIND_LK(l, o) kIdiomLk_##l##_##o,
-#define SIMBOT_IDIOM_KIND_KS(o) kIdiomKs_##o,
-  SIMBOT_IDIOM_LIST(SIMBOT_IDIOM_KIND)
-#undef SIMBOT_IDIOM_KIND
-#undef SIMBOT_IDIOM_KIND_CB
-#undef SIMBOT_IDIOM_KIND_BSJ
-#undef SIMBOT_IDIOM_KIND_BS
-#undef SIMBOT_IDIOM_KIND_LKC
-#undef SIMBOT_IDIOM_KIND_LK
-#undef SIMBOT_IDIOM_KIND_KS
+#define SIMBOT_IDIOM_NAMED(name, first) kIdiom##name,
+  SIMBOT_IDIOM_NAMES
+#undef SIMBOT_IDIOM_NAMED
       kIdiomEnd
 };
 static_assert(kIdiomEnd == kIdiomCount, "one kind per shape");

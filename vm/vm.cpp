@@ -327,39 +327,14 @@ Stop Vm::State::run(Tick until) {
 #undef SIMBOT_PAIR
     };
     if (!kProfile) fusedLabels = kFused;
-      // In the order of kIdiomShapes (idioms.h).
       // In the order of kIdiomShapes (idioms.h): the idioms, and DBG followed
       // by each (the DBG that starts most statements).
-#define SIMBOT_IDIOM(name, first) &&I_##name,
-#define SIMBOT_IDIOM_CB(l, c, b) &&I_CB_##l##_##c##_##b,
-#define SIMBOT_IDIOM_BSJ(s, o) &&I_BSJ_##s##_##o,
-#define SIMBOT_IDIOM_BS(s, o) &&I_BS_##s##_##o,
-#define SIMBOT_IDIOM_LKC(l, o) &&I_LKC_##l##_##o,
-#define SIMBOT_IDIOM_LK(l, o) &&I_LK_##l##_##o,
-#define SIMBOT_IDIOM_KS(o) &&I_KS_##o,
-    static const void* const kIdioms[] = {SIMBOT_IDIOM_LIST(SIMBOT_IDIOM)};
-#undef SIMBOT_IDIOM
-#undef SIMBOT_IDIOM_CB
-#undef SIMBOT_IDIOM_BSJ
-#undef SIMBOT_IDIOM_BS
-#undef SIMBOT_IDIOM_LKC
-#undef SIMBOT_IDIOM_LK
-#undef SIMBOT_IDIOM_KS
-#define SIMBOT_IDIOM(name, first) &&D_##name,
-#define SIMBOT_IDIOM_CB(l, c, b) &&D_CB_##l##_##c##_##b,
-#define SIMBOT_IDIOM_BSJ(s, o) &&D_BSJ_##s##_##o,
-#define SIMBOT_IDIOM_BS(s, o) &&D_BS_##s##_##o,
-#define SIMBOT_IDIOM_LKC(l, o) &&D_LKC_##l##_##o,
-#define SIMBOT_IDIOM_LK(l, o) &&D_LK_##l##_##o,
-#define SIMBOT_IDIOM_KS(o) &&D_KS_##o,
-    static const void* const kDbgIdioms[] = {SIMBOT_IDIOM_LIST(SIMBOT_IDIOM)};
-#undef SIMBOT_IDIOM
-#undef SIMBOT_IDIOM_CB
-#undef SIMBOT_IDIOM_BSJ
-#undef SIMBOT_IDIOM_BS
-#undef SIMBOT_IDIOM_LKC
-#undef SIMBOT_IDIOM_LK
-#undef SIMBOT_IDIOM_KS
+#define SIMBOT_IDIOM_NAMED(name, first) &&I_##name,
+    static const void* const kIdioms[] = {SIMBOT_IDIOM_NAMES};
+#undef SIMBOT_IDIOM_NAMED
+#define SIMBOT_IDIOM_NAMED(name, first) &&D_##name,
+    static const void* const kDbgIdioms[] = {SIMBOT_IDIOM_NAMES};
+#undef SIMBOT_IDIOM_NAMED
     static_assert(std::size(kDbgIdioms) == kIdiomCount);
     static_assert(std::size(kIdioms) == kIdiomCount);
     if (!kProfile) {
@@ -725,7 +700,7 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
   IDIOM_BYTE_BRANCH(ByteJNZ, JNZ, v != 0)
 #define SIMBOT_IDIOM(l, c, b)                            \
   I_CB_##l##_##c##_##b : { /* l x; PUSHW k; c; b t */    \
-    IDIOM_ENTER(kIdiomCb_##l##_##c##_##b, l, 2)          \
+    IDIOM_ENTER(kIdiomCB_##l##_##c##_##b, l, 2)          \
     IDIOM_LOAD_##l(x) unsigned path = 0;                 \
     const bool r = compare16<Op::c>(x, OPND16(3), path); \
     const bool taken = Op::b == Op::JZ ? !r : r;         \
@@ -738,7 +713,7 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
 #undef SIMBOT_IDIOM
 #define SIMBOT_IDIOM(s, o)                        \
   I_BS_##s##_##o : { /* LDGW a; s b; o; STGW c */ \
-    IDIOM_ENTER(kIdiomBs_##s##_##o, LDGW, 2)      \
+    IDIOM_ENTER(kIdiomBS_##s##_##o, LDGW, 2)      \
     const uint32_t x = M_RD16(OPND16(0));         \
     const uint32_t y = IDIOM_SRC_##s(OPND16(3));  \
     M_WR16(OPND16(7), IDIOM_OP_##o(x, y));        \
@@ -751,7 +726,7 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
 #undef SIMBOT_IDIOM
 #define SIMBOT_IDIOM(l, o)                                   \
   I_LK_##l##_##o : { /* l x; PUSHW k; o */                   \
-    IDIOM_ENTER(kIdiomLk_##l##_##o, l, 2)                    \
+    IDIOM_ENTER(kIdiomLK_##l##_##o, l, 2)                    \
     IDIOM_LOAD_##l(x) e[esp++] = IDIOM_OP_##o(x, OPND16(3)); \
     clk += ic.base;                                          \
     count += 2;                                              \
@@ -762,7 +737,7 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
 #undef SIMBOT_IDIOM
 #define SIMBOT_IDIOM(s, o)                                \
   I_BSJ_##s##_##o : { /* LDGW a; s b; o; STGW c; JMP t */ \
-    IDIOM_ENTER(kIdiomBsj_##s##_##o, LDGW, 2)             \
+    IDIOM_ENTER(kIdiomBSJ_##s##_##o, LDGW, 2)             \
     const uint32_t x = M_RD16(OPND16(0));                 \
     const uint32_t y = IDIOM_SRC_##s(OPND16(3));          \
     M_WR16(OPND16(7), IDIOM_OP_##o(x, y));                \
@@ -776,7 +751,7 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
   // CALL's own faults (stack overflow, no headroom) leave it to run alone.
 #define SIMBOT_IDIOM(l, o)                                                  \
   I_LKC_##l##_##o : { /* l x; PUSHW k; o; CALL f */                         \
-    IDIOM_ENTER(kIdiomLkc_##l##_##o, l, 2)                                  \
+    IDIOM_ENTER(kIdiomLKC_##l##_##o, l, 2)                                  \
     IDIOM_LOAD_##l(x) if (msp < stackLimit + kCallFrameBytes ||             \
                           esp + 1 > kEvalSlots - kEvalHeadroom) goto L_##l; \
     e[esp++] = IDIOM_OP_##o(x, OPND16(3));                                  \
@@ -809,7 +784,7 @@ I_Mul : { /* LDGW a; LDGW b; MULW */
   NEXT;
 #define SIMBOT_IDIOM(o)                            \
   I_KS_##o : { /* PUSHW k; o; STGW a */            \
-    IDIOM_ENTER(kIdiomKs_##o, PUSHW, 1)            \
+    IDIOM_ENTER(kIdiomKS_##o, PUSHW, 1)            \
     const uint32_t v = e[--esp];                   \
     M_WR16(OPND16(4), IDIOM_OP_##o(v, OPND16(0))); \
     clk += ic.base;                                \
@@ -860,21 +835,9 @@ I_LoadRet : { /* LDLW x; RET: RET's fault leaves it to run alone */
     ip += static_cast<uint32_t>(instructionSize(Op::first)); \
     goto I_##name;                                           \
   }
-#define SIMBOT_IDIOM(name, first) DBG_THEN(name, first)
-#define SIMBOT_IDIOM_CB(l, c, b) DBG_THEN(CB_##l##_##c##_##b, l)
-#define SIMBOT_IDIOM_BSJ(s, o) DBG_THEN(BSJ_##s##_##o, LDGW)
-#define SIMBOT_IDIOM_BS(s, o) DBG_THEN(BS_##s##_##o, LDGW)
-#define SIMBOT_IDIOM_LKC(l, o) DBG_THEN(LKC_##l##_##o, l)
-#define SIMBOT_IDIOM_LK(l, o) DBG_THEN(LK_##l##_##o, l)
-#define SIMBOT_IDIOM_KS(o) DBG_THEN(KS_##o, PUSHW)
-  SIMBOT_IDIOM_LIST(SIMBOT_IDIOM)
-#undef SIMBOT_IDIOM
-#undef SIMBOT_IDIOM_CB
-#undef SIMBOT_IDIOM_BSJ
-#undef SIMBOT_IDIOM_BS
-#undef SIMBOT_IDIOM_LKC
-#undef SIMBOT_IDIOM_LK
-#undef SIMBOT_IDIOM_KS
+#define SIMBOT_IDIOM_NAMED(name, first) DBG_THEN(name, first)
+  SIMBOT_IDIOM_NAMES
+#undef SIMBOT_IDIOM_NAMED
 #undef DBG_THEN
 #undef M_RD8
 #undef M_RD16
