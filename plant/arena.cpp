@@ -242,10 +242,9 @@ EventList Arena::edgeHandlerEntered(int robot, std::int64_t tick) {
   }
   m.rewindTo(tick);
   m.refereeTurn(tick, m.D, m.tmp, robot, ev);
-  // The turn moves the robot: contacts and edges are reconciled after it,
-  // as after a turn at a plant event (process()).
+  // The turn moves the robot's edge detectors: edges are reconciled after
+  // it, as after a turn at a plant event (process(); its contacts stand).
   for (int pass = 0; pass < 3; ++pass) {
-    m.contacts(tick, m.D, m.tmp, nullptr, ev);
     m.edges(m.D, m.tmp, nullptr, ev);
     bool turned = false;
     for (int j = 0; j < m.nR; ++j) turned = m.refereeTurn(tick, m.D, m.tmp, j, ev) || turned;

@@ -44,8 +44,9 @@ int Arena::Impl::reported(const int* found, RootKind k, int who) const {
 // divider, hit, leaving the field -- the floor first, so a ball reaching
 // floor and robot together is a miss, thesis VIII.H); per robot: referee
 // put-back, reflex end; contacts (robot-robot, divider, wall) and the
-// reflexes they start; edge detectors; the referee's turn. A put-back or a
-// turn moves a robot, so contacts and edges are reconciled again after it.
+// reflexes they start; edge detectors; the referee's turn. A put-back
+// moves a robot, so contacts and edges are reconciled again after it; a
+// turn moves its edge detectors, so edges are.
 void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<double>& y,
                           const int* found, EventList& ev) {
   double* ys = y.data();
@@ -186,12 +187,17 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
   }
   for (int pass = 0; pass < 3; ++pass) {
     const int* f = pass == 0 ? found : nullptr;
-    contacts(T, d, y, f, ev);
+    // Contacts follow the centres alone, which a turn leaves where they
+    // were: after a turn they stand as decided. Deciding them again from
+    // the sign of a function that is zero to round-off at the tick of its
+    // crossing could end a contact at the tick it began, or not, by the
+    // last bit (a robot turned at its wall contact's tick, parallel to it).
+    if (pass == 0 || moved) contacts(T, d, y, f, ev);
     edges(d, y, f, ev);
     bool turned = false;
     for (int i = 0; i < nR; ++i) turned = refereeTurn(T, d, y, i, ev) || turned;
     if (!turned && !(moved && pass == 0)) break;
-    moved = false;
+    if (pass > 0) moved = false;
   }
 }
 
@@ -230,7 +236,7 @@ void Arena::Impl::contacts(std::int64_t T, Discrete& d, std::vector<double>& y, 
   };
   if (nR == 2) {
     const int rep = reported(found, RootKind::RobotRobot, 0);
-    const bool c = rep != 0 ? rep < 0 : robotG(ys) < 0;
+    const bool c = rep != 0 ? rep < 0 : sided(RootKind::RobotRobot, 0, robotG(ys)) < 0;
     if (c && !d.robotContact) {
       for (int i = 0; i < 2; ++i) {
         const Bumper side = sideOf(heading(ys, i), centre(ys, 1 - i) - centre(ys, i));
@@ -248,7 +254,7 @@ void Arena::Impl::contacts(std::int64_t T, Discrete& d, std::vector<double>& y, 
   auto obstacle = [&](int i, RootKind k, double g, bool& touching, ContactWith with,
                       const Vec2& towards) {
     const int rep = reported(found, k, i);
-    const bool c = rep != 0 ? rep < 0 : g < 0;
+    const bool c = rep != 0 ? rep < 0 : sided(k, i, g) < 0;
     if (c && !touching) {
       const Bumper side = sideOf(heading(ys, i), towards);
       contactEvent(EventKind::Contact, i, side, with, -1);
@@ -275,8 +281,9 @@ void Arena::Impl::edges(Discrete& d, std::vector<double>& y, const int* found, E
   for (int i = 0; i < nR; ++i) {
     RobotDisc& r = d.r[static_cast<std::size_t>(i)];
     for (int k = 0; k < 2; ++k) {
-      const int rep = reported(found, k == 0 ? RootKind::EdgeFore : RootKind::EdgeAft, i);
-      const bool low = rep != 0 ? rep < 0 : edgeG(y.data(), i, k) < 0;
+      const RootKind kind = k == 0 ? RootKind::EdgeFore : RootKind::EdgeAft;
+      const int rep = reported(found, kind, i);
+      const bool low = rep != 0 ? rep < 0 : sided(kind, i, edgeG(y.data(), i, k)) < 0;
       if (low == r.edgeLow[static_cast<std::size_t>(k)]) continue;
       r.edgeLow[static_cast<std::size_t>(k)] = low;
       Event e{low ? EventKind::EdgeEnter : EventKind::EdgeLeave};

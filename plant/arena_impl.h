@@ -184,6 +184,7 @@ struct Arena::Impl {
   bool firedAt(std::int64_t tick, const RootDesc& rd) const;
   int nRoots = 0;
   int nRootsRegistered = -1;
+  std::array<double, kMaxRoots> rootShift{};
   std::vector<int> rootsFound;
 
   // ---- dense output records
@@ -234,6 +235,17 @@ struct Arena::Impl {
   double ballDividerG(const Ball& b, double t) const;
 
   double rootValue(const RootDesc& rd, double t, const double* y) const;
+  // Root j of the list as CVODE, crossedTick() and the event rules see it
+  // in this segment: shifted by rootShift[j] (arena_roots.cpp, "Sided
+  // roots").
+  double sidedValue(int j, double t, const double* y) const {
+    return rootValue(roots[static_cast<std::size_t>(j)], t, y) -
+           rootShift[static_cast<std::size_t>(j)];
+  }
+  // g, a value of root function (k, who), shifted as that root is in this
+  // segment's list (unshifted if it is not listed).
+  double sided(RootKind k, int who, double g) const;
+  void sideRoots(double t0, const std::vector<double>& y);
 
   // ------------------------------------------------------------ CVODE
   // callbacks

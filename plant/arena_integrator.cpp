@@ -222,6 +222,7 @@ void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, b
   segWheel = wheelTarget;
   segGun = gunTarget;
   buildRoots();
+  sideRoots(t0, y);
   if (nRoots != nRootsRegistered) {
     cv::check(CVodeRootInit(mem.get(), nRoots, nRoots > 0 ? &Impl::rootThunk : nullptr),
               "CVodeRootInit");

@@ -7,6 +7,8 @@
 // CVODE evaluates them through rootThunk; crossedTick() decides the tick of
 // a crossing CVODE reported. They only read the state: the rules that act
 // on a crossing are in arena_events.cpp.
+#include <limits>
+
 #include "plant/arena_impl.h"
 
 namespace simbot::plant {
@@ -134,9 +136,65 @@ double Arena::Impl::rootValue(const RootDesc& rd, double t, const double* y) con
 int Arena::Impl::rootThunk(sunrealtype t, N_Vector y, sunrealtype* g, void* user) {
   const Impl* self = static_cast<const Impl*>(user);
   const double* yy = N_VGetArrayPointer(y);
-  for (int i = 0; i < self->nRoots; ++i)
-    g[i] = self->rootValue(self->roots[static_cast<std::size_t>(i)], t, yy);
+  for (int i = 0; i < self->nRoots; ++i) g[i] = self->sidedValue(i, t, yy);
   return 0;
+}
+
+// Sided roots. A contact or edge function's sign is the discrete state
+// (touching, or the detector low, exactly when g < 0), but at the tick of
+// a crossing the rules decide by the direction CVODE reported, and there
+// the function can be exactly 0 (a crossing exactly on a tick) or on the
+// old side by round-off (the dense output is not CVODE's own
+// interpolation to the last bit). CVODE ignores a root function that
+// starts a segment at exactly 0, and one that starts on the wrong side
+// crosses the wrong way or not at all: a reflex backing off a wall at
+// once ended the contact only at the next event (rules_test.cpp,
+// ExactTicks.WallContactEndsTheTickAfterItBegins). So each such function
+// starts the segment strictly on the side its discrete state says: where
+// it does not, it is shifted by its start value plus as much again (at
+// least the smallest normal double). The shift is round-off sized, far
+// below the distance a robot moves in a tick; it holds for the whole
+// segment, in CVODE's root finding, crossedTick() and the event rules.
+void Arena::Impl::sideRoots(double t0, const std::vector<double>& y) {
+  for (int j = 0; j < nRoots; ++j) {
+    const RootDesc& rd = roots[static_cast<std::size_t>(j)];
+    auto robot = [&]() -> const RobotDisc& { return D.r[static_cast<std::size_t>(rd.robot)]; };
+    int side = 0;  // -1: the state says g < 0, +1: g >= 0, 0: no state
+    switch (rd.kind) {
+      case RootKind::EdgeFore:
+        side = robot().edgeLow[0] ? -1 : 1;
+        break;
+      case RootKind::EdgeAft:
+        side = robot().edgeLow[1] ? -1 : 1;
+        break;
+      case RootKind::Wall:
+        side = robot().wallContact ? -1 : 1;
+        break;
+      case RootKind::Divider:
+        side = robot().dividerContact ? -1 : 1;
+        break;
+      case RootKind::RobotRobot:
+        side = D.robotContact ? -1 : 1;
+        break;
+      default:
+        break;
+    }
+    double shift = 0;
+    if (side != 0) {
+      const double g0 = rootValue(rd, t0, y.data());
+      if (side * g0 <= 0)
+        shift = g0 - side * std::max(std::abs(g0), std::numeric_limits<double>::min());
+    }
+    rootShift[static_cast<std::size_t>(j)] = shift;
+  }
+}
+
+double Arena::Impl::sided(RootKind k, int who, double g) const {
+  for (int j = 0; j < nRoots; ++j)
+    if (roots[static_cast<std::size_t>(j)].kind == k &&
+        roots[static_cast<std::size_t>(j)].robot == who)
+      return g - rootShift[static_cast<std::size_t>(j)];
+  return g;
 }
 
 void Arena::Impl::buildRoots() {
@@ -175,7 +233,9 @@ void Arena::Impl::buildRoots() {
 // a function that has not fired there already: two crossings exactly on
 // one tick (both reflexes of a head-on contact ending) are found in one
 // step, or, as the steps fall, the second in the segment that the first
-// one's re-initialisation starts; both are events of that tick.
+// one's re-initialisation starts; both are events of that tick. A sided
+// root (see above) is on its old side at the segment's first tick by
+// construction: it does not cross there.
 std::int64_t Arena::Impl::crossedTick(std::int64_t T0) {
   const std::int64_t k = T0 - 1;
   if (k < segTick) return T0;
@@ -187,9 +247,9 @@ std::int64_t Arena::Impl::crossedTick(std::int64_t T0) {
     const int dir = rootsFound[static_cast<std::size_t>(j)];
     if (dir == 0) continue;
     const RootDesc& rd = roots[static_cast<std::size_t>(j)];
-    if (first && firedAt(k, rd)) continue;
-    const double gk = rootValue(rd, tk, tmp.data());
-    const double gT = rootValue(rd, tT, qtmp.data());
+    if (first && (firedAt(k, rd) || rootShift[static_cast<std::size_t>(j)] != 0)) continue;
+    const double gk = sidedValue(j, tk, tmp.data());
+    const double gT = sidedValue(j, tT, qtmp.data());
     if ((!first && dir * gk >= 0) || std::abs(gk) <= kOnTickFraction * std::abs(gT - gk)) return k;
   }
   return T0;

@@ -82,6 +82,42 @@ TEST(ExactTicks, WallContactAndReflexEnd) {
   EXPECT_EQ(e->tick, reflexEnd);
 }
 
+// From (2.25, -6.40625) heading north at 1.5 ft/s the body reaches the
+// north wall after 7.46875 + 6.40625 = 13.875 ft, 9.25 s = 85,248,000
+// ticks; the reflex backs off at once, so the contact function, 0 at the
+// contact's tick, is positive from the next tick on: the contact ends
+// there. Twice: as is, and with a referee that turns a robot at its first
+// reflex (at the contact's tick, by 45 degrees about its centre, which
+// stays where it was; the robot then backs off at 45 degrees to the wall).
+// From this start the function is exactly 0.0 at the contact's tick:
+// CVODE ignores a root function that starts a segment at exactly 0, and
+// the end was found 0.19 s late, at the next event, until the function was
+// sided (arena_roots.cpp); with the turn, the contact was decided again
+// from that 0 and ended at the tick it began, until a turn left contacts
+// standing (arena_events.cpp).
+TEST(ExactTicks, WallContactEndsTheTickAfterItBegins) {
+  for (const int reflexLimit : {3, 0}) {
+    Profile p = thesis();
+    p.referee.reflex_limit = reflexLimit;
+    const std::int64_t contact = kStart + 85'248'000;
+    Arena a(config(p, {Pose{2.25, -6.40625, 0}}));
+    a.advance(kStart);
+    a.setWheels(0, frame("ffg0ffg0"), kStart);
+    const auto evs = eventsUntil(a, contact + 1000);
+    const auto c = first(evs, EventKind::Contact, 0);
+    ASSERT_TRUE(c.has_value()) << "reflex_limit " << reflexLimit;
+    EXPECT_EQ(c->tick, contact) << "reflex_limit " << reflexLimit;
+    const auto turn = first(evs, EventKind::RefereeTurn, 0);
+    EXPECT_EQ(turn.has_value(), reflexLimit == 0);
+    if (turn) {
+      EXPECT_EQ(turn->tick, contact);
+    }
+    const auto ce = first(evs, EventKind::ContactEnd, 0);
+    ASSERT_TRUE(ce.has_value()) << "reflex_limit " << reflexLimit;
+    EXPECT_EQ(ce->tick, contact + 1) << "reflex_limit " << reflexLimit;
+  }
+}
+
 // thesis-1997's gun: motors always on, no spin-up, no stroke time, 105 ft/s.
 // The muzzle is flush with the body edge, 0.53125 ft ahead of the centre.
 // A robot whose muzzle is 7 ft from a wall fires at tick L: the ball flies
