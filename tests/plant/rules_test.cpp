@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "plant_support.h"
 
@@ -82,39 +83,48 @@ TEST(ExactTicks, WallContactAndReflexEnd) {
   EXPECT_EQ(e->tick, reflexEnd);
 }
 
-// From (2.25, -6.40625) heading north at 1.5 ft/s the body reaches the
-// north wall after 7.46875 + 6.40625 = 13.875 ft, 9.25 s = 85,248,000
-// ticks; the reflex backs off at once, so the contact function, 0 at the
-// contact's tick, is positive from the next tick on: the contact ends
-// there. Twice: as is, and with a referee that turns a robot at its first
-// reflex (at the contact's tick, by 45 degrees about its centre, which
-// stays where it was; the robot then backs off at 45 degrees to the wall).
-// From this start the function is exactly 0.0 at the contact's tick:
-// CVODE ignores a root function that starts a segment at exactly 0, and
-// the end was found 0.19 s late, at the next event, until the function was
-// sided (arena_roots.cpp); with the turn, the contact was decided again
-// from that 0 and ended at the tick it began, until a turn left contacts
+// Every wall contact whose crossing falls exactly on a tick, straight at
+// the north wall from (2.25, y0) and at the east wall from (y0, 0.25), with
+// y0 = -6.5 + k/64 for k = 0..299: the body reaches the wall after
+// 13.96875 - k/64 ft at 1.5 ft/s, 85,824,000 - 96,000 k ticks. The reflex
+// backs off at once, so the contact function, 0 at the contact's tick, is
+// positive from the next tick on: the contact ends there. Each start twice:
+// as is, and with a referee that turns a robot at its first reflex (at the
+// contact's tick, by 45 degrees about its centre, which stays where it
+// was; the robot then backs off at 45 degrees to the wall). For k = 6 the
+// function is exactly 0.0 at the contact's tick: CVODE ignores a root
+// function that starts a segment at exactly 0, and the end was found 0.19
+// s late, at the next event, until the function was sided
+// (arena_roots.cpp); with the turn, the contact was decided again from
+// that 0 and ended at the tick it began, until a turn left contacts
 // standing (arena_events.cpp).
 TEST(ExactTicks, WallContactEndsTheTickAfterItBegins) {
   for (const int reflexLimit : {3, 0}) {
     Profile p = thesis();
     p.referee.reflex_limit = reflexLimit;
-    const std::int64_t contact = kStart + 85'248'000;
-    Arena a(config(p, {Pose{2.25, -6.40625, 0}}));
-    a.advance(kStart);
-    a.setWheels(0, frame("ffg0ffg0"), kStart);
-    const auto evs = eventsUntil(a, contact + 1000);
-    const auto c = first(evs, EventKind::Contact, 0);
-    ASSERT_TRUE(c.has_value()) << "reflex_limit " << reflexLimit;
-    EXPECT_EQ(c->tick, contact) << "reflex_limit " << reflexLimit;
-    const auto turn = first(evs, EventKind::RefereeTurn, 0);
-    EXPECT_EQ(turn.has_value(), reflexLimit == 0);
-    if (turn) {
-      EXPECT_EQ(turn->tick, contact);
+    for (int k = 0; k < 300; ++k) {
+      for (const bool north : {true, false}) {
+        const double y0 = -6.5 + k / 64.0;
+        const std::int64_t contact = kStart + 85'824'000 - 96'000 * std::int64_t{k};
+        Arena a(config(p, {north ? Pose{2.25, y0, 0} : Pose{y0, 0.25, 90}}));
+        a.advance(kStart);
+        a.setWheels(0, frame("ffg0ffg0"), kStart);
+        const auto evs = eventsUntil(a, contact + 1000);
+        const std::string where = "k " + std::to_string(k) + (north ? " north" : " east") +
+                                  ", reflex_limit " + std::to_string(reflexLimit);
+        const auto c = first(evs, EventKind::Contact, 0);
+        ASSERT_TRUE(c.has_value()) << where;
+        ASSERT_EQ(c->tick, contact) << where;
+        const auto turn = first(evs, EventKind::RefereeTurn, 0);
+        ASSERT_EQ(turn.has_value(), reflexLimit == 0) << where;
+        if (turn) {
+          ASSERT_EQ(turn->tick, contact) << where;
+        }
+        const auto ce = first(evs, EventKind::ContactEnd, 0);
+        ASSERT_TRUE(ce.has_value()) << where;
+        ASSERT_EQ(ce->tick, contact + 1) << where;
+      }
     }
-    const auto ce = first(evs, EventKind::ContactEnd, 0);
-    ASSERT_TRUE(ce.has_value()) << "reflex_limit " << reflexLimit;
-    EXPECT_EQ(ce->tick, contact + 1) << "reflex_limit " << reflexLimit;
   }
 }
 
