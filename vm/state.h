@@ -10,6 +10,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <optional>
 #include <string>
 #include <vector>
@@ -81,6 +82,42 @@ inline uint32_t fromFloat(float f) { return std::bit_cast<uint32_t>(f); }
 inline int16_t asInt16(uint32_t v) { return static_cast<int16_t>(static_cast<uint16_t>(v)); }
 static_assert(Tick{kPrtTicks} * kTimerHz == kTicksPerSecond,
               "PRT0's period must divide the clock into Dynamic C's 1,024 Hz tick");
+
+// A little-endian 16-bit word at p (code operands, memory): one load on a
+// little-endian host, where byte loads cost the dispatch loop instructions.
+inline uint32_t le16(const uint8_t* p) {
+  if constexpr (std::endian::native == std::endian::little) {
+    uint16_t v;
+    std::memcpy(&v, p, 2);
+    return v;
+  } else {
+    return static_cast<uint32_t>(p[0] | (p[1] << 8));
+  }
+}
+inline void setLe16(uint8_t* p, uint32_t v) {
+  if constexpr (std::endian::native == std::endian::little) {
+    const auto h = static_cast<uint16_t>(v);
+    std::memcpy(p, &h, 2);
+  } else {
+    p[0] = static_cast<uint8_t>(v);
+    p[1] = static_cast<uint8_t>(v >> 8);
+  }
+}
+// A word of the 64 KiB memory m at a; its last byte's word wraps to 0.
+inline uint32_t memRd16(const uint8_t* m, uint32_t a) {
+  a &= 0xFFFF;
+  if (__builtin_expect(a == 0xFFFF, 0)) return static_cast<uint32_t>(m[0xFFFF] | (m[0] << 8));
+  return le16(m + a);
+}
+inline void memWr16(uint8_t* m, uint32_t a, uint32_t v) {
+  a &= 0xFFFF;
+  if (__builtin_expect(a == 0xFFFF, 0)) {
+    m[0xFFFF] = static_cast<uint8_t>(v);
+    m[0] = static_cast<uint8_t>(v >> 8);
+  } else {
+    setLe16(m + a, v);
+  }
+}
 
 inline uint32_t w(int32_t v) { return static_cast<uint32_t>(v) & 0xFFFFu; }
 
@@ -226,15 +263,10 @@ struct Vm::State {
     return true;
   }
   uint8_t rd8(uint32_t a) const { return mem[a & 0xFFFF]; }
-  uint16_t rd16(uint32_t a) const {
-    return static_cast<uint16_t>(mem[a & 0xFFFF] | (mem[(a + 1) & 0xFFFF] << 8));
-  }
+  uint16_t rd16(uint32_t a) const { return static_cast<uint16_t>(memRd16(mem.data(), a)); }
   uint32_t rd32(uint32_t a) const { return rd16(a) | (static_cast<uint32_t>(rd16(a + 2)) << 16); }
   void wr8(uint32_t a, uint32_t v) { mem[a & 0xFFFF] = static_cast<uint8_t>(v); }
-  void wr16(uint32_t a, uint32_t v) {
-    wr8(a, v);
-    wr8(a + 1, v >> 8);
-  }
+  void wr16(uint32_t a, uint32_t v) { memWr16(mem.data(), a, v); }
   void wr32(uint32_t a, uint32_t v) {
     wr16(a, v);
     wr16(a + 2, v >> 16);

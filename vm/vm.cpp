@@ -472,7 +472,7 @@ boundary:
   ip += static_cast<uint32_t>(instructionSize(static_cast<Op>(op)));
   DISPATCH();
   // Operands, read from the padded code.
-#define U16() static_cast<uint32_t>(operand[0] | (operand[1] << 8))
+#define U16() le16(operand)
 #define I32()                                              \
   (static_cast<uint32_t>(operand[0] | (operand[1] << 8)) | \
    (static_cast<uint32_t>(operand[2]) << 16) | (static_cast<uint32_t>(operand[3]) << 24))
@@ -639,15 +639,10 @@ boundary:
   // one. Operands are read at their offsets from the first's.
 // As rd16, rd8, wr16 and wr8, on m.
 #define M_RD8(a) static_cast<uint32_t>(m[(a)&0xFFFF])
-#define M_RD16(a) (M_RD8(a) | (M_RD8((a) + 1) << 8))
+#define M_RD16(a) memRd16(m, (a))
 #define M_WR8(a, v) (m[(a)&0xFFFF] = static_cast<uint8_t>(v))
-#define M_WR16(a, v)                   \
-  {                                    \
-    const uint32_t wa = (a), wv = (v); \
-    M_WR8(wa, wv);                     \
-    M_WR8(wa + 1, wv >> 8);            \
-  }
-#define OPND16(off) static_cast<uint32_t>(operand[off] | (operand[(off) + 1] << 8))
+#define M_WR16(a, v) memWr16(m, (a), (v))
+#define OPND16(off) le16(operand + (off))
 #define IDIOM_ENTER(kind, first, peak)                                                       \
   const IdiomCost& ic = idiomCosts[kind];                                                    \
   if (__builtin_expect(clk + ic.span >= limit || esp > kEvalSlots - kEvalGuard - (peak), 0)) \
