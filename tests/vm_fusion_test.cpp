@@ -3,7 +3,8 @@
 // For every idiom a loop built around it must stop at every horizon, accept
 // an interrupt requested at every tick, take PRT0's ticks, fault, overflow
 // the expression stack and stop at breakpoints exactly where, when and
-// with what state the unfused run does.
+// with what state the unfused run does. The same for every join (a loop's
+// closer run with the compare-and-branch at its JMP's target).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -340,6 +341,258 @@ TEST(VmIdiom, ABreakpointOnAnyPieceStopsThereEveryPass) {
           }
         }
     }
+}
+
+// ---- joins (idioms.h SIMBOT_JOINS) ----
+
+struct JoinCase {
+  std::string closer;  // IJ (INCGW a; JMP t) or a BSJ idiom's name
+  Op load, compare;    // the target: load x; PUSHW k; compare; JZ out
+};
+
+const std::vector<JoinCase>& joinCases() {
+  static const std::vector<JoinCase> cases = {
+#define SIMBOT_JOIN_CASE(C, l, c) {#C, Op::l, Op::c},
+      SIMBOT_JOINS(SIMBOT_JOIN_CASE)
+#undef SIMBOT_JOIN_CASE
+  };
+  return cases;
+}
+
+std::string nameOf(const JoinCase& j) {
+  return j.closer + " to " + std::string(vm::info(j.load).name) + " PUSHW " +
+         std::string(vm::info(j.compare).name) + " JZ ";
+}
+
+// A loop entered at its closer, so that its target first runs joined:
+//   top:  load v; PUSHW 0x7FFE; compare; JZ out     (v: x, or the auto)
+//         INCGW hits (the auto: v += 1)
+//   closer: x += 1 (INCGW x, or x = x ADDW 1 / SUBW 0xFFFF); JMP top
+//   out:  v += 1; INCGW i; JMP top (an IJ closer too)
+// v counts up from 0x7FFC across 0x8000, so that every comparison goes
+// both ways within a few passes, signed ones with and without overflow.
+// Growing: each pass leaves a value on the expression stack; Fault:
+// the auto is read at FP + 3 (0xFFFF, past the end). `pieces` receives
+// the target's and the closer's pieces' addresses.
+vm::Image joinProgram(const JoinCase& j, Variant v, int dbgs = 0, int pairs = 0,
+                      std::vector<uint32_t>* pieces = nullptr) {
+  Assembler a;
+  const uint16_t x = a.data(2), hits = a.data(2), i = a.data(2), ints = a.data(2), one = a.data(2),
+                 minusOne = a.data(2);
+  auto set16 = [&](uint16_t at, uint16_t value) {
+    a.image.data[at - vm::kDataBase] = static_cast<uint8_t>(value);
+    a.image.data[at - vm::kDataBase + 1] = static_cast<uint8_t>(value >> 8);
+  };
+  set16(x, 0x7FFC);
+  set16(one, 1);
+  set16(minusOne, 0xFFFF);
+  const bool isAuto = j.load == Op::LDLW;
+  auto step = [&] {  // v += 1
+    if (isAuto)
+      a.op(Op::LDLW, 0).op(Op::PUSHW, 1).op(Op::ADDW).op(Op::STLW, 0);
+    else
+      a.op(Op::INCGW, x);
+  };
+  for (int k = 0; k < dbgs; ++k) a.op(Op::DBG);
+  for (int k = 0; k < pairs; ++k) a.op(Op::PUSHW, 0).op(Op::POP);
+  a.op(Op::ENTER, 4).op(Op::PUSHW, 0x7FFC).op(Op::STLW, 0);
+  a.jump(Op::JMP, "closer");
+  a.line = 10;
+  a.bind("top");
+  if (pieces) pieces->clear();
+  auto piece = [&] {
+    if (pieces) pieces->push_back(a.here());
+  };
+  piece();
+  a.op(j.load, isAuto ? (v == Variant::Fault ? 3u : 0u) : x);
+  piece();
+  a.op(Op::PUSHW, 0x7FFE);
+  piece();
+  a.op(j.compare);
+  piece();
+  a.jump(Op::JZ, "out");
+  a.line = 11;
+  a.op(Op::INCGW, hits);
+  if (isAuto) step();
+  if (v == Variant::Growing) a.op(Op::PUSHW, 7);
+  a.line = 12;
+  a.bind("closer");
+  if (j.closer == "IJ") {
+    piece();
+    a.op(Op::INCGW, x);
+  } else {
+    const bool sub = j.closer.find("SUBW") != std::string::npos;
+    const bool global = j.closer.find("LDGW_") != std::string::npos;
+    piece();
+    a.op(Op::LDGW, x);
+    piece();
+    if (global)
+      a.op(Op::LDGW, sub ? minusOne : one);
+    else
+      a.op(Op::PUSHW, sub ? 0xFFFFu : 1u);
+    piece();
+    a.op(sub ? Op::SUBW : Op::ADDW);
+    piece();
+    a.op(Op::STGW, x);
+  }
+  piece();
+  a.jump(Op::JMP, "top");
+  a.line = 13;
+  a.bind("out");
+  step();
+  if (v == Variant::Growing) a.op(Op::PUSHW, 7);
+  a.op(Op::INCGW, i);
+  a.jump(Op::JMP, "top");
+  a.line = 20;
+  a.bind("handler").op(Op::INCGW, ints).op(Op::RETI);
+  a.image.vectors.push_back({vm::kVecPIOA, static_cast<uint16_t>(a.label("handler")), "handler"});
+  return a.finish();
+}
+
+// One pass of these loops is under 400 T-states: three passes.
+constexpr vm::Tick kJoinSweep = 1200;
+
+TEST(VmJoin, EveryHorizonStopsWhereTheUnfusedRunStops) {
+  for (const JoinCase& j : joinCases()) {
+    const auto img = joinProgram(j, Variant::Plain);
+    for (vm::Tick h = 1; h <= kJoinSweep; ++h) {
+      TestHost h1, h2;
+      vm::Vm fused(img, h1, costs());
+      vm::Vm plain(img, h2, costs());
+      plain.enableProfile();
+      ASSERT_EQ(fused.run(h), plain.run(h)) << nameOf(j) << h;
+      expectSame(fused, plain, nameOf(j) + "horizon " + std::to_string(h));
+      if (HasFatalFailure()) return;
+      ASSERT_EQ(fused.run(h + 3000), plain.run(h + 3000)) << nameOf(j) << h;
+      expectSame(fused, plain, nameOf(j) + "resumed from " + std::to_string(h));
+      if (HasFatalFailure()) return;
+    }
+  }
+}
+
+TEST(VmJoin, AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused) {
+  for (const JoinCase& j : joinCases()) {
+    const auto img = joinProgram(j, Variant::Plain);
+    for (vm::Tick at = 1; at <= kJoinSweep; ++at) {
+      TestHost h1, h2;
+      vm::Vm fused(img, h1, costs());
+      vm::Vm plain(img, h2, costs());
+      plain.enableProfile();
+      h1.schedule(at, Irq::Pio);
+      h2.schedule(at, Irq::Pio);
+      h1.runUntil(fused, at + 1000);
+      h2.runUntil(plain, at + 1000);
+      const std::string what = nameOf(j) + "request at " + std::to_string(at);
+      ASSERT_EQ(h1.events.size(), h2.events.size()) << what;
+      ASSERT_FALSE(h1.events.empty()) << what;
+      for (size_t k = 0; k < h1.events.size(); ++k) {
+        EXPECT_EQ(h1.events[k].tick, h2.events[k].tick) << what;
+        EXPECT_EQ(h1.events[k].pc, h2.events[k].pc) << what;
+      }
+      expectSame(fused, plain, what);
+      if (HasFatalFailure()) return;
+    }
+  }
+}
+
+TEST(VmJoin, PrtTicksLandingInsideAreTakenWhereTheyAreUnfused) {
+  // As for the idioms: prefixes of DBG and PUSHW POP move the loop against
+  // PRT0's ticks.
+  vm::CostKnobs knobs = vm::calibratedKnobs();
+  knobs.timerService = vm::TimerService::Always;
+  const vm::CostTable timed = vm::makeCostTable(knobs);
+  for (const JoinCase& j : joinCases())
+    for (int p = 0; p < 12; ++p)
+      for (int q = 0; q < 3; ++q) {
+        const vm::Image img = joinProgram(j, Variant::Plain, p, q);
+        TestHost h1, h2;
+        vm::Vm fused(img, h1, timed);
+        vm::Vm plain(img, h2, timed);
+        plain.enableProfile();
+        const vm::Tick end = 3 * vm::kPrtTicks + 500;
+        ASSERT_EQ(fused.run(end), plain.run(end));
+        const std::string what =
+            nameOf(j) + "prefix " + std::to_string(p) + "," + std::to_string(q);
+        ASSERT_EQ(fused.timerIsrCycles(), plain.timerIsrCycles()) << what;
+        ASSERT_EQ(fused.stats().interrupts[static_cast<int>(Irq::Timer)], 3u) << what;
+        expectSame(fused, plain, what);
+        if (HasFatalFailure()) return;
+      }
+}
+
+TEST(VmJoin, ATargetThatFaultsFaultsAsItDoesAlone) {
+  // The auto targets read FP + 3: the unfused run faults in the target's
+  // LDLW, first reached through the closer's JMP.
+  int faulting = 0;
+  for (const JoinCase& j : joinCases()) {
+    const auto img = joinProgram(j, Variant::Fault);
+    TestHost h1, h2;
+    vm::Vm fused(img, h1, costs());
+    vm::Vm plain(img, h2, costs());
+    plain.enableProfile();
+    const Stop stop = plain.run(1'000'000);
+    ASSERT_EQ(fused.run(1'000'000), stop) << nameOf(j);
+    expectSame(fused, plain, nameOf(j) + "fault");
+    if (HasFatalFailure()) return;
+    if (stop == Stop::Fault) {
+      ++faulting;
+      EXPECT_EQ(plain.fault()->line, 10) << nameOf(j);
+    }
+  }
+  EXPECT_EQ(faulting,
+            static_cast<int>(std::count_if(joinCases().begin(), joinCases().end(),
+                                           [](const JoinCase& j) { return j.load == Op::LDLW; })));
+}
+
+TEST(VmJoin, TheExpressionStackGuardStopsWhereItDoesUnfused) {
+  for (const JoinCase& j : joinCases()) {
+    const auto img = joinProgram(j, Variant::Growing);
+    TestHost h1, h2;
+    vm::Vm fused(img, h1, costs());
+    vm::Vm plain(img, h2, costs());
+    plain.enableProfile();
+    ASSERT_EQ(plain.run(100'000'000), Stop::Fault) << nameOf(j);
+    ASSERT_EQ(fused.run(100'000'000), Stop::Fault) << nameOf(j);
+    expectSame(fused, plain, nameOf(j) + "guard");
+    if (HasFatalFailure()) return;
+  }
+}
+
+TEST(VmJoin, ABreakpointOnAnyPieceOfTheCloserOrTheTargetStopsThereEveryPass) {
+  // Set before the first run, and after some passes have run joined (the
+  // closer's entry must then stop joining: the target is far from it).
+  for (const JoinCase& j : joinCases()) {
+    std::vector<uint32_t> at;
+    const auto img = joinProgram(j, Variant::Plain, 0, 0, &at);
+    for (size_t k = 0; k < at.size(); ++k)
+      for (const vm::Tick before : {vm::Tick{0}, vm::Tick{1000}}) {
+        TestHost h1, h2;
+        vm::Vm fused(img, h1, costs());
+        vm::Vm plain(img, h2, costs());
+        plain.enableProfile();
+        if (before) {
+          ASSERT_EQ(fused.run(before), plain.run(before));
+        }
+        fused.setBreakpoint(at[k]);
+        plain.setBreakpoint(at[k]);
+        int stops = 0;
+        for (int pass = 0; pass < 6; ++pass) {
+          const Stop stop = plain.run(20'000);
+          ASSERT_EQ(fused.run(20'000), stop) << nameOf(j) << k;
+          const std::string what = nameOf(j) + "piece " + std::to_string(k);
+          expectSame(fused, plain, what);
+          if (HasFatalFailure()) return;
+          if (stop != Stop::Breakpoint) break;
+          EXPECT_EQ(plain.pc(), at[k]) << what;
+          ++stops;
+        }
+        // The target's pieces run every pass (the closer's, only while the
+        // comparison holds).
+        if (k < 4) {
+          EXPECT_EQ(stops, 6) << nameOf(j) << k;
+        }
+      }
+  }
 }
 
 }  // namespace

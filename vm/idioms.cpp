@@ -62,6 +62,27 @@ void Vm::State::setIdiomCosts() {
     }
     idiomCosts[i] = c;
   }
+  // A join's boundaries: after each of its closer's pieces (the last one's
+  // is its target's start), then inside the target, at the slowest paths.
+  auto slowest = [&](Op op) {
+    const auto o = static_cast<int>(op);
+    const int32_t delta =
+        *std::max_element(costs.branchDelta[o].begin(), costs.branchDelta[o].end());
+    return costs.op[o] + static_cast<uint32_t>(std::max(delta, 0));
+  };
+  for (int j = 0; j < kJoinEnd; ++j) {
+    const int closer = kJoinClosers[j / kJoinTargetCount];
+    const int target = kJoinTargets[j % kJoinTargetCount];
+    uint32_t span = 0;
+    if (closer < 0) {
+      span += slowest(Op::JMP);  // INCGW a; JMP t
+    } else {
+      const IdiomShape& shape = kIdiomShapes[closer];
+      for (int k = 1; k < shape.n; ++k) span += slowest(shape.pieces[k]);
+    }
+    span += slowest(kIdiomShapes[target].pieces[0]) + idiomCosts[target].span;
+    joinSpans[j] = span;
+  }
 }
 
 int Vm::State::idiomAt(uint32_t address) const {
@@ -89,6 +110,36 @@ int Vm::State::idiomAt(uint32_t address) const {
     }
     return -1;
   }
+  return -1;
+}
+
+int Vm::State::joinAt(uint32_t address) const {
+  const auto end = static_cast<uint32_t>(dispatch.size());
+  if (address >= end) return -1;
+  // The closer, and where its JMP is.
+  int closer = -1;
+  uint32_t jump = 0;
+  if (dispatch[address] == static_cast<uint8_t>(Op::INCGW) &&
+      costs.op[static_cast<int>(Op::INCGW)] <= kMaxStepTstates) {
+    closer = 0;
+    jump = address + static_cast<uint32_t>(instructionSize(Op::INCGW));
+    if (jump >= end || dispatch[jump] != static_cast<uint8_t>(Op::JMP)) return -1;
+  } else {
+    const int idiom = idiomAt(address);
+    for (int c = 1; c < kJoinCloserCount; ++c)
+      if (kJoinClosers[c] == idiom) closer = c;
+    if (closer < 0) return -1;
+    jump = address;
+    const IdiomShape& shape = kIdiomShapes[idiom];
+    for (int k = 0; k < shape.n - 1; ++k)
+      jump += static_cast<uint32_t>(instructionSize(shape.pieces[k]));
+  }
+  // decode() made a JMP outside the code a trap: its target is in the code.
+  const auto rel = static_cast<int16_t>(padded[jump + 1] | (padded[jump + 2] << 8));
+  const auto target = static_cast<uint32_t>(static_cast<int64_t>(jump) + 3 + rel);
+  const int idiom = idiomAt(target);
+  for (int t = 0; t < kJoinTargetCount; ++t)
+    if (kJoinTargets[t] == idiom) return closer * kJoinTargetCount + t;
   return -1;
 }
 

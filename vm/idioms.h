@@ -81,6 +81,22 @@ namespace simbot::vm::detail {
   {{Op::LDLW, Op::RET}, 2}
 // clang-format on
 
+// Joins: a loop's closing piece (INCGW a; JMP t, or a BSJ idiom) whose JMP
+// goes to a compare-and-branch that exits the loop (CB with JZ) runs that
+// compare-and-branch in the same dispatch (vm.cpp "Joins"). Every pair of a
+// closer and a target, closers in this order: IJ (INCGW; JMP), then the
+// BSJ idioms.
+// clang-format off
+#define SIMBOT_JOIN_COMPARES(X, C, l)                                   \
+  X(C, l, LTW) X(C, l, LEW) X(C, l, GTW) X(C, l, GEW) X(C, l, EQW)     \
+  X(C, l, NEW) X(C, l, LTUW) X(C, l, LEUW) X(C, l, GTUW) X(C, l, GEUW)
+#define SIMBOT_JOIN_TARGETS(X, C) SIMBOT_JOIN_COMPARES(X, C, LDGW) SIMBOT_JOIN_COMPARES(X, C, LDLW)
+#define SIMBOT_JOINS(X)                                                         \
+  SIMBOT_JOIN_TARGETS(X, IJ) SIMBOT_JOIN_TARGETS(X, BSJ_LDGW_ADDW)              \
+  SIMBOT_JOIN_TARGETS(X, BSJ_LDGW_SUBW) SIMBOT_JOIN_TARGETS(X, BSJ_PUSHW_ADDW)  \
+  SIMBOT_JOIN_TARGETS(X, BSJ_PUSHW_SUBW)
+// clang-format on
+
 struct IdiomShape {
   Op pieces[5];
   int n;
@@ -97,6 +113,26 @@ enum IdiomKind : int {
       kIdiomEnd
 };
 static_assert(kIdiomEnd == kIdiomCount, "one kind per shape");
+
+// The joins' indices: closer c with target t is c * kJoinTargetCount + t.
+enum JoinKind : int {
+#define SIMBOT_JOIN_KIND(C, l, c) kJoin_##C##_##l##_##c,
+  SIMBOT_JOINS(SIMBOT_JOIN_KIND)
+#undef SIMBOT_JOIN_KIND
+      kJoinEnd
+};
+// The targets, as idioms.
+inline constexpr int kJoinTargets[] = {
+#define SIMBOT_JOIN_TARGET(C, l, c) kIdiomCB_##l##_##c##_JZ,
+    SIMBOT_JOIN_TARGETS(SIMBOT_JOIN_TARGET, IJ)
+#undef SIMBOT_JOIN_TARGET
+};
+inline constexpr int kJoinTargetCount = static_cast<int>(std::size(kJoinTargets));
+// The closers that are idioms (the first closer, IJ, is not one).
+inline constexpr int kJoinClosers[] = {-1, kIdiomBSJ_LDGW_ADDW, kIdiomBSJ_LDGW_SUBW,
+                                       kIdiomBSJ_PUSHW_ADDW, kIdiomBSJ_PUSHW_SUBW};
+inline constexpr int kJoinCloserCount = static_cast<int>(std::size(kJoinClosers));
+static_assert(kJoinEnd == kJoinCloserCount * kJoinTargetCount, "one join per closer and target");
 
 // The farthest an entry that fuses pieces can be before the last of them
 // (DBG, then PUSHW base; LDGW i; ADDW; PUSHW v; STIB or LDGW a; LDGW b;

@@ -200,6 +200,16 @@ struct Vm::State {
   // The idiom whose pieces start at `address` (all ordinary and none a trap
   // in `dispatch`), or -1.
   int idiomAt(uint32_t address) const;
+  // The joins' labels (idioms.h), set by run<false>, and per join the most
+  // its boundaries can lie after its entry's clock (idioms.cpp).
+  const void* const* joinLabels = nullptr;
+  std::array<uint32_t, kJoinEnd> joinSpans{};
+  // The join whose closer starts at `address` (all its pieces and its
+  // target's ordinary and none a trap in `dispatch`), or -1.
+  int joinAt(uint32_t address) const;
+  // The addresses whose entry was ever a join's: a breakpoint anywhere may
+  // be on its target, so setBreakpoint re-decodes them all.
+  std::vector<uint32_t> joinEntries;
   // The handler that starts an instruction longer than kMaxStepTstates on
   // the fast path (null: such instructions go to the slow boundary).
   std::array<const void*, 2> longLabels{};

@@ -279,6 +279,12 @@ void Vm::State::setFast(int k, uint32_t address) {
       label = idiomLabels[i];
     else if (o == static_cast<uint8_t>(Op::DBG) && (i = idiomAt(address + 1)) >= 0)
       label = dbgIdiomLabels[i];
+    const int j = joinAt(address);
+    if (j >= 0) {
+      label = joinLabels[j];
+      if (std::find(joinEntries.begin(), joinEntries.end(), address) == joinEntries.end())
+        joinEntries.push_back(address);
+    }
   }
   const uint32_t cost = trap ? 0u : isLong ? kMaxStepTstates : costs.op[o];
   fast[k][address] = Fast{label, cost, o, size};
@@ -337,10 +343,15 @@ Stop Vm::State::run(Tick until) {
 #undef SIMBOT_IDIOM_NAMED
     static_assert(std::size(kDbgIdioms) == kIdiomCount);
     static_assert(std::size(kIdioms) == kIdiomCount);
+#define SIMBOT_JOIN_LABEL(C, l, c) &&J_##C##_##l##_##c,
+    static const void* const kJoins[] = {SIMBOT_JOINS(SIMBOT_JOIN_LABEL)};
+#undef SIMBOT_JOIN_LABEL
+    static_assert(std::size(kJoins) == kJoinEnd);
     if (!kProfile) {
       setIdiomCosts();
       idiomLabels = kIdioms;
       dbgIdiomLabels = kDbgIdioms;
+      joinLabels = kJoins;
     }
     longLabels[kRun] = &&L_Long_;
 #endif
@@ -693,17 +704,21 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
   NEXT;
   IDIOM_BYTE_BRANCH(ByteJZ, JZ, v == 0)
   IDIOM_BYTE_BRANCH(ByteJNZ, JNZ, v != 0)
-#define SIMBOT_IDIOM(l, c, b)                            \
-  I_CB_##l##_##c##_##b : { /* l x; PUSHW k; c; b t */    \
-    IDIOM_ENTER(kIdiomCB_##l##_##c##_##b, l, 2)          \
-    IDIOM_LOAD_##l(x) unsigned path = 0;                 \
-    const bool r = compare16<Op::c>(x, OPND16(3), path); \
-    const bool taken = Op::b == Op::JZ ? !r : r;         \
-    clk += ic.path[path * 2 + (taken ? 1 : 0)];          \
-    count += 3;                                          \
-    ip = taken ? IDIOM_TARGET(opPc + 10, 7) : opPc + 10; \
-  }                                                      \
-  NEXT;
+  // A compare-and-branch's pieces but the first, that piece dispatched.
+#define IDIOM_CB_BODY(l, c, b)                                  \
+  {                                                             \
+    const IdiomCost& cb = idiomCosts[kIdiomCB_##l##_##c##_##b]; \
+    IDIOM_LOAD_##l(x) unsigned path = 0;                        \
+    const bool r = compare16<Op::c>(x, OPND16(3), path);        \
+    const bool taken = Op::b == Op::JZ ? !r : r;                \
+    clk += cb.path[path * 2 + (taken ? 1 : 0)];                 \
+    count += 3;                                                 \
+    ip = taken ? IDIOM_TARGET(opPc + 10, 7) : opPc + 10;        \
+  }
+#define SIMBOT_IDIOM(l, c, b)       \
+  I_CB_##l##_##c##_##b              \
+      : {/* l x; PUSHW k; c; b t */ \
+         IDIOM_ENTER(kIdiomCB_##l##_##c##_##b, l, 2) IDIOM_CB_BODY(l, c, b)} NEXT;
   SIMBOT_IDIOMS_CB(SIMBOT_IDIOM)
 #undef SIMBOT_IDIOM
 #define SIMBOT_IDIOM(s, o)                        \
@@ -815,6 +830,67 @@ I_LoadRet : { /* LDLW x; RET: RET's fault leaves it to run alone */
   mfp = f.mfp;
 }
   NEXT;
+  // Joins (idioms.h): a loop's closer, its JMP, then the compare-and-branch
+  // at the JMP's target, in one dispatch. The closer's first piece has been
+  // dispatched as usual. If all the boundaries up to the target's last
+  // piece come before `limit` at their slowest paths (joinSpans) and the
+  // pushes stay inside the guard, nothing can happen at them; otherwise
+  // the closer runs as it does alone (its idiom, or the INCGW; JMP pair),
+  // and the target is dispatched after it. A target that would fault
+  // leaves from its first piece, as its idiom does.
+#define JOIN_CLOSE_IJ(t)                     \
+  M_WR16(OPND16(0), M_RD16(OPND16(0)) + 1u); \
+  clk += opCost[static_cast<int>(Op::JMP)];  \
+  count += 1;                                \
+  t = IDIOM_TARGET(opPc + 6, 3);
+#define JOIN_ALONE_IJ F_INCGW_JMP
+#define JOIN_CLOSE_BSJ(s, o, t)                  \
+  {                                              \
+    const uint32_t x = M_RD16(OPND16(0));        \
+    const uint32_t y = IDIOM_SRC_##s(OPND16(3)); \
+    M_WR16(OPND16(7), IDIOM_OP_##o(x, y));       \
+    clk += idiomCosts[kIdiomBSJ_##s##_##o].base; \
+    count += 4;                                  \
+    t = IDIOM_TARGET(opPc + 13, 10);             \
+  }
+#define JOIN_CLOSE_BSJ_LDGW_ADDW(t) JOIN_CLOSE_BSJ(LDGW, ADDW, t)
+#define JOIN_CLOSE_BSJ_LDGW_SUBW(t) JOIN_CLOSE_BSJ(LDGW, SUBW, t)
+#define JOIN_CLOSE_BSJ_PUSHW_ADDW(t) JOIN_CLOSE_BSJ(PUSHW, ADDW, t)
+#define JOIN_CLOSE_BSJ_PUSHW_SUBW(t) JOIN_CLOSE_BSJ(PUSHW, SUBW, t)
+#define JOIN_ALONE_BSJ_LDGW_ADDW I_BSJ_LDGW_ADDW
+#define JOIN_ALONE_BSJ_LDGW_SUBW I_BSJ_LDGW_SUBW
+#define JOIN_ALONE_BSJ_PUSHW_ADDW I_BSJ_PUSHW_ADDW
+#define JOIN_ALONE_BSJ_PUSHW_SUBW I_BSJ_PUSHW_SUBW
+#define SIMBOT_JOIN(C, l, c)                                                                      \
+  J_##C##_##l##_##c : {                                                                           \
+    if (__builtin_expect(                                                                         \
+            clk + joinSpans[kJoin_##C##_##l##_##c] >= limit || esp > kEvalSlots - kEvalGuard - 2, \
+            0))                                                                                   \
+      goto JOIN_ALONE_##C;                                                                        \
+    uint32_t t;                                                                                   \
+    JOIN_CLOSE_##C(t) /* the target's first piece, as NEXT dispatches it */                       \
+        opPc = t;                                                                                 \
+    clk += opCost[static_cast<int>(Op::l)];                                                       \
+    ++count;                                                                                      \
+    operand = code + t + 1;                                                                       \
+    ip = t + static_cast<uint32_t>(instructionSize(Op::l));                                       \
+    IDIOM_CB_BODY(l, c, JZ)                                                                       \
+  }                                                                                               \
+  NEXT;
+  SIMBOT_JOINS(SIMBOT_JOIN)
+#undef SIMBOT_JOIN
+#undef JOIN_CLOSE_IJ
+#undef JOIN_ALONE_IJ
+#undef JOIN_CLOSE_BSJ
+#undef JOIN_CLOSE_BSJ_LDGW_ADDW
+#undef JOIN_CLOSE_BSJ_LDGW_SUBW
+#undef JOIN_CLOSE_BSJ_PUSHW_ADDW
+#undef JOIN_CLOSE_BSJ_PUSHW_SUBW
+#undef JOIN_ALONE_BSJ_LDGW_ADDW
+#undef JOIN_ALONE_BSJ_LDGW_SUBW
+#undef JOIN_ALONE_BSJ_PUSHW_ADDW
+#undef JOIN_ALONE_BSJ_PUSHW_SUBW
+#undef IDIOM_CB_BODY
   // DBG, then the idiom after it: the boundary between them, then the
   // idiom's first piece charged as NEXT would, without the table load.
 #define DBG_THEN(name, first)                                \
@@ -1450,6 +1526,9 @@ void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
     for (int k = 0; k < 2; ++k)
       if (!s.fast[k].empty())
         for (uint32_t a = from; a <= codeAddress; ++a) s.setFast(k, a);
+    // And the joins, whose target may be anywhere (a copy: setFast adds).
+    if (!s.fast[0].empty())
+      for (const uint32_t a : std::vector<uint32_t>(s.joinEntries)) s.setFast(0, a);
   }
   s.anyBreakpoint =
       std::any_of(s.breakpoints.begin(), s.breakpoints.end(), [](uint8_t b) { return b != 0; });
