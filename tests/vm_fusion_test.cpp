@@ -595,4 +595,35 @@ TEST(VmJoin, ABreakpointOnAnyPieceOfTheCloserOrTheTargetStopsThereEveryPass) {
   }
 }
 
+TEST(VmIdiom, AWordAt0xFFFFWrapsAsItDoesUnfused) {
+  // The handlers access a global's word at once: the decoder must leave a
+  // global at 0xFFFF (high byte at 0x0000) to the unfused pieces.
+  Assembler a;
+  const uint16_t r = a.data(2);
+  a.bind("top");
+  a.op(Op::LDGW, 0xFFFF).op(Op::PUSHW, 0x0101).op(Op::ADDW).op(Op::STGW, 0xFFFF);  // BS
+  a.op(Op::LDGW, 0xFFFF).op(Op::LDGW, 0xFFFF).op(Op::MULW).op(Op::STGW, r);        // Mul
+  a.op(Op::INCGW, 0xFFFF).jump(Op::JMP, "cb");                                     // IJ
+  a.bind("cb");
+  a.op(Op::LDGW, 0xFFFF).op(Op::PUSHW, 0x7FFE).op(Op::LTW).jump(Op::JZ, "top");  // CB
+  a.op(Op::LDGW, 0xFFFF).op(Op::PUSHW, 3).op(Op::ADDW).op(Op::STGW, 0xFFFF);
+  a.jump(Op::JMP, "cb");  // BSJ, joined
+  const vm::Image img = a.finish();
+  for (vm::Tick h = 1; h <= 1500; h += 7) {
+    TestHost h1, h2;
+    vm::Vm fused(img, h1, costs());
+    vm::Vm plain(img, h2, costs());
+    plain.enableProfile();
+    ASSERT_EQ(fused.run(h), plain.run(h)) << h;
+    expectSame(fused, plain, "horizon " + std::to_string(h));
+    if (HasFatalFailure()) return;
+    ASSERT_EQ(fused.read16(0xFFFF), plain.read16(0xFFFF)) << h;
+    ASSERT_EQ(fused.read8(0x0000), plain.read8(0x0000)) << h;
+  }
+  TestHost h1;
+  vm::Vm fused(img, h1, costs());
+  fused.run(1500);
+  EXPECT_NE(fused.read8(0x0000), 0) << "the high byte went to 0x0000";
+}
+
 }  // namespace

@@ -35,6 +35,10 @@ constexpr std::array<bool, 256> kStartsIdiom = [] {
 }();
 }  // namespace
 
+bool Vm::State::wrapsAt(uint32_t address) const {
+  return (padded[address + 1] | (padded[address + 2] << 8)) == 0xFFFF;
+}
+
 void Vm::State::setIdiomCosts() {
   for (int i = 0; i < kIdiomCount; ++i) {
     const IdiomShape& shape = kIdiomShapes[i];
@@ -104,6 +108,9 @@ int Vm::State::idiomAt(uint32_t address) const {
         const auto o = static_cast<uint8_t>(shape.pieces[k]);
         // The first piece is dispatched as usual: it must be an ordinary one.
         if (a >= end || dispatch[a] != o || (k == 0 && costs.op[o] > kMaxStepTstates)) break;
+        // The handlers read and write globals' words as one access: a word
+        // at 0xFFFF, which wraps to 0x0000, runs unfused.
+        if ((shape.pieces[k] == Op::LDGW || shape.pieces[k] == Op::STGW) && wrapsAt(a)) break;
         a += static_cast<uint32_t>(instructionSize(shape.pieces[k]));
       }
       if (k == shape.n) return i;
@@ -123,7 +130,8 @@ int Vm::State::joinAt(uint32_t address) const {
       costs.op[static_cast<int>(Op::INCGW)] <= kMaxStepTstates) {
     closer = 0;
     jump = address + static_cast<uint32_t>(instructionSize(Op::INCGW));
-    if (jump >= end || dispatch[jump] != static_cast<uint8_t>(Op::JMP)) return -1;
+    if (jump >= end || dispatch[jump] != static_cast<uint8_t>(Op::JMP) || wrapsAt(address))
+      return -1;
   } else {
     const int idiom = idiomAt(address);
     for (int c = 1; c < kJoinCloserCount; ++c)

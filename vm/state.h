@@ -200,6 +200,9 @@ struct Vm::State {
   // The idiom whose pieces start at `address` (all ordinary and none a trap
   // in `dispatch`), or -1.
   int idiomAt(uint32_t address) const;
+  // The instruction at `address` (LDGW, STGW, INCGW) addresses the word at
+  // 0xFFFF.
+  bool wrapsAt(uint32_t address) const;
   // The joins' labels (idioms.h), set by run<false>, and per join the most
   // its boundaries can lie after its entry's clock (idioms.cpp).
   const void* const* joinLabels = nullptr;

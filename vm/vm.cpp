@@ -650,9 +650,11 @@ boundary:
   // one. Operands are read at their offsets from the first's.
 // As rd16, rd8, wr16 and wr8, on m.
 #define M_RD8(a) static_cast<uint32_t>(m[(a)&0xFFFF])
-#define M_RD16(a) memRd16(m, (a))
+// Words: the decoder takes no idiom or join whose global is at 0xFFFF (its
+// word wraps), and an auto's address is checked below 0xFFFF.
+#define M_RD16(a) le16(m + (a))
 #define M_WR8(a, v) (m[(a)&0xFFFF] = static_cast<uint8_t>(v))
-#define M_WR16(a, v) memWr16(m, (a), (v))
+#define M_WR16(a, v) setLe16(m + (a), (v))
 #define OPND16(off) le16(operand + (off))
 #define IDIOM_ENTER(kind, first, peak)                                                       \
   const IdiomCost& ic = idiomCosts[kind];                                                    \
