@@ -382,7 +382,6 @@ Stop Vm::State::run(Tick until) {
       if (op != kTrap) profile[opPc] += d.cost; \
     }                                           \
     ++count;                                    \
-    operand = code + ip + 1;                    \
     ip += d.size;                               \
     FAST_DISPATCH(d);                           \
   }
@@ -405,7 +404,9 @@ Stop Vm::State::run(Tick until) {
 
   uint32_t opPc = 0;
   uint8_t op = 0;
-  const uint8_t* operand = code;
+  // The operands of the instruction at opPc: an address, not a variable, so
+  // that no register holds it (the compiler folds it into the loads).
+#define operand (code + opPc + 1)
 boundary:
   if (fault) return Stop::Fault;
   if (sp > kEvalSlots - kEvalGuard) {
@@ -479,7 +480,6 @@ boundary:
   // due there (see "Fast path").
   limit = xop[opPc] == kTrap || burn || (anyPending && iff1) ? 0 : std::min(until, nextTimer);
   LOAD();
-  operand = code + pc + 1;
   ip += static_cast<uint32_t>(instructionSize(static_cast<Op>(op)));
   DISPATCH();
   // Operands, read from the padded code.
@@ -616,7 +616,6 @@ boundary:
   clk += opCost[op];                                        \
   if constexpr (kProfile) profile[opPc] += opCost[op];      \
   ++count;                                                  \
-  operand = code + ip + 1;                                  \
   ip += static_cast<uint32_t>(instructionSize(Op::second)); \
   goto L_##second;
 #define SIMBOT_PAIR(a, b) \
@@ -874,7 +873,6 @@ I_LoadRet : { /* LDLW x; RET: RET's fault leaves it to run alone */
         opPc = t;                                                                                 \
     clk += opCost[static_cast<int>(Op::l)];                                                       \
     ++count;                                                                                      \
-    operand = code + t + 1;                                                                       \
     ip = t + static_cast<uint32_t>(instructionSize(Op::l));                                       \
     IDIOM_CB_BODY(l, c, JZ)                                                                       \
   }                                                                                               \
@@ -904,7 +902,6 @@ I_LoadRet : { /* LDLW x; RET: RET's fault leaves it to run alone */
     opPc = ip;                                               \
     clk += opCost[static_cast<int>(Op::first)];              \
     ++count;                                                 \
-    operand = code + ip + 1;                                 \
     ip += static_cast<uint32_t>(instructionSize(Op::first)); \
     goto I_##name;                                           \
   }
@@ -1436,6 +1433,7 @@ L_Trap_ :
 #undef CO_TARGET
 }
 #undef CASE
+#undef operand
 #undef DISPATCH
 #undef FAST_DISPATCH
 #undef NEXT
