@@ -314,11 +314,16 @@ Stop Vm::State::run(Tick until) {
 #undef OP
       &&L_Trap_,  // kTrap
   };
-#define CASE(name) L_##name:
+// An ordinary handler sets ip past its instruction itself (NEXT leaves ip
+// at opPc): a constant size, and one load fewer per fast dispatch. (COEND
+// and CODONE share a handler: the same size.)
+#define CASE(name) L_##name : ip = opPc + static_cast<uint32_t>(instructionSize(Op::name));
+#define NEXT_IP
 #define DISPATCH() goto* kLabels[op]
 #define FAST_DISPATCH(d) goto* d.label
 #else
 #define CASE(name) case Op::name:
+#define NEXT_IP ip += d.size;
 #define DISPATCH() goto dispatchOp
 #define FAST_DISPATCH(d) goto dispatchOp
   static const void* const kLabels[kOpCount + 1] = {};  // Fast::label unused
@@ -382,7 +387,7 @@ Stop Vm::State::run(Tick until) {
       if (op != kTrap) profile[opPc] += d.cost; \
     }                                           \
     ++count;                                    \
-    ip += d.size;                               \
+    NEXT_IP                                     \
     FAST_DISPATCH(d);                           \
   }
   // The slow boundary after a handler that has saved its state (SAVE()).
@@ -618,10 +623,11 @@ boundary:
   ++count;                                                  \
   ip += static_cast<uint32_t>(instructionSize(Op::second)); \
   goto L_##second;
-#define SIMBOT_PAIR(a, b) \
-  F_##a##_##b : {         \
-    FIRST_##a;            \
-    NEXT_TO(b)            \
+#define SIMBOT_PAIR(a, b)                                      \
+  F_##a##_##b : {                                              \
+    ip = opPc + static_cast<uint32_t>(instructionSize(Op::a)); \
+    FIRST_##a;                                                 \
+    NEXT_TO(b)                                                 \
   }
   SIMBOT_FUSED_PAIRS(SIMBOT_PAIR)
 #undef SIMBOT_PAIR
@@ -895,6 +901,7 @@ I_LoadRet : { /* LDLW x; RET: RET's fault leaves it to run alone */
   // idiom's first piece charged as NEXT would, without the table load.
 #define DBG_THEN(name, first)                                \
   D_##name : {                                               \
+    ip = opPc + 1; /* past DBG */                            \
     if (__builtin_expect(clk >= limit, 0)) {                 \
       SAVE();                                                \
       goto boundary;                                         \
@@ -1433,6 +1440,7 @@ L_Trap_ :
 #undef CO_TARGET
 }
 #undef CASE
+#undef NEXT_IP
 #undef operand
 #undef DISPATCH
 #undef FAST_DISPATCH
