@@ -314,16 +314,20 @@ Stop Vm::State::run(Tick until) {
 #undef OP
       &&L_Trap_,  // kTrap
   };
-// An ordinary handler sets ip past its instruction itself (NEXT leaves ip
-// at opPc): a constant size, and one load fewer per fast dispatch. (COEND
-// and CODONE share a handler: the same size.)
-#define CASE(name) L_##name : ip = opPc + static_cast<uint32_t>(instructionSize(Op::name));
+// An ordinary handler sets ip past its instruction and op itself (NEXT
+// leaves ip at opPc and op unset): constants, and two loads fewer per fast
+// dispatch.
+#define CASE(name)                                                         \
+  L_##name : ip = opPc + static_cast<uint32_t>(instructionSize(Op::name)); \
+  op = static_cast<uint8_t>(Op::name);
 #define NEXT_IP
+#define NEXT_OP
 #define DISPATCH() goto* kLabels[op]
 #define FAST_DISPATCH(d) goto* d.label
 #else
 #define CASE(name) case Op::name:
 #define NEXT_IP ip += d.size;
+#define NEXT_OP op = d.op;
 #define DISPATCH() goto dispatchOp
 #define FAST_DISPATCH(d) goto dispatchOp
   static const void* const kLabels[kOpCount + 1] = {};  // Fast::label unused
@@ -377,18 +381,18 @@ Stop Vm::State::run(Tick until) {
     goto slowNext;                         \
   }                                        \
   DISPATCH_NEXT
-#define DISPATCH_NEXT                           \
-  {                                             \
-    const Fast& d = fd[ip];                     \
-    opPc = ip;                                  \
-    op = d.op;                                  \
-    clk += d.cost;                              \
-    if constexpr (kProfile) {                   \
-      if (op != kTrap) profile[opPc] += d.cost; \
-    }                                           \
-    ++count;                                    \
-    NEXT_IP                                     \
-    FAST_DISPATCH(d);                           \
+#define DISPATCH_NEXT                             \
+  {                                               \
+    const Fast& d = fd[ip];                       \
+    opPc = ip;                                    \
+    NEXT_OP                                       \
+    clk += d.cost;                                \
+    if constexpr (kProfile) {                     \
+      if (d.op != kTrap) profile[opPc] += d.cost; \
+    }                                             \
+    ++count;                                      \
+    NEXT_IP                                       \
+    FAST_DISPATCH(d);                             \
   }
   // The slow boundary after a handler that has saved its state (SAVE()).
 #define SLOW goto boundary
@@ -626,6 +630,7 @@ boundary:
 #define SIMBOT_PAIR(a, b)                                      \
   F_##a##_##b : {                                              \
     ip = opPc + static_cast<uint32_t>(instructionSize(Op::a)); \
+    op = static_cast<uint8_t>(Op::a);                          \
     FIRST_##a;                                                 \
     NEXT_TO(b)                                                 \
   }
@@ -947,6 +952,7 @@ slowNext:
   SLOW;
 #if SIMBOT_COMPUTED_GOTO
 L_Long_ : {
+  op = fd[opPc].op;
   const uint32_t rest = opCost[op] - kMaxStepTstates;
   if constexpr (kProfile) profile[opPc] += rest;
   burn = rest;
@@ -1414,13 +1420,15 @@ L_Trap_ :
       }
       SLOW;
       CASE(COEND)
-      CASE(CODONE) {
-        SAVE();
-        const uint32_t cd = U16();
-        if (!checkAccess(cd, kCoDataSize, opPc)) SLOW;
-        costateEnd(cd, op == static_cast<uint8_t>(Op::CODONE));
-        costateEvent(cd, Bus::CostateEvent::End, opPc);
-      }
+      goto coEnd;  // past CODONE's op
+      CASE(CODONE)
+    coEnd : {
+      SAVE();
+      const uint32_t cd = U16();
+      if (!checkAccess(cd, kCoDataSize, opPc)) SLOW;
+      costateEnd(cd, op == static_cast<uint8_t>(Op::CODONE));
+      costateEvent(cd, Bus::CostateEvent::End, opPc);
+    }
       SLOW;
 #if !SIMBOT_COMPUTED_GOTO
   }
@@ -1441,6 +1449,7 @@ L_Trap_ :
 }
 #undef CASE
 #undef NEXT_IP
+#undef NEXT_OP
 #undef operand
 #undef DISPATCH
 #undef FAST_DISPATCH
