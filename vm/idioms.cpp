@@ -74,19 +74,25 @@ void Vm::State::setIdiomCosts() {
         *std::max_element(costs.branchDelta[o].begin(), costs.branchDelta[o].end());
     return costs.op[o] + static_cast<uint32_t>(std::max(delta, 0));
   };
-  for (int j = 0; j < kJoinEnd; ++j) {
-    const int closer = kJoinClosers[j / kJoinTargetCount];
-    const int target = kJoinTargets[j % kJoinTargetCount];
-    uint32_t span = 0;
+  // (Per closer and per target, then their sums: this runs at every VM's
+  // first run.)
+  std::array<uint32_t, kJoinCloserCount> closerSpan{};
+  for (int c = 0; c < kJoinCloserCount; ++c) {
+    const int closer = kJoinClosers[c];
     if (closer < 0) {
-      span += slowest(Op::JMP);  // INCGW a; JMP t
+      closerSpan[c] = slowest(Op::JMP);  // INCGW a; JMP t
     } else {
       const IdiomShape& shape = kIdiomShapes[closer];
-      for (int k = 1; k < shape.n; ++k) span += slowest(shape.pieces[k]);
+      for (int k = 1; k < shape.n; ++k) closerSpan[c] += slowest(shape.pieces[k]);
     }
-    span += slowest(kIdiomShapes[target].pieces[0]) + idiomCosts[target].span;
-    joinSpans[j] = span;
   }
+  std::array<uint32_t, kJoinTargetCount> targetSpan{};
+  for (int t = 0; t < kJoinTargetCount; ++t) {
+    const int target = kJoinTargets[t];
+    targetSpan[t] = slowest(kIdiomShapes[target].pieces[0]) + idiomCosts[target].span;
+  }
+  for (int j = 0; j < kJoinEnd; ++j)
+    joinSpans[j] = closerSpan[j / kJoinTargetCount] + targetSpan[j % kJoinTargetCount];
 }
 
 int Vm::State::idiomAt(uint32_t address) const {
@@ -120,7 +126,7 @@ int Vm::State::idiomAt(uint32_t address) const {
   return -1;
 }
 
-int Vm::State::joinAt(uint32_t address) const {
+int Vm::State::joinAt(uint32_t address, int idiom) const {
   const auto end = static_cast<uint32_t>(dispatch.size());
   if (address >= end) return -1;
   // The closer, and where its JMP is.
@@ -132,8 +138,7 @@ int Vm::State::joinAt(uint32_t address) const {
     jump = address + static_cast<uint32_t>(instructionSize(Op::INCGW));
     if (jump >= end || dispatch[jump] != static_cast<uint8_t>(Op::JMP) || wrapsAt(address))
       return -1;
-  } else {
-    const int idiom = idiomAt(address);
+  } else if (idiom >= 0) {
     for (int c = 1; c < kJoinCloserCount; ++c)
       if (kJoinClosers[c] == idiom) closer = c;
     if (closer < 0) return -1;
@@ -141,13 +146,15 @@ int Vm::State::joinAt(uint32_t address) const {
     const IdiomShape& shape = kIdiomShapes[idiom];
     for (int k = 0; k < shape.n - 1; ++k)
       jump += static_cast<uint32_t>(instructionSize(shape.pieces[k]));
+  } else {
+    return -1;
   }
   // decode() made a JMP outside the code a trap: its target is in the code.
   const auto rel = static_cast<int16_t>(padded[jump + 1] | (padded[jump + 2] << 8));
   const auto target = static_cast<uint32_t>(static_cast<int64_t>(jump) + 3 + rel);
-  const int idiom = idiomAt(target);
+  const int there = idiomAt(target);
   for (int t = 0; t < kJoinTargetCount; ++t)
-    if (kJoinTargets[t] == idiom) return closer * kJoinTargetCount + t;
+    if (kJoinTargets[t] == there) return closer * kJoinTargetCount + t;
   return -1;
 }
 

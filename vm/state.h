@@ -208,8 +208,9 @@ struct Vm::State {
   const void* const* joinLabels = nullptr;
   std::array<uint32_t, kJoinEnd> joinSpans{};
   // The join whose closer starts at `address` (all its pieces and its
-  // target's ordinary and none a trap in `dispatch`), or -1.
-  int joinAt(uint32_t address) const;
+  // target's ordinary and none a trap in `dispatch`), or -1; `idiom` is
+  // idiomAt(address).
+  int joinAt(uint32_t address, int idiom) const;
   // The addresses whose entry was ever a join's: a breakpoint anywhere may
   // be on its target, so setBreakpoint re-decodes them all.
   std::vector<uint32_t> joinEntries;

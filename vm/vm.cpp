@@ -274,12 +274,13 @@ void Vm::State::setFast(int k, uint32_t address) {
       label = fusedLabels[f];
   }
   if (k == 0 && idiomLabels && !trap && !isLong) {
-    int i = idiomAt(address);
+    const int here = idiomAt(address);
+    int i = here;
     if (i >= 0)
       label = idiomLabels[i];
     else if (o == static_cast<uint8_t>(Op::DBG) && (i = idiomAt(address + 1)) >= 0)
       label = dbgIdiomLabels[i];
-    const int j = joinAt(address);
+    const int j = joinAt(address, here);
     if (j >= 0) {
       label = joinLabels[j];
       if (std::find(joinEntries.begin(), joinEntries.end(), address) == joinEntries.end())
