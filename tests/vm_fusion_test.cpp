@@ -187,6 +187,60 @@ void expectSame(const vm::Vm& f, const vm::Vm& p, const std::string& what) {
         << what << " at 0x" << std::hex << a;
 }
 
+// The fused run and the unfused (profiling) run of img stop at horizon h
+// alike, and run on alike to h + resume.
+void expectSameAtHorizon(const vm::Image& img, vm::Tick h, vm::Tick resume,
+                         const std::string& name) {
+  TestHost h1, h2;
+  vm::Vm fused(img, h1, costs());
+  vm::Vm plain(img, h2, costs());
+  plain.enableProfile();
+  ASSERT_EQ(fused.run(h), plain.run(h)) << name << h;
+  expectSame(fused, plain, name + "horizon " + std::to_string(h));
+  if (::testing::Test::HasFatalFailure()) return;
+  ASSERT_EQ(fused.run(h + resume), plain.run(h + resume)) << name << h;
+  expectSame(fused, plain, name + "resumed from " + std::to_string(h));
+}
+
+// A PIO interrupt requested at tick `at` is accepted by both runs at the
+// same ticks and pcs, up to at + tail.
+void expectSameInterrupt(const vm::Image& img, vm::Tick at, vm::Tick tail,
+                         const std::string& name) {
+  TestHost h1, h2;
+  vm::Vm fused(img, h1, costs());
+  vm::Vm plain(img, h2, costs());
+  plain.enableProfile();
+  h1.schedule(at, Irq::Pio);
+  h2.schedule(at, Irq::Pio);
+  h1.runUntil(fused, at + tail);
+  h2.runUntil(plain, at + tail);
+  const std::string what = name + "request at " + std::to_string(at);
+  ASSERT_EQ(h1.events.size(), h2.events.size()) << what;
+  ASSERT_FALSE(h1.events.empty()) << what;
+  for (size_t k = 0; k < h1.events.size(); ++k) {
+    EXPECT_EQ(h1.events[k].tick, h2.events[k].tick) << what;
+    EXPECT_EQ(h1.events[k].pc, h2.events[k].pc) << what;
+  }
+  expectSame(fused, plain, what);
+}
+
+// With the BIOS timer service on, three PRT0 ticks land where they do
+// unfused.
+void expectSamePrtTicks(const vm::Image& img, const std::string& what) {
+  vm::CostKnobs knobs = vm::calibratedKnobs();
+  knobs.timerService = vm::TimerService::Always;
+  const vm::CostTable timed = vm::makeCostTable(knobs);
+  TestHost h1, h2;
+  vm::Vm fused(img, h1, timed);
+  vm::Vm plain(img, h2, timed);
+  plain.enableProfile();
+  const vm::Tick end = 3 * vm::kPrtTicks + 500;
+  ASSERT_EQ(fused.run(end), plain.run(end)) << what;
+  ASSERT_EQ(fused.timerIsrCycles(), plain.timerIsrCycles()) << what;
+  ASSERT_EQ(fused.stats().interrupts[static_cast<int>(Irq::Timer)], 3u) << what;
+  expectSame(fused, plain, what);
+}
+
 // One pass of any of these loops is under 700 T-states: the sweeps cover
 // at least three passes.
 constexpr vm::Tick kSweep = 2100;
@@ -196,16 +250,7 @@ TEST(VmIdiom, EveryHorizonStopsWhereTheUnfusedRunStops) {
     for (const bool dbg : {false, true}) {
       const auto img = idiomProgram(s, Variant::Plain, dbg);
       for (vm::Tick h = 1; h <= kSweep; ++h) {
-        TestHost h1, h2;
-        vm::Vm fused(img, h1, costs());
-        vm::Vm plain(img, h2, costs());
-        plain.enableProfile();
-        ASSERT_EQ(fused.run(h), plain.run(h)) << nameOf(s) << h;
-        expectSame(fused, plain, nameOf(s) + "horizon " + std::to_string(h));
-        if (HasFatalFailure()) return;
-        // Resuming from there runs on as the unfused run does.
-        ASSERT_EQ(fused.run(h + 1000), plain.run(h + 1000)) << nameOf(s) << h;
-        expectSame(fused, plain, nameOf(s) + "resumed from " + std::to_string(h));
+        expectSameAtHorizon(img, h, 1000, nameOf(s));
         if (HasFatalFailure()) return;
       }
     }
@@ -216,53 +261,24 @@ TEST(VmIdiom, AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused) {
     for (const bool dbg : {false, true}) {
       const auto img = idiomProgram(s, Variant::Plain, dbg);
       for (vm::Tick at = 1; at <= kSweep; ++at) {
-        TestHost h1, h2;
-        vm::Vm fused(img, h1, costs());
-        vm::Vm plain(img, h2, costs());
-        plain.enableProfile();
-        h1.schedule(at, Irq::Pio);
-        h2.schedule(at, Irq::Pio);
-        h1.runUntil(fused, at + 1500);
-        h2.runUntil(plain, at + 1500);
-        const std::string what = nameOf(s) + "request at " + std::to_string(at);
-        ASSERT_EQ(h1.events.size(), h2.events.size()) << what;
-        ASSERT_FALSE(h1.events.empty()) << what;
-        for (size_t k = 0; k < h1.events.size(); ++k) {
-          EXPECT_EQ(h1.events[k].tick, h2.events[k].tick) << what;
-          EXPECT_EQ(h1.events[k].pc, h2.events[k].pc) << what;
-        }
-        expectSame(fused, plain, what);
+        expectSameInterrupt(img, at, 1500, nameOf(s));
         if (HasFatalFailure()) return;
       }
     }
 }
 
 TEST(VmIdiom, PrtTicksLandingInsideAreTakenWhereTheyAreUnfused) {
-  // The BIOS timer service on: PRT0 ticks every kPrtTicks. A prefix of p
-  // DBG (62 T-states) and q PUSHW POP (29) moves the loop against the
-  // ticks, so that they land at every offset into the idiom's pieces.
-  vm::CostKnobs knobs = vm::calibratedKnobs();
-  knobs.timerService = vm::TimerService::Always;
-  const vm::CostTable timed = vm::makeCostTable(knobs);
+  // A prefix of p DBG (62 T-states) and q PUSHW POP (29) moves the loop
+  // against PRT0's ticks, so that they land at every offset into the
+  // idiom's pieces.
   for (const IdiomShape& s : kIdiomShapes)
-    for (const bool dbg : {false, true}) {
+    for (const bool dbg : {false, true})
       for (int p = 0; p < 12; ++p)
         for (int q = 0; q < 3; ++q) {
-          const vm::Image img = idiomProgram(s, Variant::Plain, dbg, p, q);
-          TestHost h1, h2;
-          vm::Vm fused(img, h1, timed);
-          vm::Vm plain(img, h2, timed);
-          plain.enableProfile();
-          const vm::Tick end = 3 * vm::kPrtTicks + 500;
-          ASSERT_EQ(fused.run(end), plain.run(end));
-          const std::string what =
-              nameOf(s) + "prefix " + std::to_string(p) + "," + std::to_string(q);
-          ASSERT_EQ(fused.timerIsrCycles(), plain.timerIsrCycles()) << what;
-          ASSERT_EQ(fused.stats().interrupts[static_cast<int>(Irq::Timer)], 3u) << what;
-          expectSame(fused, plain, what);
+          expectSamePrtTicks(idiomProgram(s, Variant::Plain, dbg, p, q),
+                             nameOf(s) + "prefix " + std::to_string(p) + "," + std::to_string(q));
           if (HasFatalFailure()) return;
         }
-    }
 }
 
 TEST(VmIdiom, APieceThatFaultsFaultsAsItDoesAlone) {
@@ -456,15 +472,7 @@ TEST(VmJoin, EveryHorizonStopsWhereTheUnfusedRunStops) {
   for (const JoinCase& j : joinCases()) {
     const auto img = joinProgram(j, Variant::Plain);
     for (vm::Tick h = 1; h <= kJoinSweep; ++h) {
-      TestHost h1, h2;
-      vm::Vm fused(img, h1, costs());
-      vm::Vm plain(img, h2, costs());
-      plain.enableProfile();
-      ASSERT_EQ(fused.run(h), plain.run(h)) << nameOf(j) << h;
-      expectSame(fused, plain, nameOf(j) + "horizon " + std::to_string(h));
-      if (HasFatalFailure()) return;
-      ASSERT_EQ(fused.run(h + 3000), plain.run(h + 3000)) << nameOf(j) << h;
-      expectSame(fused, plain, nameOf(j) + "resumed from " + std::to_string(h));
+      expectSameAtHorizon(img, h, 3000, nameOf(j));
       if (HasFatalFailure()) return;
     }
   }
@@ -474,22 +482,7 @@ TEST(VmJoin, AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused) {
   for (const JoinCase& j : joinCases()) {
     const auto img = joinProgram(j, Variant::Plain);
     for (vm::Tick at = 1; at <= kJoinSweep; ++at) {
-      TestHost h1, h2;
-      vm::Vm fused(img, h1, costs());
-      vm::Vm plain(img, h2, costs());
-      plain.enableProfile();
-      h1.schedule(at, Irq::Pio);
-      h2.schedule(at, Irq::Pio);
-      h1.runUntil(fused, at + 1000);
-      h2.runUntil(plain, at + 1000);
-      const std::string what = nameOf(j) + "request at " + std::to_string(at);
-      ASSERT_EQ(h1.events.size(), h2.events.size()) << what;
-      ASSERT_FALSE(h1.events.empty()) << what;
-      for (size_t k = 0; k < h1.events.size(); ++k) {
-        EXPECT_EQ(h1.events[k].tick, h2.events[k].tick) << what;
-        EXPECT_EQ(h1.events[k].pc, h2.events[k].pc) << what;
-      }
-      expectSame(fused, plain, what);
+      expectSameInterrupt(img, at, 1000, nameOf(j));
       if (HasFatalFailure()) return;
     }
   }
@@ -498,24 +491,11 @@ TEST(VmJoin, AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused) {
 TEST(VmJoin, PrtTicksLandingInsideAreTakenWhereTheyAreUnfused) {
   // As for the idioms: prefixes of DBG and PUSHW POP move the loop against
   // PRT0's ticks.
-  vm::CostKnobs knobs = vm::calibratedKnobs();
-  knobs.timerService = vm::TimerService::Always;
-  const vm::CostTable timed = vm::makeCostTable(knobs);
   for (const JoinCase& j : joinCases())
     for (int p = 0; p < 12; ++p)
       for (int q = 0; q < 3; ++q) {
-        const vm::Image img = joinProgram(j, Variant::Plain, p, q);
-        TestHost h1, h2;
-        vm::Vm fused(img, h1, timed);
-        vm::Vm plain(img, h2, timed);
-        plain.enableProfile();
-        const vm::Tick end = 3 * vm::kPrtTicks + 500;
-        ASSERT_EQ(fused.run(end), plain.run(end));
-        const std::string what =
-            nameOf(j) + "prefix " + std::to_string(p) + "," + std::to_string(q);
-        ASSERT_EQ(fused.timerIsrCycles(), plain.timerIsrCycles()) << what;
-        ASSERT_EQ(fused.stats().interrupts[static_cast<int>(Irq::Timer)], 3u) << what;
-        expectSame(fused, plain, what);
+        expectSamePrtTicks(joinProgram(j, Variant::Plain, p, q),
+                           nameOf(j) + "prefix " + std::to_string(p) + "," + std::to_string(q));
         if (HasFatalFailure()) return;
       }
 }
