@@ -3,7 +3,7 @@
 # (clang-format), the normal build with warnings as errors, the same suite
 # built with AddressSanitizer and UndefinedBehaviorSanitizer, the threaded
 # bench and tournament built with ThreadSanitizer, and a short campaign
-# (45 s) of each libFuzzer target.
+# (30 s) of each libFuzzer target.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
@@ -36,4 +36,4 @@ cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSIMBOT_TSA
 cmake --build build-tsan --parallel "$jobs" --target bench_test
 TSAN_OPTIONS=halt_on_error=1 \
   ctest --test-dir build-tsan -R '^(Bench|Tournament)\.' --output-on-failure --parallel "$jobs"
-./scripts/fuzz.sh 45
+./scripts/fuzz.sh 30
