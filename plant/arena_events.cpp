@@ -31,12 +31,8 @@ void Arena::Impl::startReflex(Discrete& d, const std::vector<double>& y, int i, 
 
 // Finds the reported crossing direction of a root, 0 if not reported.
 int Arena::Impl::reported(const int* found, RootKind k, int who) const {
-  if (!found) return 0;
-  for (int j = 0; j < nRoots; ++j)
-    if (roots[static_cast<std::size_t>(j)].kind == k &&
-        roots[static_cast<std::size_t>(j)].robot == who)
-      return found[j];
-  return 0;
+  const int j = found ? rootIndex(k, who) : -1;
+  return j < 0 ? 0 : found[j];
 }
 
 // Applies everything that happens at tick T (time te) to (d, y) and lists

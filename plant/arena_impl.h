@@ -245,6 +245,8 @@ struct Arena::Impl {
   // g, a value of root function (k, who), shifted as that root is in this
   // segment's list (unshifted if it is not listed).
   double sided(RootKind k, int who, double g) const;
+  // Root function (k, who)'s index in this segment's list, or -1.
+  int rootIndex(RootKind k, int who) const;
   void sideRoots(double t0, const std::vector<double>& y);
 
   // ------------------------------------------------------------ CVODE

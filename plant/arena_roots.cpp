@@ -189,12 +189,17 @@ void Arena::Impl::sideRoots(double t0, const std::vector<double>& y) {
   }
 }
 
-double Arena::Impl::sided(RootKind k, int who, double g) const {
+int Arena::Impl::rootIndex(RootKind k, int who) const {
   for (int j = 0; j < nRoots; ++j)
     if (roots[static_cast<std::size_t>(j)].kind == k &&
         roots[static_cast<std::size_t>(j)].robot == who)
-      return g - rootShift[static_cast<std::size_t>(j)];
-  return g;
+      return j;
+  return -1;
+}
+
+double Arena::Impl::sided(RootKind k, int who, double g) const {
+  const int j = rootIndex(k, who);
+  return j < 0 ? g : g - rootShift[static_cast<std::size_t>(j)];
 }
 
 void Arena::Impl::buildRoots() {

@@ -734,12 +734,18 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
          IDIOM_ENTER(kIdiomCB_##l##_##c##_##b, l, 2) IDIOM_CB_BODY(l, c, b)} NEXT;
   SIMBOT_IDIOMS_CB(SIMBOT_IDIOM)
 #undef SIMBOT_IDIOM
+  // LDGW a; s b; o; STGW c: c = a o b (the BS and BSJ idioms, the joins'
+  // BSJ closers).
+#define IDIOM_LOAD_OP_STORE(s, o)                \
+  {                                              \
+    const uint32_t x = M_RD16(OPND16(0));        \
+    const uint32_t y = IDIOM_SRC_##s(OPND16(3)); \
+    M_WR16(OPND16(7), IDIOM_OP_##o(x, y));       \
+  }
 #define SIMBOT_IDIOM(s, o)                        \
   I_BS_##s##_##o : { /* LDGW a; s b; o; STGW c */ \
     IDIOM_ENTER(kIdiomBS_##s##_##o, LDGW, 2)      \
-    const uint32_t x = M_RD16(OPND16(0));         \
-    const uint32_t y = IDIOM_SRC_##s(OPND16(3));  \
-    M_WR16(OPND16(7), IDIOM_OP_##o(x, y));        \
+    IDIOM_LOAD_OP_STORE(s, o)                     \
     clk += ic.base;                               \
     count += 3;                                   \
     ip = opPc + 10;                               \
@@ -761,9 +767,7 @@ I_Byte : {  // PUSHW base; LDGW i; ADDW; LDIB
 #define SIMBOT_IDIOM(s, o)                                \
   I_BSJ_##s##_##o : { /* LDGW a; s b; o; STGW c; JMP t */ \
     IDIOM_ENTER(kIdiomBSJ_##s##_##o, LDGW, 2)             \
-    const uint32_t x = M_RD16(OPND16(0));                 \
-    const uint32_t y = IDIOM_SRC_##s(OPND16(3));          \
-    M_WR16(OPND16(7), IDIOM_OP_##o(x, y));                \
+    IDIOM_LOAD_OP_STORE(s, o)                             \
     clk += ic.base;                                       \
     count += 4;                                           \
     ip = IDIOM_TARGET(opPc + 13, 10);                     \
@@ -859,9 +863,7 @@ I_LoadRet : { /* LDLW x; RET: RET's fault leaves it to run alone */
 #define JOIN_ALONE_IJ F_INCGW_JMP
 #define JOIN_CLOSE_BSJ(s, o, t)                  \
   {                                              \
-    const uint32_t x = M_RD16(OPND16(0));        \
-    const uint32_t y = IDIOM_SRC_##s(OPND16(3)); \
-    M_WR16(OPND16(7), IDIOM_OP_##o(x, y));       \
+    IDIOM_LOAD_OP_STORE(s, o)                    \
     clk += idiomCosts[kIdiomBSJ_##s##_##o].base; \
     count += 4;                                  \
     t = IDIOM_TARGET(opPc + 13, 10);             \
@@ -903,6 +905,7 @@ I_LoadRet : { /* LDLW x; RET: RET's fault leaves it to run alone */
 #undef JOIN_ALONE_BSJ_PUSHW_ADDW
 #undef JOIN_ALONE_BSJ_PUSHW_SUBW
 #undef IDIOM_CB_BODY
+#undef IDIOM_LOAD_OP_STORE
   // DBG, then the idiom after it: the boundary between them, then the
   // idiom's first piece charged as NEXT would, without the table load.
 #define DBG_THEN(name, first)                                \
