@@ -1,79 +1,88 @@
-// plant/arena.cpp -- the arena: continuous motion with CVODE, discrete events.
+// plant/arena.cpp -- the arena: closed-form wheels, ARKODE, discrete events.
 //
 // This file is the arena's protocol with the scheduler: the public Arena
-// methods (inputs, advance and retreat, queries). The implementation is
+// methods (inputs, advance/retreat, queries). The implementation is
 // split by job (arena_impl.h): the root functions in arena_roots.cpp, the
 // integrator and dense output in arena_integrator.cpp, the event rules in
-// arena_events.cpp. The design of the whole follows.
+// arena_events.cpp, the rigid contacts in contact.cpp. The design of the
+// whole follows.
 //
-// One CVODE instance (Adams-Moulton, Newton iteration with a dense linear
-// solver and a difference-quotient Jacobian; the problem is small and not
-// stiff) integrates, per robot, x, y, heading (radians, unwrapped), the two
-// wheel ground speeds (first-order lag toward the commanded speed), a signed
-// odometer (for the bumper reflex distance) and the two gun-wheel speeds
-// (fraction of full speed, first-order spin-up with the motor on, coast-down
-// with its own time constant with it off). Balls in flight are
-// closed forms of time (straight line at the muzzle speed, z = h - g t^2 / 2)
-// that live only in the root functions, so a launch does not grow the state.
-// A zero time constant is handled by holding that state constant in the RHS
-// and setting it to the commanded value at every re-initialisation.
+// Motion. Between two inputs that change it (a segment), each robot's
+// wheel speeds follow a first-order lag toward their targets, so they, the
+// heading (their integral), a signed odometer (for the bumper reflex
+// distance) and the gun wheels (fraction of full speed, spin-up with the
+// motor on, coast-down with it off) are closed forms of time
+// (arena_impl.h, Motion). Only the centres' x and y have none: one ARKODE
+// ERKStep instance (Dormand-Prince 5(4), the pair's last stage reused as
+// the next step's first) integrates them, 2 values a robot. A one-step
+// method restarts for free at an input (ERKStepReset keeps its planned
+// step), where CVODE's multistep method started again at order 1 with a
+// tiny step. Balls in flight are closed forms too (straight line at the
+// muzzle speed, z = h - g t^2 / 2) that live only in the root functions.
+// A zero time constant starts the segment at the target.
+//
+// Contacts are rigid (contact.h): while a body pushes against a wall, the
+// divider or the other robot, the right-hand side takes the velocity into
+// the contact away; contacts start and end at roots.
 //
 // Events. Every discrete change (edge detector entering or leaving the wire's
-// range, bumper contact, reflex end, ball hit or miss, centre leaving the
-// field) is the zero of a root function; CVODE locates it (CV_ROOT_RETURN)
-// at t, and it happens at tick T = ceil(t * 9,216,000) (time.cpp). At T we
-// evaluate every root function again on the state at T and compare with the
-// discrete flags: a function CVODE reported takes its new side from the
-// reported crossing direction (immune to round-off at T), every other one
-// from its sign at T, which also catches a second crossing inside the same
-// tick. A root that changes nothing (a ball passing the divider's plane
-// beside the wall, the closest approach of a ball that misses) lets
-// integration go on without a re-initialisation; it only updates the
-// ball's closest distance to its target, which its ball_miss reports.
+// range, contact starting or ending, reflex end, ball hit or miss, centre
+// leaving the field) is the zero of a root function; ARKODE locates it
+// (ARK_ROOT_RETURN) at t, and it happens at tick T = ceil(t * 9,216,000)
+// (time.cpp), or the tick before when the crossing is on it (crossedTick).
+// At T we evaluate every root function again on the state at T and compare
+// with the discrete flags: a function ARKODE reported takes its new side
+// from the reported crossing direction (immune to round-off at T), every
+// other one from its sign at T, which also catches a second crossing inside
+// the same tick. A root that changes nothing (a ball passing the divider's
+// plane beside the wall, the closest approach of a ball that misses) lets
+// integration go on without a reset; it only updates the ball's closest
+// distance to its target, which its ball_miss reports.
 //
 // The events at T are a prediction (DESIGN.md "co-simulation"): advance()
 // returns them and keeps the post-event state aside; they are applied (and
-// CVODE re-initialised with CVodeReInit, as in sundials' cvRocket example)
-// when the scheduler proceeds, or discarded if an input at an earlier tick
-// changes the plant. Hence an input can re-initialise at any tick between the
-// last re-initialisation and now().
+// ARKODE reset with ERKStepReset, as at every discontinuity in sundials'
+// examples) when the scheduler proceeds, or discarded if an input at an
+// earlier tick changes the plant. Hence an input can reset at any tick
+// between the last reset and now().
 //
 // Stepping is independent of how the caller chops time. advance(stop) does
-// not stop CVODE at `stop`: it takes whole internal steps until CVODE has
+// not stop ARKODE at `stop`: it takes whole internal steps until ARKODE has
 // returned a time at or past the stop (the last step may overshoot it; the
 // segments keep the overshoot for the next advance(), which steps only if
-// they do not reach its stop yet). CVODE is given a stop time only at a
+// they do not reach its stop yet). ARKODE is given a stop time only at a
 // discontinuity known when the segment starts: the next ball launch, set at
-// every re-initialisation (an input that schedules a launch re-initialises).
-// A root whose tick lies beyond the caller's stop is held, not reported: the
-// call returns at its stop, and a later advance() whose stop reaches the
-// root's tick reports it there, with the same events, exactly as a single
-// long advance() would have. A re-initialisation drops a held root (it lies
-// past the input's tick). Between re-initialisations the sequence of CVode
-// calls is therefore the same whatever the stops were, and so are the steps,
-// the segments, the roots and every query; the only CVode argument that is
-// not a state of the plant, tout, matters only on the first call after a
-// (re)initialisation (CVODE's initial step guess) and is a fixed horizon.
+// every reset (an input that schedules a launch resets). A root whose tick
+// lies beyond the caller's stop is held, not reported: the call returns at
+// its stop, and a later advance() whose stop reaches the root's tick
+// reports it there, with the same events, exactly as a single long
+// advance() would have. A reset drops a held root (it lies past the
+// input's tick). Between resets the sequence of ERKStepEvolve calls is
+// therefore the same whatever the stops were, and so are the steps, the
+// step bounds (set from the state at each step's end), the segments, the
+// roots and every query; tout, the only argument that is not a state of
+// the plant, matters only to the first step's guess and is a fixed
+// horizon past the integrator's own time.
 //
-// Dense output. CVODE runs in CV_ONE_STEP mode; after every internal step
-// we store the step's Nordsieck data as Taylor coefficients c_k =
-// y^(k)(t_n) / k! from CVodeGetDky(t_n, k) for k = 0..q. On the step's
-// interval [t_{n-1}, t_n] that polynomial is exactly CVODE's own interpolant,
-// so a query at any tick since the last re-initialisation evaluates it
-// without touching the integrator: results never depend on whether (or how
-// often) anyone queried. The buffers are cleared, not freed, at each
-// re-initialisation, so after warm-up nothing is allocated per step.
+// Dense output. ARKODE runs in ARK_ONE_STEP mode; after every internal step
+// we keep the quintic Hermite polynomial of x and y matching their values,
+// slopes and curvatures at both ends of the step (arena_integrator.cpp), so
+// a query at any tick since the last reset evaluates it and the closed
+// forms without touching the integrator: results never depend on whether
+// (or how often) anyone queried. The buffers are cleared, not freed, at
+// each reset, so after warm-up nothing is allocated per step.
 //
-// Root finding only sees sign changes between step ends, so the maximum
-// step is bounded such that no point of a robot moves more than 1 inch per
-// step: an edge detector cannot cross the 4-inch band around the wire
-// unnoticed, nor two bodies graze unnoticed by more than that. Balls move
-// 100 times faster, so their root functions are built not to graze: the hit
-// function is the along-track offset to the opponent's centre plus the
-// half-chord (zero at the entry point of a hit and at the closest approach
-// of a miss), the divider function the signed distance past the wall's near
-// face along the ball's travel, the floor a concave parabola, the field's
-// boundary a convex function the ball starts inside of.
+// Root finding only sees sign changes between step ends, so a step never
+// lets a point of a robot move farther than the nearest edge, wall,
+// divider or robot is, and at least 1 inch (stepBound): an edge detector
+// cannot cross the 4-inch band around the wire unnoticed, nor two bodies
+// graze unnoticed. Balls move 100 times faster, so their root functions
+// are built not to graze: the hit function is the along-track offset to
+// the opponent's centre plus the half-chord (zero at the entry point of a
+// hit and at the closest approach of a miss), the divider function the
+// signed distance past the wall's near face along the ball's travel, the
+// floor a concave parabola, the field's boundary a convex function the
+// ball starts inside of.
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -345,14 +354,14 @@ int Arena::hits(int robot) const {
 
 IntegratorStats Arena::stats() const {
   Impl& m = *impl_;
+  // ARKODE's counters run on over resets (ERKStepReset keeps them); the
+  // dense output's own right-hand sides are counted with them.
   IntegratorStats s = m.acc;
   long v = 0;
-  CVodeGetNumSteps(m.mem.get(), &v);
-  s.steps += v;
-  CVodeGetNumRhsEvals(m.mem.get(), &v);
-  s.rhs_evals += v;
-  CVodeGetNumLinRhsEvals(m.mem.get(), &v);
-  s.rhs_evals += v;
+  ERKStepGetNumSteps(m.mem.get(), &v);
+  s.steps = v;
+  ERKStepGetNumRhsEvals(m.mem.get(), &v);
+  s.rhs_evals = v + m.ownRhs;
   return s;
 }
 

@@ -219,6 +219,10 @@ bool Arena::Impl::refereeTurn(std::int64_t T, Discrete& d, std::vector<double>& 
   return true;
 }
 
+// Contacts start where their gap reaches 0 and end where the root
+// function of the segment (contactG: the force while pushing, the gap
+// while touching without pushing) reaches 0 from below; which contacts
+// push is decided at the reset that follows (setActive).
 void Arena::Impl::contacts(std::int64_t T, Discrete& d, std::vector<double>& y, const int* found,
                            EventList& ev) {
   const double* ys = y.data();
@@ -230,9 +234,12 @@ void Arena::Impl::contacts(std::int64_t T, Discrete& d, std::vector<double>& y, 
     e.other = static_cast<std::int8_t>(other);
     ev.push(e);
   };
+  auto touchingNow = [&](RootKind rk, contact::Kind ck, int i) {
+    const int rep = reported(found, rk, i);
+    return rep != 0 ? rep < 0 : sided(rk, i, contactG(ck, i, ys)) < 0;
+  };
   if (nR == 2) {
-    const int rep = reported(found, RootKind::RobotRobot, 0);
-    const bool c = rep != 0 ? rep < 0 : sided(RootKind::RobotRobot, 0, robotG(ys)) < 0;
+    const bool c = touchingNow(RootKind::RobotRobot, contact::Kind::Robot, 0);
     if (c && !d.robotContact) {
       for (int i = 0; i < 2; ++i) {
         const Bumper side = sideOf(heading(ys, i), centre(ys, 1 - i) - centre(ys, i));
@@ -246,13 +253,18 @@ void Arena::Impl::contacts(std::int64_t T, Discrete& d, std::vector<double>& y, 
     d.robotContact = c;
   }
   // A robot against a fixed obstacle: contact starts (the bumper on the
-  // side facing `towards`, and its reflex) or ends where g changes sign.
-  auto obstacle = [&](int i, RootKind k, double g, bool& touching, ContactWith with,
-                      const Vec2& towards) {
-    const int rep = reported(found, k, i);
-    const bool c = rep != 0 ? rep < 0 : sided(k, i, g) < 0;
+  // side facing the obstacle, and its reflex) or ends.
+  auto obstacle = [&](int i, RootKind rk, contact::Kind ck, bool& touching, ContactWith with) {
+    const bool c = touchingNow(rk, ck, i);
     if (c && !touching) {
-      const Bumper side = sideOf(heading(ys, i), towards);
+      std::array<double, 2 * kXY> q{};
+      for (int r = 0; r < nR; ++r) {
+        q[static_cast<std::size_t>(kXY * r + X)] = ys[r * kPerRobot + X];
+        q[static_cast<std::size_t>(kXY * r + Y)] = ys[r * kPerRobot + Y];
+      }
+      Vec2 normal;
+      contact::gap(bodies, contact::Constraint{ck, i}, q.data(), &normal);
+      const Bumper side = sideOf(heading(ys, i), -normal);
       contactEvent(EventKind::Contact, i, side, with, -1);
       startReflex(d, y, i, side, T, ev);
     } else if (!c && touching) {
@@ -262,13 +274,10 @@ void Arena::Impl::contacts(std::int64_t T, Discrete& d, std::vector<double>& y, 
   };
   for (int i = 0; i < nR; ++i) {
     RobotDisc& r = d.r[static_cast<std::size_t>(i)];
-    const Vec2 cc = centre(ys, i);
-    obstacle(i, RootKind::Divider, dividerG(ys, i), r.dividerContact, ContactWith::Divider,
-             geom::closestPointOnRect(cc, geom::dividerRect(cfg.field)) - cc);
+    obstacle(i, RootKind::Divider, contact::Kind::Divider, r.dividerContact, ContactWith::Divider);
     if (cfg.field.field_walls) {
-      const Vec2 normal = std::abs(cc.x()) >= std::abs(cc.y()) ? Vec2(cc.x() >= 0 ? 1 : -1, 0)
-                                                               : Vec2(0, cc.y() >= 0 ? 1 : -1);
-      obstacle(i, RootKind::Wall, wallG(ys, i), r.wallContact, ContactWith::Wall, normal);
+      obstacle(i, RootKind::WallX, contact::Kind::WallX, r.wallContact[0], ContactWith::Wall);
+      obstacle(i, RootKind::WallY, contact::Kind::WallY, r.wallContact[1], ContactWith::Wall);
     }
   }
 }

@@ -17,7 +17,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "plant/cvode.h"
+#include "plant/arkode.h"
+#include "plant/contact.h"
 #include "plant/geometry.h"
 #include "plant/plant.h"
 
@@ -27,22 +28,25 @@ using geom::Vec2;
 
 namespace arena_detail {
 
+// A robot's full state as the event rules, roots and queries see it. Only
+// X and Y are integrated (kXY a robot); the rest is closed form (Motion).
 constexpr int kPerRobot = 8;
 enum : int { X = 0, Y = 1, H = 2, VL = 3, VR = 4, S = 5, G1 = 6, G2 = 7 };
+constexpr int kXY = 2;
 // Every ball two robots with two full magazines can have in flight: balls
 // are never reloaded, so a launch always finds a free slot.
 constexpr int kMaxBalls = 64;
 static_assert(kMaxBalls >= 2 * 2 * kMaxBallsPerGun, "the ball table must hold every magazine");
-constexpr int kMaxRoots = 2 * 6 + 1 + kMaxBalls * 4;
+constexpr int kMaxRoots = 2 * 7 + 1 + kMaxBalls * 4;
 constexpr int kRing = 16;
 static_assert(kRing > kMaxRefereeLimit, "the referee must see one event more than its limit");
-// CVode's tout in CV_ONE_STEP mode only bounds the first step's guess after a
-// (re)initialisation; a fixed horizon keeps it independent of the caller.
+// ERKStepEvolve's tout in ARK_ONE_STEP mode only bounds the first step's
+// guess after creation; a fixed horizon keeps it independent of the caller.
 constexpr double kFirstStepHorizon = 1.0;  // s
 constexpr double kNoStopTime = 1e12;       // s, far beyond any match
 // A crossing this close after a tick (in ticks) is taken as on the tick.
 // Round-off in a root function is far smaller: an odometer of 300 ft has an
-// ulp of 6e-14 ft, top speed moves 1.6e-7 ft per tick; CVODE's root
+// ulp of 6e-14 ft, top speed moves 1.6e-7 ft per tick; ARKODE's root
 // tolerance (100 ulp of t) is 3e-6 tick after 3 minutes.
 constexpr double kOnTickFraction = 1.0 / 1024;
 
@@ -50,7 +54,10 @@ enum class RootKind : std::uint8_t {
   EdgeFore,
   EdgeAft,
   OutOfField,
-  Wall,
+  // Contacts (contact.h): while inactive the gap to the obstacle, while
+  // active minus the contact's force; negative exactly while touching.
+  WallX,
+  WallY,
   Divider,
   ReflexEnd,
   RobotRobot,
@@ -101,7 +108,10 @@ struct RobotDisc {
   Bumper reflexSide = Bumper::Front;
   double reflexS0 = 0;
   std::array<bool, 2> edgeLow{};
-  bool wallContact = false, dividerContact = false;
+  // Touching the east or west wall, the north or south wall, the divider:
+  // the contact's constraint is active (contact.h).
+  std::array<bool, 2> wallContact{};
+  bool dividerContact = false;
   Ring reflexTicks, eventTicks;
   std::uint8_t portB = 0;
   std::array<bool, 2> gunOn{};
@@ -118,6 +128,55 @@ struct Discrete {
   std::array<Ball, kMaxBalls> balls{};
 };
 
+// One robot's closed-form motion within a segment (DESIGN.md "Continuous
+// motion"): each wheel's ground speed follows a first-order lag toward its
+// target, v(t) = vt + (v0 - vt) e^{-dt/tau}, so its path length is
+// vt dt - (v0 - vt) tau expm1(-dt/tau); the heading is the difference of
+// the two path lengths over the track, the odometer their mean; each gun
+// wheel follows its own lag. A zero time constant starts the segment at
+// the target (applyJumps).
+struct Motion {
+  double t0 = 0;
+  double h0 = 0, s0 = 0;
+  double vl0 = 0, vr0 = 0, tl = 0, tr = 0;
+  double tau = 0, track = 1;
+  std::array<double, 2> g0{}, gt{}, gtau{};
+
+  struct At {
+    double vl, vr;  // wheel speeds, ft/s
+    double h;       // heading, rad
+    double s;       // odometer, ft
+    double dv;      // d/dt of the mean wheel speed, ft/s^2
+  };
+  At at(double t) const {
+    const double dt = t - t0;
+    At a{};
+    if (tau > 0) {
+      const double em1 = std::expm1(-dt / tau);
+      const double e = 1.0 + em1;
+      a.vl = tl + (vl0 - tl) * e;
+      a.vr = tr + (vr0 - tr) * e;
+      const double il = tl * dt - (vl0 - tl) * tau * em1;
+      const double ir = tr * dt - (vr0 - tr) * tau * em1;
+      a.h = h0 + (il - ir) / track;
+      a.s = s0 + 0.5 * (il + ir);
+      a.dv = 0.5 * ((tl - a.vl) + (tr - a.vr)) / tau;
+    } else {
+      a.vl = vl0;
+      a.vr = vr0;
+      a.h = h0 + (vl0 - vr0) * dt / track;
+      a.s = s0 + 0.5 * (vl0 + vr0) * dt;
+      a.dv = 0;
+    }
+    return a;
+  }
+  double gun(int g, double t) const {
+    const auto k = static_cast<std::size_t>(g);
+    if (gtau[k] <= 0) return g0[k];
+    return gt[k] + (g0[k] - gt[k]) * std::exp(-(t - t0) / gtau[k]);
+  }
+};
+
 }  // namespace arena_detail
 
 using namespace arena_detail;
@@ -126,20 +185,23 @@ struct Arena::Impl {
   // ---- configuration
   ArenaConfig cfg;
   int nR = 0;
-  int n = 0;  // state size
+  int n = 0;   // full state size (kPerRobot a robot)
+  int nx = 0;  // integrated state size (kXY a robot)
   double half = 0, wireHalf = 0;
+  contact::Bodies bodies;  // radii and masses for the contact solve
 
   // ---- SUNDIALS objects, in creation order (destroyed in reverse)
-  cv::Context ctx;
-  cv::Vector yv;
-  cv::Vector dky;
-  cv::FixedPointSolver nls;
-  cv::Memory mem;
+  ark::Context ctx;
+  ark::Vector yv;
+  ark::Vector dky;
+  ark::ErkMemory mem;
 
   // ---- discrete state being integrated, and the pending prediction
   Discrete D;
   std::array<std::array<double, 2>, 2> wheelTarget{};
   std::array<std::array<double, 2>, 2> gunTarget{};
+  std::array<Motion, 2> motion{};
+  contact::Active active;  // the constraints of the segment (from D)
   bool pending = false;
   // The prediction came from a root (its crossing directions in
   // pendingFound), not from a scheduled launch; retreat() holds it again.
@@ -152,19 +214,21 @@ struct Arena::Impl {
 
   // ---- time
   std::int64_t now = 0;      // tick reached
-  std::int64_t segTick = 0;  // tick of the last (re)initialisation
+  std::int64_t segTick = 0;  // tick of the last reset
   double segT0 = 0;          // its time in seconds
-  // What the last (re)initialisation gave CVODE, and whether CVode has been
-  // called since: a re-initialisation at the same tick with the same state
-  // and dynamics before any step would leave CVODE exactly as it is.
+  // What the last reset gave ARKODE, and whether it has stepped since: a
+  // reset at the same tick with the same state and dynamics before any
+  // step would leave ARKODE exactly as it is.
   bool fresh = false;
   std::vector<double> segY;
   std::array<std::array<double, 2>, 2> segWheel{}, segGun{};
 
-  // ---- the integrator's own position (see "Stepping" above)
-  double tOut = 0;               // tout for CVode: segT0 + kFirstStepHorizon
-  double tReturned = 0;          // time of CVode's last return: roots up to it are known
-  std::int64_t launchStop = -1;  // tick CVODE's stop time is set at (a launch), or -1
+  // ---- the integrator's own position (see "Stepping" in arena.cpp)
+  double tReturned = 0;          // time of ERKStepEvolve's last return: roots up to it are known
+  double tStepEnd = 0;           // end of ARKODE's last internal step
+  bool lastRoot = false;         // ARKODE's last return was a root
+  bool rootsMuted = false;       // clearRootFlag(): every root function reads 1
+  std::int64_t launchStop = -1;  // tick the stop time is set at (a launch), or -1
   // A root found beyond the caller's stop, with events: reported by a later
   // advance() whose stop reaches heldTick.
   bool held = false;
@@ -175,8 +239,8 @@ struct Arena::Impl {
   // ---- roots
   std::array<RootDesc, kMaxRoots> roots{};
   // The root functions whose crossings were events at tick firedTick (over
-  // every re-initialisation at that tick): crossedTick() never puts
-  // another crossing of one of them there.
+  // every reset at that tick): crossedTick() never puts another crossing
+  // of one of them there.
   std::int64_t firedTick = -1;
   std::array<RootDesc, kMaxRoots> fired{};
   int nFired = 0;
@@ -187,21 +251,25 @@ struct Arena::Impl {
   std::array<double, kMaxRoots> rootShift{};
   std::vector<int> rootsFound;
 
-  // ---- dense output records
+  // ---- dense output: one quintic Hermite polynomial a step for x and y
+  // (arena_integrator.cpp, "Dense output"); the rest is closed form.
   struct Rec {
-    double tlo, thi, tn;
-    int q;
-    std::size_t off;
+    double tlo, thi;
+    std::size_t off;  // 6 Taylor coefficients about tlo for each of nx components
   };
   std::vector<Rec> recs;
   std::vector<double> coef;
+  // Slope and curvature of x, y at the end of ARKODE's last step.
+  std::vector<double> endY, endF, endA;
 
   // ---- statistics
   IntegratorStats acc{};
+  long ownRhs = 0;  // right-hand sides evaluated for the dense output
 
   // ---- scratch
   std::vector<double> tmp;
-  mutable std::vector<double> qtmp;  // for const queries
+  mutable std::vector<double> qtmp;   // for const queries
+  mutable std::vector<double> rootY;  // the full state inside the root function
 
   explicit Impl(const ArenaConfig& c);
 
@@ -209,12 +277,13 @@ struct Arena::Impl {
   const RobotParams& P(int i) const { return cfg.robots[static_cast<std::size_t>(i)].params; }
   double radius(int i) const { return P(i).body_diameter_ft / 2; }
 
-  double maxStep() const;
-  bool atRest(const std::vector<double>& y) const;
-  double maxStepSet = -1;  // the value last given to CVodeSetMaxStep
+  double pointSpeed() const;
+  double stepBound(const double* y, double ahead) const;
+  bool atRest() const;
+  double maxStepSet = -1;  // the value last given to ERKStepSetMaxStep
 
   // ------------------------------------------------------------ geometry on a
-  // state
+  // full state
   static Vec2 centre(const double* y, int i) {
     return Vec2(y[i * kPerRobot + X], y[i * kPerRobot + Y]);
   }
@@ -223,10 +292,13 @@ struct Arena::Impl {
   Vec2 detector(const double* y, int i, int k) const;
   double edgeG(const double* y, int i, int k) const;
   double outG(const double* y, int i) const;
-  double wallG(const double* y, int i) const { return outG(y, i) - radius(i); }
+  double wallGap(const double* y, int i, int axis) const;
   double dividerG(const double* y, int i) const;
   double robotG(const double* y) const;
   double reflexG(const double* y, int i, const Discrete& d) const;
+  // The contact functions: the gap while inactive, minus the force while
+  // active (contact.h); negative exactly while touching.
+  double contactG(contact::Kind k, int i, const double* y) const;
 
   void ballAt(const Ball& b, double t, double& x, double& yy, double& z) const;
   double ballHitG(const Ball& b, double t, const double* y, double& perp2, double& dist2) const;
@@ -235,7 +307,7 @@ struct Arena::Impl {
   double ballDividerG(const Ball& b, double t) const;
 
   double rootValue(const RootDesc& rd, double t, const double* y) const;
-  // Root j of the list as CVODE, crossedTick() and the event rules see it
+  // Root j of the list as ARKODE, crossedTick() and the event rules see it
   // in this segment: shifted by rootShift[j] (arena_roots.cpp, "Sided
   // roots").
   double sidedValue(int j, double t, const double* y) const {
@@ -249,7 +321,7 @@ struct Arena::Impl {
   int rootIndex(RootKind k, int who) const;
   void sideRoots(double t0, const std::vector<double>& y);
 
-  // ------------------------------------------------------------ CVODE
+  // ------------------------------------------------------------ ARKODE
   // callbacks
   static int rhsThunk(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
     static_cast<Impl*>(user)->rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
@@ -257,7 +329,13 @@ struct Arena::Impl {
   }
   static int rootThunk(sunrealtype t, N_Vector y, sunrealtype* g, void* user);
 
-  void rhs(double, const double* y, double* f) const;
+  // Velocities of x, y (nx values) at t with positions xy, after the
+  // active contacts' projection; `acc`, if given, their time derivative.
+  void rhs(double t, const double* xy, double* f, double* accel = nullptr) const;
+  // The full state at t from positions xy and the closed forms.
+  void fullState(double t, const double* xy, double* out) const;
+  // Contact solve inputs at t: free velocities and the positions.
+  void freeVelocities(double t, double* v, double* a) const;
 
   // A gun wheel spins up under its motor and coasts down, more slowly,
   // when the motor is off (DESIGN.md "Guns"): the time constant follows
@@ -268,26 +346,23 @@ struct Arena::Impl {
 
   void computeTargets(const Discrete& d);
   void applyJumps(std::vector<double>& y) const;
+  void setMotion(double t0, const std::vector<double>& y);
+  void setActive(const Discrete& d);
 
   void buildRoots();
 
-  void clearStopTime();
-
-  void accumulateStats();
-
   void reinit(std::int64_t tick, double t0, std::vector<double>& y, bool first = false);
 
-  void recordStep(double tret);
+  void clearRootFlag();
+  void recordStep(double tn, const double* ynew);
+  void setMaxStep(double h);
 
   // Time used for tick `tick` inside the current segment.
   double timeOfTick(std::int64_t tick) const { return std::max(secondsFromTick(tick), segT0); }
 
   const Rec& recordAt(double t) const;
   double component(const Rec& r, double t, int i) const;
-  void evalAt(double t, std::vector<double>& out) const {
-    const Rec& r = recordAt(t);
-    for (int i = 0; i < n; ++i) out[static_cast<std::size_t>(i)] = component(r, t, i);
-  }
+  void evalAt(double t, std::vector<double>& out) const;
   std::array<double, 3> poseAt(int robot, std::int64_t tick) const;
 
   void checkRobot(int robot) const {

@@ -1,41 +1,74 @@
-// plant/arena_integrator.cpp -- CVODE and dense output for the arena.
+// plant/arena_integrator.cpp -- ARKODE and dense output for the arena.
 //
-// Set-up of the integrator, the right-hand side and its targets, the
-// re-initialisation at a discontinuity, the dense output records kept per
-// step, and the stepping loop (advance, predict, retreat, commit) whose
-// independence from the caller's stops arena.cpp's header comment
-// ("Stepping", "Dense output") argues.
+// Set-up of the integrator, the right-hand side (closed-form wheels, the
+// contacts' projection), the reset at a discontinuity, the dense output
+// records kept per step, and the stepping loop (advance, predict, retreat,
+// commit) whose independence from the caller's stops arena.cpp's header
+// comment ("Stepping", "Dense output") argues.
 #include <cstring>
 
 #include "plant/arena_impl.h"
 
 namespace simbot::plant {
 
+namespace {
+
+// ERKStep's tolerances on x and y (ft), relative and absolute. Against the
+// exact motion (closed-form heading, Boost.Math quadrature of x and y;
+// tests/plant/tolerance_test.cpp) the arcs, spins and straight runs of the
+// default profile stay within 1e-9 ft over 10 s, 1/380 of the 3.8e-7 ft a
+// point at top speed moves in a tick; at 1e-9 the straight run is 2.0e-9
+// ft off.
+constexpr double kTolerance = 3e-10;
+// Step of the central difference that gives the curvature of x and y while
+// a contact whose normal turns is active (the other robot, the divider's
+// corner): its error, about 1e-9 ft/s^2, enters the quintic times h^2/120.
+constexpr double kCurvatureStep = 1e-6;  // s
+// The step while nothing moves: nothing can cross, but an unbounded step
+// grows without limit (to 1e153 s in a port-B flood) and the step that
+// the next reset keeps would then be meaningless.
+constexpr double kRestStep = 10;  // s
+
+}  // namespace
+
 Arena::Impl::Impl(const ArenaConfig& c)
     : cfg(c),
       nR(static_cast<int>(c.robots.size())),
       n(kPerRobot * static_cast<int>(c.robots.size())),
-      yv(kPerRobot * static_cast<sunindextype>(c.robots.size()), ctx.get()),
-      dky(kPerRobot * static_cast<sunindextype>(c.robots.size()), ctx.get()),
-      nls(yv.get(), ctx.get()),
-      mem(CV_ADAMS, ctx.get()) {
+      nx(kXY * static_cast<int>(c.robots.size())),
+      yv(kXY * static_cast<sunindextype>(c.robots.size()), ctx.get()),
+      dky(kXY * static_cast<sunindextype>(c.robots.size()), ctx.get()),
+      mem(&Impl::rhsThunk, 0.0, yv.get(), ctx.get()) {
   if (nR < 1 || nR > 2) throw std::invalid_argument("Arena: 1 or 2 robots");
   half = cfg.field.size_ft / 2;
   wireHalf = half - cfg.field.wire_inset_ft;
+  bodies.robots = nR;
+  bodies.half = half;
+  bodies.divider = geom::dividerRect(cfg.field);
+  double massSum = 0;
+  for (int i = 0; i < nR; ++i) massSum += P(i).mass_lb;
+  for (int i = 0; i < nR; ++i) {
+    bodies.radius[static_cast<std::size_t>(i)] = radius(i);
+    bodies.invMass[static_cast<std::size_t>(i)] = massSum / nR / P(i).mass_lb;
+  }
   pendingY.assign(static_cast<std::size_t>(n), 0.0);
   tmp.assign(static_cast<std::size_t>(n), 0.0);
   qtmp.assign(static_cast<std::size_t>(n), 0.0);
+  rootY.assign(static_cast<std::size_t>(n), 0.0);
   segY.assign(static_cast<std::size_t>(n), 0.0);
+  endY.assign(static_cast<std::size_t>(nx), 0.0);
+  endF.assign(static_cast<std::size_t>(nx), 0.0);
+  endA.assign(static_cast<std::size_t>(nx), 0.0);
   rootsFound.assign(kMaxRoots, 0);
   heldFound.assign(kMaxRoots, 0);
   pendingFound.assign(kMaxRoots, 0);
   recs.reserve(1024);
-  coef.reserve(static_cast<std::size_t>(1024 * 13 * n));
+  coef.reserve(static_cast<std::size_t>(1024 * 6 * nx));
 
-  double* y = yv.data();
+  std::vector<double>& y = tmp;
   for (int i = 0; i < nR; ++i) {
     const RobotSetup& rs = cfg.robots[static_cast<std::size_t>(i)];
-    double* r = y + i * kPerRobot;
+    double* r = y.data() + i * kPerRobot;
     r[X] = rs.start.x_ft;
     r[Y] = rs.start.y_ft;
     r[H] = geom::degToRad(rs.start.heading_deg);
@@ -44,93 +77,151 @@ Arena::Impl::Impl(const ArenaConfig& c)
     d.latched = MotorFrame{};  // stopped until the first frame latches
     d.ballsLeft = {rs.params.balls_per_gun, rs.params.balls_per_gun};
   }
-  // Initial flags from geometry, silently (nothing has happened yet).
+  // Initial flags from geometry, silently (nothing has happened yet): a
+  // body put down touching something starts in contact with it.
   for (int i = 0; i < nR; ++i) {
     RobotDisc& d = D.r[static_cast<std::size_t>(i)];
-    for (int k = 0; k < 2; ++k) d.edgeLow[static_cast<std::size_t>(k)] = edgeG(y, i, k) < 0;
-    d.wallContact = cfg.field.field_walls && wallG(y, i) < 0;
-    d.dividerContact = dividerG(y, i) < 0;
+    for (int k = 0; k < 2; ++k) {
+      d.edgeLow[static_cast<std::size_t>(k)] = edgeG(y.data(), i, k) < 0;
+      d.wallContact[static_cast<std::size_t>(k)] =
+          cfg.field.field_walls && wallGap(y.data(), i, k) <= 0;
+    }
+    d.dividerContact = dividerG(y.data(), i) <= 0;
   }
-  D.robotContact = nR == 2 && robotG(y) < 0;
+  D.robotContact = nR == 2 && robotG(y.data()) <= 0;
 
-  cv::check(CVodeInit(mem.get(), &Impl::rhsThunk, 0.0, yv.get()), "CVodeInit");
-  cv::check(CVodeSetUserData(mem.get(), this), "CVodeSetUserData");
-  // rtol = atol = 5e-10 (ft, rad, ft/s; issue 13 part 4, README "The
-  // plant's integrator"). Against the exact motion from rest (closed-form
-  // heading, Boost.Math quadrature; tests/plant/tolerance_test.cpp), 277
-  // random 10-s arcs of the default profile stay within 9.5e-9 ft and
-  // 2.2e-9 rad: 1/40 of the 3.8e-7 ft a point at top speed moves in a tick
-  // (1e-10: 5.2e-9 ft, 11 % more steps in the 180-s match; 1e-9 puts an
-  // edge crossing 0.08 tick past a tick boundary on the wrong tick).
-  // Two crossings exactly on one tick may then fall in different steps:
-  // crossedTick() keeps them on that tick.
-  cv::check(CVodeSStolerances(mem.get(), 5e-10, 5e-10), "CVodeSStolerances");
-  // Adams with functional iteration: the motion is not stiff (time
-  // constants of 0.1 s and more against steps the roots and the maximum
-  // step keep far shorter), so no Jacobian and no linear solve.
-  cv::check(CVodeSetNonlinearSolver(mem.get(), nls.get()), "CVodeSetNonlinearSolver");
-  cv::check(CVodeSetMaxNumSteps(mem.get(), 100000), "CVodeSetMaxNumSteps");
-  cv::check(CVodeSetNoInactiveRootWarn(mem.get()), "CVodeSetNoInactiveRootWarn");
-  // CVODE's own messages would go to stderr: a failure is reported as the
+  void* m = mem.get();
+  ark::check(ERKStepSetUserData(m, this), "ERKStepSetUserData");
+  // Dormand-Prince 5(4): the fifth-order pair with the smallest error
+  // constants ARKODE ships, its last stage reused as the next step's first.
+  ark::check(ERKStepSetTableNum(m, ARKODE_DORMAND_PRINCE_7_4_5), "ERKStepSetTableNum");
+  ark::check(ERKStepSStolerances(m, kTolerance, kTolerance), "ERKStepSStolerances");
+  // ARKODE's root finder locates a crossing on its own interpolant, the
+  // quartic Hermite it uses with a fifth-order table (one more right-hand
+  // side, only in a step with a sign change); crossedTick() then decides
+  // the tick from the quintic dense output below.
+  ark::check(ERKStepSetMaxNumSteps(m, 100000), "ERKStepSetMaxNumSteps");
+  // ARKODE's own messages would go to stderr: a failure is reported as the
   // run's plant fault instead (SolverError).
-  cv::check(CVodeSetErrFile(mem.get(), nullptr), "CVodeSetErrFile");
-  std::copy(y, y + n, tmp.begin());
+  ark::check(ERKStepSetErrFile(m, nullptr), "ERKStepSetErrFile");
   reinit(0, 0.0, tmp, /*first=*/true);
 }
 
-double Arena::Impl::maxStep() const {
-  double pointSpeed = 0;
+// The fastest any point of any robot can move (ft/s): the top of the speed
+// table with the larger trim, plus the spin of the body's edge.
+double Arena::Impl::pointSpeed() const {
+  double best = 0;
   for (int i = 0; i < nR; ++i) {
     const RobotParams& p = P(i);
     double v = 0;
     for (double s : p.speed_table_fps) v = std::max(v, s);
     v *= std::max(p.left_trim, p.right_trim);
+    const Motion& m = motion[static_cast<std::size_t>(i)];
+    v = std::max({v, std::abs(m.tl), std::abs(m.tr), std::abs(m.vl0), std::abs(m.vr0)});
     const double omega = 2 * v / p.track_ft;
-    pointSpeed = std::max(pointSpeed, v + omega * radius(i));
+    best = std::max(best, v + omega * radius(i));
   }
-  if (pointSpeed <= 0) return 0.0;  // nothing moves: no limit
-  return (1.0 / 12.0) / (nR * pointSpeed);
+  return best;
+}
+
+// Root finding only sees sign changes between step ends. The step never
+// lets a point of a robot move more than 1 inch relative to another body
+// (the guarantee CVODE's plant gave), and beyond that no farther than the
+// nearest root function is from zero: no edge, wall, divider or robot can
+// then be crossed and left again unseen inside a step. ARKODE chooses a
+// step's size at the end of the step before it, so a bound set after step
+// k applies from step k + 2: it is the distance at the end of step k less
+// what step k + 1, already planned (`ahead`), can move.
+double Arena::Impl::stepBound(const double* y, double ahead) const {
+  const double v = pointSpeed();
+  if (v <= 0) return kRestStep;  // nothing can move
+  const double floor = (1.0 / 12.0) / (nR * v);
+  if (active.count > 0) return floor;
+  double d = HUGE_VAL;
+  for (int i = 0; i < nR; ++i) {
+    d = std::min({d, std::abs(edgeG(y, i, 0)), std::abs(edgeG(y, i, 1)), std::abs(dividerG(y, i))});
+    if (cfg.field.field_walls)
+      d = std::min({d, std::abs(wallGap(y, i, 0)), std::abs(wallGap(y, i, 1))});
+    else
+      d = std::min(d, std::abs(outG(y, i)));
+  }
+  if (nR == 2) d = std::min(d, std::abs(robotG(y)) / 2);
+  return std::max(floor, d / v - ahead);
 }
 
 // Every wheel and its target at rest and no ball in flight: the state and
-// every root function are then constant until the next re-initialisation
-// (nothing changes the right-hand side without one), so no crossing can
-// hide inside a step and maxStep() need not bound it.
-bool Arena::Impl::atRest(const std::vector<double>& y) const {
+// every root function are then constant until the next reset (nothing
+// changes the right-hand side without one), so no crossing can hide inside
+// a step and only kRestStep bounds it.
+bool Arena::Impl::atRest() const {
   for (const Ball& b : D.balls)
     if (b.active) return false;
   for (int i = 0; i < nR; ++i) {
-    const double* r = y.data() + i * kPerRobot;
-    const auto& wt = wheelTarget[static_cast<std::size_t>(i)];
-    if (r[VL] != 0 || r[VR] != 0 || wt[0] != 0 || wt[1] != 0) return false;
+    const Motion& m = motion[static_cast<std::size_t>(i)];
+    if (m.vl0 != 0 || m.vr0 != 0 || m.tl != 0 || m.tr != 0) return false;
   }
   return true;
 }
 
-void Arena::Impl::rhs(double, const double* y, double* f) const {
+void Arena::Impl::freeVelocities(double t, double* v, double* a) const {
   for (int i = 0; i < nR; ++i) {
-    const RobotParams& p = P(i);
-    const double* r = y + i * kPerRobot;
-    double* d = f + i * kPerRobot;
-    const double v = 0.5 * (r[VL] + r[VR]);
-    d[X] = v * std::sin(r[H]);
-    d[Y] = v * std::cos(r[H]);
-    d[H] = (r[VL] - r[VR]) / p.track_ft;  // clockwise when the left wheel is faster
-    const auto& wt = wheelTarget[static_cast<std::size_t>(i)];
-    d[VL] = p.motor_lag_s > 0 ? (wt[0] - r[VL]) / p.motor_lag_s : 0.0;
-    d[VR] = p.motor_lag_s > 0 ? (wt[1] - r[VR]) / p.motor_lag_s : 0.0;
-    d[S] = v;
-    const auto& gt = gunTarget[static_cast<std::size_t>(i)];
-    for (int g = 0; g < 2; ++g) {
-      const double target = gt[static_cast<std::size_t>(g)];
-      const double tau = gunTau(p, target);
-      d[G1 + g] = tau > 0 ? (target - r[G1 + g]) / tau : 0.0;
+    const Motion& m = motion[static_cast<std::size_t>(i)];
+    const Motion::At w = m.at(t);
+    const double sp = 0.5 * (w.vl + w.vr);
+    const double sh = std::sin(w.h), ch = std::cos(w.h);
+    v[kXY * i + X] = sp * sh;
+    v[kXY * i + Y] = sp * ch;
+    if (a) {
+      const double omega = (w.vl - w.vr) / m.track;  // clockwise when the left wheel is faster
+      a[kXY * i + X] = w.dv * sh + sp * omega * ch;
+      a[kXY * i + Y] = w.dv * ch - sp * omega * sh;
     }
   }
 }
 
+void Arena::Impl::rhs(double t, const double* xy, double* f, double* accel) const {
+  freeVelocities(t, f, accel);
+  if (active.count == 0) return;
+  contact::project(bodies, active, xy, f, f);
+  if (!accel) return;
+  if (!active.turning()) {
+    // Fixed normals: the projection is a constant linear map, so it maps
+    // the free curvature to the constrained one.
+    contact::project(bodies, active, xy, accel, accel);
+    return;
+  }
+  // Normals that turn with the bodies: the derivative along the path by a
+  // central difference of the right-hand side.
+  std::array<double, 2 * kXY> qp{}, qm{}, fp{}, fm{};
+  for (int j = 0; j < nx; ++j) {
+    qp[static_cast<std::size_t>(j)] = xy[j] + kCurvatureStep * f[j];
+    qm[static_cast<std::size_t>(j)] = xy[j] - kCurvatureStep * f[j];
+  }
+  rhs(t + kCurvatureStep, qp.data(), fp.data());
+  rhs(t - kCurvatureStep, qm.data(), fm.data());
+  for (int j = 0; j < nx; ++j)
+    accel[j] =
+        (fp[static_cast<std::size_t>(j)] - fm[static_cast<std::size_t>(j)]) / (2 * kCurvatureStep);
+}
+
+void Arena::Impl::fullState(double t, const double* xy, double* out) const {
+  for (int i = 0; i < nR; ++i) {
+    const Motion& m = motion[static_cast<std::size_t>(i)];
+    const Motion::At w = m.at(t);
+    double* r = out + i * kPerRobot;
+    r[X] = xy[kXY * i + X];
+    r[Y] = xy[kXY * i + Y];
+    r[H] = w.h;
+    r[VL] = w.vl;
+    r[VR] = w.vr;
+    r[S] = w.s;
+    r[G1] = m.gun(0, t);
+    r[G2] = m.gun(1, t);
+  }
+}
+
 // ------------------------------------------------------------ targets and
-// reinit
+// reset
 void Arena::Impl::computeTargets(const Discrete& d) {
   for (int i = 0; i < nR; ++i) {
     const RobotParams& p = P(i);
@@ -168,26 +259,84 @@ void Arena::Impl::applyJumps(std::vector<double>& y) const {
   }
 }
 
-void Arena::Impl::clearStopTime() {
-#if SUNDIALS_VERSION_MAJOR > 6 || (SUNDIALS_VERSION_MAJOR == 6 && SUNDIALS_VERSION_MINOR >= 5)
-  cv::check(CVodeClearStopTime(mem.get()), "CVodeClearStopTime");
-#else
-  // No CVodeClearStopTime before SUNDIALS 6.5: a stop time no step ever
-  // comes near changes nothing (CVODE only shortens a step that would
-  // pass it, and uses it for the first step's guess only if it is closer
-  // than tout).
-  cv::check(CVodeSetStopTime(mem.get(), kNoStopTime), "CVodeSetStopTime");
-#endif
+void Arena::Impl::setMotion(double t0, const std::vector<double>& y) {
+  for (int i = 0; i < nR; ++i) {
+    const RobotParams& p = P(i);
+    const double* r = y.data() + i * kPerRobot;
+    Motion& m = motion[static_cast<std::size_t>(i)];
+    m.t0 = t0;
+    m.h0 = r[H];
+    m.s0 = r[S];
+    m.vl0 = r[VL];
+    m.vr0 = r[VR];
+    m.tl = wheelTarget[static_cast<std::size_t>(i)][0];
+    m.tr = wheelTarget[static_cast<std::size_t>(i)][1];
+    m.tau = p.motor_lag_s;
+    m.track = p.track_ft;
+    for (int g = 0; g < 2; ++g) {
+      const auto k = static_cast<std::size_t>(g);
+      m.g0[k] = r[G1 + g];
+      m.gt[k] = gunTarget[static_cast<std::size_t>(i)][k];
+      m.gtau[k] = gunTau(p, m.gt[k]);
+    }
+  }
 }
 
-void Arena::Impl::accumulateStats() {
-  long v = 0;
-  CVodeGetNumSteps(mem.get(), &v);
-  acc.steps += v;
-  CVodeGetNumRhsEvals(mem.get(), &v);
-  acc.rhs_evals += v;
-  CVodeGetNumLinRhsEvals(mem.get(), &v);
-  acc.rhs_evals += v;
+// The contacts that push in this segment: of those the discrete state says
+// are touching, the largest set whose forces are all positive at the
+// segment's start (after the wheels' jumps), or zero and growing (a robot
+// at rest against a wall that starts to drive into it: its speed, and so
+// the force, is 0 at the start). The solve is repeated without the
+// weakest force until none is left out. A touching contact left out (its
+// body already moves away: an instant reflex, a new frame with no motor
+// lag) ends when its gap opens (contactG).
+void Arena::Impl::setActive(const Discrete& d) {
+  contact::Active cand;
+  auto add = [&](contact::Kind k, int i) {
+    cand.c[static_cast<std::size_t>(cand.count++)] = contact::Constraint{k, i};
+  };
+  for (int i = 0; i < nR; ++i) {
+    const RobotDisc& r = d.r[static_cast<std::size_t>(i)];
+    if (r.wallContact[0]) add(contact::Kind::WallX, i);
+    if (r.wallContact[1]) add(contact::Kind::WallY, i);
+    if (r.dividerContact) add(contact::Kind::Divider, i);
+  }
+  if (nR == 2 && d.robotContact) add(contact::Kind::Robot, 0);
+  active = cand;
+  if (cand.count == 0) return;
+  std::array<double, 2 * kXY> xy{}, v{}, vf{}, af{};
+  for (int i = 0; i < nR; ++i) {
+    xy[static_cast<std::size_t>(kXY * i + X)] = segY[static_cast<std::size_t>(i * kPerRobot + X)];
+    xy[static_cast<std::size_t>(kXY * i + Y)] = segY[static_cast<std::size_t>(i * kPerRobot + Y)];
+  }
+  freeVelocities(segT0, vf.data(), af.data());
+  // A force this small is zero: round-off of speeds of order 1 ft/s.
+  constexpr double kZeroForce = 1e-12;  // ft/s
+  for (;;) {
+    std::array<double, contact::kMaxActive> mu{}, dmu{};
+    contact::project(bodies, active, xy.data(), vf.data(), v.data(), mu.data());
+    contact::project(bodies, active, xy.data(), af.data(), v.data(), dmu.data());
+    int worst = -1;
+    auto weaker = [&](int a, int b) {
+      const auto ka = static_cast<std::size_t>(a), kb = static_cast<std::size_t>(b);
+      return mu[ka] != mu[kb] ? mu[ka] < mu[kb] : dmu[ka] < dmu[kb];
+    };
+    for (int j = 0; j < active.count; ++j) {
+      const auto k = static_cast<std::size_t>(j);
+      const bool pushes = mu[k] > kZeroForce || (mu[k] >= -kZeroForce && dmu[k] > 0);
+      if (!pushes && (worst < 0 || weaker(j, worst))) worst = j;
+    }
+    if (worst < 0) break;
+    for (int j = worst; j + 1 < active.count; ++j)
+      active.c[static_cast<std::size_t>(j)] = active.c[static_cast<std::size_t>(j + 1)];
+    if (--active.count == 0) break;
+  }
+}
+
+void Arena::Impl::setMaxStep(double h) {
+  if (h == maxStepSet) return;
+  ark::check(ERKStepSetMaxStep(mem.get(), h), "ERKStepSetMaxStep");
+  maxStepSet = h;
 }
 
 // (Re)starts the integration at tick `tick`, time t0, from state y, under
@@ -195,87 +344,143 @@ void Arena::Impl::accumulateStats() {
 void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, bool first) {
   computeTargets(D);
   applyJumps(y);
-  std::copy(y.begin(), y.end(), yv.data());
-  // An input at the tick of the last re-initialisation, before any step,
-  // that leaves the state and everything the right-hand side reads as
-  // they were: CVODE is already exactly where CVodeReInit would put it
-  // (no step, no RHS evaluation since), so it is not called. The root set
-  // and stop time are rebuilt below as always.
+  // A reset at the tick of the last one, before any step, that leaves the
+  // state and everything the right-hand side reads as they were: ARKODE is
+  // already exactly where a reset would put it, so none is made. The root
+  // set and stop time are rebuilt below as always.
   const bool same = fresh && tick == segTick && t0 == segT0 && wheelTarget == segWheel &&
                     gunTarget == segGun &&
                     std::memcmp(y.data(), segY.data(), y.size() * sizeof(double)) == 0;
-  if (!first && !same) {
-    accumulateStats();
-    cv::check(CVodeReInit(mem.get(), t0, yv.get()), "CVodeReInit");
-    ++acc.reinits;
+  std::copy(y.begin(), y.end(), segY.begin());
+  segTick = tick;
+  segT0 = t0;
+  setMotion(t0, y);
+  setActive(D);
+  double* xy = yv.data();
+  for (int i = 0; i < nR; ++i) {
+    xy[kXY * i + X] = y[static_cast<std::size_t>(i * kPerRobot + X)];
+    xy[kXY * i + Y] = y[static_cast<std::size_t>(i * kPerRobot + Y)];
   }
-  // At rest the steps grow as fast as CVODE allows (a solo program that
-  // never drives: a few steps instead of one per maxStep()); the dense
-  // output is the same constant state either way.
-  const double hmax = atRest(y) ? 0.0 : maxStep();  // 0: no bound
-  if (hmax != maxStepSet) {
-    cv::check(CVodeSetMaxStep(mem.get(), hmax), "CVodeSetMaxStep");
-    maxStepSet = hmax;
+  if (!same) {
+    if (!first) {
+      ++acc.reinits;
+      clearRootFlag();
+    }
+    ark::check(ERKStepReset(mem.get(), t0, yv.get()), "ERKStepReset");
   }
   fresh = true;
-  std::copy(y.begin(), y.end(), segY.begin());
   segWheel = wheelTarget;
   segGun = gunTarget;
+  // The reset keeps ARKODE's planned step (a one-step method restarts for
+  // free) and the bound of the step after it: both are kept within half
+  // the distance to the nearest feature.
+  const double bound = atRest() ? kRestStep : 0.5 * stepBound(y.data(), 0.0);
+  setMaxStep(bound);
+  if (!first && bound > 0) {
+    double planned = 0;
+    ERKStepGetCurrentStep(mem.get(), &planned);
+    if (planned > bound) ark::check(ERKStepSetInitStep(mem.get(), bound), "ERKStepSetInitStep");
+  }
   buildRoots();
   sideRoots(t0, y);
   if (nRoots != nRootsRegistered) {
-    cv::check(CVodeRootInit(mem.get(), nRoots, nRoots > 0 ? &Impl::rootThunk : nullptr),
-              "CVodeRootInit");
+    ark::check(ERKStepRootInit(mem.get(), nRoots, nRoots > 0 ? &Impl::rootThunk : nullptr),
+               "ERKStepRootInit");
+    if (nRoots > 0)  // (the root memory exists only now)
+      ark::check(ERKStepSetNoInactiveRootWarn(mem.get()), "ERKStepSetNoInactiveRootWarn");
     nRootsRegistered = nRoots;
   }
-  segTick = tick;
-  segT0 = t0;
   now = tick;
-  tOut = t0 + kFirstStepHorizon;
   tReturned = t0;
+  tStepEnd = t0;
   held = false;
-  // The only discontinuity known in advance: the next ball launch. CVODE
-  // must not step across it; any other stop time from the last segment
-  // (a launch this re-initialisation came before) is cleared.
+  lastRoot = false;
+  // The only discontinuity known in advance: the next ball launch. ARKODE
+  // must not step across it; a stop time from the last segment (a launch
+  // this reset came before) is moved out of reach.
   const std::int64_t nl = nextLaunch();
   if (nl > tick) {
-    cv::check(CVodeSetStopTime(mem.get(), secondsFromTick(nl)), "CVodeSetStopTime");
+    ark::check(ERKStepSetStopTime(mem.get(), secondsFromTick(nl)), "ERKStepSetStopTime");
     launchStop = nl;
-  } else {
-    clearStopTime();
+  } else if (launchStop >= 0) {
+    // Without a reset (nothing that moves changed) the old one is still
+    // armed: ARKODE 6.4 has no way to clear it but one out of reach.
+    ark::check(ERKStepSetStopTime(mem.get(), kNoStopTime), "ERKStepSetStopTime");
     launchStop = -1;
   }
   recs.clear();
   coef.clear();
-  recs.push_back(Rec{t0, t0, t0, 0, 0});
-  coef.insert(coef.end(), y.begin(), y.end());
+  // The segment's first record: the state at t0 alone.
+  recs.push_back(Rec{t0, t0, 0});
+  for (int j = 0; j < nx; ++j) {
+    coef.push_back(xy[j]);
+    for (int k = 1; k < 6; ++k) coef.push_back(0.0);
+    endY[static_cast<std::size_t>(j)] = xy[j];
+  }
+  rhs(t0, endY.data(), endF.data(), endA.data());
+  ownRhs += active.turning() ? 3 : 1;
+}
+
+// ARKODE 6.4 keeps the flag of a root found at its last return across a
+// reset (only a later return clears it), and while it is set every step
+// evaluates all root functions once more, with an interpolation that costs
+// a right-hand side. Before a reset that follows a root, the rest of that
+// step is looked at (no new step is taken): that return clears it. The
+// discrete state has already changed, so the root functions read as a
+// constant 1 for it (no crossing, no zero; the reset follows).
+void Arena::Impl::clearRootFlag() {
+  if (!lastRoot || tReturned >= tStepEnd) return;
+  rootsMuted = true;
+  double tr = 0;
+  const int flag =
+      ERKStepEvolve(mem.get(), tStepEnd + kFirstStepHorizon, dky.get(), &tr, ARK_ONE_STEP);
+  rootsMuted = false;
+  ark::check(flag, "ERKStepEvolve");
+  lastRoot = false;
 }
 
 // ------------------------------------------------------------ dense output
-void Arena::Impl::recordStep(double tret) {
-  double tn = 0;
-  CVodeGetCurrentTime(mem.get(), &tn);
-  Rec& last = recs.back();
-  if (tn <= last.tn) {
-    last.thi = std::max(last.thi, tret);
-    return;
-  }
-  int q = 0;
-  CVodeGetLastOrder(mem.get(), &q);
-  Rec r{last.thi, std::max(tn, tret), tn, 0, coef.size()};
-  double fact = 1.0;
-  for (int k = 0; k <= q; ++k) {
-    if (k > 0) fact *= k;
-    if (CVodeGetDky(mem.get(), tn, k, dky.get()) < 0) break;
-    const double* d = dky.data();
-    for (int i = 0; i < n; ++i) coef.push_back(d[i] / fact);
-    r.q = k;
+// Each step [t0, t1] of ARKODE gets the quintic Hermite polynomial of x and
+// y matching their values, slopes and curvatures at both ends (slope from
+// the right-hand side, curvature its time derivative, from the closed
+// forms): the polynomial is exact to O(h^6), where ARKODE's cubic is
+// O(h^4) and put event ticks one off. With s = (t - t0), h = t1 - t0 and
+// A, B, C the mismatches of the quadratic Taylor part at t1 in value,
+// h * slope and h^2 * curvature, the coefficients of s^3..s^5 (times h^k)
+// are 10A - 4B + C/2, -15A + 7B - C, 6A - 3B + C/2.
+void Arena::Impl::recordStep(double tn, const double* ynew) {
+  const Rec& last = recs.back();
+  const double t0 = last.thi;
+  const double h = tn - t0;
+  Rec r{t0, tn, coef.size()};
+  std::array<double, 2 * kXY> f1{}, a1{};
+  rhs(tn, ynew, f1.data(), a1.data());
+  ownRhs += active.turning() ? 3 : 1;
+  for (int j = 0; j < nx; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    const double c0 = endY[k], c1 = h * endF[k], c2 = 0.5 * h * h * endA[k];
+    const double A = ynew[j] - c0 - c1 - c2;
+    const double B = h * f1[k] - c1 - 2 * c2;
+    const double C = h * h * a1[k] - 2 * c2;
+    const double c3 = 10 * A - 4 * B + 0.5 * C;
+    const double c4 = -15 * A + 7 * B - C;
+    const double c5 = 6 * A - 3 * B + 0.5 * C;
+    const double h2 = h * h, h3 = h2 * h;
+    coef.push_back(c0);
+    coef.push_back(endF[k]);
+    coef.push_back(0.5 * endA[k]);
+    coef.push_back(c3 / h3);
+    coef.push_back(c4 / (h3 * h));
+    coef.push_back(c5 / (h3 * h2));
+    endY[k] = ynew[j];
+    endF[k] = f1[k];
+    endA[k] = a1[k];
   }
   recs.push_back(r);
 }
 
 // First record whose interval reaches t; past the end, the last one
-// (advance() steps until CVODE has returned a time at or past now(), so
+// (advance() steps until ARKODE has returned a time at or past now(), so
 // at most a rounding of the tick's time).
 const Arena::Impl::Rec& Arena::Impl::recordAt(double t) const {
   auto it = std::lower_bound(recs.begin(), recs.end(), t,
@@ -284,13 +489,18 @@ const Arena::Impl::Rec& Arena::Impl::recordAt(double t) const {
   return *it;
 }
 
-// Component i of the dense output polynomial of record r at time t.
+// Component i (of x, y) of the dense output polynomial of record r at t.
 double Arena::Impl::component(const Rec& r, double t, int i) const {
-  const double dt = t - r.tn;
-  double sum = coef[r.off + static_cast<std::size_t>(r.q * n + i)];
-  for (int k = r.q - 1; k >= 0; --k)
-    sum = sum * dt + coef[r.off + static_cast<std::size_t>(k * n + i)];
-  return sum;
+  const double s = t - r.tlo;
+  const double* c = coef.data() + r.off + static_cast<std::size_t>(6 * i);
+  return c[0] + s * (c[1] + s * (c[2] + s * (c[3] + s * (c[4] + s * c[5]))));
+}
+
+void Arena::Impl::evalAt(double t, std::vector<double>& out) const {
+  const Rec& r = recordAt(t);
+  std::array<double, 2 * kXY> xy{};
+  for (int j = 0; j < nx; ++j) xy[static_cast<std::size_t>(j)] = component(r, t, j);
+  fullState(t, xy.data(), out.data());
 }
 
 // One robot's x, y and heading (rad) at a tick: what the eyes need, at a
@@ -304,7 +514,8 @@ std::array<double, 3> Arena::Impl::poseAt(int robot, std::int64_t tick) const {
             pendingY[static_cast<std::size_t>(base + H)]};
   const double t = timeOfTick(tick);
   const Rec& r = recordAt(t);
-  return {component(r, t, base + X), component(r, t, base + Y), component(r, t, base + H)};
+  return {component(r, t, kXY * robot + X), component(r, t, kXY * robot + Y),
+          motion[static_cast<std::size_t>(robot)].at(t).h};
 }
 
 // State at a tick (after the events of that tick).
@@ -382,12 +593,12 @@ bool Arena::Impl::predict(std::int64_t T, double te, const int* found, EventList
   return true;
 }
 
-// Back to `tick` (>= the last re-initialisation, < now): the caller stops
-// there instead. A prediction from a root is held
-// again, exactly as if advance() had been given `tick` as its stop (its
-// root lay beyond it); one from a launch is predicted again by the
-// advance() whose stop reaches the launch. No CVODE call: the steps
-// taken stay, as they would after an advance() that overshot.
+// Back to `tick` (>= the last reset, < now): the caller stops there
+// instead. A prediction from a root is held again, exactly as if advance()
+// had been given `tick` as its stop (its root lay beyond it); one from a
+// launch is predicted again by the advance() whose stop reaches the
+// launch. No ARKODE call: the steps taken stay, as they would after an
+// advance() that overshot.
 void Arena::Impl::retreat(std::int64_t tick) {
   if (tick >= now || tick < segTick) return;
   if (pending && pendingFromRoot) {
@@ -411,7 +622,7 @@ AdvanceResult Arena::Impl::advance(std::int64_t stopTick) {
   if (launchesDue(now) && predict(now, timeOfTick(now), nullptr, res.events)) return res;
   std::int64_t stop = stopTick;
   const std::int64_t nl = nextLaunch();
-  if (nl > now && nl < stop) stop = nl;  // CVODE's stop time is set there
+  if (nl > now && nl < stop) stop = nl;  // ARKODE's stop time is set there
   const double tStop = secondsFromTick(stop);
   for (;;) {
     if (held) {
@@ -424,18 +635,43 @@ AdvanceResult Arena::Impl::advance(std::int64_t stopTick) {
       continue;  // (cannot happen: it had events when found)
     }
     // Every root up to tReturned has been reported or held; all roots at
-    // ticks <= stop lie before the first time CVODE returns past tStop.
+    // ticks <= stop lie before the first time ARKODE returns past tStop.
     if (tReturned >= tStop) break;
     double tret = 0;
     fresh = false;
-    const int flag = CVode(mem.get(), tOut, yv.get(), &tret, CV_ONE_STEP);
-    cv::check(flag, "CVode");
-    recordStep(tret);
+    // tout matters only to the first step's size guess (after creation);
+    // a fixed horizon past the current time keeps it independent of the
+    // caller.
+    const int flag =
+        ERKStepEvolve(mem.get(), tStepEnd + kFirstStepHorizon, yv.get(), &tret, ARK_ONE_STEP);
+    ark::check(flag, "ERKStepEvolve");
+    double tn = 0;
+    ERKStepGetCurrentTime(mem.get(), &tn);
+    if (tn > tStepEnd) {
+      // A new internal step: its end state (at a root return ARKODE hands
+      // back the root's state; its own interpolant gives the step's end,
+      // exactly, at tn).
+      const double* yn = yv.data();
+      if (tret != tn) {
+        ark::check(ERKStepGetDky(mem.get(), tn, 0, dky.get()), "ERKStepGetDky");
+        yn = dky.data();
+      }
+      recordStep(tn, yn);
+      tStepEnd = tn;
+      recs.back().thi = std::max(tn, tret);
+      fullState(tn, yn, qtmp.data());
+      double ahead = 0;
+      ERKStepGetCurrentStep(mem.get(), &ahead);
+      setMaxStep(atRest() ? kRestStep : stepBound(qtmp.data(), ahead));
+    } else if (tret > recs.back().thi) {
+      recs.back().thi = tret;
+    }
     tReturned = tret;
-    if (flag == CV_TSTOP_RETURN) launchStop = -1;  // CVODE disarms a reached stop time
-    if (flag != CV_ROOT_RETURN) continue;
+    lastRoot = flag == ARK_ROOT_RETURN;
+    if (flag == ARK_TSTOP_RETURN) launchStop = -1;  // ARKODE disarms a reached stop time
+    if (flag != ARK_ROOT_RETURN) continue;
     ++acc.roots;
-    cv::check(CVodeGetRootInfo(mem.get(), rootsFound.data()), "CVodeGetRootInfo");
+    ark::check(ERKStepGetRootInfo(mem.get(), rootsFound.data()), "ERKStepGetRootInfo");
     const std::int64_t T0 = eventTickFromSeconds(tret);
     const std::int64_t k = crossedTick(T0);
     std::int64_t T = std::max(k, now);
@@ -450,11 +686,11 @@ AdvanceResult Arena::Impl::advance(std::int64_t stopTick) {
         res.tick = T;
         return res;
       }
-      continue;  // nothing changed: integrate on without a reinit
+      continue;  // nothing changed: integrate on without a reset
     }
-    // Beyond the caller's stop. CVODE stays where the root left it (the
-    // next CVode call looks at the rest of that step, as when a root with
-    // no events is passed over); a later advance reports it at T.
+    // Beyond the caller's stop. ARKODE stays where the root left it (the
+    // next call looks at the rest of that step, as when a root with no
+    // events is passed over); a later advance reports it at T.
     if (eventsAt(T, te, rootsFound.data(), res.events)) {
       held = true;
       heldTick = T;

@@ -4,14 +4,16 @@
 // of time and state (arena.cpp, "Events"): edge detectors, walls, divider,
 // field, reflex end, robot-robot contact and the balls' closed-form
 // flights. buildRoots() lists the ones the current discrete state needs;
-// CVODE evaluates them through rootThunk; crossedTick() decides the tick of
+// ARKODE evaluates them through rootThunk; crossedTick() decides the tick of
 // a crossing CVODE reported. They only read the state: the rules that act
 // on a crossing are in arena_events.cpp.
-#include <limits>
-
 #include "plant/arena_impl.h"
 
 namespace simbot::plant {
+
+namespace {
+constexpr double kMinSide = 1e-150;
+}  // namespace
 
 Vec2 Arena::Impl::detector(const double* y, int i, int k) const {
   const double off = radius(i) - P(i).edge_detector_inset_ft;
@@ -26,6 +28,34 @@ double Arena::Impl::edgeG(const double* y, int i, int k) const {
 double Arena::Impl::outG(const double* y, int i) const {
   const Vec2 c = centre(y, i);
   return half - std::max(std::abs(c.x()), std::abs(c.y()));
+}
+
+// Gap between robot i's body and the east or west wall (axis 0) or the
+// north or south wall (axis 1).
+double Arena::Impl::wallGap(const double* y, int i, int axis) const {
+  return half - std::abs(y[i * kPerRobot + axis]) - radius(i);
+}
+
+double Arena::Impl::contactG(contact::Kind k, int i, const double* y) const {
+  std::array<double, 2 * kXY> q{}, v{}, vf{};
+  for (int r = 0; r < nR; ++r) {
+    const double* s = y + r * kPerRobot;
+    const double sp = 0.5 * (s[VL] + s[VR]);
+    q[static_cast<std::size_t>(kXY * r + X)] = s[X];
+    q[static_cast<std::size_t>(kXY * r + Y)] = s[Y];
+    vf[static_cast<std::size_t>(kXY * r + X)] = sp * std::sin(s[H]);
+    vf[static_cast<std::size_t>(kXY * r + Y)] = sp * std::cos(s[H]);
+  }
+  for (int j = 0; j < active.count; ++j) {
+    const contact::Constraint& c = active.c[static_cast<std::size_t>(j)];
+    if (c.kind != k || c.robot != i) continue;
+    // Pushing in this segment: minus its force, which reaches 0 when the
+    // body would start to move away.
+    std::array<double, contact::kMaxActive> mu{};
+    contact::project(bodies, active, q.data(), vf.data(), v.data(), mu.data());
+    return -mu[static_cast<std::size_t>(j)];
+  }
+  return contact::gap(bodies, contact::Constraint{k, i}, q.data());
 }
 
 double Arena::Impl::dividerG(const double* y, int i) const {
@@ -108,14 +138,16 @@ double Arena::Impl::rootValue(const RootDesc& rd, double t, const double* y) con
       return edgeG(y, rd.robot, 1);
     case RootKind::OutOfField:
       return outG(y, rd.robot);
-    case RootKind::Wall:
-      return wallG(y, rd.robot);
+    case RootKind::WallX:
+      return contactG(contact::Kind::WallX, rd.robot, y);
+    case RootKind::WallY:
+      return contactG(contact::Kind::WallY, rd.robot, y);
     case RootKind::Divider:
-      return dividerG(y, rd.robot);
+      return contactG(contact::Kind::Divider, rd.robot, y);
     case RootKind::ReflexEnd:
       return reflexG(y, rd.robot, D);
     case RootKind::RobotRobot:
-      return robotG(y);
+      return contactG(contact::Kind::Robot, 0, y);
     case RootKind::BallFloor: {
       double x, yy, z;
       ballAt(D.balls[static_cast<std::size_t>(rd.robot)], t, x, yy, z);
@@ -135,8 +167,13 @@ double Arena::Impl::rootValue(const RootDesc& rd, double t, const double* y) con
 
 int Arena::Impl::rootThunk(sunrealtype t, N_Vector y, sunrealtype* g, void* user) {
   const Impl* self = static_cast<const Impl*>(user);
-  const double* yy = N_VGetArrayPointer(y);
-  for (int i = 0; i < self->nRoots; ++i) g[i] = self->sidedValue(i, t, yy);
+  if (self->rootsMuted) {
+    for (int i = 0; i < self->nRoots; ++i) g[i] = 1.0;
+    return 0;
+  }
+  double* full = self->rootY.data();
+  self->fullState(t, N_VGetArrayPointer(y), full);
+  for (int i = 0; i < self->nRoots; ++i) g[i] = self->sidedValue(i, t, full);
   return 0;
 }
 
@@ -167,8 +204,11 @@ void Arena::Impl::sideRoots(double t0, const std::vector<double>& y) {
       case RootKind::EdgeAft:
         side = robot().edgeLow[1] ? -1 : 1;
         break;
-      case RootKind::Wall:
-        side = robot().wallContact ? -1 : 1;
+      case RootKind::WallX:
+        side = robot().wallContact[0] ? -1 : 1;
+        break;
+      case RootKind::WallY:
+        side = robot().wallContact[1] ? -1 : 1;
         break;
       case RootKind::Divider:
         side = robot().dividerContact ? -1 : 1;
@@ -182,8 +222,7 @@ void Arena::Impl::sideRoots(double t0, const std::vector<double>& y) {
     double shift = 0;
     if (side != 0) {
       const double g0 = rootValue(rd, t0, y.data());
-      if (side * g0 <= 0)
-        shift = g0 - side * std::max(std::abs(g0), std::numeric_limits<double>::min());
+      if (side * g0 <= 0) shift = g0 - side * std::max(std::abs(g0), kMinSide);
     }
     rootShift[static_cast<std::size_t>(j)] = shift;
   }
@@ -211,7 +250,10 @@ void Arena::Impl::buildRoots() {
     add(RootKind::EdgeFore, i);
     add(RootKind::EdgeAft, i);
     add(RootKind::OutOfField, i);
-    if (cfg.field.field_walls) add(RootKind::Wall, i);
+    if (cfg.field.field_walls) {
+      add(RootKind::WallX, i);
+      add(RootKind::WallY, i);
+    }
     add(RootKind::Divider, i);
     if (D.r[static_cast<std::size_t>(i)].reflex) add(RootKind::ReflexEnd, i);
   }

@@ -66,6 +66,7 @@ struct RobotParams {
   // uniform in [1 - trim_spread, 1 + trim_spread]. 0 = the trims as given.
   double trim_spread = 0;
   double motor_lag_s = 0;  // first-order lag; 0 = instant
+  double mass_lb = 35;     // how hard it pushes the other robot (contact.h)
   // bumper reflex (hard-wired in the motor controller)
   double reflex_distance_ft = 0;
   int reflex_speed_step = 15;
@@ -397,7 +398,8 @@ void drawWheelTrims(RobotParams& params, RandomBits& bits);
 // one word; exactly 1 with no draw if the spread is 0 or bits is null.
 double muzzleFactor(const RobotParams& params, RandomBits* bits);
 
-// The arena integrates all robots and balls with one CVODE instance.
+// The arena integrates all robots and balls: closed forms and one ARKODE
+// ERKStep instance.
 //
 // Protocol (all ticks): advance(stop) integrates from now() towards stop and
 // returns at the first tick that has discrete events, or at stop. Those

@@ -35,6 +35,7 @@ enum class Kind {
   Time,         // s, ms
   Angle,        // deg, rad  (stored in degrees)
   Accel,        // ft/s^2, m/s^2
+  Mass,         // lb, kg
   Ratio,        // "1"
   Probability,  // "1", in [0, 1]
   Reading,      // "reading" (A/D reading units)
@@ -148,6 +149,9 @@ const std::vector<KeyDef>& keyTable() {
       // (crossChecks keeps it within left_trim/right_trim's own range).
       {"robot", "trim_spread", Kind::Ratio, {0, 0.25}, true, D(p.robot.trim_spread)},
       {"robot", "motor_lag", Kind::Time, {0.001, 10, true}, true, D(p.robot.motor_lag_s)},
+      // Only the ratio of the two robots' masses matters (contact.h: how
+      // one pushes the other); the range spans any robot a student builds.
+      {"robot", "mass", Kind::Mass, {0.5, 500}, true, D(p.robot.mass_lb)},
       {"bumper", "reflex_distance", Kind::Length, {0.05, 20}, true, D(p.robot.reflex_distance_ft)},
       {"bumper", "reflex_speed_step", Kind::Step, {0, 15}, true, I(p.robot.reflex_speed_step)},
       {"eyes", "max", Kind::Reading, {16, 65535}, true, D(p.robot.eye_max)},
@@ -251,6 +255,10 @@ double unitFactor(Kind k, std::string_view u) {
       if (u == "ft/s^2") return 1.0;
       if (u == "m/s^2") return 1.0 / 0.3048;
       break;
+    case Kind::Mass:
+      if (u == "lb") return 1.0;
+      if (u == "kg") return 1.0 / 0.45359237;
+      break;
     case Kind::Ratio:
     case Kind::Probability:
       if (u == "1") return 1.0;
@@ -287,6 +295,8 @@ const char* allowedUnits(Kind k) {
       return "deg, rad";
     case Kind::Accel:
       return "ft/s^2, m/s^2";
+    case Kind::Mass:
+      return "lb, kg";
     case Kind::Ratio:
     case Kind::Probability:
       return "1";
@@ -319,6 +329,8 @@ const char* internalUnit(Kind k) {
       return "deg";
     case Kind::Accel:
       return "ft/s^2";
+    case Kind::Mass:
+      return "lb";
     default:
       return allowedUnits(k);
   }

@@ -125,30 +125,42 @@ TEST(Motion, WheelLagStepResponse) {
   }
 }
 
-// maxStep() bounds a step to 1/12 ft of the fastest point's travel so that
-// no root crossing hides inside it: a robot of the default profile, alone
+// The step bound (arena_integrator.cpp stepBound). The default robot
 // (top speed v = 1.45 ft/s, track 0.75 ft, body 12.75 in: radius 0.53125 ft)
-// has a point speed of v + (2 v / 0.75) 0.53125 = 3.5042 ft/s, so a step of
-// at most 0.023781 s and at least ceil(1 / 0.023781) = 43 steps for each
-// second it moves. At rest (wheels and targets 0, no ball) nothing can
-// cross, the bound is off, and CVODE's steps grow as fast as it allows: far
-// fewer than 100 s / 0.023781 = 4,205 steps for 100 s, and the pose is
-// exactly the start.
-TEST(Motion, AtRestTheStepIsUnboundedAndMovingItIsBoundAgain) {
+// has a point speed of v + (2 v / 0.75) 0.53125 = 3.5042 ft/s, so while it
+// touches something a step is at most (1/12) / 3.5042 = 0.023781 s: at least
+// ceil(1 / 0.023781) = 43 steps for each second it pushes. At rest (wheels
+// and targets 0, no ball) nothing can cross, the bound is off, and ARKODE's
+// steps grow as fast as it allows: far fewer than 100 s / 0.023781 = 4,205
+// steps for 100 s, and the pose is exactly the start. Far from everything
+// (a spin at (1, 1): the nearest feature, the divider's tip, is 4.6 ft away)
+// the bound is that distance over the point speed, and a spin, whose centre
+// does not move, takes a handful of steps.
+TEST(Motion, AtRestTheStepIsUnboundedAndTouchingItIsOneInch) {
   Profile p = defaults();
   p.robot.left_trim = p.robot.right_trim = 1.0;
-  Arena a(config(p, {Pose{1, 1, 10}}));
+  const double r = 12.75 / 24;
+  Arena a(config(p, {Pose{8 - r, 1, 90}}));  // put down against the east wall, facing it
   const auto rest = ticks(100.0);
   a.advance(rest);
   const IntegratorStats atRest = a.stats();
   EXPECT_LT(atRest.steps, 100);
   const Pose q = a.pose(0, rest);
-  EXPECT_EQ(q.x_ft, 1.0);
+  EXPECT_EQ(q.x_ft, 8 - r);
   EXPECT_EQ(q.y_ft, 1.0);
-  EXPECT_EQ(q.heading_deg, 10.0);
-  ASSERT_TRUE(a.setWheels(0, frame("cfg0crg0"), rest));  // spin in place, far from walls
+  EXPECT_EQ(q.heading_deg, 90.0);
+  ASSERT_TRUE(a.setWheels(0, frame("ffg0ffg0"), rest));  // full ahead into the wall
   a.advance(rest + ticks(1.0));
   EXPECT_GE(a.stats().steps - atRest.steps, 43);
+  // Held by the wall all along: the centre has not moved.
+  EXPECT_NEAR(a.pose(0, rest + ticks(1.0)).x_ft, 8 - r, 1e-12);
+
+  Arena b(config(p, {Pose{1, 1, 10}}));
+  b.advance(rest);
+  const IntegratorStats spinStart = b.stats();
+  ASSERT_TRUE(b.setWheels(0, frame("cfg0crg0"), rest));  // spin in place
+  b.advance(rest + ticks(1.0));
+  EXPECT_LT(b.stats().steps - spinStart.steps, 10);
 }
 
 TEST(Motion, ForeDetectorEntersWireRangeAtClosedFormTick) {

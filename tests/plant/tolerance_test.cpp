@@ -5,12 +5,12 @@
 // of x and y (lag_arc_oracle.h); and edge-wire crossings, whose tick must
 // be the ceiling of the oracle's crossing time.
 //
-// The bounds are those the README states for rtol = atol = 5e-10: position
-// within 1e-8 ft (1/38 of the 3.8e-7 ft a point at the top speed of
-// 3.5 ft/s moves in a tick), heading within 2.5e-9 rad. Measured over 277
-// random arcs, which include the last two below: 9.5e-9 ft and 2.2e-9 rad
-// at worst at 5e-10 (5.2e-9 ft and 6.8e-10 rad at 1e-10). At 1e-9 the last
-// arc is 1.8e-8 ft off and the spin 3.1e-9 rad, so twice looser fails here.
+// The bounds are those the README states for ERKStep at rtol = atol =
+// 1e-9 with the quintic dense output: position within 1e-9 ft (1/380 of
+// the 3.8e-7 ft a point at the top speed of 3.5 ft/s moves in a tick);
+// the heading is a closed form, within 1e-12 rad (round-off of the
+// degrees a pose reports). CVODE's plant, before, needed 1e-8 ft and
+// 2.5e-9 rad here.
 #include <cmath>
 #include <numbers>
 
@@ -22,8 +22,8 @@ using namespace plant_test;
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kMaxPositionErrorFt = 1e-8;
-constexpr double kMaxHeadingErrorRad = 2.5e-9;
+constexpr double kMaxPositionErrorFt = 1e-9;
+constexpr double kMaxHeadingErrorRad = 1e-12;
 constexpr std::int64_t kTicksPerSecond = 9'216'000;
 
 struct Start {
