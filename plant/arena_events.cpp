@@ -258,10 +258,7 @@ void Arena::Impl::contacts(std::int64_t T, Discrete& d, std::vector<double>& y, 
     const bool c = touchingNow(rk, ck, i);
     if (c && !touching) {
       std::array<double, 2 * kXY> q{};
-      for (int r = 0; r < nR; ++r) {
-        q[static_cast<std::size_t>(kXY * r + X)] = ys[r * kPerRobot + X];
-        q[static_cast<std::size_t>(kXY * r + Y)] = ys[r * kPerRobot + Y];
-      }
+      centresOf(ys, q.data());
       Vec2 normal;
       contact::gap(bodies, contact::Constraint{ck, i}, q.data(), &normal);
       const Bumper side = sideOf(heading(ys, i), -normal);

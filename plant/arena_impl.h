@@ -280,6 +280,10 @@ struct Arena::Impl {
   double pointSpeed() const;
   double stepBound(const double* y, double ahead) const;
   bool atRest() const;
+  // Both fixed for a segment (they read its motion and balls): set at
+  // each reset, read at every step.
+  double segSpeed = 0;     // pointSpeed()
+  bool segRest = false;    // atRest()
   double maxStepSet = -1;  // the value last given to ERKStepSetMaxStep
 
   // ------------------------------------------------------------ geometry on a
@@ -292,9 +296,11 @@ struct Arena::Impl {
   Vec2 detector(const double* y, int i, int k) const;
   double edgeG(const double* y, int i, int k) const;
   double outG(const double* y, int i) const;
-  double wallGap(const double* y, int i, int axis) const;
-  double dividerG(const double* y, int i) const;
-  double robotG(const double* y) const;
+  // The centres (kXY a robot) of a full state.
+  void centresOf(const double* y, double* q) const;
+  // Gap (ft) between robot i's body and a wall, the divider or (i = 0) the
+  // other robot: contact.h's, on a full state.
+  double gapOf(contact::Kind k, int i, const double* y) const;
   double reflexG(const double* y, int i, const Discrete& d) const;
   // The contact functions: the gap while inactive, minus the force while
   // active (contact.h); negative exactly while touching.
@@ -330,11 +336,12 @@ struct Arena::Impl {
   static int rootThunk(sunrealtype t, N_Vector y, sunrealtype* g, void* user);
 
   // Velocities of x, y (nx values) at t with positions xy, after the
-  // active contacts' projection; `acc`, if given, their time derivative.
+  // active contacts' projection; `accel`, if given, their time derivative.
   void rhs(double t, const double* xy, double* f, double* accel = nullptr) const;
   // The full state at t from positions xy and the closed forms.
   void fullState(double t, const double* xy, double* out) const;
-  // Contact solve inputs at t: free velocities and the positions.
+  // The centres' velocities at t as the wheels alone would give them (no
+  // contact), and, if `a` is given, their time derivatives.
   void freeVelocities(double t, double* v, double* a) const;
 
   // A gun wheel spins up under its motor and coasts down, more slowly,

@@ -84,11 +84,12 @@ Arena::Impl::Impl(const ArenaConfig& c)
     for (int k = 0; k < 2; ++k) {
       d.edgeLow[static_cast<std::size_t>(k)] = edgeG(y.data(), i, k) < 0;
       d.wallContact[static_cast<std::size_t>(k)] =
-          cfg.field.field_walls && wallGap(y.data(), i, k) <= 0;
+          cfg.field.field_walls &&
+          gapOf(k == 0 ? contact::Kind::WallX : contact::Kind::WallY, i, y.data()) <= 0;
     }
-    d.dividerContact = dividerG(y.data(), i) <= 0;
+    d.dividerContact = gapOf(contact::Kind::Divider, i, y.data()) <= 0;
   }
-  D.robotContact = nR == 2 && robotG(y.data()) <= 0;
+  D.robotContact = nR == 2 && gapOf(contact::Kind::Robot, 0, y.data()) <= 0;
 
   void* m = mem.get();
   ark::check(ERKStepSetUserData(m, this), "ERKStepSetUserData");
@@ -133,19 +134,21 @@ double Arena::Impl::pointSpeed() const {
 // k applies from step k + 2: it is the distance at the end of step k less
 // what step k + 1, already planned (`ahead`), can move.
 double Arena::Impl::stepBound(const double* y, double ahead) const {
-  const double v = pointSpeed();
+  const double v = segSpeed;
   if (v <= 0) return kRestStep;  // nothing can move
   const double floor = (1.0 / 12.0) / (nR * v);
   if (active.count > 0) return floor;
   double d = HUGE_VAL;
   for (int i = 0; i < nR; ++i) {
-    d = std::min({d, std::abs(edgeG(y, i, 0)), std::abs(edgeG(y, i, 1)), std::abs(dividerG(y, i))});
+    d = std::min({d, std::abs(edgeG(y, i, 0)), std::abs(edgeG(y, i, 1)),
+                  std::abs(gapOf(contact::Kind::Divider, i, y))});
     if (cfg.field.field_walls)
-      d = std::min({d, std::abs(wallGap(y, i, 0)), std::abs(wallGap(y, i, 1))});
+      d = std::min({d, std::abs(gapOf(contact::Kind::WallX, i, y)),
+                    std::abs(gapOf(contact::Kind::WallY, i, y))});
     else
       d = std::min(d, std::abs(outG(y, i)));
   }
-  if (nR == 2) d = std::min(d, std::abs(robotG(y)) / 2);
+  if (nR == 2) d = std::min(d, std::abs(gapOf(contact::Kind::Robot, 0, y)) / 2);
   return std::max(floor, d / v - ahead);
 }
 
@@ -305,10 +308,7 @@ void Arena::Impl::setActive(const Discrete& d) {
   active = cand;
   if (cand.count == 0) return;
   std::array<double, 2 * kXY> xy{}, v{}, vf{}, af{};
-  for (int i = 0; i < nR; ++i) {
-    xy[static_cast<std::size_t>(kXY * i + X)] = segY[static_cast<std::size_t>(i * kPerRobot + X)];
-    xy[static_cast<std::size_t>(kXY * i + Y)] = segY[static_cast<std::size_t>(i * kPerRobot + Y)];
-  }
+  centresOf(segY.data(), xy.data());
   freeVelocities(segT0, vf.data(), af.data());
   // A force this small is zero: round-off of speeds of order 1 ft/s.
   constexpr double kZeroForce = 1e-12;  // ft/s
@@ -355,12 +355,11 @@ void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, b
   segTick = tick;
   segT0 = t0;
   setMotion(t0, y);
+  segSpeed = pointSpeed();
+  segRest = atRest();
   setActive(D);
   double* xy = yv.data();
-  for (int i = 0; i < nR; ++i) {
-    xy[kXY * i + X] = y[static_cast<std::size_t>(i * kPerRobot + X)];
-    xy[kXY * i + Y] = y[static_cast<std::size_t>(i * kPerRobot + Y)];
-  }
+  centresOf(y.data(), xy);
   if (!same) {
     if (!first) {
       ++acc.reinits;
@@ -374,9 +373,9 @@ void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, b
   // The reset keeps ARKODE's planned step (a one-step method restarts for
   // free) and the bound of the step after it: both are kept within half
   // the distance to the nearest feature.
-  const double bound = atRest() ? kRestStep : 0.5 * stepBound(y.data(), 0.0);
+  const double bound = segRest ? kRestStep : 0.5 * stepBound(y.data(), 0.0);
   setMaxStep(bound);
-  if (!first && bound > 0) {
+  if (!first) {
     double planned = 0;
     ERKStepGetCurrentStep(mem.get(), &planned);
     if (planned > bound) ark::check(ERKStepSetInitStep(mem.get(), bound), "ERKStepSetInitStep");
@@ -662,7 +661,7 @@ AdvanceResult Arena::Impl::advance(std::int64_t stopTick) {
       fullState(tn, yn, qtmp.data());
       double ahead = 0;
       ERKStepGetCurrentStep(mem.get(), &ahead);
-      setMaxStep(atRest() ? kRestStep : stepBound(qtmp.data(), ahead));
+      setMaxStep(segRest ? kRestStep : stepBound(qtmp.data(), ahead));
     } else if (tret > recs.back().thi) {
       recs.back().thi = tret;
     }

@@ -30,19 +30,25 @@ double Arena::Impl::outG(const double* y, int i) const {
   return half - std::max(std::abs(c.x()), std::abs(c.y()));
 }
 
-// Gap between robot i's body and the east or west wall (axis 0) or the
-// north or south wall (axis 1).
-double Arena::Impl::wallGap(const double* y, int i, int axis) const {
-  return half - std::abs(y[i * kPerRobot + axis]) - radius(i);
+void Arena::Impl::centresOf(const double* y, double* q) const {
+  for (int r = 0; r < nR; ++r) {
+    q[kXY * r + X] = y[r * kPerRobot + X];
+    q[kXY * r + Y] = y[r * kPerRobot + Y];
+  }
+}
+
+double Arena::Impl::gapOf(contact::Kind k, int i, const double* y) const {
+  std::array<double, 2 * kXY> q{};
+  centresOf(y, q.data());
+  return contact::gap(bodies, contact::Constraint{k, i}, q.data());
 }
 
 double Arena::Impl::contactG(contact::Kind k, int i, const double* y) const {
   std::array<double, 2 * kXY> q{}, v{}, vf{};
+  centresOf(y, q.data());
   for (int r = 0; r < nR; ++r) {
     const double* s = y + r * kPerRobot;
     const double sp = 0.5 * (s[VL] + s[VR]);
-    q[static_cast<std::size_t>(kXY * r + X)] = s[X];
-    q[static_cast<std::size_t>(kXY * r + Y)] = s[Y];
     vf[static_cast<std::size_t>(kXY * r + X)] = sp * std::sin(s[H]);
     vf[static_cast<std::size_t>(kXY * r + Y)] = sp * std::cos(s[H]);
   }
@@ -56,15 +62,6 @@ double Arena::Impl::contactG(contact::Kind k, int i, const double* y) const {
     return -mu[static_cast<std::size_t>(j)];
   }
   return contact::gap(bodies, contact::Constraint{k, i}, q.data());
-}
-
-double Arena::Impl::dividerG(const double* y, int i) const {
-  const Vec2 c = centre(y, i);
-  return dividerClearance(c.x(), c.y(), radius(i), cfg.field);
-}
-
-double Arena::Impl::robotG(const double* y) const {
-  return (centre(y, 0) - centre(y, 1)).norm() - radius(0) - radius(1);
 }
 
 double Arena::Impl::reflexG(const double* y, int i, const Discrete& d) const {

@@ -53,6 +53,30 @@ double reachTime(double d) {
 
 std::int64_t tickAfter(double t) { return static_cast<std::int64_t>(std::ceil(t * kTicks)); }
 
+// The contact's event ticks worked from t_c as the header comment says:
+// start at T_c, the reflex from te = T_c / 9,216,000 at speed v(te), the
+// end at T_end.
+struct ContactTicks {
+  std::int64_t start;
+  double te, ve, tEnd;
+  std::int64_t end;
+};
+ContactTicks expectedTicks(double tc) {
+  ContactTicks k{};
+  k.start = tickAfter(tc);
+  k.te = static_cast<double>(k.start) / kTicks;
+  k.ve = speed(k.te);
+  k.tEnd = k.te + kTau * std::log((k.ve + kV) / kV);
+  k.end = tickAfter(k.tEnd);
+  return k;
+}
+
+// How far robots A and B overlap at a tick (negative: the gap between them).
+double overlap(const Arena& a, std::int64_t tick) {
+  const Pose qa = a.pose(0, tick), qb = a.pose(1, tick);
+  return 2 * kR - std::hypot(qa.x_ft - qb.x_ft, qa.y_ft - qb.y_ft);
+}
+
 Profile rigid() {
   Profile p = defaults();
   p.robot.left_trim = p.robot.right_trim = 1.0;
@@ -99,24 +123,20 @@ TEST(RigidContact, WallAtSixtyDegreesHoldsTheBodyAndEndsWhenTheWheelsReverse) {
   ASSERT_TRUE(a.setWheels(0, frame("ffg0ffg0"), 0));
   const double tc = reachTime(2 / std::sin(ang));
   EXPECT_NEAR(tc, 1.742689, 1e-6);
-  const std::int64_t Tc = tickAfter(tc);
-  const double te = static_cast<double>(Tc) / kTicks;
-  const double ve = speed(te);
-  const double tEnd = te + kTau * std::log((ve + kV) / kV);
-  EXPECT_NEAR(tEnd - te, 0.103971, 1e-6);
-  const std::int64_t Tend = tickAfter(tEnd);
+  const ContactTicks k = expectedTicks(tc);
+  EXPECT_NEAR(k.tEnd - k.te, 0.103971, 1e-6);
   double deepest = -1, yAtEnd = 0, yAtStart = 0;
   const Contact c = run(a, 0, ContactWith::Wall, ticks(3.0), [&](std::int64_t tick) {
     const Pose q = a.pose(0, tick);
     deepest = std::max(deepest, q.x_ft + kR - 8);
-    if (tick == Tc) yAtStart = q.y_ft;
-    if (tick == Tend) yAtEnd = q.y_ft;
+    if (tick == k.start) yAtStart = q.y_ft;
+    if (tick == k.end) yAtEnd = q.y_ft;
   });
-  EXPECT_EQ(c.start, Tc);
-  EXPECT_EQ(c.end, Tend);
+  EXPECT_EQ(c.start, k.start);
+  EXPECT_EQ(c.end, k.end);
   EXPECT_LE(deepest, kTolerance);
   EXPECT_GE(deepest, -kTolerance);  // it did reach the wall
-  const double slide = std::cos(ang) * (-kV * (tEnd - te) + ve * kTau);
+  const double slide = std::cos(ang) * (-kV * (k.tEnd - k.te) + k.ve * kTau);
   EXPECT_NEAR(slide, 0.033370, 1e-6);
   // The 1/1000-s probes include both event ticks (events stop advance()).
   EXPECT_NEAR(yAtEnd - yAtStart, slide, 1e-7);
@@ -130,15 +150,13 @@ TEST(RigidContact, DividerHoldsTheBodyOnItsNearSide) {
   ASSERT_TRUE(a.setWheels(0, frame("ffg0ffg0"), 0));
   const double tc = reachTime(2.4375);
   EXPECT_NEAR(tc, 1.831034, 1e-6);
-  const std::int64_t Tc = tickAfter(tc);
-  const double te = static_cast<double>(Tc) / kTicks;
-  const std::int64_t Tend = tickAfter(te + kTau * std::log((speed(te) + kV) / kV));
+  const ContactTicks k = expectedTicks(tc);
   double deepest = -1;
   const Contact c = run(a, 0, ContactWith::Divider, ticks(3.0), [&](std::int64_t tick) {
     deepest = std::max(deepest, a.pose(0, tick).x_ft + kR + 0.03125);
   });
-  EXPECT_EQ(c.start, Tc);
-  EXPECT_EQ(c.end, Tend);
+  EXPECT_EQ(c.start, k.start);
+  EXPECT_EQ(c.end, k.end);
   EXPECT_LE(deepest, kTolerance);
   EXPECT_GE(deepest, -kTolerance);
 }
@@ -154,38 +172,32 @@ TEST(RigidContact, HeadOnRobotsDoNotOverlap) {
   ASSERT_TRUE(a.setWheels(1, frame("ffg0ffg0"), 0));
   const double tc = reachTime(2.46875);
   EXPECT_NEAR(tc, 1.852586, 1e-6);
-  const std::int64_t Tc = tickAfter(tc);
-  const double te = static_cast<double>(Tc) / kTicks;
-  const std::int64_t Tend = tickAfter(te + kTau * std::log((speed(te) + kV) / kV));
+  const ContactTicks k = expectedTicks(tc);
   double deepest = -1;
-  const Contact c = run(a, 0, ContactWith::Robot, ticks(3.0), [&](std::int64_t tick) {
-    const Pose qa = a.pose(0, tick), qb = a.pose(1, tick);
-    deepest = std::max(deepest, 2 * kR - std::hypot(qa.x_ft - qb.x_ft, qa.y_ft - qb.y_ft));
-  });
-  EXPECT_EQ(c.start, Tc);
-  EXPECT_EQ(c.end, Tend);
+  const Contact c = run(a, 0, ContactWith::Robot, ticks(3.0),
+                        [&](std::int64_t tick) { deepest = std::max(deepest, overlap(a, tick)); });
+  EXPECT_EQ(c.start, k.start);
+  EXPECT_EQ(c.end, k.end);
   EXPECT_LE(deepest, kTolerance);
   EXPECT_GE(deepest, -kTolerance);
 }
 
 // A drives east at full speed into B, which stands still, 2.5 ft ahead
-// (gap 2.5 - 2 r = 1.4375 ft, t_c = 0.991379 + 0.15 - 7.5e-5 = 1.141305 s). From the contact on
-// they share the normal speed: B, whose wheels do not turn, moves east at half of A's wheel speed
-// (equal masses, contact.h) while they touch. B's own reflex (forward: its back bumper was hit)
-// then drives it away.
+// (gap 2.5 - 2 r = 1.4375 ft, t_c = 0.991379 + 0.15 - 7.5e-5 = 1.141305
+// s). From the contact on they share the normal speed: B, whose wheels do
+// not turn, moves east at half of A's wheel speed (equal masses,
+// contact.h) while they touch. B's own reflex (forward: its back bumper
+// was hit) then drives it away.
 TEST(RigidContact, APushedRobotMovesAtHalfThePushersSpeed) {
   const Profile p = rigid();
   Arena a(config(p, {Pose{-3, 0, 90}, Pose{-0.5, 0, 90}}));
   ASSERT_TRUE(a.setWheels(0, frame("ffg0ffg0"), 0));
   const double tc = reachTime(1.4375);
   EXPECT_NEAR(tc, 1.141305, 1e-6);
-  const std::int64_t Tc = tickAfter(tc);
   double deepest = -1;
-  const Contact c = run(a, 0, ContactWith::Robot, ticks(3.0), [&](std::int64_t tick) {
-    const Pose qa = a.pose(0, tick), qb = a.pose(1, tick);
-    deepest = std::max(deepest, 2 * kR - std::hypot(qa.x_ft - qb.x_ft, qa.y_ft - qb.y_ft));
-  });
-  EXPECT_EQ(c.start, Tc);
+  const Contact c = run(a, 0, ContactWith::Robot, ticks(3.0),
+                        [&](std::int64_t tick) { deepest = std::max(deepest, overlap(a, tick)); });
+  EXPECT_EQ(c.start, expectedTicks(tc).start);
   ASSERT_GT(c.end, c.start);
   EXPECT_LE(deepest, kTolerance);
   // Right after the contact both centres move east at the mean of A's
