@@ -77,11 +77,8 @@ bool Vm::State::fastForward(Tick until) {
   // The regime in which every pass costs the same: a signed compare's
   // overflow branch is never taken when both sides are non-negative.
   const bool regime = !isSigned || (number(v) >= 0 && number(loop.limit) >= 0);
-  const bool anyBreak =
-      anyBreakpoint && std::any_of(breakpoints.begin() + loop.top, breakpoints.begin() + loop.exit,
-                                   [](uint8_t b) { return b != 0; });
   if (measure.loop == index && measure.accepted == acceptances &&
-      v == ((measure.counter + 1) & mask) && regime && !anyBreak &&
+      v == ((measure.counter + 1) & mask) && regime && !loop.breakpointInside &&
       (!isSigned || number(measure.counter) >= 0)) {
     const Tick pass = now - measure.start;
     const Tick bound = std::min(until, nextTimer);

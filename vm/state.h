@@ -240,6 +240,9 @@ struct Vm::State {
     bool wide;       // a long counter
     bool isSigned;   // LTW, LEW, LTL, LEL
     bool inclusive;  // <=
+    // A breakpoint inside turns fast-forward off (kept by setBreakpoint, so
+    // that no arrival scans the loop's bytes).
+    bool breakpointInside = false;
   };
   std::vector<Loop> loops;
   std::vector<int16_t> loopAtTop;  // per code byte: index into loops, or -1

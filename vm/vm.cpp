@@ -1553,6 +1553,10 @@ void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
   }
   s.anyBreakpoint =
       std::any_of(s.breakpoints.begin(), s.breakpoints.end(), [](uint8_t b) { return b != 0; });
+  for (State::Loop& loop : s.loops)
+    loop.breakpointInside =
+        std::any_of(s.breakpoints.begin() + loop.top, s.breakpoints.begin() + loop.exit,
+                    [](uint8_t b) { return b != 0; });
 }
 
 void Vm::enableProfile() {
