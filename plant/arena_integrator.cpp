@@ -13,13 +13,18 @@ namespace simbot::plant {
 
 namespace {
 
-// ERKStep's tolerances on x and y (ft), relative and absolute. Against the
+// ERKStep's tolerances on x and y: absolute (ft) and relative. Against the
 // exact motion (closed-form heading, Boost.Math quadrature of x and y;
 // tests/plant/tolerance_test.cpp) the arcs, spins and straight runs of the
 // default profile stay within 1e-9 ft over 10 s, 1/380 of the 3.8e-7 ft a
 // point at top speed moves in a tick; at 1e-9 the straight run is 2.0e-9
-// ft off.
-constexpr double kTolerance = 3e-10;
+// ft off. The relative one is ten times smaller because the centres sit
+// up to 7.5 ft from the origin: at 3e-10 it let a whole match drift 8.2e-9
+// ft from the exact motion and put 2 of its 139 root events a tick off
+// (tests/plant/match_oracle_test.cpp); at 3e-11 the drift is 1.4e-9 ft,
+// for 12% more steps.
+constexpr double kAbsoluteTolerance = 3e-10;  // ft
+constexpr double kRelativeTolerance = 3e-11;
 // Step of the central difference that gives the curvature of x and y while
 // a contact whose normal turns is active (the other robot, the divider's
 // corner): its error, about 1e-9 ft/s^2, enters the quintic times h^2/120.
@@ -96,7 +101,7 @@ Arena::Impl::Impl(const ArenaConfig& c)
   // Dormand-Prince 5(4): the fifth-order pair with the smallest error
   // constants ARKODE ships, its last stage reused as the next step's first.
   ark::check(ERKStepSetTableNum(m, ARKODE_DORMAND_PRINCE_7_4_5), "ERKStepSetTableNum");
-  ark::check(ERKStepSStolerances(m, kTolerance, kTolerance), "ERKStepSStolerances");
+  ark::check(ERKStepSStolerances(m, kRelativeTolerance, kAbsoluteTolerance), "ERKStepSStolerances");
   // ARKODE's root finder locates a crossing on its own interpolant, the
   // quartic Hermite it uses with a fifth-order table (one more right-hand
   // side, only in a step with a sign change); crossedTick() then decides
