@@ -44,19 +44,21 @@ double Arena::Impl::gapOf(contact::Kind k, int i, const double* y) const {
 }
 
 double Arena::Impl::contactG(contact::Kind k, int i, const double* y) const {
-  std::array<double, 2 * kXY> q{}, v{}, vf{};
+  std::array<double, 2 * kXY> q{};
   centresOf(y, q.data());
-  for (int r = 0; r < nR; ++r) {
-    const double* s = y + r * kPerRobot;
-    const double sp = 0.5 * (s[VL] + s[VR]);
-    vf[static_cast<std::size_t>(kXY * r + X)] = sp * std::sin(s[H]);
-    vf[static_cast<std::size_t>(kXY * r + Y)] = sp * std::cos(s[H]);
-  }
   for (int j = 0; j < active.count; ++j) {
     const contact::Constraint& c = active.c[static_cast<std::size_t>(j)];
     if (c.kind != k || c.robot != i) continue;
     // Pushing in this segment: minus its force, which reaches 0 when the
-    // body would start to move away.
+    // body would start to move away. (The free velocities only here: most
+    // calls are gaps, and a root evaluation makes seven.)
+    std::array<double, 2 * kXY> v{}, vf{};
+    for (int r = 0; r < nR; ++r) {
+      const double* s = y + r * kPerRobot;
+      const double sp = 0.5 * (s[VL] + s[VR]);
+      vf[static_cast<std::size_t>(kXY * r + X)] = sp * std::sin(s[H]);
+      vf[static_cast<std::size_t>(kXY * r + Y)] = sp * std::cos(s[H]);
+    }
     std::array<double, contact::kMaxActive> mu{};
     contact::project(bodies, active, q.data(), vf.data(), v.data(), mu.data());
     return -mu[static_cast<std::size_t>(j)];
