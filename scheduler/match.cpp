@@ -3,9 +3,10 @@
 // notifications) are in robot_bus.cpp; the classes in match_impl.h.
 //
 // Larger rounds. A round is a run of sub-rounds, each exactly one round of
-// the one-character protocol of match.h: from t_k = the earliest VM clock,
-// every VM runs to h_k = min(next queued event, t_k + 9,600, the plant's
-// next event). What a round saves is the plant's round trip: the plant is
+// the one-character protocol of match.h: every VM runs to h_k = min(next
+// queued event, a_k + 9,600, the plant's next event), a_k the earliest tick
+// at which a VM can act (Vm::quietUntil, at least the earliest VM clock
+// t_k). What a round saves is the plant's round trip: the plant is
 // advanced once, to P = min(next queued event that is not a serial byte,
 // the finish of a NUL already in a serial port, t + 8 x 9,600) (only to
 // the first sub-round's horizon while a ball is in flight or a launch is
@@ -233,6 +234,13 @@ Tick Match::earliestClock() const {
   Tick t = INT64_MAX;
   for (const auto& r : robots_)
     if (!r->vm().fault()) t = std::min(t, r->now());
+  return t == INT64_MAX ? queue_.nextTick() : t;
+}
+
+Tick Match::earliestAction() const {
+  Tick t = INT64_MAX;
+  for (const auto& r : robots_)
+    if (!r->vm().fault()) t = std::min(t, r->quietUntil());
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 
@@ -540,7 +548,7 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
     const Tick t = earliestClock();
     roundStart = t;
     if (trace_.on()) trace_.flushBefore(std::min(t, arena_.now()));
-    Tick horizon = std::min(queue_.nextTick(), t + kLookahead);
+    Tick horizon = std::min(queue_.nextTick(), earliestAction() + kLookahead);
     // The plant goes further than the first sub-round when no ball is in
     // flight, past serial bytes (header comment: "Larger rounds", (d)).
     Tick plantStop = horizon;
@@ -567,7 +575,7 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
       sampleUpTo(horizon);  // before the next sub-round's records, as between rounds
       if (queue_.nextTick() == horizon && !serialBytesInRound(horizon)) break;
       ++subRounds_;
-      horizon = std::min(queue_.nextTick(), earliestClock() + kLookahead);
+      horizon = std::min(queue_.nextTick(), earliestAction() + kLookahead);
     }
     if (horizon < step.tick) {
       // The round ends before the plant's stop: it goes back to the horizon

@@ -4,11 +4,16 @@
 // robots and the plant knows nothing of bytecode.
 //
 // Co-simulation protocol, one round at a time (t = the earliest VM clock):
-//   1. h = min(next queued event, t + 9,600). The lookahead of one character
-//      time is exact: a robot's program reaches another robot only through
-//      a latched motor frame, which happens when a NUL leaves the shift
-//      register, at least 9,600 ticks after the byte entered it; so no event
-//      another VM could observe is created inside a round.
+//   1. h = min(next queued event, a + 9,600), where a >= t is the earliest
+//      tick at which a VM can act (Vm::quietUntil: its clock, or, while it
+//      runs a delay loop fast-forward has measured, the arrival at the
+//      loop's top where the compare fails; no bus access or acceptance
+//      comes before it unless the host raises a request, at an event). The
+//      lookahead of one character time is exact: a robot's program reaches
+//      another robot only through a latched motor frame, which happens when
+//      a NUL leaves the shift register, at least 9,600 ticks after the byte
+//      entered it, which its VM did at or after a; so no event another VM
+//      could observe is created inside a round.
 //   2. The plant integrates ahead to h; its first root, if earlier, caps h.
 //      (Several such rounds share one plant advance when nothing happens
 //      between them: match.cpp, "Larger rounds"; MatchResult::rounds counts

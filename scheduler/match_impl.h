@@ -96,6 +96,7 @@ class Robot : public vm::Bus, public plant::RobotMemory {
 
   // The robot's clock (match ticks) and its program's VM.
   Tick now() const { return bus.base + vm_->now(); }
+  Tick quietUntil() const { return bus.base + vm_->quietUntil(); }
   vm::Vm& vm() { return *vm_; }
   const vm::Vm& vm() const { return *vm_; }
   // A VM as at load, its clock at t: fresh memory (with the profile's
@@ -294,6 +295,9 @@ class Match {
 
  private:
   Tick earliestClock() const;
+  // The earliest tick at which a robot that has not faulted can act:
+  // the least of their Vm::quietUntil (match ticks).
+  Tick earliestAction() const;
   bool allExited() const {
     return std::all_of(robots_.begin(), robots_.end(), [](const auto& r) {
       return (r->result.exited || r->vm().fault()) && !r->reloadPending;

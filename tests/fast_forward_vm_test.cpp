@@ -94,6 +94,62 @@ TEST(FastForward, WholeLoopEndsWhereSteppingEnds) {
   EXPECT_EQ(stepped.stats().fastForwarded, 0u);
 }
 
+// Vm::quietUntil, which lets the scheduler run longer rounds: stopped
+// anywhere inside a measured delay loop, the VM names the arrival at the
+// loop's top where the compare fails, and no bus access comes before it.
+// The oracle: the first arrival at the top, T0, found by stepping tick by
+// tick with fast-forward off, plus 700 passes of 252 T-states.
+TEST(FastForward, QuietUntilIsTheLoopsExitAndNoAccessComesSooner) {
+  const auto img =
+      testkit::compileOrDie("int z; main() { for (z = 0; z < 700; z++) ; outport(PIODB, 1); }");
+  ASSERT_EQ(img.delayLoops.size(), 1u);
+  const uint32_t top = img.delayLoops[0].top;
+  vm::CostTable off = testkit::calibratedCosts();
+  off.knobs.fastForward = false;
+  TestHost stepHost;
+  vm::Vm stepped(img, stepHost, off);
+  Tick t0 = 0;
+  while (stepped.pc() != top) stepped.run(++t0);
+  t0 = stepped.now();
+  const Tick exitArrival = t0 + 700 * 252;
+
+  TestHost host;
+  vm::Vm v(img, host, testkit::calibratedCosts());
+  int inside = 0;
+  for (Tick h = 997; host.outs.empty(); h += 997) {
+    v.run(h);
+    const Tick q = v.quietUntil();
+    EXPECT_GE(q, v.now());
+    const bool inLoop = v.pc() >= top && v.pc() < img.delayLoops[0].exit;
+    // From the second pass on (the first one measures the pass).
+    if (inLoop && v.now() >= t0 + 2 * 252) {
+      ++inside;
+      EXPECT_EQ(q, exitArrival) << "stopped at " << v.now();
+    } else {
+      EXPECT_EQ(q, v.now()) << "stopped at " << v.now();
+    }
+  }
+  EXPECT_GT(inside, 100);
+  ASSERT_EQ(host.outs.size(), 1u);
+  // The access comes where stepping puts it, after the exit arrival (the
+  // final test, LDGW PUSHW LTW JZ, and the outport's instructions).
+  stepHost.runUntil(stepped, vm::kTicksPerSecond);
+  ASSERT_EQ(stepHost.outs.size(), 1u);
+  EXPECT_EQ(host.outs[0].tick, stepHost.outs[0].tick);
+  EXPECT_GT(host.outs[0].tick, exitArrival);
+}
+
+// A request the host raises ends the quiet at once.
+TEST(FastForward, QuietUntilIsNowWhileARequestIsPending) {
+  const auto img = testkit::compileOrDie(kDelayWithHandler);
+  TestHost host;
+  vm::Vm v(img, host, testkit::calibratedCosts());
+  v.run(50'000);
+  ASSERT_GT(v.quietUntil(), v.now() + 100'000);
+  v.request(Irq::Pio);
+  EXPECT_EQ(v.quietUntil(), v.now());
+}
+
 }  // namespace
 
 namespace {

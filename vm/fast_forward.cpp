@@ -55,40 +55,56 @@ void Vm::State::findLoops() {
   }
 }
 
+namespace {
+
+using Loop = Vm::State::Loop;
+
+// A counter value as a signed or unsigned number of the counter's width.
+int64_t counterNumber(const Loop& loop, uint32_t x) {
+  if (!loop.isSigned) return loop.wide ? int64_t{x} : int64_t{x & 0xFFFFu};
+  return loop.wide ? static_cast<int32_t>(x) : static_cast<int16_t>(x);
+}
+
+// Passes still to run from `from` while the compare holds, the counter
+// staying below the top of its range (it never wraps here).
+int64_t passesLeft(const Loop& loop, uint32_t from) {
+  const int64_t top = loop.isSigned ? (loop.wide ? INT32_MAX : INT16_MAX)
+                                    : (loop.wide ? int64_t{UINT32_MAX} : int64_t{UINT16_MAX});
+  const int64_t n = counterNumber(loop, loop.limit);
+  const int64_t last = std::min(loop.inclusive ? n : n - 1, top - 1);
+  const int64_t v = counterNumber(loop, from);
+  return last >= v ? last - v + 1 : 0;
+}
+
+// The regime in which every pass costs the same: a signed compare's
+// overflow branch is never taken when both sides are non-negative.
+bool inRegime(const Loop& loop, uint32_t v) {
+  return !loop.isSigned || (counterNumber(loop, v) >= 0 && counterNumber(loop, loop.limit) >= 0);
+}
+
+}  // namespace
+
 bool Vm::State::fastForward(Tick until) {
   const int index = loopAtTop[pc];
-  const Loop& loop = loops[static_cast<size_t>(index)];
-  const uint32_t v = loop.wide ? rd32(loop.counter) : rd16(loop.counter);
+  Loop& loop = loops[static_cast<size_t>(index)];
+  uint32_t v = loop.wide ? rd32(loop.counter) : rd16(loop.counter);
+  bool applied = false;
   const uint32_t mask = loop.wide ? 0xFFFFFFFFu : 0xFFFFu;
-  const bool isSigned = loop.isSigned, inclusive = loop.inclusive;
-  // As a signed or unsigned number of the counter's width.
-  auto number = [&](uint32_t x) -> int64_t {
-    if (!isSigned) return x & mask;
-    return loop.wide ? static_cast<int32_t>(x) : static_cast<int16_t>(x);
-  };
-  // Passes still to run from v while the compare holds, the counter staying
-  // below the top of its range (it never wraps here).
-  auto passesLeft = [&](uint32_t from) -> int64_t {
-    const int64_t top = isSigned ? (loop.wide ? INT32_MAX : INT16_MAX) : int64_t{mask};
-    const int64_t n = number(loop.limit);
-    const int64_t last = std::min(inclusive ? n : n - 1, top - 1);
-    return last >= number(from) ? last - number(from) + 1 : 0;
-  };
-  // The regime in which every pass costs the same: a signed compare's
-  // overflow branch is never taken when both sides are non-negative.
-  const bool regime = !isSigned || (number(v) >= 0 && number(loop.limit) >= 0);
+  const bool regime = inRegime(loop, v);
   if (measure.loop == index && measure.accepted == acceptances &&
       v == ((measure.counter + 1) & mask) && regime && !loop.breakpointInside &&
-      (!isSigned || number(measure.counter) >= 0)) {
+      inRegime(loop, measure.counter)) {
     const Tick pass = now - measure.start;
+    loop.pass = pass;
     const Tick bound = std::min(until, nextTimer);
     const int64_t n =
-        pass > 0 && bound > now ? std::min<int64_t>(passesLeft(v), (bound - now) / pass) : 0;
+        pass > 0 && bound > now ? std::min<int64_t>(passesLeft(loop, v), (bound - now) / pass) : 0;
     if (n > 0) {
+      v += static_cast<uint32_t>(n);
       if (loop.wide)
-        wr32(loop.counter, v + static_cast<uint32_t>(n));
+        wr32(loop.counter, v);
       else
-        wr16(loop.counter, v + static_cast<uint32_t>(n));
+        wr16(loop.counter, v);
       now += n * pass;
       const uint64_t skipped =
           static_cast<uint64_t>(n) * (stats.instructions - measure.instructions);
@@ -97,10 +113,11 @@ bool Vm::State::fastForward(Tick until) {
       if (profiling)
         for (uint32_t a = loop.top; a < loop.exit; ++a)
           profile[a] += static_cast<uint64_t>(n) * (profile[a] - measure.profile[a - loop.top]);
-      measure.loop = -1;
-      return true;
+      applied = true;
     }
   }
+  // The pass that starts here is measured (after passes applied, the VM has
+  // landed at the top: quietUntil needs the measure there too).
   measure.loop = index;
   measure.start = now;
   measure.counter = v;
@@ -108,7 +125,23 @@ bool Vm::State::fastForward(Tick until) {
   measure.accepted = acceptances;
   if (profiling)
     std::copy(profile.begin() + loop.top, profile.begin() + loop.exit, measure.profile.begin());
-  return false;
+  return applied;
+}
+
+// While the VM is inside the pass that began at measure.start (the compare
+// held there and nothing was accepted since, so it only counts), the loop
+// runs that pass and the rest, each costing loop.pass, and touches nothing
+// but its counter until the arrival at its top where the compare fails.
+Tick Vm::State::quietUntil() const {
+  if (fault || anyPending || lib.active || lib.awaitingBegin || burn || halted || measure.loop < 0)
+    return now;
+  const Loop& loop = loops[static_cast<size_t>(measure.loop)];
+  if (pc < loop.top || pc >= loop.exit || measure.accepted != acceptances ||
+      loop.breakpointInside || loop.pass <= 0 || !inRegime(loop, measure.counter))
+    return now;
+  const int64_t passes = passesLeft(loop, measure.counter);  // this one included
+  if (passes <= 0) return now;
+  return std::max(now, std::min(measure.start + passes * loop.pass, nextTimer));
 }
 
 }  // namespace simbot::vm

@@ -243,6 +243,9 @@ struct Vm::State {
     // A breakpoint inside turns fast-forward off (kept by setBreakpoint, so
     // that no arrival scans the loop's bytes).
     bool breakpointInside = false;
+    // The cost of a pass in the constant-cost regime, once measured (0
+    // until then): every pass there costs the same.
+    Tick pass = 0;
   };
   std::vector<Loop> loops;
   std::vector<int16_t> loopAtTop;  // per code byte: index into loops, or -1
@@ -259,6 +262,7 @@ struct Vm::State {
   uint64_t acceptances = 0;  // interrupts accepted so far (a pass with one is no measure)
   void findLoops();
   bool fastForward(Tick until);
+  Tick quietUntil() const;
   std::string consoleLine;
   Vm* self = nullptr;
 

@@ -1522,6 +1522,7 @@ void Vm::cancelRequest(Irq irq) {
 
 bool Vm::pending(Irq irq) const { return s_->pend[static_cast<int>(irq)]; }
 Tick Vm::now() const { return s_->now; }
+Tick Vm::quietUntil() const { return s_->quietUntil(); }
 bool Vm::halted() const { return s_->halted; }
 const Fault* Vm::fault() const { return s_->fault ? &*s_->fault : nullptr; }
 bool Vm::interruptsEnabled() const { return s_->iff1; }

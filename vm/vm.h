@@ -116,6 +116,13 @@ class Vm {
   // after an instruction that touched the bus.
   Stop run(Tick until);
 
+  // A tick before which this VM, left alone, neither touches the bus nor
+  // accepts an interrupt: now() in general; later while it runs a delay
+  // loop that fast-forward has measured (the arrival at its top where the
+  // compare fails, or PRT0's next tick if sooner). A request the host
+  // raises makes it now() again.
+  Tick quietUntil() const;
+
   // Raise a request now (at now()); it stays pending until accepted. For
   // vectored sources the vector byte selects the #INT_VEC handler.
   void request(Irq irq, uint8_t vector = 0);
