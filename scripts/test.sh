@@ -8,13 +8,20 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
 jobs=$(nproc)
+# Each phase's wall time, so that the suite's 30-minute budget can be kept.
+phase() { echo "test.sh: $1 took $((SECONDS - mark)) s (total $SECONDS s)"; mark=$SECONDS; }
+mark=$SECONDS
 mapfile -t sources < <(find compiler vm plant scheduler trace tools tests bench fuzz \
   -path tests/browser/node_modules -prune -o \( -name '*.cpp' -o -name '*.h' \) -print | sort)
 clang-format --dry-run --Werror "${sources[@]}"
+phase "set-up and layout check"
 ./scripts/build.sh build -DSIMBOT_WERROR=ON
+phase "normal build"
 ctest --test-dir build --output-on-failure --parallel "$jobs" --timeout 900
+phase "normal tests"
 ./scripts/build.sh build-asan -DSIMBOT_SANITIZE=ON -DSIMBOT_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=Debug \
   -DSIMBOT_WERROR=ON
+phase "sanitizer build"
 # Left out under the sanitizers, to keep the suite under 30 minutes: checks
 # that repeat whole CLI matches for determinism or variation (cli.match.*,
 # cli.variation: 39 s under ASan), run every program with and without
@@ -33,6 +40,7 @@ ctest --test-dir build --output-on-failure --parallel "$jobs" --timeout 900
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-asan --output-on-failure --parallel "$jobs" --timeout 1800 \
   -E '^(cli\.match\.deterministic|cli\.variation|fast_forward\.identical|Explain\.FromTheJsonlFile|batch\.kill_and_resume|browser\.viewer|stats\.oracle|VmIdiom\.EveryHorizonStopsWhereTheUnfusedRunStops|VmIdiom\.AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused|VmJoin\.EveryHorizonStopsWhereTheUnfusedRunStops|VmJoin\.AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused)$'
+phase "sanitizer tests"
 # ThreadSanitizer: only the suite that runs work on several threads.
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSIMBOT_TSAN=ON \
   -DSIMBOT_BENCHMARKS=OFF -DSIMBOT_WERROR=ON > build-tsan.configure.log 2>&1 ||
@@ -40,4 +48,6 @@ cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSIMBOT_TSA
 cmake --build build-tsan --parallel "$jobs" --target bench_test
 TSAN_OPTIONS=halt_on_error=1 \
   ctest --test-dir build-tsan -R '^(Bench|Tournament)\.' --output-on-failure --parallel "$jobs"
+phase "ThreadSanitizer build and tests"
 ./scripts/fuzz.sh 30
+phase "fuzzing build and campaigns"
