@@ -43,15 +43,16 @@ Pose lerp(const Pose& a, const Pose& b, Tick t) {
 }
 
 // "cfgrcfgr" -> "L +12 R +12": each wheel's speed step, negative in
-// reverse, "stop" when its g/s character says stop.
+// reverse, "stop" when its g/s character says stop; decoded by the motor
+// controller's own rule (plant::parseMotorFrame). "" if it is not a frame.
 std::string describeFrame(const std::string& f) {
-  if (f.size() != 8) return "";
-  auto wheel = [](const std::string& w) -> std::string {
-    if (w[2] == 's') return "stop";
-    const int speed = std::isdigit(static_cast<unsigned char>(w[0])) ? w[0] - '0' : w[0] - 'a' + 10;
-    return fmt::format("{}{}", w[1] == 'r' ? '-' : '+', speed);
+  const auto frame = plant::parseMotorFrame(f);
+  if (!frame) return "";
+  auto wheel = [](const plant::WheelCommand& w) -> std::string {
+    if (!w.go) return "stop";
+    return fmt::format("{}{}", w.forward ? '+' : '-', w.speed);
   };
-  return fmt::format("L {} R {}", wheel(f.substr(0, 4)), wheel(f.substr(4, 4)));
+  return fmt::format("L {} R {}", wheel(frame->left), wheel(frame->right));
 }
 
 int median(std::vector<int> v) {
