@@ -28,8 +28,8 @@
 
 namespace simbot::plant {
 
+using timebase::kTicksPerChar;
 using timebase::Tick;
-inline constexpr Tick kTicksPerChar = 9600;
 
 // The robot memory the serial library reads from and writes to.
 class RobotMemory {

@@ -729,35 +729,18 @@ void Match::finish(MatchResult& result) {
 
 namespace {
 
-// A non-negative decimal number of `unit`s as an exact tick count: digits
-// are scaled as integers so that "12.5s" is exactly 115,200,000 ticks.
+// A non-negative decimal number of `unit`s as an exact tick count, read by
+// the one parser of durations (timebase::ticksFromDecimal): "12.5s" is
+// exactly 115,200,000 ticks, "1e-3s" 9,216; an injection is at a tick, so a
+// time between two ticks is refused rather than rounded.
 Tick parseDuration(const std::string& digits, int64_t ticksPerUnit, const std::string& whole) {
-  const auto bad = [&] {
-    return std::invalid_argument("'" + whole +
-                                 "': WHEN must be a time (12.5s, 800ms), a tick (115200000t) "
-                                 "or a program point (line:N#K, pass:N#K)");
-  };
-  if (digits.empty()) throw bad();
-  int64_t integer = 0, fraction = 0, scale = 1;
-  bool point = false;
-  for (char ch : digits) {
-    if (ch == '.' && !point) {
-      point = true;
-      continue;
-    }
-    if (ch < '0' || ch > '9') throw bad();
-    if (integer > 1'000'000'000 || scale > 1'000'000'000) throw bad();
-    if (point) {
-      fraction = fraction * 10 + (ch - '0');
-      scale *= 10;
-    } else {
-      integer = integer * 10 + (ch - '0');
-    }
-  }
-  const int64_t ticks = integer * ticksPerUnit + fraction * ticksPerUnit / scale;
-  if (fraction * ticksPerUnit % scale != 0)
-    throw std::invalid_argument("'" + whole + "' is not a whole number of ticks");
-  return ticks;
+  const auto ticks = timebase::ticksFromDecimal(digits, ticksPerUnit);
+  if (!ticks)
+    throw std::invalid_argument("'" + whole +
+                                "': WHEN must be a time (12.5s, 800ms), a tick (115200000t) "
+                                "or a program point (line:N#K, pass:N#K)");
+  if (!ticks->exact) throw std::invalid_argument("'" + whole + "' is not a whole number of ticks");
+  return ticks->ticks;
 }
 
 int parsePositive(const std::string& s, const std::string& whole, const char* what) {

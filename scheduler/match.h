@@ -164,7 +164,7 @@ struct MatchConfig {
 // A reload waits at least this long, so that the bytes a faulted robot's
 // serial port still held (two characters) are on the wire before its port
 // is reset.
-inline constexpr Tick kMinReloadDelay = 2 * 9'600;
+inline constexpr Tick kMinReloadDelay = 2 * timebase::kTicksPerChar;
 
 // A run abandoned because MatchConfig::stop became true.
 struct Stopped : std::runtime_error {

@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <optional>
 #include <stdexcept>
+#include <string_view>
 #include <type_traits>
+#include <utility>
 
 #include "plant/plant.h"
 #include "scheduler/event_queue.h"
@@ -89,12 +92,45 @@ TEST(Timebase, SecondsFromTicks) {
   EXPECT_EQ(ticksFromSeconds(timebase::secondsFromTicks(123'456'789)), 123'456'789);
 }
 
+TEST(Timebase, DecimalsAsWritten) {
+  using timebase::ticksFromDecimal;
+  const auto ticks = [](std::string_view text, timebase::Tick unit) {
+    const auto t = ticksFromDecimal(text, unit);
+    return t ? std::optional(std::pair(t->ticks, t->exact)) : std::nullopt;
+  };
+  using P = std::pair<timebase::Tick, bool>;
+  EXPECT_EQ(ticks("12.5", 9'216'000), P(115'200'000, true));  // 12.5 * 9,216,000
+  EXPECT_EQ(ticks("1e-3", 9'216'000), P(9'216, true));
+  EXPECT_EQ(ticks("0.001", 9'216'000), P(9'216, true));
+  EXPECT_EQ(ticks("25E+2", 1), P(2'500, true));
+  EXPECT_EQ(ticks(".5", 9'216), P(4'608, true));  // half a millisecond
+  // Trailing zeros of a fraction are not significant digits: 23 digits.
+  EXPECT_EQ(ticks("0.500000000000000000000", 9'216'000), P(4'608'000, true));
+  // 1e-7 s = 0.9216 ticks -> 1; 4.5 ticks -> 5 (halves away from zero).
+  EXPECT_EQ(ticks("1e-7", 9'216'000), P(1, false));
+  EXPECT_EQ(ticks("4.5", 1), P(5, false));
+  EXPECT_EQ(ticks("1e-400", 9'216'000), P(0, false));
+  EXPECT_EQ(ticks("0e99", 1), P(0, true));
+  // 1e11 s is the most; a tick more is refused.
+  EXPECT_EQ(ticks("1e11", 9'216'000), P(921'600'000'000'000'000, true));
+  EXPECT_EQ(ticks("921600000000000001", 1), std::nullopt);
+  EXPECT_EQ(ticks("0.1234567890123456789", 9'216'000), std::nullopt);  // 19 significant
+  for (const char* bad : {"", ".", "1.2.3", "-1", "+1", "1e", "1e+", "e5", "1s", "0x10", " 1"})
+    EXPECT_EQ(ticks(bad, 1), std::nullopt) << bad;
+}
+
 TEST(Timebase, InjectionTimesAgreeWithTheConversion) {
   // An injection's WHEN is parsed as an exact decimal (a non-whole tick is
   // refused); a whole tick is the same tick ticksFromSeconds gives.
   EXPECT_EQ(scheduler::parseInjection("A:edge_fore@12.5s", 1).tick, ticksFromSeconds(12.5));
   EXPECT_EQ(scheduler::parseInjection("A:edge_fore@0.043s", 1).tick, 396'288);
   EXPECT_EQ(scheduler::parseInjection("A:edge_fore@800ms", 1).tick, ticksFromSeconds(0.8));
+  // The same decimals as --seconds: 1e-3 s = 9,216 ticks.
+  EXPECT_EQ(scheduler::parseInjection("A:edge_fore@1e-3s", 1).tick, ticksFromSeconds(1e-3));
+  EXPECT_EQ(scheduler::parseInjection("A:edge_fore@2.5E3t", 1).tick, 2'500);
+  // 1e-7 s is 0.9216 ticks: an injection is at a tick, so it is refused.
+  EXPECT_THROW(scheduler::parseInjection("A:edge_fore@1e-7s", 1), std::invalid_argument);
+  EXPECT_THROW(scheduler::parseInjection("A:edge_fore@-1s", 1), std::invalid_argument);
 }
 
 }  // namespace

@@ -16,19 +16,14 @@
 #include <vector>
 
 #include "plant/plant.h"
+#include "timebase/tick.h"
 #include "tools/runner.h"
 
 namespace simbot::tools {
 
-std::int64_t vcdPicoseconds(std::int64_t tick) {
-  // 1e12 / 9,216,000 = 1,953,125 / 18; split so that nothing overflows.
-  const std::int64_t q = tick / 18, r = tick % 18;
-  return q * 1'953'125 + (r * 1'953'125 + 9) / 18;
-}
-
 namespace {
 
-constexpr trace::Tick kBitTicks = 960;  // one bit at 9600 baud
+constexpr trace::Tick kBitTicks = timebase::kTicksPerBit;
 
 enum Wire : int {
   kTxd,
@@ -123,7 +118,7 @@ struct VcdSink::State {
       Signal& s = signals[static_cast<size_t>(index)];
       if (s.now == s.written) continue;
       if (!stampedNow) {
-        std::fprintf(file, "#%lld\n", static_cast<long long>(vcdPicoseconds(tick)));
+        std::fprintf(file, "#%lld\n", static_cast<long long>(timebase::picosecondsFromTicks(tick)));
         stampedNow = true;
         stamped = tick;
       }
@@ -357,7 +352,8 @@ void VcdSink::close() {
   }
   s.flushTick();
   if (s.headerDone && s.lastTick > s.stamped)
-    std::fprintf(file_, "#%lld\n", static_cast<long long>(vcdPicoseconds(s.lastTick)));
+    std::fprintf(file_, "#%lld\n",
+                 static_cast<long long>(timebase::picosecondsFromTicks(s.lastTick)));
   const bool ok = !std::ferror(file_) && std::fflush(file_) == 0;
   const bool closed = std::fclose(file_) == 0;
   file_ = nullptr;

@@ -37,9 +37,6 @@
 
 namespace simbot::tools {
 
-// Picoseconds of tick t, rounded to the nearest (halves up).
-std::int64_t vcdPicoseconds(std::int64_t tick);
-
 class VcdSink final : public trace::Sink {
  public:
   // Opens (truncates) the file now; ToolError if it cannot.

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "timebase/tick.h"
 #include "tools/explain.h"
 #include "tools/json_text.h"
 #include "tools/runner.h"
@@ -112,6 +113,7 @@ json ReplaySink::data() const {
   for (const auto& line : explain::textLines(columns_->explainer.report()))
     report.push_back({jsonString(line.text, false), line.t ? json(*line.t) : json(nullptr)});
   return {{"format", "simbot-replay/1"},
+          {"char_ticks", timebase::kTicksPerChar},
           {"explain", std::move(report)},
           {"kinds", columns_->kinds},
           {"watch", columns_->watch},

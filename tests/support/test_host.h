@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "compiler/compiler.h"
+#include "timebase/tick.h"
 #include "vm/vm.h"
 
 namespace simbot::testkit {
@@ -17,7 +18,7 @@ namespace simbot::testkit {
 using vm::Irq;
 using vm::Tick;
 
-inline constexpr Tick kTicksPerChar = 9600;  // 8N1 at 9600 baud
+using timebase::kTicksPerChar;
 
 struct Access {
   Tick tick;

@@ -90,6 +90,7 @@ function buildModel(data) {
     injections: rowsOf(K.injection),
     consoleLines: rowsOf(K.console),
     truncatedAt: data.truncated_at === undefined ? null : data.truncated_at,
+    charTicks: data.char_ticks,  // one serial character (timebase/tick.h)
     winner: endRows ? K.end.winner[0] : '',
     coin: endRows ? K.end.tie_broken_by_coin[0] : false,
     steps: stepLists(K),

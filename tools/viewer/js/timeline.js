@@ -10,8 +10,6 @@
 // falls inside the window is drawn, found by binary search, and items that
 // would share a pixel column are drawn once.
 
-const CHAR_TICKS = 9600;  // one 8N1 character at 9600 baud
-
 function createTimeline(canvas, tooltip, model, callbacks) {
   const ctx = canvas.getContext('2d');
   const lanes = [];
@@ -79,8 +77,8 @@ function createTimeline(canvas, tooltip, model, callbacks) {
 
   function drawSerial(robot, y, h) {
     const s = robot.serial;
-    const charPx = xOf(CHAR_TICKS) - xOf(0);
-    drawBoxes(s.t, CHAR_TICKS, y + 2, h - 4, '#3d6fa8', (i, x0, x1) => {
+    const charPx = xOf(model.charTicks) - xOf(0);
+    drawBoxes(s.t, model.charTicks, y + 2, h - 4, '#3d6fa8', (i, x0, x1) => {
       const b = s.byte[i];
       const text = b === 0 ? 'NUL' : b >= 32 && b < 127 ? String.fromCharCode(b) : `0x${b.toString(16)}`;
       if (charPx >= 14) {
