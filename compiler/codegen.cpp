@@ -32,6 +32,35 @@ using vm::Op;
 
 constexpr int kDataLimit = 0xF000;  // the rest is left to the stack
 
+// How the image's readers (--watch) must take a data symbol's memory.
+vm::Symbol::Value symbolValue(const Type* t) {
+  using V = vm::Symbol::Value;
+  switch (t->kind) {
+    case TypeKind::Char:
+      return V::Char;
+    case TypeKind::Int:
+      return V::Int;
+    case TypeKind::UInt:
+      return V::UInt;
+    case TypeKind::Long:
+      return V::Long;
+    case TypeKind::ULong:
+      return V::ULong;
+    case TypeKind::Float:
+      return V::Float;
+    case TypeKind::Ptr:
+      return V::Pointer;
+    case TypeKind::Func:
+      return V::Code;
+    case TypeKind::Void:
+    case TypeKind::Array:
+    case TypeKind::Struct:
+    case TypeKind::Union:
+      break;
+  }
+  return V::Aggregate;
+}
+
 // Where an lvalue lives: an absolute address, a frame offset, or an address
 // already pushed on the eval stack.
 struct Loc {
@@ -385,19 +414,20 @@ vm::Image CodeGen::run() {
   // Symbols.
   using K = vm::Symbol::Kind;
   for (Function* f : prog_.functions)
-    img_.symbols.push_back(vm::Symbol{
-        f->name, f->isHandler ? K::Handler : K::Function, static_cast<uint32_t>(f->address),
-        static_cast<uint32_t>(f->codeSize), typeName(f->type), f->defPos.line});
+    img_.symbols.push_back(vm::Symbol{f->name, f->isHandler ? K::Handler : K::Function,
+                                      static_cast<uint32_t>(f->address),
+                                      static_cast<uint32_t>(f->codeSize), typeName(f->type),
+                                      vm::Symbol::Value::Code, f->defPos.line});
   for (Obj* g : prog_.globals)
     img_.symbols.push_back(vm::Symbol{g->name, K::Global, static_cast<uint32_t>(g->address),
                                       static_cast<uint32_t>(g->type->size), typeName(g->type),
-                                      g->pos.line});
+                                      symbolValue(g->type), g->pos.line});
   for (Function* f : prog_.functions) {
     auto add = [&](Obj* o) {
       K kind = o->storage == Storage::Auto ? K::Auto : o->isParam ? K::Param : K::Static;
       img_.symbols.push_back(vm::Symbol{o->symName, kind, static_cast<uint32_t>(o->address),
                                         static_cast<uint32_t>(o->type->size), typeName(o->type),
-                                        o->pos.line});
+                                        symbolValue(o->type), o->pos.line});
     };
     for (Obj* p : f->params) add(p);
     for (Obj* l : f->locals) add(l);

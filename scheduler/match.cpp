@@ -258,10 +258,9 @@ void Match::resolveWatches() {
             s.kind != vm::Symbol::Kind::Param)
           throw std::invalid_argument("--watch " + name + ": only globals and static locals " +
                                       "can be watched ('" + name + "' is an auto variable)");
-        if (s.size > 4 || s.type.find('[') != std::string::npos ||
-            s.type.find("struct") != std::string::npos || s.type.find("union") != std::string::npos)
+        if (s.value == vm::Symbol::Value::Aggregate || s.value == vm::Symbol::Value::Code)
           throw std::invalid_argument("--watch " + name + ": only scalar variables can be watched");
-        r->watches.push_back({name, static_cast<uint16_t>(s.address), s.type});
+        r->watches.push_back({name, static_cast<uint16_t>(s.address), s.value});
         found = true;
       }
     }

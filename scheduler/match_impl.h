@@ -137,7 +137,7 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   struct Watch {
     std::string name;
     uint16_t address;
-    std::string type;
+    vm::Symbol::Value value;
   };
   std::vector<Watch> watches;
   trace::Watch watchedValues() const;

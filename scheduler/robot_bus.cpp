@@ -121,25 +121,36 @@ void Robot::byteDone(Tick t) {
   updateSerialRequest();
 }
 
-// Each watched variable's value as its C type reads it.
+// Each watched variable's value as its C type reads it (the compiler's
+// vm::Symbol::Value; resolveWatches admits scalars only).
 trace::Watch Robot::watchedValues() const {
+  using V = vm::Symbol::Value;
   trace::Watch values;
   for (const auto& w : watches) {
-    const bool isUnsigned = w.type.find("unsigned") != std::string::npos;
     trace::WatchValue v;
-    if (w.type.find('*') != std::string::npos) {
-      v = std::int64_t{vm_->read16(w.address)};
-    } else if (w.type.find("float") != std::string::npos ||
-               w.type.find("double") != std::string::npos) {
-      v = static_cast<double>(std::bit_cast<float>(vm_->read32(w.address)));
-    } else if (w.type.find("long") != std::string::npos) {
-      const uint32_t raw = vm_->read32(w.address);
-      v = isUnsigned ? std::int64_t{raw} : std::int64_t{static_cast<int32_t>(raw)};
-    } else if (w.type.find("char") != std::string::npos) {
-      v = std::int64_t{vm_->read8(w.address)};
-    } else {
-      const uint16_t raw = vm_->read16(w.address);
-      v = isUnsigned ? std::int64_t{raw} : std::int64_t{static_cast<int16_t>(raw)};
+    switch (w.value) {
+      case V::Char:
+        v = std::int64_t{vm_->read8(w.address)};
+        break;
+      case V::Int:
+        v = std::int64_t{static_cast<int16_t>(vm_->read16(w.address))};
+        break;
+      case V::UInt:
+      case V::Pointer:
+        v = std::int64_t{vm_->read16(w.address)};
+        break;
+      case V::Long:
+        v = std::int64_t{static_cast<int32_t>(vm_->read32(w.address))};
+        break;
+      case V::ULong:
+        v = std::int64_t{vm_->read32(w.address)};
+        break;
+      case V::Float:
+        v = static_cast<double>(std::bit_cast<float>(vm_->read32(w.address)));
+        break;
+      case V::Aggregate:
+      case V::Code:
+        continue;
     }
     values.emplace_back(w.name, v);
   }

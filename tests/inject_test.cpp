@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "plant/plant.h"
 #include "scheduler/match.h"
@@ -157,6 +158,56 @@ TEST(Inject, WatchedVariableAppearsInTraceRecords) {
   EXPECT_TRUE(sawAcceptance);
   c.watches = {"nosuch"};
   EXPECT_THROW(testkit::runTraced(c), std::invalid_argument);
+}
+
+// Each scalar kind is read as its C type (Dynamic C: char unsigned, int 16
+// bits, long 32, float IEEE single, pointers 16): values by hand, and the
+// pointer's is the address the image gives the struct it points to. An
+// array or a struct is refused; a pointer to a struct is a scalar.
+TEST(Inject, WatchedValuesAsTheirTypesReadThem) {
+  const char* source =
+      "struct pt { int x; int y; };\n"
+      "struct pt s;\n"
+      "struct pt *p;\n"
+      "char c;\n"
+      "int i;\n"
+      "unsigned int u;\n"
+      "long l;\n"
+      "unsigned long ul;\n"
+      "float f;\n"
+      "int a[3];\n"
+      "main()\n"
+      "{\n"
+      "    p = &s; c = 200; i = -2; u = 65534; l = -100000L; ul = 3000000000UL; f = 1.5;\n"
+      "    while (1);\n"
+      "}\n";
+  scheduler::MatchConfig c = soloConfig({});
+  c.robots[0] = {"A", "types.dc", testkit::compileOrDie(source, "types.dc")};
+  c.endTick = scheduler::kTicksPerSecond;
+  c.stopWhenAllExited = false;
+  c.watches = {"p", "c", "i", "u", "l", "ul", "f"};
+  const auto r = testkit::runTraced(c);
+  std::optional<nlohmann::json> last;
+  for (const auto& line : r.trace) {
+    const auto j = nlohmann::json::parse(line);
+    if (j.at("type") == "sample" && j.contains("watch")) last = j.at("watch");
+  }
+  ASSERT_TRUE(last.has_value());
+  uint32_t address = 0;
+  for (const auto& sym : c.robots[0].image.symbols)
+    if (sym.name == "s") address = sym.address;
+  ASSERT_NE(address, 0u);
+  EXPECT_EQ(last->at("p"), address);
+  EXPECT_EQ(last->at("c"), 200);
+  EXPECT_EQ(last->at("i"), -2);
+  EXPECT_EQ(last->at("u"), 65534);
+  EXPECT_EQ(last->at("l"), -100000);
+  EXPECT_EQ(last->at("ul"), 3000000000LL);
+  EXPECT_EQ(last->at("f"), 1.5);
+  for (const char* aggregate : {"s", "a", "main"}) {
+    c.watches = {aggregate};
+    EXPECT_THROW(testkit::runTraced(c), std::invalid_argument) << aggregate;
+  }
 }
 
 TEST(Inject, ParsesWhenForms) {

@@ -69,12 +69,18 @@ struct VectorBinding {
 
 struct Symbol {
   enum class Kind : uint8_t { Function, Handler, Global, Static, Auto, Param };
+  // What the memory of a data symbol holds, as a reader of it (--watch)
+  // must take it: one of the scalars (Dynamic C's char is unsigned, int 16
+  // bits, long 32, float IEEE single, pointers 16), or an aggregate (array,
+  // struct, union); a function's is Code.
+  enum class Value : uint8_t { Char, Int, UInt, Long, ULong, Float, Pointer, Aggregate, Code };
   std::string name;  // for statics and autos: "function.name"
   Kind kind;
   uint32_t address;  // code address (functions), memory address (data),
                      // frame offset (autos)
   uint32_t size;     // bytes (data) or code bytes (functions)
-  std::string type;  // C type as written, e.g. "unsigned long"
+  std::string type;  // C type for people, e.g. "unsigned long", "struct pt *"
+  Value value;
   int line;
 };
 
