@@ -226,8 +226,11 @@ int fusedIndex(uint8_t first, uint8_t second) {
   return -1;
 }
 
-// A 16-bit comparison as its handler does it (COMPARE, SIGNED_COMPARE in
-// run()): the result and the path its branches take.
+// A 16-bit comparison as the Z180 code does it, for the compare handlers
+// (COMPARE16 in run()) and the compare-and-branch idioms alike: the result,
+// and the path its branches take. Signed: the first branch (JP PO) is taken
+// when the subtraction did not overflow (it jumps over the sign
+// correction), the second when the result is 0. Unsigned: one branch.
 template <Op C>
 bool compare16(uint32_t a, uint32_t b, unsigned& path) {
   if constexpr (C == Op::LTW || C == Op::LEW || C == Op::GTW || C == Op::GEW) {
@@ -530,28 +533,17 @@ boundary:
   }
   // A comparison that materialises 0/1: its one branch is taken when the
   // result is 0 (it jumps over INC HL).
-#define COMPARE(expr)                \
-  {                                  \
-    const uint32_t b = POPV;         \
-    const uint32_t a = TOP;          \
-    TOP = (expr) ? 1u : 0u;          \
-    BRANCH_COST(TOP == 0 ? 1u : 0u); \
-  }                                  \
-  NEXT
-  // Signed: first branch (JP PO) taken when the subtraction HL - DE did
-  // not overflow (it jumps over the sign correction), second taken when
-  // the result is 0.
-#define SIGNED_COMPARE_BODY(expr, hl, de)                             \
-  {                                                                   \
-    const uint32_t b = POPV;                                          \
-    const uint32_t a = TOP;                                           \
-    const int32_t diff = int32_t{asInt16(hl)} - int32_t{asInt16(de)}; \
-    const bool overflow = diff < -32768 || diff > 32767;              \
-    TOP = (expr) ? 1u : 0u;                                           \
-    BRANCH_COST((overflow ? 0u : 1u) | (TOP == 0 ? 2u : 0u));         \
+  // A 16-bit comparison: the result, and the path its branches take, from
+  // compare16, the one statement of the compare semantics (the idioms' too).
+#define COMPARE16_BODY(c)                           \
+  {                                                 \
+    const uint32_t b = POPV;                        \
+    unsigned path = 0;                              \
+    TOP = compare16<Op::c>(TOP, b, path) ? 1u : 0u; \
+    BRANCH_COST(path);                              \
   }
-#define SIGNED_COMPARE(expr, hl, de) \
-  SIGNED_COMPARE_BODY(expr, hl, de)  \
+#define COMPARE16(c) \
+  COMPARE16_BODY(c)  \
   NEXT
   // A shift by n: op[] is one pass; n = 0 takes the JR Z (path 1), n > 1
   // adds n - 1 further passes, run like a long instruction's tail (in
@@ -588,7 +580,7 @@ boundary:
     const uint32_t b = POPV;  \
     TOP = (TOP + b) & 0xFFFF; \
   }
-#define FIRST_LTW SIGNED_COMPARE_BODY(asInt16(a) < asInt16(b), a, b)
+#define FIRST_LTW COMPARE16_BODY(LTW)
 #define FIRST_SUBW            \
   {                           \
     const uint32_t b = POPV;  \
@@ -1144,17 +1136,16 @@ L_Trap_ :
       NEXT;
       CASE(W2B) TOP &= 0xFF;
       NEXT;
-      CASE(EQW) COMPARE((a & 0xFFFF) == (b & 0xFFFF));
-      CASE(NEW) COMPARE((a & 0xFFFF) != (b & 0xFFFF));
-      // LTW and GEW compute a - b (EX DE,HL first); LEW and GTW b - a.
-      CASE(LTW) SIGNED_COMPARE(asInt16(a) < asInt16(b), a, b);
-      CASE(LEW) SIGNED_COMPARE(asInt16(a) <= asInt16(b), b, a);
-      CASE(GTW) SIGNED_COMPARE(asInt16(a) > asInt16(b), b, a);
-      CASE(GEW) SIGNED_COMPARE(asInt16(a) >= asInt16(b), a, b);
-      CASE(LTUW) COMPARE((a & 0xFFFF) < (b & 0xFFFF));
-      CASE(LEUW) COMPARE((a & 0xFFFF) <= (b & 0xFFFF));
-      CASE(GTUW) COMPARE((a & 0xFFFF) > (b & 0xFFFF));
-      CASE(GEUW) COMPARE((a & 0xFFFF) >= (b & 0xFFFF));
+      CASE(EQW) COMPARE16(EQW);
+      CASE(NEW) COMPARE16(NEW);
+      CASE(LTW) COMPARE16(LTW);
+      CASE(LEW) COMPARE16(LEW);
+      CASE(GTW) COMPARE16(GTW);
+      CASE(GEW) COMPARE16(GEW);
+      CASE(LTUW) COMPARE16(LTUW);
+      CASE(LEUW) COMPARE16(LEUW);
+      CASE(GTUW) COMPARE16(GTUW);
+      CASE(GEUW) COMPARE16(GEUW);
 
       CASE(ADDL) BINARY(a + b);
       CASE(SUBL) BINARY(a - b);
@@ -1444,9 +1435,8 @@ L_Trap_ :
 #undef BINARY
 #undef BRANCH_COST
 #undef SHIFT
-#undef COMPARE
-#undef SIGNED_COMPARE
-#undef SIGNED_COMPARE_BODY
+#undef COMPARE16
+#undef COMPARE16_BODY
 #undef U16
 #undef I32
 #undef CO_TARGET
