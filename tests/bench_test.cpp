@@ -6,9 +6,9 @@
 #include <cmath>
 #include <string>
 
-#include "scheduler/metrics.h"
 #include "stats/stats.h"
 #include "support/traced.h"
+#include "tools/bench_metrics.h"
 #include "tools/run_table.h"
 #include "tools/runner.h"
 #include "tools/tournament.h"
@@ -211,7 +211,7 @@ TEST(Bench, ObserverDoesNotChangeTheMatch) {
   c.robots.push_back({"B", "fig92", tools::compileProgramFile(kShared + "/programs/fig92.dc")});
   c.endTick = 10 * scheduler::kTicksPerSecond;
   const auto plain = testkit::runTraced(c);
-  scheduler::MetricsObserver observer;
+  tools::MetricsObserver observer;
   c.observer = &observer;
   const auto watched = testkit::runTraced(c);
   EXPECT_EQ(plain.trace, watched.trace);

@@ -163,9 +163,9 @@ CsvRow benchHeader() {
                    "b_start_x_ft",      "b_start_y_ft", "b_start_heading_deg",
                    "outcome",           "fault",        "winner",
                    "tie_broken_by_coin"};
-  for (const auto& name : scheduler::metricNames()) header.push_back(name);
+  for (const auto& name : metricNames()) header.push_back(name);
   // Robot B's, in head-to-head (empty otherwise).
-  for (const auto& name : scheduler::metricNames()) header.push_back("b_" + name);
+  for (const auto& name : metricNames()) header.push_back("b_" + name);
   return header;
 }
 
@@ -210,7 +210,7 @@ CsvRow benchRow(const BenchRun& run) {
     row.push_back(v ? fmt::format("{}", *v) : "");
   };
   for (const auto& v : run.metrics.values) add(v);
-  for (size_t m = 0; m < scheduler::metricNames().size(); ++m)
+  for (size_t m = 0; m < metricNames().size(); ++m)
     add(run.metricsB ? run.metricsB->values[m] : std::nullopt);
   return row;
 }
@@ -229,7 +229,7 @@ BenchRun benchRunFromRow(const CsvRow& row) {
   run.fault = row[10];
   run.winner = row[11];
   run.coin = row[12] == "1";
-  const size_t metrics = scheduler::metricNames().size();
+  const size_t metrics = metricNames().size();
   run.metrics.values.resize(metrics);
   for (size_t m = 0; m < metrics; ++m)
     if (!row[13 + m].empty()) run.metrics.values[m] = real(row[13 + m]);
@@ -374,16 +374,16 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile, c
     // Robot B is measured when it is a program (head-to-head), on the
     // same thresholds.
     const bool measureB = config.family == "head-to-head";
-    scheduler::MetricsObserver observer(0, config.thresholds), observerB(1, config.thresholds);
+    MetricsObserver observer(0, config.thresholds), observerB(1, config.thresholds);
     ObserverPair both(observer, observerB);
     mc.observer = measureB ? static_cast<scheduler::MatchObserver*>(&both) : &observer;
     try {
       const scheduler::MatchResult r = scheduler::runMatch(mc);
       observer.finish(r.endTick);
-      run.metrics = scheduler::collectMetrics(observer, r.robots[0]);
+      run.metrics = collectMetrics(observer, r.robots[0]);
       if (measureB) {
         observerB.finish(r.endTick);
-        run.metricsB = scheduler::collectMetrics(observerB, r.robots[1]);
+        run.metricsB = collectMetrics(observerB, r.robots[1]);
         run.winner = r.winner;
         run.coin = r.tieBrokenByCoin;
       }
@@ -401,7 +401,7 @@ BenchResult runBench(const BenchConfig& config, const plant::Profile& profile, c
                              robot.start.heading_deg);
       run.outcome = "error";
       run.fault = fmt::format("internal error (starts{}): {}", poses, e.what());
-      run.metrics.values.assign(scheduler::metricNames().size(), std::nullopt);
+      run.metrics.values.assign(metricNames().size(), std::nullopt);
     }
     run.done = true;
     if (io.table) io.table->append(benchRow(run));

@@ -1,5 +1,5 @@
 // simbot bench: scenario families run over many seeds, measured per run by
-// scheduler::MetricsObserver, summarised with censoring (README "bench").
+// MetricsObserver, summarised with censoring (README "bench").
 #pragma once
 #include <atomic>
 #include <cstdint>
@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "plant/plant.h"
-#include "scheduler/metrics.h"
 #include "stats/stats.h"
+#include "tools/bench_metrics.h"
 #include "tools/run_table.h"
 #include "tools/scenario.h"
 
@@ -28,7 +28,7 @@ struct BenchConfig {
   int threads = 0;       // 0: hardware concurrency
   std::string opponent;  // head-to-head: B's program
   bool progress = true;
-  scheduler::MetricThresholds thresholds;  // what counts as acquired and aimed
+  MetricThresholds thresholds;  // what counts as acquired and aimed
   // The seeds' key in place of each program's file name (simbot compare:
   // both sides play the very same seeded runs).
   std::string seedKey;
@@ -45,10 +45,10 @@ struct BenchRun {
   // measured up to its end); "error" (simbot failed on it: no metrics).
   std::string outcome;
   std::string fault;  // what faulted or failed, one line; empty when ok
-  scheduler::RunMetrics metrics;
+  RunMetrics metrics;
   // Head-to-head: robot B's metrics and who won ("A" or "B"; by the most
   // hits, a tie by the seeded coin).
-  std::optional<scheduler::RunMetrics> metricsB;
+  std::optional<RunMetrics> metricsB;
   std::string winner;
   bool coin = false;
   // The run's warnings (injections that never fired, ...): for stderr

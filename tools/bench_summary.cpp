@@ -24,11 +24,11 @@ constexpr const char* kEdgeLegs[] = {"edge_enter_s", "edge_accept_s", "edge_latc
                                      "edge_leave_s"};
 
 size_t metricIndex(const std::string& name) {
-  const auto& names = scheduler::metricNames();
+  const auto& names = metricNames();
   return static_cast<size_t>(std::find(names.begin(), names.end(), name) - names.begin());
 }
 
-const scheduler::RunMetrics& metricsOf(const BenchRun& run, bool robotB) {
+const RunMetrics& metricsOf(const BenchRun& run, bool robotB) {
   return robotB ? *run.metricsB : run.metrics;
 }
 
@@ -48,7 +48,7 @@ double reachedByHorizon(const BenchConfig& config) { return std::min(60.0, confi
 
 std::vector<stats::Observation> timeObservations(const std::vector<const BenchRun*>& runs,
                                                  bool robotB, size_t metric, double seconds) {
-  const std::string& name = scheduler::metricNames()[metric];
+  const std::string& name = metricNames()[metric];
   // An edge leg: the legs before it give its start (and whether it began).
   size_t leg = 0;
   while (leg < std::size(kEdgeLegs) && name != kEdgeLegs[leg]) ++leg;
@@ -76,7 +76,7 @@ namespace {
 
 MetricEstimate estimate(const BenchConfig& config, const std::vector<const BenchRun*>& runs,
                         bool robotB, size_t m) {
-  const std::string& name = scheduler::metricNames()[m];
+  const std::string& name = metricNames()[m];
   MetricEstimate e;
   e.metric = name;
   switch (metricKind(name)) {
@@ -176,7 +176,7 @@ std::vector<ProgramSummary> summarize(const BenchResult& result) {
       std::vector<const BenchRun*> measured;
       for (const BenchRun* run : runs)
         if (robot == 0 || run->metricsB) measured.push_back(run);
-      for (size_t m = 0; m < scheduler::metricNames().size(); ++m)
+      for (size_t m = 0; m < metricNames().size(); ++m)
         r.metrics.push_back(estimate(c, measured, robot == 1, m));
       s.robots.push_back(std::move(r));
     }

@@ -45,7 +45,7 @@ CLI::Validator seedValidator() {
       "SEED");
 }
 
-void addThresholdOptions(CLI::App& cmd, scheduler::MetricThresholds& t) {
+void addThresholdOptions(CLI::App& cmd, MetricThresholds& t) {
   cmd.add_option("--seen-threshold", t.seen,
                  "eye reading above which the beacon counts as seen, both eyes for acquire_s "
                  "(default 48, ICEMAN's)")

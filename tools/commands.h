@@ -3,7 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 
-#include "scheduler/metrics.h"
+#include "tools/bench_metrics.h"
 
 namespace simbot::tools {
 
@@ -24,7 +24,7 @@ Subcommand addBenchCommand(CLI::App& app);
 // or two profiles, and a test of each metric.
 Subcommand addCompareCommand(CLI::App& app);
 // --seen-threshold, --aim-max-diff, --aim-min-sum (bench and compare).
-void addThresholdOptions(CLI::App& cmd, scheduler::MetricThresholds& thresholds);
+void addThresholdOptions(CLI::App& cmd, MetricThresholds& thresholds);
 Subcommand addTournamentCommand(CLI::App& app);
 Subcommand addExplainCommand(CLI::App& app);  // tools/explain_command.cpp
 

@@ -28,7 +28,7 @@ std::optional<double> finite(double v) {
 }
 
 size_t indexOf(const std::string& name) {
-  const auto& names = scheduler::metricNames();
+  const auto& names = metricNames();
   return static_cast<size_t>(std::find(names.begin(), names.end(), name) - names.begin());
 }
 
@@ -43,7 +43,7 @@ int64_t total(const std::vector<const BenchRun*>& runs, size_t m) {
 std::vector<CompareRow> compareRuns(const BenchResult& a, const BenchResult& b) {
   const auto sa = summarize(a), sb = summarize(b);
   const auto ra = measured(a), rb = measured(b);
-  const auto& names = scheduler::metricNames();
+  const auto& names = metricNames();
   std::vector<CompareRow> rows;
   for (size_t m = 0; m < names.size(); ++m) {
     CompareRow row;

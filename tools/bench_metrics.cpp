@@ -1,10 +1,12 @@
-// The bench's per-run measurements and its statistics (metrics.h).
-#include "scheduler/metrics.h"
+// The bench's per-run measurements (bench_metrics.h).
+#include "tools/bench_metrics.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace simbot::scheduler {
+namespace simbot::tools {
+
+using scheduler::kTicksPerSecond;
 
 // ---- observer
 
@@ -137,4 +139,4 @@ RunMetrics collectMetrics(const MetricsObserver& o, const RobotResult& robot) {
   return m;
 }
 
-}  // namespace simbot::scheduler
+}  // namespace simbot::tools

@@ -1,5 +1,7 @@
 // Measurements of one robot's behaviour in a run (simbot bench), taken by a
-// MatchObserver at exact ticks (the bench's statistics are in stats/).
+// scheduler::MatchObserver at exact ticks (the bench's statistics are in
+// stats/). What they measure is the bench's, not the match's: ICEMAN's own
+// tests of acquiring and aiming, the edge legs, the stall time.
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -8,7 +10,10 @@
 
 #include "scheduler/match.h"
 
-namespace simbot::scheduler {
+namespace simbot::tools {
+
+using scheduler::RobotResult;
+using scheduler::Tick;
 
 // What counts as acquiring and aiming at the beacon, on the eye readings of
 // one left-then-right pair. The defaults are ICEMAN's own tests (thesis
@@ -22,7 +27,7 @@ struct MetricThresholds {
 };
 
 // Collects the raw happenings of one robot (by default A) during a run.
-class MetricsObserver final : public MatchObserver {
+class MetricsObserver final : public scheduler::MatchObserver {
  public:
   explicit MetricsObserver(int robot = 0, MetricThresholds thresholds = {})
       : robot_(robot), thresholds_(thresholds) {}
@@ -65,4 +70,4 @@ struct RunMetrics {
 const std::vector<std::string>& metricNames();
 RunMetrics collectMetrics(const MetricsObserver& o, const RobotResult& robot);
 
-}  // namespace simbot::scheduler
+}  // namespace simbot::tools
