@@ -23,8 +23,6 @@ namespace simbot::tools {
 
 namespace {
 
-constexpr trace::Tick kBitTicks = timebase::kTicksPerBit;
-
 enum Wire : int {
   kTxd,
   kRs485,
@@ -274,9 +272,9 @@ void VcdSink::State::record(const trace::Entry& e) {
           const auto byte = static_cast<unsigned>(x.byte);
           set(r, kTxd, "0");  // start bit
           for (int bit = 0; bit < 8; ++bit)
-            schedule(e.t + kBitTicks * (bit + 1), Later::SetWire, r, kTxd,
+            schedule(e.t + timebase::kTicksPerBit * (bit + 1), Later::SetWire, r, kTxd,
                      ((byte >> bit) & 1) ? '1' : '0');
-          schedule(e.t + kBitTicks * 9, Later::SetWire, r, kTxd, '1');  // stop bit
+          schedule(e.t + timebase::kTicksPerBit * 9, Later::SetWire, r, kTxd, '1');  // stop bit
         } else if constexpr (std::is_same_v<R, rec::SerialIsr>) {
           ++st.serialDepth;
           set(r, kInSerial, "1");

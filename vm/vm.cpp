@@ -230,7 +230,8 @@ int fusedIndex(uint8_t first, uint8_t second) {
 // (COMPARE16 in run()) and the compare-and-branch idioms alike: the result,
 // and the path its branches take. Signed: the first branch (JP PO) is taken
 // when the subtraction did not overflow (it jumps over the sign
-// correction), the second when the result is 0. Unsigned: one branch.
+// correction), the second when the result is 0. Unsigned: one branch,
+// taken when the result is 0 (it jumps over INC HL).
 template <Op C>
 bool compare16(uint32_t a, uint32_t b, unsigned& path) {
   if constexpr (C == Op::LTW || C == Op::LEW || C == Op::GTW || C == Op::GEW) {
@@ -531,10 +532,9 @@ boundary:
     clk += d;                                                                   \
     if constexpr (kProfile) profile[opPc] += static_cast<uint64_t>(int64_t{d}); \
   }
-  // A comparison that materialises 0/1: its one branch is taken when the
-  // result is 0 (it jumps over INC HL).
-  // A 16-bit comparison: the result, and the path its branches take, from
-  // compare16, the one statement of the compare semantics (the idioms' too).
+  // A 16-bit comparison that materialises 0/1: the result, and the path its
+  // branches take, from compare16, the one statement of the compare
+  // semantics (the idioms' too).
 #define COMPARE16_BODY(c)                           \
   {                                                 \
     const uint32_t b = POPV;                        \
