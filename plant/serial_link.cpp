@@ -4,14 +4,27 @@
 
 namespace simbot::plant {
 
-void SerialLink::send(Tick t0, uint16_t buf, uint16_t ccAddress, RobotMemory& memory) {
+std::optional<OverwrittenSend> SerialLink::send(Tick t0, uint16_t buf, uint16_t ccAddress,
+                                                RobotMemory& memory) {
+  std::optional<OverwrittenSend> overwritten;
+  if (unfetched_ > 0) overwritten = OverwrittenSend{sentAt_, sentCount_, fetched_};
   pointer_ = buf;
   ccAddress_ = ccAddress;
   tie_ = true;
-  if (!tdrFull_) service(t0, memory);  // the library loads buf[0] itself
+  sentAt_ = t0;
+  sentCount_ = memory.read8(ccAddress);
+  fetched_ = 0;
+  fetch(t0, memory);  // the library loads buf[0] itself when the TDR is empty
+  unfetched_ = memory.read8(ccAddress_);
+  return overwritten;
 }
 
 void SerialLink::service(Tick t, RobotMemory& memory) {
+  fetch(t, memory);
+  unfetched_ = memory.read8(ccAddress_);
+}
+
+void SerialLink::fetch(Tick t, RobotMemory& memory) {
   if (tdrFull_) return;
   const uint8_t count = memory.read8(ccAddress_);
   if (count == 0) {
@@ -21,6 +34,7 @@ void SerialLink::service(Tick t, RobotMemory& memory) {
   const uint8_t byte = memory.read8(pointer_);
   pointer_ = static_cast<uint16_t>(pointer_ + 1);
   memory.write8(ccAddress_, static_cast<uint8_t>(count - 1));
+  ++fetched_;
   loadTdr(t, byte);
 }
 

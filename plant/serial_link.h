@@ -39,6 +39,16 @@ class RobotMemory {
   virtual void write8(uint16_t address, uint8_t value) = 0;
 };
 
+// A send that restarted the library while it still had bytes of the
+// previous send to fetch (as *cc read after the library's last step: the
+// program may rewrite *cc itself before sending again): the rest of that
+// frame never goes out.
+struct OverwrittenSend {
+  Tick sentAt;      // ser_send_z1 of the overwritten send returned (T0)
+  int count;        // its *cc then
+  int fetched;      // bytes of it the port had taken
+};
+
 // A frame the receiver finished at a NUL: the last 8 characters before it
 // (or all of them, when fewer), and the command when they form a valid one.
 struct ReceivedFrame {
@@ -48,8 +58,9 @@ struct ReceivedFrame {
 
 class SerialLink {
  public:
-  // ser_send_z1 returned at `t0`.
-  void send(Tick t0, uint16_t buf, uint16_t ccAddress, RobotMemory& memory);
+  // ser_send_z1 returned at `t0`; the send it overwrote, if any.
+  std::optional<OverwrittenSend> send(Tick t0, uint16_t buf, uint16_t ccAddress,
+                                      RobotMemory& memory);
   // The library's transmit interrupt service routine ran at `t`.
   void service(Tick t, RobotMemory& memory);
   // The TSR finished its byte at `t` (== nextByteDone()). Returns the frame
@@ -78,6 +89,7 @@ class SerialLink {
   const std::string& pending() const { return received_; }
 
  private:
+  void fetch(Tick t, RobotMemory& memory);
   void loadTdr(Tick t, uint8_t byte);
   void moveTdrToTsr(Tick t);
 
@@ -85,6 +97,12 @@ class SerialLink {
   bool tie_ = false;
   uint16_t pointer_ = 0;
   uint16_t ccAddress_ = 0;
+  // The current send: when, its count, bytes fetched, and *cc after the
+  // library's last step (above zero: a new send overwrites it).
+  Tick sentAt_ = 0;
+  int sentCount_ = 0;
+  int fetched_ = 0;
+  uint8_t unfetched_ = 0;
   // port state
   bool tdrFull_ = false;
   uint8_t tdr_ = 0;

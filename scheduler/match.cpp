@@ -160,8 +160,6 @@ void Robot::reload(Tick t) {
   // joins the reloaded program's frames).
   if (!link.idle()) throw std::logic_error("a reload with bytes still in the serial port");
   link = plant::SerialLink{};
-  sendCcAddress = 0;
-  sendUnfetched = 0;
   serialEventAt = -1;
   pio = plant::PioPortA{};
   // The reset PIO sees the lines as they are; unarmed, it raises nothing.

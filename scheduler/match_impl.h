@@ -172,11 +172,6 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   uint64_t earlierTimerIsrCycles = 0;
   uint64_t earlierInstructions = 0, earlierFastForwarded = 0;
   plant::SerialLink link;
-  // What the serial library had still to fetch of the current send after
-  // its last step: a new send while it is above zero overwrites that frame.
-  // (Read back after each step, since the program may rewrite *cc itself.)
-  uint16_t sendCcAddress = 0;
-  int sendUnfetched = 0;
   plant::PioPortA pio;
   uint8_t edgeLines = 0xFF;
   int enb485 = -1;  // never written

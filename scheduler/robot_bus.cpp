@@ -64,17 +64,18 @@ int Robot::adSample(Tick t, int channel) {
 
 void Robot::serialSend(Tick t, uint16_t buf, uint16_t cc) {
   if (match.tracing()) match.emit(t, trace::rec::SerialSend{index, vm_->read8(cc)});
-  if (sendUnfetched > 0) ++result.framesOverwritten;
-  link.send(t, buf, cc, *this);
-  sendCcAddress = cc;
-  sendUnfetched = vm_->read8(cc);
+  if (const auto overwritten = link.send(t, buf, cc, *this)) {
+    ++result.framesOverwritten;
+    if (match.tracing())
+      match.emit(t, trace::rec::FrameOverwritten{index, overwritten->sentAt, overwritten->count,
+                                                 overwritten->fetched});
+  }
   scheduleSerial(t);
   updateSerialRequest();
 }
 
 void Robot::serialTxService(Tick t, vm::Vm&) {
   link.service(t, *this);
-  sendUnfetched = vm_->read8(sendCcAddress);
   scheduleSerial(t);
   updateSerialRequest();
 }

@@ -322,8 +322,21 @@ TEST(Explain, OverwrittenSend) {
   EXPECT_EQ(o.t, sends[1].first);
   EXPECT_EQ(o.previous_t, sends[0].first);
   EXPECT_EQ(o.previous_count, 9);
-  EXPECT_LT(o.previous_bytes_fetched, 9);
+  // The second send comes less than a character time (9,600 ticks) after
+  // the first, so the port has taken two bytes of it: buf[0], which the
+  // library loaded itself and went straight to the idle shift register,
+  // and buf[1], which the first transmit interrupt put in the TDR, full
+  // until buf[0] is out.
+  ASSERT_LT(sends[1].first - sends[0].first, 9600);
+  EXPECT_EQ(o.previous_bytes_fetched, 2);
   EXPECT_EQ(o.function, "main");
+  // The trace records it at the new send, as the report does.
+  const auto records = r.all<rec::FrameOverwritten>(0);
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0].first, sends[1].first);
+  EXPECT_EQ(records[0].second.previous_t, sends[0].first);
+  EXPECT_EQ(records[0].second.previous_count, 9);
+  EXPECT_EQ(records[0].second.fetched, 2);
   // Solo: no opponent, so no range, no stall.
   EXPECT_TRUE(r.report.stalls.empty());
 }

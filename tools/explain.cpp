@@ -83,14 +83,6 @@ struct Explainer::State {
     std::optional<Pose> last;
     int shots = 0, oneEye = 0;
   };
-  // The serial library's current send: its *cc and how many of its bytes
-  // the port has taken. The port's data register (TDR) is modelled from
-  // the records: a byte's start bit (serial_byte) empties it; the library
-  // fills it at the send, and each transmit interrupt fills it if empty.
-  struct Send {
-    Tick t = 0;
-    int count = 0, fetched = 0;
-  };
   struct Robot {
     double radius = 0;
     int eyeBackground = 16;
@@ -101,8 +93,6 @@ struct Explainer::State {
     std::optional<Tick> visibleSince;
     Window window;
     std::string halted;
-    std::optional<Send> send;
-    bool tdrFull = false;
     std::vector<std::size_t> handlers;                       // open handler runs
     std::map<std::string, std::size_t> touch;                // open contacts by what they touch
     std::map<std::size_t, std::optional<Pose>> handlerLast;  // a run's latest sample inside it
@@ -267,39 +257,30 @@ struct Explainer::State {
   void on(Tick t, const rec::Sample& x) {
     if (x.robot < robots) sample(t, x);
   }
-  // Takes a byte of the current send into the port, if there is room.
-  void fetch(Robot& me) {
-    if (me.tdrFull || !me.send || me.send->fetched >= me.send->count) return;
-    ++me.send->fetched;
-    me.tdrFull = true;
-  }
-  void on(Tick t, const rec::SerialSend& x) {
-    Robot& me = r[x.robot];
-    if (me.send && me.send->fetched < me.send->count) {
-      OverwrittenSend o;
-      o.robot = x.robot;
-      o.t = t;
-      o.previous_t = me.send->t;
-      o.previous_count = me.send->count;
-      o.previous_bytes_fetched = me.send->fetched;
-      if (!me.handlers.empty()) {
-        const HandlerRun& h = report.handler_runs[me.handlers.back()];
-        o.handler = h.handler;
-        o.line = h.line;
-        o.function = h.function;
-      } else if (me.last) {
-        o.line = me.last->line;
-        o.function = me.last->function;
-      }
-      report.overwritten.push_back(std::move(o));
+  void on(Tick t, const rec::FrameOverwritten& x) {
+    if (x.robot >= robots) return;
+    OverwrittenSend o;
+    o.robot = x.robot;
+    o.t = t;
+    o.previous_t = x.previous_t;
+    o.previous_count = static_cast<int>(x.previous_count);
+    o.previous_bytes_fetched = static_cast<int>(x.fetched);
+    const Robot& me = r[x.robot];
+    if (!me.handlers.empty()) {
+      const HandlerRun& h = report.handler_runs[me.handlers.back()];
+      o.handler = h.handler;
+      o.line = h.line;
+      o.function = h.function;
+    } else if (me.last) {
+      o.line = me.last->line;
+      o.function = me.last->function;
     }
-    me.send = Send{t, static_cast<int>(x.count), 0};
-    fetch(me);  // the library loads buf[0] itself when the port has room
-    eachOpenRun(x.robot, [](HandlerRun& h) { ++h.sends; });
+    report.overwritten.push_back(std::move(o));
   }
-  void on(Tick, const rec::SerialByte& x) { r[x.robot].tdrFull = false; }
+  void on(Tick, const rec::SerialSend& x) {
+    if (x.robot < robots) eachOpenRun(x.robot, [](HandlerRun& h) { ++h.sends; });
+  }
   void on(Tick t, const rec::SerialIsr& x) {
-    fetch(r[x.robot]);
     if (x.robot >= robots) return;
     RobotInfo& info = report.robots[static_cast<size_t>(x.robot)];
     ++info.serial_isr_runs;

@@ -286,6 +286,7 @@ const EVENT_STYLE = {
   injection: { glyph: '!', color: '#40ffa0', label: 'injection' },
   fault: { glyph: 'F', color: '#ff2020', label: 'FAULT' },
   reload: { glyph: 'L', color: '#ffa040', label: 'reloaded' },
+  frame_overwritten: { glyph: 'W', color: '#ff8080', label: 'send overwritten' },
   console: { glyph: 'c', color: '#c0c0c0', label: 'console' },
   exit: { glyph: 'E', color: '#c0c0c0', label: 'main returned' },
 };
@@ -301,6 +302,8 @@ function describeEvent(kind, c, i) {
     case 'injection': return `${c.what[i]} (line ${c.line[i]})`;
     case 'fault': return `line ${c.line[i]}: ${c.message[i]}`;
     case 'reload': return `reload ${c.reloads[i]}: main starts again`;
+    case 'frame_overwritten':
+      return `the port had taken ${c.fetched[i]} of the previous send's ${c.previous_count[i]} bytes`;
     case 'console': return c.text[i];
     default: return '';
   }
@@ -325,6 +328,7 @@ const STEP_KINDS = [
   ['frames', 'motor frames', ['frame_latched', 'frame_rejected']],
   ['rejected', 'rejected frames', ['frame_rejected']],
   ['sends', 'serial sends', ['serial_send']],
+  ['overwritten', 'overwritten sends', ['frame_overwritten']],
   ['interrupts', 'edge interrupts', ['interrupt_accepted']],
   ['edges', 'edge detector', ['edge_enter', 'edge_leave']],
   ['contacts', 'contacts', ['contact']],
