@@ -332,6 +332,7 @@ struct CostKnobs {
   // Not calibration: run marked delay loops in one step where nothing can
   // happen to the robot meanwhile (exact; off for checking).
   bool fastForward = true;
+  bool operator==(const CostKnobs&) const = default;
 };
 
 // Tables resolved against the knobs, built once per VM configuration.
@@ -359,6 +360,7 @@ struct CostTable {
   uint32_t adConversion = 0;
   uint32_t printfChar = 0;
   CostKnobs knobs;
+  bool operator==(const CostTable&) const = default;
 };
 
 // Throws std::invalid_argument when a knob is outside its hardware range.

@@ -13,7 +13,7 @@
 namespace simbot::vm {
 
 void Vm::State::findLoops() {
-  const auto& code = image.code;
+  const auto& code = image->code;
   auto at = [&](uint32_t a) -> int { return a < code.size() ? code[a] : -1; };
   // Reads past the end of the code give 0 (a mark is not trusted yet).
   auto byte = [&](uint32_t a) -> uint32_t { return a < code.size() ? code[a] : 0; };
@@ -24,7 +24,7 @@ void Vm::State::findLoops() {
     return static_cast<uint32_t>(static_cast<int32_t>(operand + 2) +
                                  static_cast<int16_t>(u16at(operand)));
   };
-  for (const auto& mark : image.delayLoops) {
+  for (const auto& mark : image->delayLoops) {
     uint32_t a = mark.top;
     if (mark.exit > code.size() || mark.exit <= a || mark.exit - a > kMaxLoopBytes) continue;
     const bool wide = is(a, Op::LDGL);

@@ -150,6 +150,7 @@ struct IdiomCost {
   uint32_t span = 0;
   uint32_t base = 0;
   uint32_t path[8]{};
+  bool operator==(const IdiomCost&) const = default;
 };
 
 }  // namespace simbot::vm::detail

@@ -163,32 +163,32 @@ void Vm::State::libBegin() {
   switch (id) {
     case Lib::AD_RD8:
       // Sampled at the start of the conversion, which then takes its time.
-      lib.result = w(bus.adSample(now, static_cast<int>(asInt16(a[0]))));
+      lib.result = w(bus->adSample(now, static_cast<int>(asInt16(a[0]))));
       lib.remaining = costs.adConversion;
       busTouched = true;
       lib.active = lib.remaining > 0;
       if (!lib.active) eval[sp++] = lib.result;
       return;
     case Lib::OUTPORT:
-      bus.out(now, static_cast<uint16_t>(a[0]), static_cast<uint8_t>(a[1]));
+      bus->out(now, static_cast<uint16_t>(a[0]), static_cast<uint8_t>(a[1]));
       busTouched = true;
       return;
     case Lib::INPORT:
-      eval[sp++] = bus.in(now, static_cast<uint16_t>(a[0]));
+      eval[sp++] = bus->in(now, static_cast<uint16_t>(a[0]));
       busTouched = true;
       return;
     case Lib::SER_INIT_Z1:
       // The routine restores the caller's interrupt state (JP PO; EI): IFF1
       // is as it was before the call.
-      bus.serialInit(now, asInt16(a[0]), asInt16(a[1]));
+      bus->serialInit(now, asInt16(a[0]), asInt16(a[1]));
       busTouched = true;
       return;
     case Lib::SER_SEND_Z1:
-      bus.serialSend(now, static_cast<uint16_t>(a[0]), static_cast<uint16_t>(a[1]));
+      bus->serialSend(now, static_cast<uint16_t>(a[0]), static_cast<uint16_t>(a[1]));
       busTouched = true;
       return;
     case Lib::HV_ENB:
-      bus.hvEnable(now);
+      bus->hvEnable(now);
       busTouched = true;
       return;
     case Lib::ABS: {
@@ -203,9 +203,9 @@ void Vm::State::libBegin() {
     case Lib::DELAYSEC:
     case Lib::DELAYTICKS: {
       // DelayTicks' interval is an unsigned int; the others' a long.
-      const uint32_t timer = id == Lib::DELAYMS    ? image.timer.ms
-                             : id == Lib::DELAYSEC ? image.timer.sec
-                                                   : image.timer.tick;
+      const uint32_t timer = id == Lib::DELAYMS    ? image->timer.ms
+                             : id == Lib::DELAYSEC ? image->timer.sec
+                                                   : image->timer.tick;
       const auto interval = static_cast<int32_t>(id == Lib::DELAYTICKS ? a[1] & 0xFFFF : a[1]);
       eval[sp++] = delayDone(a[0] & 0xFFFF, interval, timer, instructionPc) ? 1u : 0u;
       return;

@@ -56,6 +56,7 @@ struct LibCall {
   uint32_t remaining = 0;  // T-states still to burn (A/D, printf)
   uint32_t result = 0;
   std::string text;  // printf's formatted output
+  bool operator==(const LibCall&) const = default;
 };
 
 struct CallFrame {
@@ -63,6 +64,7 @@ struct CallFrame {
   uint32_t msp;
   uint32_t mfp;
   bool autoFrame = false;  // ENTER ran: RET also pops IX
+  bool operator==(const CallFrame&) const = default;
 };
 
 struct InterruptFrame {
@@ -75,6 +77,7 @@ struct InterruptFrame {
   bool halted;
   uint32_t burn;
   LibCall lib;
+  bool operator==(const InterruptFrame&) const = default;
 };
 
 inline float asFloat(uint32_t bits) { return std::bit_cast<float>(bits); }
@@ -133,10 +136,12 @@ inline int64_t truncToRange(float f, double lo, double hi) {
 using namespace detail;
 
 struct Vm::State {
-  State(const Image& img, Bus& b, const CostTable& c) : image(img), bus(b), costs(c) {}
+  State(const Image& img, Bus& b, const CostTable& c) : image(&img), bus(&b), costs(c) {}
 
-  const Image& image;
-  Bus& bus;
+  // Pointers, not references, so that a State is a value: a copy of a VM
+  // is a copy of its State pointed at the copy's bus.
+  const Image* image;
+  Bus* bus;
   CostTable costs;
   std::vector<uint8_t> mem = std::vector<uint8_t>(kMemorySize, 0);
   std::vector<uint32_t> eval = std::vector<uint32_t>(kEvalSlots, 0);
@@ -185,6 +190,7 @@ struct Vm::State {
     uint32_t cost;
     uint8_t op;
     uint8_t size;
+    bool operator==(const Fast&) const = default;
   };
   std::array<std::vector<Fast>, 2> fast;
   std::array<const void* const*, 2> fastLabels{};
@@ -246,6 +252,7 @@ struct Vm::State {
     // The cost of a pass in the constant-cost regime, once measured (0
     // until then): every pass there costs the same.
     Tick pass = 0;
+    bool operator==(const Loop&) const = default;
   };
   std::vector<Loop> loops;
   std::vector<int16_t> loopAtTop;  // per code byte: index into loops, or -1
@@ -258,6 +265,7 @@ struct Vm::State {
     uint64_t instructions = 0;
     uint64_t accepted = 0;
     std::array<uint64_t, kMaxLoopBytes> profile{};
+    bool operator==(const Measure&) const = default;
   } measure;
   uint64_t acceptances = 0;  // interrupts accepted so far (a pass with one is no measure)
   void findLoops();
@@ -265,11 +273,15 @@ struct Vm::State {
   Tick quietUntil() const;
   std::string consoleLine;
   Vm* self = nullptr;
+  // The machine at power-on at tick `start` (the constructor's and a
+  // reset's): image, bus and costs as they are.
+  void powerOn(Tick start);
+  bool operator==(const State&) const = default;
 
   // ---- faults and memory ----
   void raiseFault(std::string message, uint32_t atPc) {
     if (fault) return;
-    fault = Fault{std::move(message), now, image.lineAt(atPc)};
+    fault = Fault{std::move(message), now, image->lineAt(atPc)};
   }
   // Checks a pointer access of `size` bytes; false (and a fault) if invalid.
   bool checkAccess(uint32_t address, uint32_t size, uint32_t atPc) {
@@ -297,7 +309,7 @@ struct Vm::State {
   void emitConsole(std::string_view text) {
     for (char c : text) {
       if (c == '\n') {
-        bus.console(now, consoleLine);
+        bus->console(now, consoleLine);
         consoleLine.clear();
       } else {
         consoleLine.push_back(c);
@@ -306,7 +318,7 @@ struct Vm::State {
   }
   void flushConsole() {
     if (!consoleLine.empty()) {
-      bus.console(now, consoleLine);
+      bus->console(now, consoleLine);
       consoleLine.clear();
     }
   }
@@ -327,7 +339,7 @@ struct Vm::State {
   void timerService(uint32_t interruptedPc);
   // ---- costatements ----
   void costateEvent(uint32_t coData, Bus::CostateEvent kind, uint32_t atPc) {
-    if (costateEvents) bus.costate(now, static_cast<uint16_t>(coData), kind, image.lineAt(atPc));
+    if (costateEvents) bus->costate(now, static_cast<uint16_t>(coData), kind, image->lineAt(atPc));
   }
   // CoData's ChkSum: the XOR of the resume address's three bytes.
   static uint8_t coChecksum(uint32_t resume, uint8_t cbr) {

@@ -66,11 +66,11 @@ void Vm::State::accept() {
   }
   if (irq == Irq::SerialTx) {
     // The serial library's own ISR: short and atomic, leaves IFF1 set.
-    bus.interruptAccepted(now, irq, interruptedPc);
+    bus->interruptAccepted(now, irq, interruptedPc);
     now += costs.serialIsr;
     serialIsrCycles += costs.serialIsr;
-    bus.serialTxService(now, *self);
-    bus.interruptReturned(now, irq);
+    bus->serialTxService(now, *self);
+    bus->interruptReturned(now, irq);
     busTouched = true;
     return;
   }
@@ -97,8 +97,8 @@ void Vm::State::accept() {
   msp -= kInterruptFrameBytes;
   halted = false;
   iff1 = iff2 = false;
-  bus.interruptAccepted(now, irq, interruptedPc);
-  bus.iffChanged(now, false);
+  bus->interruptAccepted(now, irq, interruptedPc);
+  bus->iffChanged(now, false);
   now += costs.interruptAccept;
   if (profiling) profile[handler] += costs.interruptAccept;
   pc = static_cast<uint32_t>(handler);
@@ -108,8 +108,8 @@ void Vm::State::accept() {
 // library's ISR: interrupts stay disabled inside it and its EI; RETI leaves
 // IFF1 set as it was at acceptance.
 void Vm::State::timerService(uint32_t interruptedPc) {
-  bus.interruptAccepted(now, Irq::Timer, interruptedPc);
-  const TimerBlock& tb = image.timer;
+  bus->interruptAccepted(now, Irq::Timer, interruptedPc);
+  const TimerBlock& tb = image->timer;
   const uint32_t ticks = (tb.used() ? rd32(tb.tick) : biosTicks) + 1;
   const uint32_t fraction = (tb.used() ? rd8(tb.msFraction) : biosMsFraction) + kMsFractionStep;
   const bool msDue = fraction >= kMsFractionOne;
@@ -127,7 +127,7 @@ void Vm::State::timerService(uint32_t interruptedPc) {
   const uint32_t cost = costs.timerIsr[(msDue ? 0u : 1u) | (secDue ? 0u : 2u)];
   now += cost;
   timerIsrCycles += cost;
-  bus.interruptReturned(now, Irq::Timer);
+  bus->interruptReturned(now, Irq::Timer);
 }
 
 // ---- dispatch ---------------------------------------------------------------
@@ -163,7 +163,7 @@ void Vm::State::timerService(uint32_t interruptedPc) {
 // most kCodePad - 1 past its end.
 
 void Vm::State::decode() {
-  const auto& code = image.code;
+  const auto& code = image->code;
   const auto size = static_cast<uint32_t>(code.size());
   padded = code;
   padded.resize(size + kCodePad, 0);
@@ -300,7 +300,7 @@ Stop Vm::State::run(Tick until) {
   if (fault) return Stop::Fault;
   const uint8_t* const code = padded.data();
   const uint8_t* const xop = dispatch.data();
-  const uint32_t codeSize = static_cast<uint32_t>(image.code.size());
+  const uint32_t codeSize = static_cast<uint32_t>(image->code.size());
   const uint32_t* const opCost = costs.op.data();
   const int16_t* const loopTop =
       costs.knobs.fastForward && !loopAtTop.empty() ? loopAtTop.data() : nullptr;
@@ -1334,9 +1334,9 @@ L_Trap_ :
         lib = std::move(f.lib);
         const Irq irq = f.irq;
         ints.pop_back();
-        bus.interruptReturned(now, irq);
+        bus->interruptReturned(now, irq);
         // The epilogue's EI: IFF1 is set when the RETI after it ends.
-        if (costs.knobs.epilogueEi && !iff1) bus.iffChanged(now, true);
+        if (costs.knobs.epilogueEi && !iff1) bus->iffChanged(now, true);
         if (costs.knobs.epilogueEi) iff1 = iff2 = true;
         busTouched = true;
       }
@@ -1361,14 +1361,14 @@ L_Trap_ :
       SLOW;
       CASE(EI) {
         SAVE();
-        if (!iff1) bus.iffChanged(now, true);
+        if (!iff1) bus->iffChanged(now, true);
         iff1 = iff2 = true;
         eiShadow = true;
       }
       SLOW;
       CASE(DI) {
         SAVE();
-        if (iff1) bus.iffChanged(now, false);
+        if (iff1) bus->iffChanged(now, false);
         iff1 = iff2 = false;
       }
       SLOW;
@@ -1395,7 +1395,7 @@ L_Trap_ :
             raiseFault("costatement's resume address is corrupted (CoData checksum)", opPc);
             SLOW;
           }
-          if (!std::binary_search(image.resumePoints.begin(), image.resumePoints.end(),
+          if (!std::binary_search(image->resumePoints.begin(), image->resumePoints.end(),
                                   static_cast<uint16_t>(resume))) {
             raiseFault(fmt::format("costatement resumes at 0x{:04x}, not a yield point", resume),
                        opPc);
@@ -1457,30 +1457,83 @@ L_Trap_ :
 
 // ---- public interface ---------------------------------------------------
 
-Vm::Vm(const Image& image, Bus& bus, const CostTable& costs)
+Vm::Vm(const Image& image, Bus& bus, const CostTable& costs, Tick start)
     : s_(std::make_unique<State>(image, bus, costs)) {
-  State& s = *s_;
-  s.self = this;
-  std::copy(image.data.begin(), image.data.end(), s.mem.begin() + kDataBase);
-  s.stackLimit = kDataBase + static_cast<uint32_t>(image.data.size());
-  s.pc = image.entry;
-  s.handlerFor.fill(-1);
-  for (const auto& v : image.vectors) s.handlerFor[v.vector] = v.handler;
-  s.calls.reserve(kMemorySize / kCallFrameBytes);
-  s.ints.reserve(kMaxInterruptNesting);
+  s_->self = this;
+  s_->powerOn(start);
+}
+
+void Vm::State::powerOn(Tick start) {
+  std::copy(image->data.begin(), image->data.end(), mem.begin() + kDataBase);
+  stackLimit = kDataBase + static_cast<uint32_t>(image->data.size());
+  pc = image->entry;
+  now = start;
+  handlerFor.fill(-1);
+  for (const auto& v : image->vectors) handlerFor[v.vector] = v.handler;
+  calls.reserve(kMemorySize / kCallFrameBytes);
+  ints.reserve(kMaxInterruptNesting);
   const TimerService service = costs.knobs.timerService;
-  if (service == TimerService::Always || (service == TimerService::Auto && image.timer.used()))
-    s.nextTimer = kPrtTicks;
-  s.costateEvents = bus.wantCostateEvents();
-  s.findLoops();
-  s.decode();
+  if (service == TimerService::Always || (service == TimerService::Auto && image->timer.used()))
+    nextTimer = start + kPrtTicks;
+  costateEvents = bus->wantCostateEvents();
+  findLoops();
+  decode();
+}
+
+Vm::Vm(const Vm& other, Bus& bus) : s_(std::make_unique<State>(*other.s_)) {
+  s_->bus = &bus;
+  s_->self = this;
 }
 
 Vm::~Vm() = default;
 
+void Vm::restore(const Vm& snapshot) {
+  Bus* const bus = s_->bus;
+  *s_ = *snapshot.s_;
+  s_->bus = bus;
+  s_->self = this;
+}
+
+void Vm::reset(Tick t) {
+  const State& old = *s_;
+  auto fresh = std::make_unique<State>(*old.image, *old.bus, old.costs);
+  fresh->self = this;
+  fresh->powerOn(t);
+  fresh->stats = old.stats;
+  fresh->profiling = old.profiling;
+  fresh->profile = old.profile;
+  fresh->serialIsrCycles = old.serialIsrCycles;
+  fresh->timerIsrCycles = old.timerIsrCycles;
+  const std::vector<uint8_t> breakpoints = old.breakpoints;
+  s_ = std::move(fresh);
+  for (uint32_t a = 0; a < breakpoints.size(); ++a)
+    if (breakpoints[a]) setBreakpoint(a);
+}
+
+bool Vm::operator==(const Vm& other) const {
+  State mine = *s_;
+  mine.bus = other.s_->bus;
+  mine.self = other.s_->self;
+  return mine == *other.s_;
+}
+
+bool Vm::sameMachine(const Vm& other) const {
+  State mine = *s_;
+  mine.bus = other.s_->bus;
+  mine.self = other.s_->self;
+  mine.stats = other.s_->stats;
+  mine.profile = other.s_->profile;
+  mine.serialIsrCycles = other.s_->serialIsrCycles;
+  mine.timerIsrCycles = other.s_->timerIsrCycles;
+  // A delay loop's measured pass keeps the counters at its start.
+  mine.measure.instructions = other.s_->measure.instructions;
+  mine.measure.profile = other.s_->measure.profile;
+  return mine == *other.s_;
+}
+
 void Vm::fillMemory(const std::function<uint64_t()>& next) {
   State& s = *s_;
-  const auto& init = s.image.initialised;
+  const auto& init = s.image->initialised;
   uint64_t bits = 0;
   int left = 0;
   for (uint32_t a = kDataBase; a < kMemorySize; ++a) {
@@ -1517,18 +1570,18 @@ bool Vm::halted() const { return s_->halted; }
 const Fault* Vm::fault() const { return s_->fault ? &*s_->fault : nullptr; }
 bool Vm::interruptsEnabled() const { return s_->iff1; }
 uint32_t Vm::pc() const { return s_->lib.active ? s_->lib.pc : s_->burn ? s_->burnPc : s_->pc; }
-int Vm::line() const { return s_->image.lineAt(pc()); }
+int Vm::line() const { return s_->image->lineAt(pc()); }
 int Vm::interruptDepth() const { return static_cast<int>(s_->ints.size()); }
 uint8_t Vm::read8(uint16_t a) const { return s_->rd8(a); }
 void Vm::write8(uint16_t a, uint8_t v) { s_->wr8(a, v); }
 uint16_t Vm::read16(uint16_t a) const { return s_->rd16(a); }
 uint32_t Vm::read32(uint16_t a) const { return s_->rd32(a); }
 const VmStats& Vm::stats() const { return s_->stats; }
-const Image& Vm::image() const { return s_->image; }
+const Image& Vm::image() const { return *s_->image; }
 
 void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
   State& s = *s_;
-  if (s.breakpoints.empty()) s.breakpoints.assign(s.image.code.size() + 1, 0);
+  if (s.breakpoints.empty()) s.breakpoints.assign(s.image->code.size() + 1, 0);
   if (codeAddress < s.breakpoints.size()) {
     s.breakpoints[codeAddress] = enabled ? 1 : 0;
     s.dispatch[codeAddress] = enabled ? State::kTrap : s.baseDispatch[codeAddress];
@@ -1552,7 +1605,7 @@ void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
 
 void Vm::enableProfile() {
   s_->profiling = true;
-  s_->profile.assign(s_->image.code.size() + 1, 0);
+  s_->profile.assign(s_->image->code.size() + 1, 0);
 }
 const std::vector<uint64_t>& Vm::profile() const { return s_->profile; }
 uint64_t Vm::serialIsrCycles() const { return s_->serialIsrCycles; }

@@ -88,6 +88,7 @@ struct Fault {
   std::string message;
   Tick tick = 0;
   int line = 0;
+  bool operator==(const Fault&) const = default;
 };
 
 enum class Stop : uint8_t {
@@ -103,14 +104,33 @@ struct VmStats {
   // Of those, the ones fast-forward applied without dispatching them.
   uint64_t fastForwarded = 0;
   std::array<uint64_t, kIrqCount> interrupts{};
+  bool operator==(const VmStats&) const = default;
 };
 
 class Vm {
  public:
-  Vm(const Image& image, Bus& bus, const CostTable& costs);
+  // Powered on at tick `start` of the host's clock: the program at its
+  // entry, memory as the image initialises it, PRT0's first tick at
+  // start + kPrtTicks.
+  Vm(const Image& image, Bus& bus, const CostTable& costs, Tick start = 0);
   ~Vm();
+  // A VM is a value apart from the bus it talks to: a copy holds all of
+  // the other's state (memory, registers, stacks, pending requests, clock,
+  // breakpoints, counters) and talks to `bus`. Copied into another VM, or
+  // restored from a copy, it goes on byte for byte as the original would.
+  Vm(const Vm& other, Bus& bus);
   Vm(const Vm&) = delete;
   Vm& operator=(const Vm&) = delete;
+  // This VM takes `snapshot`'s state and keeps talking to its own bus.
+  void restore(const Vm& snapshot);
+  // The controller's reset at `t` (a reload): the machine as a VM powered
+  // on at t; its breakpoints, its profile switch and its counters (stats,
+  // profile, interrupt service cycles) carry on over the whole run.
+  void reset(Tick t);
+  // Same state: every part of the machine and the counters (the bus it
+  // talks to aside); sameMachine leaves the counters out.
+  bool operator==(const Vm& other) const;
+  bool sameMachine(const Vm& other) const;
 
   // Executes every instruction that starts before `until`. Returns early
   // after an instruction that touched the bus.
@@ -141,7 +161,8 @@ class Vm {
 
   // Power-on RAM from a random stream (a profile option, DESIGN.md): every
   // byte from kDataBase up that the image does not initialise is replaced,
-  // eight bytes per call of `next`, in address order. Before the first run().
+  // eight bytes per call of `next`, in address order. After power-on or
+  // reset(), before the next run().
   void fillMemory(const std::function<uint64_t()>& next);
 
   // Robot memory, for the host (serial ISR, tests, watches).
@@ -155,6 +176,7 @@ class Vm {
 
   // Stop before executing the instruction at `codeAddress` (used for
   // program-point injection and for tests). The next run() executes it.
+  // Breakpoints are kept across reset().
   void setBreakpoint(uint32_t codeAddress, bool enabled = true);
 
   // Profile: cycles charged at each code address (instruction start), when

@@ -1,0 +1,129 @@
+// A VM is a value apart from its bus: a copy taken at any tick goes on as
+// the original does, a restore from it replays the same run, and a reset
+// (a reload) is the machine of a VM powered on at that tick, with the
+// run's counters carried on. The programs are the thesis' ICEMAN (serial
+// frames, eye reads, fast-forwarded delay loops) and a costatement program
+// on the BIOS timer (PRT0's interrupt, TICK_TIMER).
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "support/test_host.h"
+#include "vm/bytecode.h"
+
+using namespace simbot;
+using testkit::TestHost;
+
+namespace {
+
+const vm::CostTable& costs() { return testkit::calibratedCosts(); }
+
+constexpr vm::Tick kSecond = vm::kTicksPerSecond;
+
+struct Program {
+  const char* name;
+  std::string path;
+};
+
+const Program kPrograms[] = {
+    {"iceman", SIMBOT_SHARED_DIR "/programs/iceman.dc"},
+    {"costate_hunter", SIMBOT_SOURCE_DIR "/programs/costate_hunter.dc"},
+};
+
+// What a host saw of a run: every port write, send and interrupt.
+void expectSameRun(const TestHost& a, const TestHost& b) {
+  ASSERT_EQ(a.outs.size(), b.outs.size());
+  for (size_t i = 0; i < a.outs.size(); ++i) {
+    EXPECT_EQ(a.outs[i].tick, b.outs[i].tick) << i;
+    EXPECT_EQ(a.outs[i].port, b.outs[i].port) << i;
+    EXPECT_EQ(a.outs[i].value, b.outs[i].value) << i;
+  }
+  EXPECT_EQ(a.sends, b.sends);
+  EXPECT_EQ(a.sentBytes, b.sentBytes);
+  ASSERT_EQ(a.events.size(), b.events.size());
+  for (size_t i = 0; i < a.events.size(); ++i) {
+    EXPECT_EQ(a.events[i].tick, b.events[i].tick) << i;
+    EXPECT_EQ(a.events[i].irq, b.events[i].irq) << i;
+  }
+}
+
+TEST(VmSnapshot, ACopyGoesOnAsTheOriginalAndARestoreReplaysIt) {
+  for (const Program& p : kPrograms) {
+    SCOPED_TRACE(p.name);
+    const vm::Image image = testkit::compileFileOrDie(p.path);
+    TestHost host;
+    vm::Vm v(image, host, costs());
+    host.runUntil(v, 3 * kSecond / 2);
+    ASSERT_EQ(v.fault(), nullptr);
+
+    // The snapshot: the VM and the host's own state (its pending requests).
+    TestHost savedHost = host;
+    const vm::Vm saved(v, savedHost);
+    EXPECT_TRUE(saved == v);
+
+    TestHost copyHost = host;
+    vm::Vm copy(v, copyHost);
+    host.runUntil(v, 4 * kSecond);
+    copyHost.runUntil(copy, 4 * kSecond);
+    EXPECT_TRUE(copy == v);
+    expectSameRun(host, copyHost);
+    // The run went on past the snapshot: it is a different state now.
+    EXPECT_FALSE(saved == v);
+    EXPECT_GT(host.events.size(), savedHost.events.size());
+
+    // Restore: back to the snapshot, and the same 2.5 s again.
+    const TestHost firstRun = host;
+    host = savedHost;
+    v.restore(saved);
+    EXPECT_TRUE(saved == v);
+    host.runUntil(v, 4 * kSecond);
+    EXPECT_TRUE(copy == v);
+    expectSameRun(host, firstRun);
+  }
+}
+
+TEST(VmReset, IsTheMachineOfAVmPoweredOnThenWithTheCountersCarriedOn) {
+  for (const Program& p : kPrograms) {
+    SCOPED_TRACE(p.name);
+    const vm::Image image = testkit::compileFileOrDie(p.path);
+    TestHost host;
+    vm::Vm v(image, host, costs());
+    v.enableProfile();
+    // Main's return, as the scheduler sets it (neither program returns).
+    const uint32_t mainReturn =
+        image.entry + static_cast<uint32_t>(vm::instructionSize(vm::Op::CALL));
+    v.setBreakpoint(mainReturn);
+    host.runUntil(v, kSecond);
+    const vm::Tick t = v.now();
+    const uint64_t instructions = v.stats().instructions;
+    ASSERT_GT(instructions, 0u);
+
+    v.reset(t);
+    TestHost freshHost;
+    vm::Vm fresh(image, freshHost, costs(), t);
+    fresh.enableProfile();
+    fresh.setBreakpoint(mainReturn);
+    EXPECT_EQ(v.now(), t);
+    EXPECT_TRUE(v.sameMachine(fresh));
+    // The counters are the whole run's.
+    EXPECT_FALSE(v == fresh);
+    EXPECT_EQ(v.stats().instructions, instructions);
+    // Powered on at another tick is another machine (the clock, PRT0).
+    TestHost otherHost;
+    vm::Vm atZero(image, otherHost, costs());
+    atZero.enableProfile();
+    atZero.setBreakpoint(mainReturn);
+    EXPECT_FALSE(v.sameMachine(atZero));
+
+    // From there both run alike; the reset one's counters are the sums.
+    TestHost resetHost;
+    vm::Vm reloaded(v, resetHost);
+    resetHost.runUntil(reloaded, t + 2 * kSecond);
+    freshHost.runUntil(fresh, t + 2 * kSecond);
+    EXPECT_TRUE(reloaded.sameMachine(fresh));
+    expectSameRun(resetHost, freshHost);
+    EXPECT_EQ(reloaded.stats().instructions, instructions + fresh.stats().instructions);
+  }
+}
+
+}  // namespace
