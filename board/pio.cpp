@@ -1,8 +1,9 @@
-#include "plant/pio.h"
+// board/pio.cpp -- the PIO's port A (pio.h).
+#include "board/pio.h"
 
-namespace simbot::plant {
+namespace simbot::board {
 
-void PioPortA::control(uint8_t word) {
+void Pio::control(uint8_t word) {
   switch (expect_) {
     case Expect::Direction:
       direction_ = word;
@@ -42,7 +43,7 @@ void PioPortA::control(uint8_t word) {
   }
 }
 
-bool PioPortA::condition() const {
+bool Pio::condition() const {
   if (mode_ != 3) return false;
   const uint8_t monitored = static_cast<uint8_t>(~mask_ & direction_);
   if (monitored == 0) return false;
@@ -51,7 +52,7 @@ bool PioPortA::condition() const {
   return andMode_ ? hits == monitored : hits != 0;
 }
 
-bool PioPortA::setInputs(uint8_t lines) {
+bool Pio::setInputs(uint8_t lines) {
   lines_ = lines;
   const bool now = condition();
   const bool rising = now && !lastCondition_;
@@ -64,15 +65,15 @@ bool PioPortA::setInputs(uint8_t lines) {
   return true;
 }
 
-bool PioPortA::returned() {
+bool Pio::returned() {
   inService_ = false;
   if (!heldRequest_) return false;
   heldRequest_ = false;
   return enabled_;
 }
 
-uint8_t PioPortA::read() const {
+uint8_t Pio::read() const {
   return static_cast<uint8_t>((lines_ & direction_) | (output_ & ~direction_));
 }
 
-}  // namespace simbot::plant
+}  // namespace simbot::board

@@ -1,4 +1,4 @@
-// The Z80 PIO's port A in mode 3 (bit control), as the course programs set it
+// board/pio.h -- the Z80 PIO's port A in mode 3 (bit control), as the course programs set it
 // up through its control port, and port B's output latch.
 //
 // Control words (Z80 PIO technical manual), written to the control port:
@@ -16,9 +16,9 @@
 #pragma once
 #include <cstdint>
 
-namespace simbot::plant {
+namespace simbot::board {
 
-class PioPortA {
+class Pio {
  public:
   // A byte written to the control port.
   void control(uint8_t word);
@@ -40,6 +40,8 @@ class PioPortA {
   int mode() const { return mode_; }
   bool condition() const;
 
+  bool operator==(const Pio&) const = default;
+
  private:
   enum class Expect : uint8_t { Any, Direction, Mask };
   int mode_ = 1;  // after reset: mode 1 (input), interrupts disabled
@@ -57,4 +59,4 @@ class PioPortA {
   bool heldRequest_ = false;
 };
 
-}  // namespace simbot::plant
+}  // namespace simbot::board

@@ -1,11 +1,12 @@
-#include "plant/serial_link.h"
+// board/serial_port.cpp -- the ASCI and the serial library (serial_port.h).
+#include "board/serial_port.h"
 
 #include <algorithm>
 
-namespace simbot::plant {
+namespace simbot::board {
 
-std::optional<OverwrittenSend> SerialLink::send(Tick t0, uint16_t buf, uint16_t ccAddress,
-                                                RobotMemory& memory) {
+std::optional<OverwrittenSend> SerialPort::send(Tick t0, uint16_t buf, uint16_t ccAddress,
+                                                Memory& memory) {
   std::optional<OverwrittenSend> overwritten;
   if (unfetched_ > 0) overwritten = OverwrittenSend{sentAt_, sentCount_, fetched_};
   pointer_ = buf;
@@ -19,12 +20,12 @@ std::optional<OverwrittenSend> SerialLink::send(Tick t0, uint16_t buf, uint16_t 
   return overwritten;
 }
 
-void SerialLink::service(Tick t, RobotMemory& memory) {
+void SerialPort::service(Tick t, Memory& memory) {
   fetch(t, memory);
   unfetched_ = memory.read8(ccAddress_);
 }
 
-void SerialLink::fetch(Tick t, RobotMemory& memory) {
+void SerialPort::fetch(Tick t, Memory& memory) {
   if (tdrFull_) return;
   const uint8_t count = memory.read8(ccAddress_);
   if (count == 0) {
@@ -38,21 +39,21 @@ void SerialLink::fetch(Tick t, RobotMemory& memory) {
   loadTdr(t, byte);
 }
 
-void SerialLink::loadTdr(Tick t, uint8_t byte) {
+void SerialPort::loadTdr(Tick t, uint8_t byte) {
   tdr_ = byte;
   tdrFull_ = true;
   tdrLoadedAt_ = t;
   if (!tsrBusy_) moveTdrToTsr(t);
 }
 
-void SerialLink::moveTdrToTsr(Tick t) {
+void SerialPort::moveTdrToTsr(Tick t) {
   tsr_ = tdr_;
   tdrFull_ = false;
   tsrBusy_ = true;
   tsrDoneAt_ = t + kTicksPerChar;
 }
 
-std::optional<ReceivedFrame> SerialLink::byteDone(Tick t) {
+std::optional<uint8_t> SerialPort::byteDone(Tick t) {
   if (!tsrBusy_ || t != tsrDoneAt_) return std::nullopt;
   tsrBusy_ = false;
   ++bytesSent_;
@@ -60,15 +61,7 @@ std::optional<ReceivedFrame> SerialLink::byteDone(Tick t) {
   // The host may learn of a load a little after the tick it happened at
   // (an ISR that ended past the horizon); the TSR takes it when it is there.
   if (tdrFull_) moveTdrToTsr(std::max(t, tdrLoadedAt_));
-  if (byte != 0) {
-    received_.push_back(static_cast<char>(byte));
-    return std::nullopt;
-  }
-  ReceivedFrame frame;
-  frame.bytes = received_.size() >= 8 ? received_.substr(received_.size() - 8) : received_;
-  if (received_.size() >= 8) frame.command = parseMotorFrame(frame.bytes);
-  received_.clear();
-  return frame;
+  return byte;
 }
 
-}  // namespace simbot::plant
+}  // namespace simbot::board

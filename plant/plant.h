@@ -216,6 +216,8 @@ class SplitMix64 final : public RandomBits {
  public:
   explicit SplitMix64(std::uint64_t seed) : s_(seed) {}
   std::uint64_t next() override;
+  // Same position in the same stream.
+  bool operator==(const SplitMix64& other) const { return s_ == other.s_; }
 
  private:
   std::uint64_t s_;

@@ -106,65 +106,48 @@ plant::ArenaConfig arenaConfigFor(const MatchConfig& config) {
 
 // ---- robot ------------------------------------------------------------------
 
-Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs_, uint64_t seed)
+namespace {
+
+// The match's cost table with this robot's controller's settings (profile
+// [controller]): its timer service, and fast-forward unless it turns it off.
+vm::CostTable robotCosts(const vm::CostTable& costs, const plant::RobotParams& params) {
+  vm::CostTable table = costs;
+  table.knobs.timerService = static_cast<vm::TimerService>(params.timer_service);
+  table.knobs.fastForward = costs.knobs.fastForward && params.fast_forward;
+  return table;
+}
+
+}  // namespace
+
+Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs, uint64_t seed)
     : spec(s),
       index(i),
       match(m),
-      costs(costs_),
-      bus(*this),
-      memoryFill(streamSeed(seed, "memory-fill-" + s.name)),
-      noise(streamSeed(seed, "eye-noise-" + s.name)),
-      gunLuck(streamSeed(seed, "gun-" + s.name)),
-      muzzle(streamSeed(seed, "muzzle-" + s.name)),
+      board(s.image, *this, robotCosts(costs, m.robotParams(i)),
+            board::StreamSeeds{
+                streamSeed(seed, "memory-fill-" + s.name), streamSeed(seed, "eye-noise-" + s.name),
+                streamSeed(seed, "gun-" + s.name), streamSeed(seed, "muzzle-" + s.name)},
+            m.robotParams(i).random_memory),
       mainReturn(s.image.entry + static_cast<uint32_t>(vm::instructionSize(vm::Op::CALL))) {
   result.name = s.name;
   result.program = s.program;
-  powerOn(0);
-}
-
-void Robot::powerOn(Tick t) {
-  bus.base = t;
-  // The timer service is this robot's controller's (profile [controller]).
-  vm::CostTable table = costs;
-  table.knobs.timerService = static_cast<vm::TimerService>(match.robotParams(index).timer_service);
-  table.knobs.fastForward = costs.knobs.fastForward && match.robotParams(index).fast_forward;
-  vm_ = std::make_unique<vm::Vm>(spec.image, bus, table);
-  faultSeen = false;
-  vm_->setBreakpoint(mainReturn);
-  for (const auto& [address, injections] : lineInjections) vm_->setBreakpoint(address);
-  if (match.profiling()) vm_->enableProfile();
-  // A reload draws the next bytes of the same stream: RAM after a power
-  // cycle holds new garbage, not the same.
-  if (match.robotParams(index).random_memory) vm_->fillMemory([this] { return memoryFill.next(); });
+  board.cpu.setBreakpoint(mainReturn);
+  if (match.profiling()) board.cpu.enableProfile();
 }
 
 void Robot::reload(Tick t) {
   reloadPending = false;
-  if (match.profiling()) {
-    const auto& p = vm_->profile();
-    earlierProfile.resize(std::max(earlierProfile.size(), p.size()));
-    for (size_t a = 0; a < p.size(); ++a) earlierProfile[a] += p[a];
-    earlierSerialIsrCycles += vm_->serialIsrCycles();
-    earlierTimerIsrCycles += vm_->timerIsrCycles();
-    earlierInstructions += vm_->stats().instructions;
-    earlierFastForwarded += vm_->stats().fastForwarded;
-  }
-  powerOn(t);
+  // The delay is long enough that no byte is left in the port. The VM
+  // keeps its breakpoints (main's return, the injections) and counters.
+  board.reset(t);
+  faultSeen = false;
   ++result.reloads;
   result.exited = false;
-  // The controller's reset clears the Z180's serial port, the library and
-  // the PIO (unarmed: no edge interrupt until the program arms it again);
-  // the delay is long enough that no byte is left in the port. The motor
-  // controller keeps its latched command; the receiver's partial frame is
-  // dropped with the link's state (a fragment from before the crash never
-  // joins the reloaded program's frames).
-  if (!link.idle()) throw std::logic_error("a reload with bytes still in the serial port");
-  link = plant::SerialLink{};
+  // The motor controller keeps its latched command; the receiver's partial
+  // frame is dropped (a fragment from before the crash never joins the
+  // reloaded program's frames).
+  receiver.clear();
   serialEventAt = -1;
-  pio = plant::PioPortA{};
-  // The reset PIO sees the lines as they are; unarmed, it raises nothing.
-  if (pio.setInputs(edgeLines)) throw std::logic_error("an unarmed PIO raised an interrupt");
-  enb485 = -1;
   // Samples up to t were taken from the faulted VM: the new one's start at
   // the next sample tick.
   snapshots.clear();
@@ -178,11 +161,10 @@ void Robot::runTo(Tick horizon) {
   for (;;) {
     if (tracing) takeSnapshots();
     if (now() >= horizon) return;
-    const vm::Stop stop =
-        vm_->run((tracing ? std::min(horizon, nextSnapshot) : horizon) - bus.base);
+    const vm::Stop stop = board.cpu.run(tracing ? std::min(horizon, nextSnapshot) : horizon);
     if (stop == vm::Stop::Fault) {
-      const vm::Fault* f = vm_->fault();
-      const Tick at = bus.base + f->tick;
+      const vm::Fault* f = board.cpu.fault();
+      const Tick at = f->tick;
       if (!faultSeen) {
         faultSeen = true;
         FaultInfo info{f->message, timebase::secondsFromTicks(at), f->line};
@@ -194,13 +176,13 @@ void Robot::runTo(Tick horizon) {
       return;
     }
     if (stop != vm::Stop::Breakpoint) continue;
-    if (vm_->pc() == mainReturn) {
+    if (board.cpu.pc() == mainReturn) {
       result.exited = true;
       result.exitTick = now();
       if (tracing) match.emit(now(), trace::rec::Exit{index});
     }
-    if (auto it = lineInjections.find(vm_->pc()); it != lineInjections.end()) {
-      const int hit = ++lineHits[vm_->pc()];
+    if (auto it = lineInjections.find(board.cpu.pc()); it != lineInjections.end()) {
+      const int hit = ++lineHits[board.cpu.pc()];
       for (int k : it->second)
         if (match.injection(k).count == hit) inject(now(), match.injection(k));
     }
@@ -211,8 +193,9 @@ void Robot::runTo(Tick horizon) {
 // reached: it was stopped there (runTo), or it idled there (halted).
 void Robot::takeSnapshots() {
   while (nextSnapshot <= now()) {
-    snapshots.push_back(Snapshot{nextSnapshot, vm_->line(), spec.image.functionAt(vm_->pc()),
-                                 vm_->interruptDepth() > 0, watchedValues()});
+    snapshots.push_back(Snapshot{nextSnapshot, board.cpu.line(),
+                                 spec.image.functionAt(board.cpu.pc()),
+                                 board.cpu.interruptDepth() > 0, watchedValues()});
     nextSnapshot += match.sampleInterval();
   }
 }
@@ -221,8 +204,8 @@ void Robot::takeSnapshots() {
 Robot::Snapshot Robot::snapshotFor(Tick t) {
   while (!snapshots.empty() && snapshots.front().tick < t) snapshots.pop_front();
   if (!snapshots.empty() && snapshots.front().tick == t) return snapshots.front();
-  const uint32_t pc = vm_->pc();
-  return Snapshot{t, vm_->fault() ? vm_->fault()->line : spec.image.lineAt(pc),
+  const uint32_t pc = board.cpu.pc();
+  return Snapshot{t, board.cpu.fault() ? board.cpu.fault()->line : spec.image.lineAt(pc),
                   spec.image.functionAt(pc), false, watchedValues()};
 }
 
@@ -406,8 +389,8 @@ void Match::applyInputs() {
     const plant::EventList immediate = [&] {
       const PartScope plant(clock_, PartClock::Plant);
       return arena_.setPortB(w.robot, w.value, w.tick,
-                             &robots_[static_cast<size_t>(w.robot)]->gunLuck,
-                             &robots_[static_cast<size_t>(w.robot)]->muzzle);
+                             &robots_[static_cast<size_t>(w.robot)]->board.gunLuck,
+                             &robots_[static_cast<size_t>(w.robot)]->board.muzzle);
     }();
     for (const auto& e : immediate) {
       if (config_.observer) config_.observer->onPlantEvent(w.tick, e);
@@ -483,9 +466,9 @@ void Match::handlePlantEvents(Tick t, const plant::EventList& events) {
       // Fore detector on port A bit 1, aft on bit 0; low within range.
       const uint8_t bit = e.detector == plant::Detector::Fore ? 0x02 : 0x01;
       if (e.kind == plant::EventKind::EdgeEnter)
-        r.plantLow |= bit;
+        r.board.plantLow |= bit;
       else
-        r.plantLow &= static_cast<uint8_t>(~bit);
+        r.board.plantLow &= static_cast<uint8_t>(~bit);
       // The plant's record first, then the port's (in emission order).
       if (trace_.on()) emit(t, plantRecord(e));
       r.updateEdgeLines(t);
@@ -554,7 +537,7 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
       // Not past a NUL that may latch new wheel speeds: the steps beyond it
       // would be thrown away (measured: they cost what the rounds save).
       for (const auto& r : robots_)
-        if (const auto nul = r->link.nulDone()) plantStop = std::min(plantStop, *nul);
+        if (const auto nul = r->board.serial.nulDone()) plantStop = std::min(plantStop, *nul);
     }
     // (Lambdas, here and below, so that the results are built in place.)
     plant::AdvanceResult step = [&] {
@@ -611,7 +594,7 @@ void Match::rounds(MatchResult& result, Tick& roundStart) {
           break;
         case QueuedEvent::Kind::ReleaseEdge: {
           Robot& r = *robots_[static_cast<size_t>(entry.payload.robot)];
-          r.injectedLow &= static_cast<uint8_t>(~entry.payload.index);
+          r.board.injectedLow &= static_cast<uint8_t>(~entry.payload.index);
           r.updateEdgeLines(horizon);
           break;
         }
@@ -679,17 +662,16 @@ void Match::finish(MatchResult& result) {
     // one instruction past the end.
     rr.cycles = static_cast<uint64_t>(rr.exited ? rr.exitTick : std::min(r->now(), result.endTick));
     rr.vmClock = static_cast<uint64_t>(r->now());
-    rr.vmInstructions = r->vm().stats().instructions + r->earlierInstructions;
-    rr.vmFastForwarded = r->vm().stats().fastForwarded + r->earlierFastForwarded;
+    rr.vmInstructions = r->vm().stats().instructions;
+    rr.vmFastForwarded = r->vm().stats().fastForwarded;
     if (config_.profile) {
       rr.profile = r->vm().profile();
-      rr.profile.resize(std::max(rr.profile.size(), r->earlierProfile.size()));
-      for (size_t a = 0; a < r->earlierProfile.size(); ++a) rr.profile[a] += r->earlierProfile[a];
-      rr.serialIsrCycles = r->vm().serialIsrCycles() + r->earlierSerialIsrCycles;
-      rr.timerIsrCycles = r->vm().timerIsrCycles() + r->earlierTimerIsrCycles;
+      rr.serialIsrCycles = r->vm().serialIsrCycles();
+      rr.timerIsrCycles = r->vm().timerIsrCycles();
     }
     for (vm::Irq irq : {vm::Irq::Pio, vm::Irq::Timer, vm::Irq::SerialTx})
-      rr.interrupts[std::string(vm::irqName(irq))] += r->interruptCounts[static_cast<size_t>(irq)];
+      rr.interrupts[std::string(vm::irqName(irq))] +=
+          r->board.interruptCounts[static_cast<size_t>(irq)];
     // After a plant fault the plant answers only from its last re-initialisation.
     rr.finalPose =
         arena_.pose(r->index, std::clamp(result.endTick, arena_.lastReinitTick(), arena_.now()));

@@ -19,19 +19,19 @@
 #include <string>
 #include <vector>
 
-#include "plant/pio.h"
-#include "plant/serial_link.h"
+#include "board/board.h"
+#include "plant/motor_receiver.h"
 #include "scheduler/event_queue.h"
 #include "scheduler/match.h"
 #include "scheduler/part_clock.h"
 
 namespace simbot::scheduler::detail {
 
-constexpr Tick kLookahead = plant::kTicksPerChar;
+constexpr Tick kLookahead = timebase::kTicksPerChar;
 // How far the plant integrates ahead in one round (header comment, "Larger
 // rounds"): eight character times. Integration past an input's tick is
 // thrown away at the input, so this bounds the work wasted per input.
-constexpr Tick kRoundLookahead = 8 * plant::kTicksPerChar;
+constexpr Tick kRoundLookahead = 8 * timebase::kTicksPerChar;
 
 // Queued events; the plant's own events come from Arena::advance.
 struct QueuedEvent {
@@ -59,50 +59,20 @@ class Match;
 // purpose, robot): the hand placement, then each robot's wheel trims.
 plant::ArenaConfig arenaConfigFor(const MatchConfig& config);
 
-// A VM's clock starts at 0 when it is made; a VM made for a reload starts
-// at tick `base` of the match, so every tick it reports is moved by `base`.
-class ShiftedBus : public vm::Bus {
- public:
-  explicit ShiftedBus(vm::Bus& to) : to_(to) {}
-  Tick base = 0;
-  void out(Tick t, uint16_t port, uint8_t value) override { to_.out(t + base, port, value); }
-  uint8_t in(Tick t, uint16_t port) override { return to_.in(t + base, port); }
-  int adSample(Tick t, int channel) override { return to_.adSample(t + base, channel); }
-  void hvEnable(Tick t) override { to_.hvEnable(t + base); }
-  void serialInit(Tick t, int mode, int divisor) override {
-    to_.serialInit(t + base, mode, divisor);
-  }
-  void serialSend(Tick t, uint16_t buf, uint16_t cc) override { to_.serialSend(t + base, buf, cc); }
-  void serialTxService(Tick t, vm::Vm& v) override { to_.serialTxService(t + base, v); }
-  void console(Tick t, std::string_view line) override { to_.console(t + base, line); }
-  void interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) override {
-    to_.interruptAccepted(t + base, irq, pc);
-  }
-  void interruptReturned(Tick t, vm::Irq irq) override { to_.interruptReturned(t + base, irq); }
-  void iffChanged(Tick t, bool iff1) override { to_.iffChanged(t + base, iff1); }
-  bool wantCostateEvents() const override { return to_.wantCostateEvents(); }
-  void costate(Tick t, uint16_t coData, CostateEvent e, int line) override {
-    to_.costate(t + base, coData, e, line);
-  }
-
- private:
-  vm::Bus& to_;
-};
-
-// One robot: its VM, the devices its program talks to, and its counters.
-class Robot : public vm::Bus, public plant::RobotMemory {
+// One robot: its board (the VM, the devices its program talks to, its
+// counters), the motor controller's receiver, and what the match keeps of
+// it (injections, watches, samples, its result). Robot is the board's bus.
+class Robot : public vm::Bus {
  public:
   Robot(Match& match, int index, const RobotSpec& spec, const vm::CostTable& costs, uint64_t seed);
 
   // The robot's clock (match ticks) and its program's VM.
-  Tick now() const { return bus.base + vm_->now(); }
-  Tick quietUntil() const { return bus.base + vm_->quietUntil(); }
-  vm::Vm& vm() { return *vm_; }
-  const vm::Vm& vm() const { return *vm_; }
-  // A VM as at load, its clock at t: fresh memory (with the profile's
-  // power-on fill), the breakpoints the match needs.
-  void powerOn(Tick t);
-  // --reload-on-fault: the faulted program starts again at t.
+  Tick now() const { return board.cpu.now(); }
+  Tick quietUntil() const { return board.cpu.quietUntil(); }
+  vm::Vm& vm() { return board.cpu; }
+  const vm::Vm& vm() const { return board.cpu; }
+  // --reload-on-fault: the controller's reset at t; the faulted program
+  // starts again.
   void reload(Tick t);
   bool reloadPending = false;
   bool faultSeen = false;  // this VM's fault is recorded
@@ -119,9 +89,6 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   void iffChanged(Tick t, bool iff1) override;
   bool wantCostateEvents() const override;
   void costate(Tick t, uint16_t coData, CostateEvent e, int line) override;
-  // plant::RobotMemory
-  uint8_t read8(uint16_t a) const override { return vm_->read8(a); }
-  void write8(uint16_t a, uint8_t v) override { vm_->write8(a, v); }
 
   // Runs the VM to `horizon` (its clock ends at or after it).
   void runTo(Tick horizon);
@@ -129,7 +96,6 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   // Port A's edge lines: low while the plant says so or an injection holds.
   void updateEdgeLines(Tick t);
   void inject(Tick t, const Injection& injection);
-  uint8_t plantLow = 0, injectedLow = 0;
   std::map<uint32_t, std::vector<int>> lineInjections;  // code address -> injections
   // Executions of each injection point, over the whole run (a reload does
   // not restart the count).
@@ -142,7 +108,6 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   std::vector<Watch> watches;
   trace::Watch watchedValues() const;
   void scheduleSerial(Tick t);
-  void updateSerialRequest();
 
   // Where the program was at each sample tick (traced runs): taken at the
   // VM's first instruction boundary at or after the tick.
@@ -162,29 +127,11 @@ class Robot : public vm::Bus, public plant::RobotMemory {
   const RobotSpec& spec;
   int index;
   Match& match;
-  const vm::CostTable& costs;
-  ShiftedBus bus;
-  std::unique_ptr<vm::Vm> vm_;
-  plant::SplitMix64 memoryFill;  // power-on RAM (profile random_memory)
-  // T-states of earlier VMs of this robot (reloads), for profiles.
-  std::vector<uint64_t> earlierProfile;
-  uint64_t earlierSerialIsrCycles = 0;
-  uint64_t earlierTimerIsrCycles = 0;
-  uint64_t earlierInstructions = 0, earlierFastForwarded = 0;
-  plant::SerialLink link;
-  plant::PioPortA pio;
-  uint8_t edgeLines = 0xFF;
-  int enb485 = -1;  // never written
-  std::array<int64_t, 2> adReads{};
-  // Interrupts accepted per source (vm::Irq), over the whole run; put into
-  // the result's map by name at the end, so counting one allocates nothing.
-  std::array<uint64_t, vm::kIrqCount> interruptCounts{};
-  std::array<int, 2> lastAdValue{-1, -1};
+  // Its clock is the match's; a reload resets it.
+  board::Board board;
+  plant::MotorReceiver receiver;
   Tick serialEventAt = -1;
   Tick serialIsrAccepted = 0;
-  plant::SplitMix64 noise;
-  plant::SplitMix64 gunLuck;  // jams and misfires
-  plant::SplitMix64 muzzle;   // muzzle-speed spread, one draw per launching stroke
   RobotResult result;
   uint32_t mainReturn;
 };

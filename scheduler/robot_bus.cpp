@@ -17,18 +17,18 @@ namespace simbot::scheduler::detail {
 void Robot::out(Tick t, uint16_t port, uint8_t value) {
   switch (port) {
     case vm::kPortPIOCA:
-      pio.control(value);
+      board.pio.control(value);
       return;
     case vm::kPortPIODA:
-      pio.writeData(value);
+      board.pio.writeData(value);
       return;
     case vm::kPortPIODB:
       match.inputs().push_back({t, index, PlantInput::Kind::PortB, value, plant::Bumper::Front});
       if (match.tracing()) match.emit(t, trace::rec::PortB{index, value});
       return;
     case vm::kPortENB485:
-      if (match.tracing() && value != enb485) match.emit(t, trace::rec::Rs485{index, value});
-      enb485 = value;
+      if (match.tracing() && value != board.enb485) match.emit(t, trace::rec::Rs485{index, value});
+      board.enb485 = value;
       return;
     default:
       return;  // PIOCB set-up and unknown ports have no effect here
@@ -36,7 +36,7 @@ void Robot::out(Tick t, uint16_t port, uint8_t value) {
 }
 
 uint8_t Robot::in(Tick, uint16_t port) {
-  if (port == vm::kPortPIODA) return pio.read();
+  if (port == vm::kPortPIODA) return board.pio.read();
   return 0xFF;
 }
 
@@ -47,62 +47,56 @@ int Robot::adSample(Tick t, int channel) {
                                                   : plant::EyeChannels::Both;
   const plant::EyeReadings e = [&] {
     const PartScope plant(match.clock(), PartClock::Plant);
-    return match.arena().eyeReadings(index, t, &noise, asked);
+    return match.arena().eyeReadings(index, t, &board.eyeNoise, asked);
   }();
   const int value = channel == 0 ? e.left : channel == 1 ? e.right : 0;
   if (match.observer()) match.observer()->onEyeRead(index, t, channel, value);
   if (channel == 0 || channel == 1) {
     // Traced as a step when it differs: a search loop reads thousands a second.
     const auto c = static_cast<size_t>(channel);
-    ++adReads[c];
-    if (match.tracing() && value != lastAdValue[c])
-      match.emit(t, trace::rec::AdRead{index, channel, value, adReads[c]});
-    lastAdValue[c] = value;
+    ++board.adReads[c];
+    if (match.tracing() && value != board.lastAdValue[c])
+      match.emit(t, trace::rec::AdRead{index, channel, value, board.adReads[c]});
+    board.lastAdValue[c] = value;
   }
   return value;
 }
 
 void Robot::serialSend(Tick t, uint16_t buf, uint16_t cc) {
-  if (match.tracing()) match.emit(t, trace::rec::SerialSend{index, vm_->read8(cc)});
-  if (const auto overwritten = link.send(t, buf, cc, *this)) {
+  if (match.tracing()) match.emit(t, trace::rec::SerialSend{index, board.cpu.read8(cc)});
+  if (const auto overwritten = board.serialSend(t, buf, cc)) {
     ++result.framesOverwritten;
     if (match.tracing())
       match.emit(t, trace::rec::FrameOverwritten{index, overwritten->sentAt, overwritten->count,
                                                  overwritten->fetched});
   }
   scheduleSerial(t);
-  updateSerialRequest();
 }
 
 void Robot::serialTxService(Tick t, vm::Vm&) {
-  link.service(t, *this);
+  board.serialService(t);
   scheduleSerial(t);
-  updateSerialRequest();
 }
 
 // A byte that entered the shift register is on the wire for one character
 // time, ending at nextByteDone().
 void Robot::scheduleSerial(Tick) {
-  const auto done = link.nextByteDone();
+  const auto done = board.serial.nextByteDone();
   if (done && *done != serialEventAt) {
     serialEventAt = *done;
     if (match.tracing())
-      match.emit(*done - plant::kTicksPerChar, trace::rec::SerialByte{index, link.shifting()});
+      match.emit(*done - timebase::kTicksPerChar,
+                 trace::rec::SerialByte{index, board.serial.shifting()});
     match.queue().schedule(*done, EventClass::SerialByte,
                            {QueuedEvent::Kind::SerialByte, index, 0});
   }
 }
 
-void Robot::updateSerialRequest() {
-  if (link.requestingInterrupt())
-    vm_->request(vm::Irq::SerialTx);
-  else
-    vm_->cancelRequest(vm::Irq::SerialTx);
-}
-
+// The byte's stop bit ended at t: the motor controller has received it.
 void Robot::byteDone(Tick t) {
   serialEventAt = -1;
-  if (auto frame = link.byteDone(t)) {
+  const std::optional<uint8_t> byte = board.serialByteDone(t);
+  if (const auto frame = byte ? receiver.receive(*byte) : std::nullopt) {
     if (match.observer()) match.observer()->onFrame(index, t, frame->command.has_value());
     if (frame->command) {
       ++result.framesLatched;
@@ -119,7 +113,6 @@ void Robot::byteDone(Tick t) {
     }
   }
   scheduleSerial(t);
-  updateSerialRequest();
 }
 
 // Each watched variable's value as its C type reads it (the compiler's
@@ -131,23 +124,23 @@ trace::Watch Robot::watchedValues() const {
     trace::WatchValue v;
     switch (w.value) {
       case V::Char:
-        v = std::int64_t{vm_->read8(w.address)};
+        v = std::int64_t{board.cpu.read8(w.address)};
         break;
       case V::Int:
-        v = std::int64_t{static_cast<int16_t>(vm_->read16(w.address))};
+        v = std::int64_t{static_cast<int16_t>(board.cpu.read16(w.address))};
         break;
       case V::UInt:
       case V::Pointer:
-        v = std::int64_t{vm_->read16(w.address)};
+        v = std::int64_t{board.cpu.read16(w.address)};
         break;
       case V::Long:
-        v = std::int64_t{static_cast<int32_t>(vm_->read32(w.address))};
+        v = std::int64_t{static_cast<int32_t>(board.cpu.read32(w.address))};
         break;
       case V::ULong:
-        v = std::int64_t{vm_->read32(w.address)};
+        v = std::int64_t{board.cpu.read32(w.address)};
         break;
       case V::Float:
-        v = static_cast<double>(std::bit_cast<float>(vm_->read32(w.address)));
+        v = static_cast<double>(std::bit_cast<float>(board.cpu.read32(w.address)));
         break;
       case V::Aggregate:
       case V::Code:
@@ -159,20 +152,19 @@ trace::Watch Robot::watchedValues() const {
 }
 
 void Robot::updateEdgeLines(Tick t) {
-  const auto lines = static_cast<uint8_t>(~(plantLow | injectedLow));
-  if (lines != edgeLines && match.tracing()) match.emit(t, trace::rec::PortA{index, lines});
-  edgeLines = lines;
-  if (pio.setInputs(edgeLines)) vm_->request(vm::Irq::Pio, pio.vector());
+  if (board.updateEdgeLines() && match.tracing())
+    match.emit(t, trace::rec::PortA{index, board.edgeLines});
 }
 
 void Robot::inject(Tick t, const Injection& injection) {
   match.fired(injection);
-  if (match.tracing()) match.emit(t, trace::rec::Injection{index, injection.text, vm_->line()});
+  if (match.tracing())
+    match.emit(t, trace::rec::Injection{index, injection.text, board.cpu.line()});
   switch (injection.source) {
     case InjectSource::EdgeFore:
     case InjectSource::EdgeAft: {
       const uint8_t bit = injection.source == InjectSource::EdgeFore ? 0x02 : 0x01;
-      injectedLow |= bit;
+      board.injectedLow |= bit;
       updateEdgeLines(t);
       match.queue().schedule(t + kInjectedEdgePulse, EventClass::Injection,
                              {QueuedEvent::Kind::ReleaseEdge, index, bit});
@@ -202,15 +194,15 @@ void Robot::console(Tick t, std::string_view line) {
 // The #INT_VEC handler the PIO's vector selects.
 std::string Robot::handlerName() const {
   for (const auto& v : spec.image.vectors)
-    if (v.vector == pio.vector()) return v.handlerName;
+    if (v.vector == board.pio.vector()) return v.handlerName;
   return "";
 }
 
 void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
-  ++interruptCounts[static_cast<size_t>(irq)];
+  ++board.interruptCounts[static_cast<size_t>(irq)];
   if (match.observer()) match.observer()->onInterruptAccepted(index, t, irq);
   if (irq == vm::Irq::Pio) {
-    pio.accepted();
+    board.pio.accepted();
     match.inputs().push_back({t, index, PlantInput::Kind::EdgeHandler, 0, plant::Bumper::Front});
   }
   // The BIOS timer service (1,024 a second) is counted, not traced.
@@ -233,7 +225,7 @@ void Robot::interruptReturned(Tick t, vm::Irq irq) {
   if (irq != vm::Irq::Pio) return;
   if (match.tracing())
     match.emit(t, trace::rec::InterruptReturned{index, std::string(vm::irqName(irq))});
-  if (pio.returned()) vm_->request(vm::Irq::Pio, pio.vector());
+  board.pioReturned();
 }
 
 void Robot::iffChanged(Tick t, bool iff1) {

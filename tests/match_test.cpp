@@ -13,7 +13,6 @@
 
 #include "compiler/compiler.h"
 #include "plant/plant.h"
-#include "plant/serial_link.h"
 #include "support/records.h"
 #include "support/traced.h"
 
@@ -499,7 +498,7 @@ main()
     // EI that lets it in, later in the round.
     const timebase::Tick injected = timebase::ticksFromSeconds(1.2 * static_cast<double>(k + 1));
     EXPECT_GT(accepted[k].first - injected, 100) << k;
-    EXPECT_LT(accepted[k].first - injected, plant::kTicksPerChar) << k;
+    EXPECT_LT(accepted[k].first - injected, timebase::kTicksPerChar) << k;
   }
   ASSERT_EQ(turns.size(), 1u);
   EXPECT_EQ(turns[0].first, accepted[5].first);
@@ -575,7 +574,7 @@ TEST(Match, IcemanAgainstFig92For180SecondsPinsItsKeyFigures) {
   EXPECT_EQ(static_cast<int>(launches.size()), r.robots[0].shots);
   // The oracle: T0 summed by hand above, the latch 9 characters later.
   EXPECT_EQ(sends[0].first, 19'705'410);
-  EXPECT_EQ(frames[0].first - sends[0].first, 9 * plant::kTicksPerChar);
+  EXPECT_EQ(frames[0].first - sends[0].first, 9 * timebase::kTicksPerChar);
   EXPECT_EQ(frames[0].first, 19'791'810);
   EXPECT_EQ(frames[0].second.bytes, "cfgrcfgr");
   // Regression values: the first fire()'s solenoids (port B 0x30, both

@@ -1,19 +1,23 @@
-// The discrete devices: the serial link (double-buffered ASCI, Dynamic C's
-// interrupt-driven send, the motor controller's framing) and the Z80 PIO's
-// port A in mode 3.
+// The board's devices: the serial port (double-buffered ASCI, Dynamic C's
+// interrupt-driven send) with the plant's motor controller receiving its
+// bytes (framing), and the Z80 PIO's port A in mode 3.
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cstring>
+#include <optional>
 
-#include "plant/pio.h"
-#include "plant/serial_link.h"
+#include "board/pio.h"
+#include "board/serial_port.h"
+#include "plant/motor_receiver.h"
 
-using namespace simbot::plant;
+using namespace simbot::board;
+using simbot::plant::MotorReceiver;
+using simbot::plant::ReceivedFrame;
 
 namespace {
 
-class Memory : public RobotMemory {
+class TestMemory : public Memory {
  public:
   std::array<uint8_t, 65536> bytes{};
   uint8_t read8(uint16_t a) const override { return bytes[a]; }
@@ -25,16 +29,17 @@ constexpr uint16_t kBuf = 0x200, kCc = 0x300;
 
 // Drives a link with an ISR that runs `latency` ticks after each request.
 struct Driver {
-  SerialLink link;
-  Memory mem;
+  SerialPort link;
+  MotorReceiver receiver;
+  TestMemory mem;
   std::vector<std::pair<Tick, ReceivedFrame>> frames;
   Tick latency = 50;
   bool interruptsEnabled = true;
 
-  void send(Tick t0, const char* text, uint8_t count) {
+  std::optional<OverwrittenSend> send(Tick t0, const char* text, uint8_t count) {
     mem.put(kBuf, text);
     mem.bytes[kCc] = count;
-    link.send(t0, kBuf, kCc, mem);
+    return link.send(t0, kBuf, kCc, mem);
   }
   // Runs until `end`, servicing requests and finishing bytes in tick order.
   void runUntil(Tick end, Tick from) {
@@ -48,12 +53,12 @@ struct Driver {
       auto done = link.nextByteDone();
       if (!done || *done > end) break;
       t = *done;
-      if (auto f = link.byteDone(t)) frames.emplace_back(t, *f);
+      if (auto f = receiver.receive(*link.byteDone(t))) frames.emplace_back(t, *f);
     }
   }
 };
 
-TEST(SerialLink, PlatformLatchesNineCharactersAfterT0) {
+TEST(SerialPort, PlatformLatchesNineCharactersAfterT0) {
   Driver d;
   d.send(1000, "4fgr4rgr", 9);
   d.runUntil(1'000'000, 1000);
@@ -67,11 +72,17 @@ TEST(SerialLink, PlatformLatchesNineCharactersAfterT0) {
   EXPECT_EQ(d.mem.bytes[kCc], 0);
 }
 
-TEST(SerialLink, SecondSendMidwayWinsAndFirstIsNeverLatched) {
+TEST(SerialPort, SecondSendMidwayWinsAndFirstIsNeverLatched) {
   Driver d;
   d.send(0, "4fgr4rgr", 9);
   d.runUntil(3 * 9600 + 100, 0);  // three bytes out, one in the TSR, one in TDR
-  d.send(3 * 9600 + 200, "cfgrcfgr", 9);
+  const auto overwritten = d.send(3 * 9600 + 200, "cfgrcfgr", 9);
+  // The library had fetched bytes 0..4 of the first (three out, one
+  // shifting, one in the TDR) and had four to go: that send is overwritten.
+  ASSERT_TRUE(overwritten.has_value());
+  EXPECT_EQ(overwritten->sentAt, 0);
+  EXPECT_EQ(overwritten->count, 9);
+  EXPECT_EQ(overwritten->fetched, 5);
   d.runUntil(2'000'000, 3 * 9600 + 200);
   ASSERT_EQ(d.frames.size(), 1u);
   EXPECT_TRUE(d.frames[0].second.command.has_value());
@@ -81,7 +92,33 @@ TEST(SerialLink, SecondSendMidwayWinsAndFirstIsNeverLatched) {
   EXPECT_EQ(d.frames[0].first, 14 * 9600);
 }
 
-TEST(SerialLink, StrcpyIntoBufferDuringSendChangesTheFrame) {
+// Byte k > 0 of a send at 0 is fetched by the interrupt 50 ticks after
+// the TDR empties, at (k - 1) x 9600 + 50: byte 7 at 57,650, byte 8 (the
+// NUL, the last) at 67,250. A send at 67,190 finds one byte unfetched and
+// overwrites the first send; one at 67,260 finds none and does not, though
+// bytes 7 and 8 are still in the port (they go out, then the new frame).
+TEST(SerialPort, ASendOverwritesOnlyWhileTheLibraryHasBytesToFetch) {
+  for (const Tick at : {Tick{67'190}, Tick{67'260}}) {
+    Driver d;
+    EXPECT_FALSE(d.send(0, "4fgr4rgr", 9).has_value());
+    d.runUntil(at - 1, 0);
+    const auto overwritten = d.send(at, "cfgrcfgr", 9);
+    d.runUntil(2'000'000, at);
+    if (at < 67'250) {
+      ASSERT_TRUE(overwritten.has_value()) << at;
+      EXPECT_EQ(overwritten->fetched, 8);
+      ASSERT_EQ(d.frames.size(), 1u);  // "4fgr4rgr", then the new frame: one NUL
+      EXPECT_EQ(d.frames[0].second.bytes, "cfgrcfgr");
+    } else {
+      EXPECT_FALSE(overwritten.has_value()) << at;
+      ASSERT_EQ(d.frames.size(), 2u);
+      EXPECT_EQ(d.frames[0].second.bytes, "4fgr4rgr");
+      EXPECT_EQ(d.frames[1].second.bytes, "cfgrcfgr");
+    }
+  }
+}
+
+TEST(SerialPort, StrcpyIntoBufferDuringSendChangesTheFrame) {
   Driver d;
   d.send(0, "4fgr4rgr", 9);
   d.runUntil(2 * 9600 + 10, 0);
@@ -93,7 +130,7 @@ TEST(SerialLink, StrcpyIntoBufferDuringSendChangesTheFrame) {
   EXPECT_TRUE(d.frames[0].second.command.has_value());
 }
 
-TEST(SerialLink, SendStallsWhileInterruptsAreOffAndResumes) {
+TEST(SerialPort, SendStallsWhileInterruptsAreOffAndResumes) {
   Driver d;
   d.interruptsEnabled = false;
   d.send(0, "4fgr4rgr", 9);
@@ -108,7 +145,7 @@ TEST(SerialLink, SendStallsWhileInterruptsAreOffAndResumes) {
   EXPECT_EQ(d.frames[0].first, 1'000'000 + d.latency + 8 * 9600);
 }
 
-TEST(SerialLink, ShortOrInvalidFramesAreRejected) {
+TEST(SerialPort, ShortOrInvalidFramesAreRejected) {
   Driver d;
   d.send(0, "4fgr", 5);
   d.runUntil(1'000'000, 0);
@@ -121,14 +158,14 @@ TEST(SerialLink, ShortOrInvalidFramesAreRejected) {
 }
 
 // ICEMAN's set-up of port A.
-PioPortA icemanPort() {
-  PioPortA p;
+Pio icemanPort() {
+  Pio p;
   for (uint8_t w : {0xff, 0xff, 0x10, 0x97, 0xfc, 0x87}) p.control(w);
   return p;
 }
 
 TEST(Pio, IcemanSetupRequestsOnFallingDetector) {
-  PioPortA p = icemanPort();
+  Pio p = icemanPort();
   EXPECT_EQ(p.mode(), 3);
   EXPECT_EQ(p.vector(), 0x10);
   EXPECT_TRUE(p.interruptEnabled());
@@ -156,7 +193,7 @@ TEST(Pio, ControlWordMatrix) {
       {0x17, 0xfc, 0xFD, false},  // interrupts disabled in the control word
   };
   for (const auto& c : cases) {
-    PioPortA p;
+    Pio p;
     for (uint8_t w : {0xff, 0xff, 0x10}) p.control(w);
     p.control(c.icw);
     p.control(c.mask);
@@ -165,14 +202,14 @@ TEST(Pio, ControlWordMatrix) {
         << std::hex << "icw " << int(c.icw) << " lines " << int(c.lines);
   }
   // Active high: a monitored bit rising from low makes the condition true.
-  PioPortA p;
+  Pio p;
   for (uint8_t w : {0xff, 0xff, 0x10, 0xB7, 0xfc}) p.control(w);
   EXPECT_FALSE(p.setInputs(0x00));
   EXPECT_TRUE(p.setInputs(0x02));
 }
 
 TEST(Pio, NoRequestWhileUnderServiceHeldUntilReti) {
-  PioPortA p = icemanPort();
+  Pio p = icemanPort();
   EXPECT_TRUE(p.setInputs(0xFD));
   p.accepted();
   EXPECT_FALSE(p.setInputs(0xFF));
@@ -182,7 +219,7 @@ TEST(Pio, NoRequestWhileUnderServiceHeldUntilReti) {
 }
 
 TEST(Pio, UnarmedPortNeverRequests) {
-  PioPortA p;  // fig92 never programs port A
+  Pio p;  // fig92 never programs port A
   EXPECT_FALSE(p.setInputs(0xFF));
   EXPECT_FALSE(p.setInputs(0xFD));
   EXPECT_FALSE(p.setInputs(0xFC));
