@@ -281,16 +281,7 @@ class Parser {
   Node* expr();
   Node* assign();
   Node* conditional();
-  Node* logOr();
-  Node* logAnd();
-  Node* bitOr();
-  Node* bitXor();
-  Node* bitAnd();
-  Node* equality();
-  Node* relational();
-  Node* shift();
-  Node* additive();
-  Node* multiplicative();
+  Node* binaryExpr(int minPrecedence);
   Node* cast();
   Node* unary();
   Node* postfix();
@@ -2384,9 +2375,35 @@ Node* Parser::assign() {
   return l;
 }
 
-// conditional = log-or ("?" expr ":" conditional)?
+// The binary operators, loosest first; all associate to the left. The
+// grammar this table stands for, one rule per level:
+//   log-or         = log-and ("||" log-and)*
+//   log-and        = bit-or ("&&" bit-or)*
+//   bit-or         = bit-xor ("|" bit-xor)*
+//   bit-xor        = bit-and ("^" bit-and)*
+//   bit-and        = equality ("&" equality)*
+//   equality       = relational (("==" | "!=") relational)*
+//   relational     = shift (("<" | "<=" | ">" | ">=") shift)*
+//   shift          = additive (("<<" | ">>") additive)*
+//   additive       = multiplicative (("+" | "-") multiplicative)*
+//   multiplicative = cast (("*" | "/" | "%") cast)*
+struct BinaryOperator {
+  std::string_view spelling;
+  NodeKind kind;
+  int precedence;  // 1 binds loosest
+};
+constexpr BinaryOperator kBinaryOperators[] = {
+    {"||", NodeKind::LogOr, 1}, {"&&", NodeKind::LogAnd, 2}, {"|", NodeKind::BitOr, 3},
+    {"^", NodeKind::BitXor, 4}, {"&", NodeKind::BitAnd, 5},  {"==", NodeKind::Eq, 6},
+    {"!=", NodeKind::Ne, 6},    {"<", NodeKind::Lt, 7},      {"<=", NodeKind::Le, 7},
+    {">", NodeKind::Gt, 7},     {">=", NodeKind::Ge, 7},     {"<<", NodeKind::Shl, 8},
+    {">>", NodeKind::Shr, 8},   {"+", NodeKind::Add, 9},     {"-", NodeKind::Sub, 9},
+    {"*", NodeKind::Mul, 10},   {"/", NodeKind::Div, 10},    {"%", NodeKind::Mod, 10}};
+constexpr int kLoosestBinary = 1;
+
+// conditional = binary ("?" expr ":" conditional)?
 Node* Parser::conditional() {
-  Node* c = logOr();
+  Node* c = binaryExpr(kLoosestBinary);
   if (!is("?")) return c;
   Pos pos = cur().pos;
   advance();
@@ -2428,144 +2445,43 @@ Node* Parser::conditional() {
   return n;
 }
 
-// log-or = log-and ("||" log-and)*
-Node* Parser::logOr() {
-  Node* n = logAnd();
-  while (is("||")) {
-    Pos pos = cur().pos;
-    advance();
-    n = logical(NodeKind::LogOr, n, logAnd(), pos);
-  }
-  return n;
-}
-
-// log-and = bit-or ("&&" bit-or)*
-Node* Parser::logAnd() {
-  Node* n = bitOr();
-  while (is("&&")) {
-    Pos pos = cur().pos;
-    advance();
-    n = logical(NodeKind::LogAnd, n, bitOr(), pos);
-  }
-  return n;
-}
-
-// bit-or = bit-xor ("|" bit-xor)*
-Node* Parser::bitOr() {
-  Node* n = bitXor();
-  while (is("|")) {
-    Pos pos = cur().pos;
-    advance();
-    Node* r = bitXor();
-    n = arith(NodeKind::BitOr, value(n), value(r), pos);
-  }
-  return n;
-}
-
-// bit-xor = bit-and ("^" bit-and)*
-Node* Parser::bitXor() {
-  Node* n = bitAnd();
-  while (is("^")) {
-    Pos pos = cur().pos;
-    advance();
-    Node* r = bitAnd();
-    n = arith(NodeKind::BitXor, value(n), value(r), pos);
-  }
-  return n;
-}
-
-// bit-and = equality ("&" equality)*
-Node* Parser::bitAnd() {
-  Node* n = equality();
-  while (is("&")) {
-    Pos pos = cur().pos;
-    advance();
-    Node* r = equality();
-    n = arith(NodeKind::BitAnd, value(n), value(r), pos);
-  }
-  return n;
-}
-
-// equality = relational (("==" | "!=") relational)*
-Node* Parser::equality() {
-  Node* n = relational();
-  for (;;) {
-    Pos pos = cur().pos;
-    if (accept("=="))
-      n = compare(NodeKind::Eq, n, relational(), pos);
-    else if (accept("!="))
-      n = compare(NodeKind::Ne, n, relational(), pos);
-    else
-      return n;
-  }
-}
-
-// relational = shift (("<" | "<=" | ">" | ">=") shift)*
-Node* Parser::relational() {
-  Node* n = shift();
-  for (;;) {
-    Pos pos = cur().pos;
-    if (accept("<"))
-      n = compare(NodeKind::Lt, n, shift(), pos);
-    else if (accept("<="))
-      n = compare(NodeKind::Le, n, shift(), pos);
-    else if (accept(">"))
-      n = compare(NodeKind::Gt, n, shift(), pos);
-    else if (accept(">="))
-      n = compare(NodeKind::Ge, n, shift(), pos);
-    else
-      return n;
-  }
-}
-
-// shift = additive (("<<" | ">>") additive)*
-Node* Parser::shift() {
-  Node* n = additive();
-  for (;;) {
-    Pos pos = cur().pos;
-    if (accept("<<")) {
-      Node* r = additive();
-      n = arith(NodeKind::Shl, value(n), value(r), pos);
-    } else if (accept(">>")) {
-      Node* r = additive();
-      n = arith(NodeKind::Shr, value(n), value(r), pos);
-    } else {
-      return n;
-    }
-  }
-}
-
-// additive = multiplicative (("+" | "-") multiplicative)*
-Node* Parser::additive() {
-  Node* n = multiplicative();
-  for (;;) {
-    Pos pos = cur().pos;
-    if (accept("+"))
-      n = newAdd(n, multiplicative(), pos);
-    else if (accept("-"))
-      n = newSub(n, multiplicative(), pos);
-    else
-      return n;
-  }
-}
-
-// multiplicative = cast (("*" | "/" | "%") cast)*
-Node* Parser::multiplicative() {
+// binary = cast (binary-operator cast)*, grouped by the table's precedences
+// (precedence climbing): the operands of an operator of precedence p bind
+// tighter than p.
+Node* Parser::binaryExpr(int minPrecedence) {
   Node* n = cast();
   for (;;) {
-    Pos pos = cur().pos;
-    NodeKind k;
-    if (is("*"))
-      k = NodeKind::Mul;
-    else if (is("/"))
-      k = NodeKind::Div;
-    else if (is("%"))
-      k = NodeKind::Mod;
-    else
-      return n;
+    const BinaryOperator* op = nullptr;
+    if (cur().kind == TokKind::Punct)
+      for (const BinaryOperator& o : kBinaryOperators)
+        if (cur().text == o.spelling) op = &o;
+    if (!op || op->precedence < minPrecedence) return n;
+    const Pos pos = cur().pos;
     advance();
-    Node* r = cast();
-    n = arith(k, value(n), value(r), pos);
+    Node* r = binaryExpr(op->precedence + 1);
+    switch (op->kind) {
+      case NodeKind::LogOr:
+      case NodeKind::LogAnd:
+        n = logical(op->kind, n, r, pos);
+        break;
+      case NodeKind::Eq:
+      case NodeKind::Ne:
+      case NodeKind::Lt:
+      case NodeKind::Le:
+      case NodeKind::Gt:
+      case NodeKind::Ge:
+        n = compare(op->kind, n, r, pos);
+        break;
+      case NodeKind::Add:
+        n = newAdd(n, r, pos);
+        break;
+      case NodeKind::Sub:
+        n = newSub(n, r, pos);
+        break;
+      default:  // | ^ & << >> * / %
+        n = arith(op->kind, value(n), value(r), pos);
+        break;
+    }
   }
 }
 
