@@ -32,7 +32,7 @@ struct Diagnostic {
   std::string format() const;
 };
 
-// The warnings, by name (README "Warnings" says what each means).
+// The warnings, by name (docs/language.md, "Warnings", says what each means).
 struct WarningInfo {
   std::string_view name;
   std::string_view summary;

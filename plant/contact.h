@@ -15,7 +15,7 @@
 // A contact pushes only: it is active while mu_c > 0 and ends (a root of the
 // arena) when mu_c reaches 0; it starts when its gap reaches 0.
 //
-// The model this is (each assumption also in README "The plant"):
+// The model this is (each assumption also in docs/plant.md):
 // - A wall or the divider is fixed and frictionless: it takes away the
 //   normal component and the centre slides along it at the tangential
 //   speed the wheels give (the wheels slip sideways). The contact force

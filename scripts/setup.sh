@@ -7,10 +7,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 packages=(
   build-essential cmake ninja-build pkg-config clang-format
+  help2man man-db              # simbot.1, the manual page, from the command line's help
   libsundials-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev
-  lua5.4 python3 linux-perf     # Lua and perf for the benchmarks (bench/vs_lua.py, README)
+  lua5.4 python3 linux-perf     # Lua and perf for the benchmarks (bench/vs_lua.py, docs/benchmarks.md)
   libjs-three                  # three.js r111, inlined in replay pages
   sigrok-cli gtkwave xvfb      # tests read --vcd output with sigrok's decoder and GTKWave
   chromium                     # the browser test (headless, software WebGL)

@@ -640,7 +640,7 @@ TEST(CompilerRobustness, MissingFile) {
 }
 
 // ---------------------------------------------------------------------------
-// Every error of a file, and the warnings (README "Warnings").
+// Every error of a file, and the warnings (docs/language.md, "Warnings").
 
 // Each warning as "LINE:COL NAME"; the source must compile.
 std::vector<std::string> warned(const std::string& source, const Options& options = {}) {

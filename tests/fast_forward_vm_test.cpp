@@ -47,7 +47,7 @@ Outcome runWithEdgeAt(const vm::Image& img, Tick at, bool fastForward) {
           v.stats().instructions};
 }
 
-// One pass costs 252 T-states (README, "The cycle model"); a window of 20
+// One pass costs 252 T-states (docs/cycle-model.md, "The cycle model"); a window of 20
 // consecutive request ticks 100 passes into the loop covers boundaries
 // inside a pass and between passes.
 TEST(FastForward, EdgeAtEveryTickOfAWindowSeesTheSteppedCounter) {

@@ -251,7 +251,7 @@ TEST(FramesOverwritten, SendsWithoutTheDelayLoopOverwriteAllButTheLast) {
   // With ICEMAN's delay loop every frame latches, none is overwritten: 700
   // passes outlast the 86,400 ticks a frame takes once a pass costs more
   // than 124 T-states, and a pass is seven instructions and a debug hook
-  // (about 250; README, "The cycle model").
+  // (about 250; docs/cycle-model.md, "The cycle model").
   const auto paced = sendAndWait(5, true);
   EXPECT_EQ(paced.framesOverwritten, 0);
   EXPECT_EQ(paced.framesLatched, 5);

@@ -586,7 +586,7 @@ TEST(Match, IcemanAgainstFig92For180SecondsPinsItsKeyFigures) {
 
 // Issue 22: bodies are rigid. In four seeded 180-s matches every 20-Hz
 // sample has both bodies inside the field, clear of the divider and of
-// each other, to the tolerance README "The plant" documents (1e-6 ft: a
+// each other, to the tolerance docs/plant.md documents (1e-6 ft: a
 // contact's crossing lies less than a tick before its event, 1.6e-7 ft at
 // top speed). The plant before rigid contacts failed this at seed 1 (B
 // 0.75 in inside the north wall at 9.85 s) and seed 7 (A and B overlapping

@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""Every command the README shows runs as written.
+"""Every command the README and the manual show runs as written.
 
-Usage: readme_test.py README SIMBOT WORKDIR
+Usage: readme_test.py SIMBOT WORKDIR README [PAGE...]
 
-Each ```sh block of the README runs, in order, with bash -e, in a sandbox
+Each ```sh block of the README, then of each manual page (docs/*.md) in
+the order given, runs with bash -e, in a sandbox
 laid out like the project's checkout (WORKDIR/main holding build/bin/simbot,
 programs/, scenarios/, profiles/, tests/, bench/, docs/, the bench binaries
 and build/python,
@@ -12,7 +13,8 @@ the files a command writes land in WORKDIR and a later block can read them.
 The Quickstart block is the exception: `.ci/run` runs `scripts/test.sh` and
 `scripts/quickstart.sh` themselves on a clean clone. A desktop program
 (GTKWave) runs under Xvfb and passes when it is still showing the file
-after a few seconds; anything else must exit with status 0.
+after a few seconds; anything else must exit with status 0. A block
+that already ran (the README shows some of the manual's) runs once.
 """
 import os
 import re
@@ -52,6 +54,10 @@ def sandbox(source, simbot, work):
         built = os.path.join(os.path.dirname(os.path.abspath(simbot)), name)
         if os.path.exists(built):
             os.symlink(built, os.path.join(main, "build", "bin", name))
+    # The manual page the build generates.
+    page = os.path.join(os.path.dirname(os.path.abspath(simbot)), "..", "simbot.1")
+    if os.path.exists(page):
+        os.symlink(os.path.abspath(page), os.path.join(main, "build", "simbot.1"))
     # The Python module beside it (the README's Python section).
     module = os.path.join(os.path.dirname(os.path.abspath(simbot)), "..", "python")
     if os.path.isdir(module):
@@ -76,13 +82,19 @@ def run_desktop(line, cwd):
 
 
 def main():
-    readme, simbot, work = sys.argv[1:4]
+    simbot, work, readme = sys.argv[1:4]
+    pages = [readme] + sys.argv[4:]
     source = os.path.dirname(os.path.abspath(readme))
     cwd = sandbox(source, simbot, os.path.abspath(work))
     failures, ran = [], 0
-    for block in blocks(open(readme, encoding="utf-8").read()):
+    seen = set()
+    every = [b for page in pages for b in blocks(open(page, encoding="utf-8").read())]
+    for block in every:
         if set(line.split("#")[0].strip() for line in block) <= CI_RUNS_THESE:
             continue
+        if tuple(block) in seen:
+            continue
+        seen.add(tuple(block))
         script = []
         for line in block:
             if line.split()[0] in DESKTOP_PROGRAMS:
@@ -109,7 +121,7 @@ def main():
                 failures.append("\n".join(script) + f"\n  status {done.returncode}: {done.stderr[-600:]}")
     for failure in failures:
         print("FAIL: " + failure)
-    print(f"{ran} README commands run, {len(failures)} failed")
+    print(f"{ran} commands of {len(pages)} pages run, {len(failures)} failed")
     sys.exit(1 if failures or ran == 0 else 0)
 
 

@@ -113,11 +113,11 @@ TEST(IcemanTiming, FiveHundredSlowSpinPassesTakeAboutTenSeconds) {
   EXPECT_FALSE(r.faulted);
 }
 
-// The calibration (README, "The cycle model"): ICEMAN's 500-pass time under
+// The calibration (docs/cycle-model.md, "The cycle model"): ICEMAN's 500-pass time under
 // every hardware setting of the knobs calibration may move, DCNTL's memory
 // (0-3) and I/O (1-4) wait states and RCR's DRAM refresh (off, or 2 or 3
 // T-states every 10/20/40/80). The calibrated knobs must be the setting
-// nearest 10 s; the table printed here is the README's.
+// nearest 10 s; the table printed here is docs/cycle-model.md's.
 TEST(IcemanTiming, CalibratedKnobsAreTheHardwareSettingNearestTenSeconds) {
   struct Row {
     vm::CostKnobs knobs;

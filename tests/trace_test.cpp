@@ -68,7 +68,7 @@ scheduler::MatchConfig duel(const std::string& shooter, plant::Pose a, plant::Po
 constexpr scheduler::Tick kSample = scheduler::kTicksPerSecond / 20;  // 460,800
 
 // Two delay loops, 30,000 passes each. A pass of `for(z=0;z<N;z++);` costs
-// 252 T-states in a debug build (README, "The cycle model"; pinned by
+// 252 T-states in a debug build (docs/cycle-model.md, "The cycle model"; pinned by
 // tests/timing_test.cpp DelayLoop.PassCostIsTheSumOfItsSequences), so the
 // first loop runs about 30,000 x 252 = 7,560,000 ticks and the second as
 // long again (15,120,000); start-up and loop set-up add hundreds of ticks.
@@ -316,18 +316,18 @@ TEST(Trace, BytesReadBackExactly) {
   EXPECT_NO_THROW(tools::traceLine(f));
 }
 
-// The README lists the record kinds as trace/records.def defines them.
-TEST(Trace, ReadmeListsTheRecordKindsOfTheDefinition) {
-  std::ifstream in(SIMBOT_SOURCE_DIR "/README.md");
+// The manual lists the record kinds as trace/records.def defines them.
+TEST(Trace, TheManualListsTheRecordKindsOfTheDefinition) {
+  std::ifstream in(SIMBOT_SOURCE_DIR "/docs/trace.md");
   std::stringstream text;
   text << in.rdbuf();
   const std::string readme = text.str();
   const std::string begin = "<!-- trace-records:begin -->\n", end = "<!-- trace-records:end -->";
   const auto from = readme.find(begin), to = readme.find(end);
-  ASSERT_NE(from, std::string::npos) << "README.md has no " << begin;
-  ASSERT_NE(to, std::string::npos) << "README.md has no " << end;
+  ASSERT_NE(from, std::string::npos) << "docs/trace.md has no " << begin;
+  ASSERT_NE(to, std::string::npos) << "docs/trace.md has no " << end;
   EXPECT_EQ(readme.substr(from + begin.size(), to - from - begin.size()), trace::recordsMarkdown())
-      << "README.md's record list differs from trace/records.def; it should read:\n"
+      << "docs/trace.md's record list differs from trace/records.def; it should read:\n"
       << trace::recordsMarkdown();
 }
 

@@ -1,5 +1,5 @@
 // simbot bench: scenario families run over many seeds, measured per run by
-// MetricsObserver, summarised with censoring (README "bench").
+// MetricsObserver, summarised with censoring (docs/tools.md, "Bench and tournament").
 #pragma once
 #include <atomic>
 #include <cstdint>

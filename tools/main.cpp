@@ -83,7 +83,7 @@ int viewCommand(const std::string& tracePath, const std::string& out) {
 
 bool given(const CLI::Option* option) { return option && option->count() > 0; }
 
-// Exit statuses (README, "Exit statuses").
+// Exit statuses (README, "Options, time, exit statuses, errors").
 constexpr int kExitBadInput = 1;
 constexpr int kExitInternalError = 2;
 constexpr int kExitRobotFault = 3;
@@ -295,8 +295,8 @@ int main(int argc, char** argv) {
   compile->add_flag("--disasm", disasm, "print the bytecode, interleaved with the source");
   compile->allow_extras();
   compile->footer(
-      "Warnings: -Wno-NAME turns one off, -Werror makes every warning an error (see the README "
-      "for the names).");
+      "Warnings: -Wno-NAME turns one off, -Werror makes every warning an error (docs/language.md "
+      "lists the names).");
 
   RunOptions soloOptions;
   GivenOptions soloGiven;

@@ -2,7 +2,7 @@
 // the set-up of a run that is not the programs themselves. A scenario gives
 // the profile, the run's length and seed, robot A's start pose, hardware
 // file and injections, and robot B: another program, or a beacon that
-// stands still or drives a scripted path. The schema is in the README
+// stands still or drives a scripted path. The schema is in docs/tools.md
 // ("Scenarios"); every key is checked, and every error is reported as
 // FILE:LINE:COL: error: MESSAGE.
 //

@@ -135,8 +135,8 @@ void forEachField(R& record, F&& f) {
 // The robot a record belongs to (its `robot` field), or -1.
 int robotOf(const Record& record);
 
-// The README's table of record kinds and their fields, made from the
-// definition (tests/trace_test.cpp checks that the README holds it).
+// The manual's table (docs/trace.md) of record kinds and their fields, made from the
+// definition (tests/trace_test.cpp checks that the page holds it).
 std::string recordsMarkdown();
 
 // Values of --watch variables, read from the robot's memory when the

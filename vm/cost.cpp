@@ -86,7 +86,7 @@ CostTable makeCostTable(const CostKnobs& knobs) {
 }
 
 // Figures from the hardware documentation and the era's run-time, before
-// any measurement against ICEMAN (README, "Cycle model").
+// any measurement against ICEMAN (docs/cycle-model.md).
 CostKnobs uncalibratedKnobs() {
   CostKnobs k;
   k.memWaitStates = 0;   // Tiny Giant: 9.216 MHz Z180 with fast SRAM

@@ -303,7 +303,7 @@ enum class TimerService : uint8_t {
   Never,   // never (the counters stand still)
 };
 
-// The only numbers calibration may move (README, "Cycle model"); each has a
+// The only numbers calibration may move (docs/cycle-model.md); each has a
 // hardware meaning and a hardware range, checked by makeCostTable.
 struct CostKnobs {
   // Extra T-states per memory cycle (Z180 DCNTL MWI bits: 0..3; the chip
@@ -366,7 +366,7 @@ struct CostTable {
 // Throws std::invalid_argument when a knob is outside its hardware range.
 CostTable makeCostTable(const CostKnobs& knobs);
 
-// The knobs' calibrated values (README states the prediction before them).
+// The knobs' calibrated values (docs/cycle-model.md states the prediction before them).
 CostKnobs calibratedKnobs();
 // The knobs before calibration: figures from the hardware documentation.
 CostKnobs uncalibratedKnobs();

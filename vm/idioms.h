@@ -1,8 +1,8 @@
 // Semantic superinstructions (idioms): runs of 3-5 ordinary instructions
 // that the fast path executes as one dispatch, with no expression-stack
 // traffic for their intermediates. Chosen from the most frequent n-grams
-// counted over the reference, shipped, test and benchmark programs (README
-// "Dispatch"). The list is shared by the decoder (idioms.cpp: which idiom
+// counted over the reference, shipped, test and benchmark programs
+// (docs/cycle-model.md, "Dispatch"). The list is shared by the decoder (idioms.cpp: which idiom
 // starts at an address, and what its pieces cost) and the handlers
 // (vm.cpp, one label per idiom, in the same order).
 #pragma once

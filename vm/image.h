@@ -9,7 +9,7 @@
 
 namespace simbot::vm {
 
-// Robot memory map (64 KiB, 16-bit addresses). Documented in the README.
+// Robot memory map (64 KiB, 16-bit addresses). Documented in docs/cycle-model.md.
 inline constexpr uint32_t kMemorySize = 0x10000;
 inline constexpr uint16_t kNullPageEnd = 0x0100;  // 0x0000-0x00FF: access faults
 inline constexpr uint16_t kDataBase = 0x0100;     // globals and statics from here

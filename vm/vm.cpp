@@ -6,7 +6,7 @@
 // long library call. An instruction's cost is charged when it starts and its
 // effects (bus accesses included) happen at its end tick.
 //
-// Faults (documented in the README): division by zero (Dynamic C's run-time
+// Faults (documented in docs/cycle-model.md): division by zero (Dynamic C's run-time
 // error handler stops the program), access to the null page 0x0000-0x00FF
 // (an assumption: on the target that is the vector area, so a stray pointer
 // would corrupt it silently; simbot stops the robot instead), a multi-byte
@@ -189,7 +189,7 @@ void Vm::State::decode() {
 
 // Superinstructions: pairs (first, second) chosen from the most frequent
 // adjacent opcodes counted over the reference, shipped, test and benchmark
-// programs (README "Dispatch"); the first half never touches the bus or
+// programs (docs/cycle-model.md, "Dispatch"); the first half never touches the bus or
 // charges a branch-dependent tail, and no half is longer than
 // kMaxStepTstates. The entry of a first half followed by its second (both
 // ordinary: no trap, no breakpoint on the second) jumps to a handler that

@@ -35,7 +35,7 @@ constexpr double kTicks = 9'216'000.0;
 constexpr double kR = 12.75 / 24;
 constexpr double kV = 1.45;
 constexpr double kTau = 0.15;
-// How far a body may be inside what it touches (README "The plant").
+// How far a body may be inside what it touches (docs/plant.md).
 constexpr double kTolerance = 1e-6;  // ft
 
 double pathLength(double t) { return kV * (t + kTau * std::expm1(-t / kTau)); }

@@ -1,11 +1,11 @@
-// The integrator's documented accuracy (README "The plant's integrator")
+// The integrator's documented accuracy (docs/plant.md, "The integrator")
 // against an independent oracle: default-profile robots (motor lag 0.15 s)
 // started from rest on 10-s arcs, straight runs and spins, compared every
 // millisecond with the closed-form heading and the Boost.Math quadrature
 // of x and y (lag_arc_oracle.h); and edge-wire crossings, whose tick must
 // be the ceiling of the oracle's crossing time.
 //
-// The bounds are those the README states for ERKStep at rtol = atol =
+// The bounds are those docs/plant.md states for ERKStep at rtol = atol =
 // 1e-9 with the quintic dense output: position within 1e-9 ft (1/380 of
 // the 3.8e-7 ft a point at the top speed of 3.5 ft/s moves in a tick);
 // the heading is a closed form, within 1e-12 rad (round-off of the

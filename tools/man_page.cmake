@@ -1,0 +1,26 @@
+# Writes the include file help2man adds to simbot.1: each subcommand's own
+# --help, under COMMANDS, in the order `simbot --help` lists them.
+# cmake -DSIMBOT=path/to/simbot -DOUT=file.h2m -P man_page.cmake
+execute_process(COMMAND ${SIMBOT} --help OUTPUT_VARIABLE top RESULT_VARIABLE status)
+if(NOT status EQUAL 0)
+  message(FATAL_ERROR "simbot --help failed")
+endif()
+string(REGEX REPLACE ".*\nSubcommands:\n" "" listing "${top}")
+string(REPLACE "\n" ";" lines "${listing}")
+set(text "[COMMANDS]\n")
+foreach(line IN LISTS lines)
+  if(NOT line MATCHES "^  ([a-z]+) ")
+    continue()
+  endif()
+  set(command ${CMAKE_MATCH_1})
+  execute_process(COMMAND ${SIMBOT} ${command} --help OUTPUT_VARIABLE help RESULT_VARIABLE status)
+  if(NOT status EQUAL 0)
+    message(FATAL_ERROR "simbot ${command} --help failed")
+  endif()
+  string(REPLACE "${SIMBOT}" "simbot" help "${help}")
+  # roff: backslashes escaped, no line starting with a control character.
+  string(REPLACE "\\" "\\e" help "${help}")
+  string(REGEX REPLACE "(^|\n)([.'])" "\\1\\\\&\\2" help "${help}")
+  string(APPEND text ".SS ${command}\n.nf\n${help}.fi\n")
+endforeach()
+file(WRITE ${OUT} "${text}")
