@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <optional>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "compiler/compiler.h"
@@ -47,31 +49,56 @@ py::dict compileProgram(const std::string& path, bool disasm) {
   return out;
 }
 
-// solo (one program) or match (two): the CLI's JSON, the trace's JSONL
-// lines when asked for, and the run's warnings.
-py::tuple playRun(const std::vector<std::string>& programs, std::optional<double> seconds,
-                  std::optional<uint64_t> seed, std::optional<std::string> profile,
-                  const std::string& scenario, const std::vector<std::string>& hw,
-                  const std::vector<std::string>& inject, const std::vector<std::string>& watch,
-                  const std::string& tracePath, const std::string& vcd, const std::string& replay,
-                  bool traceCostate, bool noFastForward, bool reloadOnFault, bool keepTrace) {
+// A run option from its Python keyword (tools/run_options.def): None
+// leaves it unset, as an option not given on the command line.
+template <class T>
+void setRunOption(T& member, py::handle value) {
+  if (!value.is_none()) member = value.cast<T>();
+}
+
+// How Python passes a run option: a value (None: not given), a list, or
+// a flag.
+template <class T>
+constexpr const char* runOptionKind() {
+  if constexpr (std::is_same_v<T, bool>) return "flag";
+  if constexpr (std::is_same_v<T, std::vector<std::string>>) return "list";
+  return "value";
+}
+
+// The Python keywords of the run options and their kinds, in their order:
+// the package builds simbot.solo's and simbot.match's signatures from them.
+std::vector<std::pair<std::string, std::string>> runOptionKeywords() {
+  using enum tools::RunOptionUse;
+  std::vector<std::pair<std::string, std::string>> keywords;
+#define RUN_OPTION(member, Type, flag, keyword, where, help) \
+  if ((where)&tools::kPython) keywords.emplace_back(keyword, runOptionKind<Type>());
+#include "tools/run_options.def"
+#undef RUN_OPTION
+  return keywords;
+}
+
+// solo (one program) or match (two) with the run options as keywords: the
+// CLI's JSON, the trace's JSONL lines when asked for, and the run's
+// warnings.
+py::tuple playRun(const std::vector<std::string>& programs, bool keepTrace,
+                  const py::kwargs& options) {
+  using enum tools::RunOptionUse;
   tools::RunOptions o;
-  if (seconds) o.seconds = *seconds;
-  if (seed) o.seed = *seed;
-  if (profile) o.profile = *profile;
-  o.secondsGiven = seconds.has_value();
-  o.seedGiven = seed.has_value();
-  o.profileGiven = profile.has_value();
-  o.scenario = scenario;
-  o.hw = hw;
-  o.injections = inject;
-  o.watches = watch;
-  o.trace = tracePath;
-  o.vcd = vcd;
-  o.replay = replay;
-  o.traceCostate = traceCostate;
-  o.noFastForward = noFastForward;
-  o.reloadOnFault = reloadOnFault;
+  size_t used = 0;
+#define RUN_OPTION(member, Type, flag, keyword, where, help)   \
+  if (((where)&tools::kPython) && options.contains(keyword)) { \
+    setRunOption(o.member, options[keyword]);                  \
+    ++used;                                                    \
+  }
+#include "tools/run_options.def"
+#undef RUN_OPTION
+  if (used != options.size())
+    for (const auto& [key, value] : options) {
+      const auto name = key.cast<std::string>();
+      const auto known = runOptionKeywords();
+      if (std::none_of(known.begin(), known.end(), [&](const auto& k) { return k.first == name; }))
+        throw py::type_error("unexpected keyword argument '" + name + "'");
+    }
   tools::JsonlLines lines;
   if (keepTrace) o.sinks.push_back(&lines);
   const bool solo = programs.size() == 1;
@@ -132,10 +159,8 @@ PYBIND11_MODULE(_simbot, m) {
     }
   });
   m.def("compile", &compileProgram, py::arg("path"), py::arg("disasm") = false);
-  m.def("play", &playRun, py::arg("programs"), py::arg("seconds"), py::arg("seed"),
-        py::arg("profile"), py::arg("scenario"), py::arg("hw"), py::arg("inject"), py::arg("watch"),
-        py::arg("trace"), py::arg("vcd"), py::arg("replay"), py::arg("trace_costate"),
-        py::arg("no_fast_forward"), py::arg("reload_on_fault"), py::arg("keep_trace"));
+  m.def("play", &playRun, py::arg("programs"), py::arg("keep_trace"));
+  m.def("run_options", &runOptionKeywords);
   m.def("bench", &benchRuns, py::arg("programs"), py::arg("family"), py::arg("seeds"),
         py::arg("seconds"), py::arg("seed"), py::arg("profile"), py::arg("opponent"),
         py::arg("threads"));

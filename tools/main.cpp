@@ -81,23 +81,10 @@ int viewCommand(const std::string& tracePath, const std::string& out) {
   return 0;
 }
 
-bool given(const CLI::Option* option) { return option && option->count() > 0; }
-
 // Exit statuses (README, "Options, time, exit statuses, errors").
 constexpr int kExitBadInput = 1;
 constexpr int kExitInternalError = 2;
 constexpr int kExitRobotFault = 3;
-
-// The options --seconds, --seed and --profile of a run command: given
-// explicitly, they win over a scenario's values.
-struct GivenOptions {
-  CLI::Option *seconds = nullptr, *seed = nullptr, *profile = nullptr;
-  void copyTo(tools::RunOptions& o) const {
-    o.secondsGiven = given(seconds);
-    o.seedGiven = given(seed);
-    o.profileGiven = given(profile);
-  }
-};
 
 int soloCommand(const std::string& program, const RunOptions& o) {
   const Played played = play({program}, o, true);
@@ -247,39 +234,27 @@ int profileCommand(const std::string& program, RunOptions o, int top) {
   return status;
 }
 
-void addRunOptions(CLI::App* cmd, RunOptions& o, GivenOptions& g, bool solo) {
-  g.seconds = cmd->add_option("--seconds", o.seconds,
-                              "simulated seconds (default: the profile's round_length)");
-  g.seed =
-      cmd->add_option("--seed", o.seed, "master seed (default 1)")->check(tools::seedValidator());
-  g.profile = cmd->add_option("--profile", o.profile, "profile name or file (default: default)");
-  cmd->add_option("--scenario", o.scenario,
-                  "scenario file (TOML): start poses, profile, hardware, injections, robot B");
-  cmd->add_option("--hw", o.hw,
-                  solo ? "hardware file" : "hardware file for a robot: A=FILE or B=FILE");
-  cmd->add_option("--trace", o.trace, "write the trace (JSONL) to this file");
-  cmd->add_option("--replay", o.replay,
-                  "write a replay page (one self-contained HTML file) to this file");
-  cmd->add_option("--vcd", o.vcd,
-                  "write the digital signals (serial TXD, ports, IFF1, handlers, motor commands, "
-                  "eye readings) as a value change dump for GTKWave and sigrok");
-  cmd->add_option("--inject", o.injections,
-                  "ROBOT:SOURCE@WHEN, SOURCE edge_fore|edge_aft|bumper_front|bumper_back, "
-                  "WHEN 12.5s|800ms|115200000t|line:N#K (K-th entry into line N)|pass:N#K "
-                  "(K-th pass of the loop on line N) (repeatable)");
-  cmd->add_option("--watch", o.watches,
-                  "add a global or static variable (FUNCTION.NAME) to every trace record "
-                  "(repeatable; needs --trace or --replay)");
-  cmd->add_flag("--no-fast-forward", o.noFastForward,
-                "step every pass of every delay loop (the result is the same, slower: for "
-                "checking)");
-  cmd->add_flag("--trace-costate", o.traceCostate,
-                "add a record each time a costatement is entered, gives way or ends (needs "
-                "--trace or --replay)");
-  cmd->add_flag("--reload-on-fault", o.reloadOnFault,
-                "reload a faulted program after the profile's [match] reload_delay: it starts "
-                "again from main with its memory as at load (thesis Appendix A)");
-  cmd->add_flag("--json", o.json, "print the summary as JSON");
+// A run option on the command line: a flag for a bool, a repeatable option
+// for a list, a seed checked as seeds are.
+void addRunOption(CLI::App* cmd, const char* flag, bool& value, const char* help) {
+  cmd->add_flag(flag, value, help);
+}
+void addRunOption(CLI::App* cmd, const char* flag, std::optional<uint64_t>& value,
+                  const char* help) {
+  cmd->add_option(flag, value, help)->check(tools::seedValidator());
+}
+template <class T>
+void addRunOption(CLI::App* cmd, const char* flag, T& value, const char* help) {
+  cmd->add_option(flag, value, help);
+}
+
+// The run options (tools/run_options.def) that `command` offers.
+void addRunOptions(CLI::App* cmd, RunOptions& o, unsigned command) {
+  using enum tools::RunOptionUse;
+#define RUN_OPTION(member, Type, flag, keyword, where, help) \
+  if ((where)&command) addRunOption(cmd, flag, o.member, help);
+#include "tools/run_options.def"
+#undef RUN_OPTION
 }
 
 }  // namespace
@@ -299,40 +274,28 @@ int main(int argc, char** argv) {
       "lists the names).");
 
   RunOptions soloOptions;
-  GivenOptions soloGiven;
   std::string soloProgram;
   auto* solo = app.add_subcommand("solo", "run one robot alone in the arena");
   solo->add_option("FILE", soloProgram, "program (.dc)")->required();
-  addRunOptions(solo, soloOptions, soloGiven, true);
+  addRunOptions(solo, soloOptions, tools::kSolo);
 
   RunOptions matchOptions;
-  GivenOptions matchGiven;
   std::string programA, programB;
   auto* match = app.add_subcommand("match", "play a match between two programs");
   match->add_option("A", programA, "robot A's program")->required();
   match->add_option("B", programB, "robot B's program")->required();
-  addRunOptions(match, matchOptions, matchGiven, false);
+  addRunOptions(match, matchOptions, tools::kMatch);
 
   RunOptions profileOptions;
-  GivenOptions profileGiven;
-  profileOptions.seconds = 60;
+  profileOptions.defaultSeconds = 60;
   std::string profileProgram;
   int profileTop = 20;
   auto* profile =
       app.add_subcommand("profile", "cycles and time per source line and function of a solo run");
   profile->add_option("FILE", profileProgram, "program (.dc)")->required();
-  profileGiven.seconds =
-      profile->add_option("--seconds", profileOptions.seconds, "simulated seconds (default 60)");
-  profileGiven.seed = profile->add_option("--seed", profileOptions.seed, "master seed (default 1)")
-                          ->check(tools::seedValidator());
-  profileGiven.profile = profile->add_option("--profile", profileOptions.profile,
-                                             "physical profile (default: default)");
-  profile->add_option("--scenario", profileOptions.scenario,
-                      "scenario file (TOML): start pose, profile, hardware, injections, robot B");
-  profile->add_option("--inject", profileOptions.injections, "as for solo (repeatable)");
+  addRunOptions(profile, profileOptions, tools::kProfile);
   profile->add_option("--top", profileTop, "source lines to list (default 20)")
       ->check(CLI::Range(1, 1'000'000));
-  profile->add_flag("--json", profileOptions.json, "print the profile as JSON");
 
   std::string viewTrace, viewOut;
   auto* view = app.add_subcommand("view", "write the replay page (HTML) of a recorded trace");
@@ -358,9 +321,6 @@ int main(int argc, char** argv) {
     std::cerr << "simbot: " << message << " (simbot --help lists the options)\n";
     return kExitBadInput;
   }
-  soloGiven.copyTo(soloOptions);
-  matchGiven.copyTo(matchOptions);
-  profileGiven.copyTo(profileOptions);
   try {
     if (*compile) return compileCommand(compileFile, disasm, compile->remaining());
     if (*solo) return soloCommand(soloProgram, soloOptions);

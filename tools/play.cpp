@@ -85,11 +85,13 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
   std::optional<Scenario> scenario;
   if (!o.scenario.empty()) scenario = loadScenario(o.scenario);
   const plant::Profile profile = loadNamedProfile(
-      preferCommandLine(o.profileGiven, scenario ? scenario->profile : std::nullopt, o.profile));
-  // Without --seconds or a scenario's, a run lasts the profile's round.
-  const double seconds =
-      preferCommandLine(o.secondsGiven, scenario ? scenario->seconds : std::nullopt,
-                        o.secondsGiven || o.seconds > 0 ? o.seconds : profile.round_length_s);
+      preferCommandLine(o.profile.has_value(), scenario ? scenario->profile : std::nullopt,
+                        o.profile.value_or("default")));
+  // Without --seconds or a scenario's, a run lasts its default: the
+  // profile's round.
+  const double seconds = preferCommandLine(
+      o.seconds.has_value(), scenario ? scenario->seconds : std::nullopt,
+      o.seconds.value_or(o.defaultSeconds > 0 ? o.defaultSeconds : profile.round_length_s));
   if (!(seconds > 0) || seconds > 1e6)
     throw ToolError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", seconds));
   scheduler::MatchConfig config;
@@ -127,7 +129,8 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
     }
   }
   config.endTick = timebase::ticksFromSeconds(seconds);
-  config.seed = preferCommandLine(o.seedGiven, scenario ? scenario->seed : std::nullopt, o.seed);
+  config.seed = preferCommandLine(o.seed.has_value(), scenario ? scenario->seed : std::nullopt,
+                                  o.seed.value_or(1));
   config.reloadOnFault = o.reloadOnFault;
   config.reloadDelay = timebase::ticksFromSeconds(profile.reload_delay_s);
   return config;

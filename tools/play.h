@@ -3,6 +3,7 @@
 // these, so `simbot match A B --json` and simbot.match(A, B) give the same
 // JSON.
 #pragma once
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -14,23 +15,16 @@
 
 namespace simbot::tools {
 
+// Where a run option is offered (tools/run_options.def).
+enum RunOptionUse : unsigned { kSolo = 1, kMatch = 2, kProfile = 4, kPython = 8 };
+
 struct RunOptions {
-  double seconds = 0;  // not given: the profile's [match] round_length
-  uint64_t seed = 1;
-  std::string profile = "default";
-  std::vector<std::string> hw;
-  std::string trace;
-  std::string vcd;
-  std::string replay;
-  std::vector<std::string> injections;
-  std::vector<std::string> watches;
-  bool traceCostate = false;
-  bool noFastForward = false;
-  std::string scenario;
-  bool json = false;
-  bool reloadOnFault = false;
-  // Options given explicitly win over the scenario's values.
-  bool secondsGiven = false, seedGiven = false, profileGiven = false;
+#define RUN_OPTION(member, Type, flag, keyword, where, help) Type member{};
+#include "tools/run_options.def"
+#undef RUN_OPTION
+  // A run's length when neither the option nor a scenario gives one (0:
+  // the profile's round_length; simbot profile: 60 s).
+  double defaultSeconds = 0;
   // More sinks for the trace's records (the Python module's in-memory
   // trace); each counts as a trace for --watch and --trace-costate.
   std::vector<trace::Sink*> sinks;

@@ -6,8 +6,10 @@ parsed, and the same seed gives the same result. Traces (the CLI's --trace
 JSONL records) come back as pandas DataFrames.
 """
 import csv
+import inspect
 import io
 import json
+import os
 import warnings
 
 from . import _simbot
@@ -33,35 +35,62 @@ def read_trace(path):
         return trace_frame([line for line in f if line.strip()])
 
 
-def _play(programs, seconds, seed, profile, scenario, hw, inject, watch, trace, vcd,
-          replay, trace_costate, no_fast_forward, reload_on_fault, keep_trace):
-    text, lines, found = _simbot.play(
-        [str(p) for p in programs], seconds, seed, profile, str(scenario or ""),
-        list(hw), list(inject), list(watch), str(trace or ""), str(vcd or ""),
-        str(replay or ""), trace_costate, no_fast_forward, reload_on_fault, keep_trace)
+# The run options, as tools/run_options.def defines them for the command
+# line too: [(keyword, kind)], kind "value" (None: not given), "list" or
+# "flag". solo's and match's signatures are made from them.
+_RUN_OPTIONS = _simbot.run_options()
+_DEFAULTS = {"value": None, "list": (), "flag": False}
+
+
+def _option(kind, value):
+    if kind == "list":
+        return [os.fspath(v) for v in value]
+    if kind == "flag":
+        return bool(value)
+    return os.fspath(value) if isinstance(value, os.PathLike) else value
+
+
+def _signature(*leading):
+    P = inspect.Parameter
+    return inspect.Signature(
+        [P(name, P.POSITIONAL_OR_KEYWORD) for name in leading]
+        + [P(k, P.POSITIONAL_OR_KEYWORD, default=_DEFAULTS[kind]) for k, kind in _RUN_OPTIONS]
+        + [P("keep_trace", P.POSITIONAL_OR_KEYWORD, default=False)])
+
+
+def _play(function, programs, args, kwargs):
+    given = function.__signature__.bind(*args, **kwargs).arguments
+    keep_trace = bool(given.pop("keep_trace", False))
+    kinds = dict(_RUN_OPTIONS)
+    options = {k: _option(kinds[k], v) for k, v in given.items() if k in kinds}
+    text, lines, found = _simbot.play([os.fspath(p) for p in programs], keep_trace, **options)
     for w in found:
         warnings.warn("simbot: " + w, RuntimeWarning, stacklevel=3)
     result = json.loads(text)
     return (result, trace_frame(lines)) if keep_trace else result
 
 
-def solo(program, seconds=None, seed=None, profile=None, scenario=None, hw=(), inject=(),
-         watch=(), trace=None, vcd=None, replay=None, trace_costate=False,
-         no_fast_forward=False, reload_on_fault=False, keep_trace=False):
+def solo(*args, **kwargs):
     """`simbot solo PROGRAM --json` as a dict; with keep_trace=True,
-    (dict, trace DataFrame). hw is a hardware file's path (at most one)."""
-    return _play([program], seconds, seed, profile, scenario, [hw] if isinstance(hw, str) else hw,
-                 inject, watch, trace, vcd, replay, trace_costate, no_fast_forward,
-                 reload_on_fault, keep_trace)
+    (dict, trace DataFrame). The keywords are the command line's options
+    (--reload-on-fault is reload_on_fault=True); hw is a hardware file's
+    path (at most one)."""
+    if isinstance(kwargs.get("hw"), (str, os.PathLike)):
+        kwargs["hw"] = [kwargs["hw"]]
+    program = solo.__signature__.bind(*args, **kwargs).arguments["program"]
+    return _play(solo, [program], args, kwargs)
 
 
-def match(a, b, seconds=None, seed=None, profile=None, scenario=None, hw=(), inject=(),
-          watch=(), trace=None, vcd=None, replay=None, trace_costate=False,
-          no_fast_forward=False, reload_on_fault=False, keep_trace=False):
+def match(*args, **kwargs):
     """`simbot match A B --json` as a dict; with keep_trace=True, (dict,
-    trace DataFrame). hw holds "A=FILE" / "B=FILE" as on the command line."""
-    return _play([a, b], seconds, seed, profile, scenario, hw, inject, watch, trace, vcd, replay,
-                 trace_costate, no_fast_forward, reload_on_fault, keep_trace)
+    trace DataFrame). The keywords are the command line's options; hw holds
+    "A=FILE" / "B=FILE" as on the command line."""
+    given = match.__signature__.bind(*args, **kwargs).arguments
+    return _play(match, [given["a"], given["b"]], args, kwargs)
+
+
+solo.__signature__ = _signature("program")
+match.__signature__ = _signature("a", "b")
 
 
 def _number(text):

@@ -33,6 +33,20 @@ def without_wall(j):
     return {k: v for k, v in j.items() if k != "wall_seconds"}
 
 
+# The keywords of solo and match are the command line's run options, from
+# one definition (tools/run_options.def): each is a --flag of `simbot match`
+# (reload_on_fault is --reload-on-fault, inject is --inject), and an
+# unknown one is refused.
+import inspect
+helped = run_cli("match", "--help")
+for name in list(inspect.signature(simbot.match).parameters)[2:-1]:
+    check(" --" + name.replace("_", "-") + " " in helped, f"match: keyword {name} is no CLI option")
+try:
+    simbot.solo(iceman, reload_on_faults=True)
+    check(False, "solo: an unknown keyword was accepted")
+except TypeError:
+    pass
+
 # A match, 20 simulated seconds, seed 7.
 expected = json.loads(run_cli("match", iceman, fig92, "--seconds", "20", "--seed", "7", "--json"))
 got = simbot.match(iceman, fig92, seconds=20, seed=7)
