@@ -102,6 +102,9 @@ std::int64_t Arena::lastReinitTick() const { return impl_->segTick; }
 
 bool Arena::setWheels(int robot, const MotorFrame& frame, std::int64_t tick) {
   Impl& m = *impl_;
+  const Journal::Entry entry(
+      m.journal.get(),
+      {.kind = Journal::Kind::SetWheels, .robot = robot, .tick = tick, .frame = frame});
   m.checkRobot(robot);
   m.checkInputTick(tick);
   const bool committedAtTick = m.pending && tick == m.pendingTick;
@@ -128,6 +131,11 @@ bool Arena::setWheels(int robot, const MotorFrame& frame, std::int64_t tick) {
 
 bool Arena::setDrive(int robot, double leftFps, double rightFps, std::int64_t tick) {
   Impl& m = *impl_;
+  const Journal::Entry entry(m.journal.get(), {.kind = Journal::Kind::SetDrive,
+                                               .robot = robot,
+                                               .tick = tick,
+                                               .left = leftFps,
+                                               .right = rightFps});
   m.checkRobot(robot);
   m.checkInputTick(tick);
   const bool committedAtTick = m.pending && tick == m.pendingTick;
@@ -152,6 +160,16 @@ bool Arena::setDrive(int robot, double leftFps, double rightFps, std::int64_t ti
 EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, RandomBits* gunLuck,
                           RandomBits* muzzle) {
   Impl& m = *impl_;
+  const Journal::Entry entry(m.journal.get(), {.kind = Journal::Kind::SetPortB,
+                                               .robot = robot,
+                                               .tick = tick,
+                                               .value = value,
+                                               .gunLuck = gunLuck != nullptr,
+                                               .muzzle = muzzle != nullptr});
+  Journal::Recorder gunLuckRecorder(m.journal.get(), gunLuck, 0);
+  Journal::Recorder muzzleRecorder(m.journal.get(), muzzle, 1);
+  gunLuck = gunLuckRecorder.use();
+  muzzle = muzzleRecorder.use();
   EventList ev;
   m.checkRobot(robot);
   m.checkInputTick(tick);
@@ -217,6 +235,9 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
 
 EventList Arena::triggerReflex(int robot, Bumper side, std::int64_t tick) {
   Impl& m = *impl_;
+  const Journal::Entry entry(
+      m.journal.get(),
+      {.kind = Journal::Kind::TriggerReflex, .robot = robot, .tick = tick, .side = side});
   EventList ev;
   m.checkRobot(robot);
   m.rewindTo(tick);
@@ -227,6 +248,8 @@ EventList Arena::triggerReflex(int robot, Bumper side, std::int64_t tick) {
 
 EventList Arena::edgeHandlerEntered(int robot, std::int64_t tick) {
   Impl& m = *impl_;
+  const Journal::Entry entry(
+      m.journal.get(), {.kind = Journal::Kind::EdgeHandlerEntered, .robot = robot, .tick = tick});
   EventList ev;
   m.checkRobot(robot);
   m.checkInputTick(tick);
@@ -263,8 +286,15 @@ EventList Arena::edgeHandlerEntered(int robot, std::int64_t tick) {
   return ev;
 }
 
-AdvanceResult Arena::advance(std::int64_t stopTick) { return impl_->advance(stopTick); }
-void Arena::retreat(std::int64_t tick) { impl_->retreat(tick); }
+AdvanceResult Arena::advance(std::int64_t stopTick) {
+  const Journal::Entry entry(impl_->journal.get(),
+                             {.kind = Journal::Kind::Advance, .tick = stopTick});
+  return impl_->advance(stopTick);
+}
+void Arena::retreat(std::int64_t tick) {
+  const Journal::Entry entry(impl_->journal.get(), {.kind = Journal::Kind::Retreat, .tick = tick});
+  impl_->retreat(tick);
+}
 
 bool Arena::ballsInFlight() const {
   const Impl& m = *impl_;

@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "plant/arena_journal.h"
 #include "plant/arkode.h"
 #include "plant/contact.h"
 #include "plant/geometry.h"
@@ -261,6 +262,10 @@ struct Arena::Impl {
   std::vector<double> coef;
   // Slope and curvature of x, y at the end of ARKODE's last step.
   std::vector<double> endY, endF, endA;
+
+  // ---- the calls that changed the arena, when it keeps them (a copy
+  // makes them again: arena_journal.h)
+  std::unique_ptr<Journal> journal;
 
   // ---- statistics
   IntegratorStats acc{};

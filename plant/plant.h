@@ -423,8 +423,17 @@ class Arena {
  public:
   explicit Arena(const ArenaConfig& config);
   ~Arena();
-  Arena(const Arena&) = delete;
-  Arena& operator=(const Arena&) = delete;
+  // The arena as a value (a snapshot of a match). SUNDIALS keeps its
+  // integrator's state private, so a copy is a new arena of the same
+  // configuration on which every call that changed this one is made again,
+  // in order, with the random words it drew; an arena's state depends on
+  // nothing else (arena.cpp, "Stepping"), so the copy goes on exactly as
+  // this one would. It costs the replay: about the time the plant took so
+  // far. Only an arena that keeps its journal, from before its first call,
+  // can be copied (std::logic_error otherwise).
+  void keepJournal();
+  Arena(const Arena& other);
+  Arena& operator=(const Arena& other);
 
   int robotCount() const;
   std::int64_t now() const;             // tick reached by the integrator

@@ -8,6 +8,9 @@
 #include <algorithm>
 #include <cstring>
 #include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "plant_support.h"
@@ -71,13 +74,21 @@ std::vector<Input> script() {
 }
 
 // Drives one arena through the script; `nextStop(now, target)` says where
-// the next advance() stops (at most target).
-ChopRun drive(const std::function<std::int64_t(std::int64_t, std::int64_t)>& nextStop) {
+// the next advance() stops (at most target). With `copyAfter` >= 0 the
+// arena keeps its journal and, after that many inputs, the run goes on with
+// a copy of it (the original is dropped); with `draws` the gun strokes draw
+// jams, misfires and muzzle speeds from seeded streams.
+ChopRun drive(const std::function<std::int64_t(std::int64_t, std::int64_t)>& nextStop,
+              int copyAfter = -1, bool draws = false) {
   const Profile p = defaults();
-  Arena a(makeArenaConfig(p, 2));
+  auto owned = std::make_unique<Arena>(makeArenaConfig(p, 2));
+  if (copyAfter >= 0) owned->keepJournal();
+  SplitMix64 gunLuck(7), muzzle(8);
   ChopRun run;
+  int inputs = 0;
   std::int64_t nextSample = 0;
   auto sample = [&] {
+    const Arena& a = *owned;
     for (; nextSample <= a.now(); nextSample += kSampleEvery) {
       // Nothing before the last re-initialisation was left unsampled.
       EXPECT_GE(nextSample, a.lastReinitTick());
@@ -92,6 +103,7 @@ ChopRun drive(const std::function<std::int64_t(std::int64_t, std::int64_t)>& nex
     }
   };
   auto advanceTo = [&](std::int64_t target) {
+    Arena& a = *owned;
     while (a.now() < target) {
       const std::int64_t stop = nextStop(a.now(), target);
       const AdvanceResult r = a.advance(stop);
@@ -104,16 +116,22 @@ ChopRun drive(const std::function<std::int64_t(std::int64_t, std::int64_t)>& nex
   };
   sample();
   for (const Input& in : script()) {
+    if (inputs++ == copyAfter) {
+      auto copy = std::make_unique<Arena>(*owned);
+      owned = std::move(copy);
+    }
+    Arena& a = *owned;
     advanceTo(in.tick);
     if (in.wheels) {
       a.setWheels(in.robot, frame(in.frame), in.tick);
     } else {
-      for (const Event& e : a.setPortB(in.robot, in.portB, in.tick))
+      for (const Event& e : a.setPortB(in.robot, in.portB, in.tick, draws ? &gunLuck : nullptr,
+                                       draws ? &muzzle : nullptr))
         run.events.push_back({in.tick, e});
     }
   }
   advanceTo(kEnd);
-  run.stats = a.stats();
+  run.stats = owned->stats();
   return run;
 }
 
@@ -172,6 +190,34 @@ TEST(Chopping, ResultsDoNotDependOnWhereAdvanceStops) {
 
   expectSame(atInputs, rounds, "every 9,600 ticks vs only at inputs");
   expectSame(atInputs, irregular, "irregular stops vs only at inputs");
+}
+
+// A copy of an arena (made by replaying its journal) goes on exactly as
+// the arena would have: copied after 5 inputs (A has fired; the ball is in
+// flight), after 13 (mid-match) or after all, with every stroke's random
+// draws, it gives the bit-identical run, events and integrator work.
+TEST(ArenaCopy, GoesOnAsTheOriginalWould) {
+  const auto atInputs = [](std::int64_t, std::int64_t target) { return target; };
+  const ChopRun original = drive(atInputs, -1, true);
+  for (const int after : {0, 5, 13, static_cast<int>(script().size()) - 1}) {
+    const ChopRun copied = drive(atInputs, after, true);
+    expectSame(original, copied, ("copied after input " + std::to_string(after)).c_str());
+  }
+  // The same with the scheduler's rounds, which retreat and re-advance.
+  constexpr std::int64_t kRound = 9'600;
+  const auto rounds = [](std::int64_t now, std::int64_t target) {
+    return std::min(target, (now / kRound + 1) * kRound);
+  };
+  expectSame(drive(rounds, -1, true), drive(rounds, 9, true), "rounds, copied after input 9");
+}
+
+// An arena that did not keep its journal cannot be copied, nor can one that
+// starts keeping it after its first call.
+TEST(ArenaCopy, NeedsTheJournalFromTheFirstCall) {
+  Arena a(makeArenaConfig(defaults(), 2));
+  EXPECT_THROW(Arena{a}, std::logic_error);
+  a.advance(1000);
+  EXPECT_THROW(a.keepJournal(), std::logic_error);
 }
 
 }  // namespace

@@ -1,0 +1,82 @@
+// plant/arena_journal.h -- internal: the calls that changed an arena, kept
+// so that a copy of it can be made by making them again (Arena's copy
+// constructor, arena_journal.cpp). SUNDIALS keeps its integrator's state
+// private, and an arena's state depends on nothing but its configuration,
+// the calls that changed it and the random words they drew (arena.cpp,
+// "Stepping": not on queries, nor on how the caller chops time).
+#pragma once
+#include <cstdint>
+#include <exception>
+#include <vector>
+
+#include "plant/plant.h"
+
+namespace simbot::plant::arena_detail {
+
+struct Journal {
+  enum class Kind : std::uint8_t {
+    SetWheels,
+    SetDrive,
+    SetPortB,
+    TriggerReflex,
+    EdgeHandlerEntered,
+    Advance,
+    Retreat
+  };
+  struct Call {
+    Kind kind;
+    int robot = 0;
+    std::int64_t tick = 0;
+    MotorFrame frame{};
+    double left = 0, right = 0;
+    std::uint8_t value = 0;
+    Bumper side = Bumper::Front;
+    bool gunLuck = false, muzzle = false;  // setPortB was given the stream
+  };
+  // The random words setPortB's calls drew, in order, each with its stream
+  // (0: gunLuck, 1: muzzle).
+  struct Draw {
+    std::uint8_t stream;
+    std::uint64_t bits;
+  };
+
+  explicit Journal(const ArenaConfig& config) : initial(config) {}
+  ArenaConfig initial;  // the configuration the arena was made with
+  std::vector<Call> calls;
+  std::vector<Draw> draws;
+
+  // Kept for the duration of one public call: the call is in the journal,
+  // and taken out again (with its draws) if the call throws.
+  class Entry {
+   public:
+    Entry(Journal* journal, const Call& call);
+    ~Entry();
+    Entry(const Entry&) = delete;
+    Entry& operator=(const Entry&) = delete;
+
+   private:
+    Journal* journal_;
+    std::size_t draws_ = 0;
+    int exceptions_ = 0;
+  };
+
+  // A stream whose words go to the journal as they are drawn.
+  class Recorder final : public RandomBits {
+   public:
+    Recorder(Journal* journal, RandomBits* source, std::uint8_t stream)
+        : journal_(journal), source_(source), stream_(stream) {}
+    std::uint64_t next() override;
+    // The stream to hand on: the recorder while journaling, else the source.
+    RandomBits* use() { return journal_ && source_ ? this : source_; }
+
+   private:
+    Journal* journal_;
+    RandomBits* source_;
+    std::uint8_t stream_;
+  };
+
+  // Makes every call again on `arena` (new, of configuration `initial`).
+  void replay(Arena& arena) const;
+};
+
+}  // namespace simbot::plant::arena_detail
