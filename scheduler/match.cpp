@@ -135,6 +135,24 @@ Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs, ui
   if (match.profiling()) board.cpu.enableProfile();
 }
 
+Robot::Robot(const Robot& other, Match& m)
+    : reloadPending(other.reloadPending),
+      faultSeen(other.faultSeen),
+      lineInjections(other.lineInjections),
+      lineHits(other.lineHits),
+      watches(other.watches),
+      snapshots(other.snapshots),
+      nextSnapshot(other.nextSnapshot),
+      spec(other.spec),
+      index(other.index),
+      match(m),
+      board(other.board, *this),
+      receiver(other.receiver),
+      serialEventAt(other.serialEventAt),
+      serialIsrAccepted(other.serialIsrAccepted),
+      result(other.result),
+      mainReturn(other.mainReturn) {}
+
 void Robot::reload(Tick t) {
   reloadPending = false;
   // The delay is long enough that no byte is left in the port. The VM
@@ -148,7 +166,7 @@ void Robot::reload(Tick t) {
   // reloaded program's frames).
   receiver.clear();
   serialEventAt = -1;
-  // Samples up to t were taken from the faulted VM: the new one's start at
+  // Samples up to t were taken from the faulted program: the reloaded one's start at
   // the next sample tick.
   snapshots.clear();
   const Tick interval = match.sampleInterval();
@@ -210,6 +228,30 @@ Robot::Snapshot Robot::snapshotFor(Tick t) {
 }
 
 // ---- match ------------------------------------------------------------------
+
+Match::Match(const Match& other)
+    : config_(other.config_),
+      costs_(other.costs_),
+      arenaConfig_(other.arenaConfig_),
+      arena_(other.arena_),
+      trace_(other.trace_),
+      coin_(other.coin_),
+      queue_(other.queue_),
+      inputs_(other.inputs_),
+      warnings_(other.warnings_),
+      fired_(other.fired_),
+      injectionAddress_(other.injectionAddress_),
+      betweenRounds_(other.betweenRounds_),
+      begun_(other.begun_),
+      over_(other.over_),
+      roundStart_(other.roundStart_),
+      result_(other.result_),
+      nextSample_(other.nextSample_),
+      rounds_(other.rounds_),
+      subRounds_(other.subRounds_),
+      clock_(other.clock_) {
+  for (const auto& r : other.robots_) robots_.push_back(std::make_unique<Robot>(*r, *this));
+}
 
 Tick Match::earliestClock() const {
   Tick t = INT64_MAX;
@@ -501,32 +543,48 @@ void Match::sampleUpTo(Tick t) {
 }
 
 MatchResult Match::run() {
-  MatchResult result;
-  if (trace_.on()) emitSetup();
-  Tick roundStart = 0;
+  runUntil(kNoPause);
+  return end();
+}
+
+bool Match::runUntil(Tick pause) {
+  if (!begun_) {
+    begun_ = true;
+    if (trace_.on()) emitSetup();
+  }
+  if (over_) return false;
   clock_.start();
   try {
-    rounds(result, roundStart);
+    rounds(pause);
   } catch (const plant::SolverError& e) {
     // The plant cannot go on: the run ends where the failing round began,
     // with everything before it kept.
-    result.plantFault = FaultInfo{e.what(), timebase::secondsFromTicks(roundStart), 0};
-    result.endTick = roundStart;
-    if (trace_.on()) emit(roundStart, trace::rec::PlantFault{e.what()}, {});
+    result_.plantFault = FaultInfo{e.what(), timebase::secondsFromTicks(roundStart_), 0};
+    result_.endTick = roundStart_;
+    over_ = true;
+    if (trace_.on()) emit(roundStart_, trace::rec::PlantFault{e.what()}, {});
   }
   clock_.stop();
+  return !over_;
+}
+
+MatchResult Match::end() {
+  runUntil(kNoPause);
+  MatchResult result = std::move(result_);
   result.parts = clock_.times();
   finish(result);
   return result;
 }
 
-void Match::rounds(MatchResult& result, Tick& roundStart) {
-  bool over = false;
+void Match::rounds(Tick pause) {
+  bool& over = over_;
+  MatchResult& result = result_;
   while (!over) {
+    const Tick t = earliestClock();
+    if (t >= pause) return;  // paused between rounds
     ++rounds_;
     if (config_.stop && config_.stop->load(std::memory_order_relaxed)) throw Stopped();
-    const Tick t = earliestClock();
-    roundStart = t;
+    roundStart_ = t;
     if (trace_.on()) trace_.flushBefore(std::min(t, arena_.now()));
     Tick horizon = std::min(queue_.nextTick(), earliestAction() + kLookahead);
     // The plant goes further than the first sub-round when no ball is in
@@ -811,5 +869,17 @@ MatchResult runMatch(const MatchConfig& config) {
   detail::Match match(config);
   return match.run();
 }
+
+MatchRun::MatchRun(const MatchConfig& config) : match_(std::make_unique<detail::Match>(config)) {}
+MatchRun::MatchRun(const MatchRun& other)
+    : match_(std::make_unique<detail::Match>(*other.match_)) {}
+MatchRun& MatchRun::operator=(const MatchRun& other) {
+  if (this != &other) match_ = std::make_unique<detail::Match>(*other.match_);
+  return *this;
+}
+MatchRun::~MatchRun() = default;
+bool MatchRun::runUntil(Tick tick) { return match_->runUntil(tick); }
+Tick MatchRun::now() const { return match_->roundStart(); }
+MatchResult MatchRun::finish() { return match_->end(); }
 
 }  // namespace simbot::scheduler

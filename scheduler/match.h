@@ -159,6 +159,9 @@ struct MatchConfig {
   // Measure the wall time spent in the VMs, the plant and the scheduler
   // (MatchResult::parts; bench/match_bench). Off: no clock is read.
   bool timeParts = false;
+  // The run can be copied (MatchRun): the plant keeps the journal its copy
+  // replays. Off: nothing is kept.
+  bool snapshots = false;
 };
 
 // A reload waits at least this long, so that the bytes a faulted robot's
@@ -237,6 +240,33 @@ struct MatchResult {
 };
 
 MatchResult runMatch(const MatchConfig& config);
+
+namespace detail {
+class Match;
+}
+
+// A match that stops between rounds and is a value: a copy (a snapshot)
+// holds everything of it, both boards, the scheduler's queue, the plant,
+// every random stream and the trace records not yet written, and goes on
+// byte for byte as the original would; the copy writes to the same trace
+// sinks. Needs MatchConfig::snapshots (the plant keeps its journal: a
+// copy replays it, arena.cpp).
+class MatchRun {
+ public:
+  explicit MatchRun(const MatchConfig& config);
+  MatchRun(const MatchRun& other);
+  MatchRun& operator=(const MatchRun& other);
+  ~MatchRun();
+  // Runs every round that starts before `tick`; false once the match is over.
+  bool runUntil(Tick tick);
+  // Where the next round starts (every robot's clock is at or past it).
+  Tick now() const;
+  // Runs to the end: the result, as runMatch's.
+  MatchResult finish();
+
+ private:
+  std::unique_ptr<detail::Match> match_;
+};
 
 // Seeded stream for one purpose (DESIGN.md: one generator per purpose).
 uint64_t streamSeed(uint64_t seed, const std::string& purpose);

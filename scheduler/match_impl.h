@@ -1,7 +1,8 @@
 // scheduler/match_impl.h -- internal: the classes of one match.
 //
-// A match is its round loop (Match, match.cpp) and its robots, each a VM
-// with the devices its program talks to (Robot). The robot's bus -- how a
+// A match is its round loop (Match, match.cpp) and its robots, each a board
+// (board/board.h: the VM and the devices its program talks to) and what the
+// match keeps of it (Robot). The robot's bus -- how a
 // VM's port writes, A/D reads, serial library calls and interrupt
 // notifications become plant inputs, queued events and trace records -- is
 // in robot_bus.cpp, apart from the round loop; both see these classes, in
@@ -65,6 +66,11 @@ plant::ArenaConfig arenaConfigFor(const MatchConfig& config);
 class Robot : public vm::Bus {
  public:
   Robot(Match& match, int index, const RobotSpec& spec, const vm::CostTable& costs, uint64_t seed);
+  // A copy of `other` in the match `match` (a snapshot of other's match):
+  // its board talks to the copy.
+  Robot(const Robot& other, Match& match);
+  Robot(const Robot&) = delete;
+  Robot& operator=(const Robot&) = delete;
 
   // The robot's clock (match ticks) and its program's VM.
   Tick now() const { return board.cpu.now(); }
@@ -145,6 +151,7 @@ class Match {
         arena_(arenaConfig_),
         coin_(streamSeed(config.seed, "coin")),
         clock_(config.timeParts) {
+    if (config.snapshots) arena_.keepJournal();
     for (trace::Sink* sink : config.sinks) trace_.attach(sink);
     if (config.robots.empty() || config.robots.size() > 2)
       throw std::invalid_argument("a match needs one or two robots");
@@ -198,9 +205,22 @@ class Match {
     }
   }
 
+  // A snapshot: every part of `other`, its robots' boards talking to this
+  // match's robots, its plant copied by replay (MatchConfig::snapshots).
+  Match(const Match& other);
+  Match& operator=(const Match&) = delete;
+
+  // The whole run (runUntil and end).
   MatchResult run();
-  // The round loop; `roundStart` is the tick the current round began at.
-  void rounds(MatchResult& result, Tick& roundStart);
+  static constexpr Tick kNoPause = INT64_MAX;
+  // Runs the rounds that start before `pause`; false once the run is over.
+  bool runUntil(Tick pause);
+  // Runs to the end; the result.
+  MatchResult end();
+  Tick roundStart() const { return over_ ? result_.endTick : earliestClock(); }
+  // The round loop, until the run is over or the next round would start at
+  // or after `pause`.
+  void rounds(Tick pause);
   bool serialBytesInRound(Tick horizon);
 
   plant::Arena& arena() { return arena_; }
@@ -272,6 +292,10 @@ class Match {
     return it == hits.end() ? 0 : it->second;
   }
   bool betweenRounds_ = false;
+  // The run so far: runUntil stops between rounds and goes on later.
+  bool begun_ = false, over_ = false;
+  Tick roundStart_ = 0;  // the tick the current round began at
+  MatchResult result_;
   Tick nextSample_ = 0;
   uint64_t rounds_ = 0;
   uint64_t subRounds_ = 0;  // sub-rounds after the first of each round

@@ -3,8 +3,9 @@
 // The VM calls these at the exact tick of each access (vm::Bus): port B
 // writes and PIO handler entries become plant inputs applied after the
 // round, A/D reads the plant's eye readings at their tick, the serial
-// library's calls drive the robot's serial link to the motor controller
-// (a latched frame sets the wheels), PIO port A follows the edge lines, and
+// library's calls drive the board's serial port, whose bytes the plant's
+// motor controller receives (a latched frame sets the wheels), PIO port A
+// follows the edge lines, and
 // each leaves its trace record. The round loop that runs the VMs and
 // applies the inputs is in match.cpp.
 #include <bit>

@@ -1,0 +1,98 @@
+// A snapshot of a whole match is a copy (scheduler::MatchRun): both
+// boards, the scheduler's queue, the plant, every random stream and the
+// trace records not yet written. Taken between rounds at tick T, the match
+// run on to its end and the snapshot run on from T write the same records
+// after T and end with the same result; and a run paused at T writes what
+// the run without a pause writes. ICEMAN vs Figure 9.2 for 60 s on the
+// default profile (seeded variation, eye noise, gun draws), and a faulting
+// program against the turret with --reload-on-fault (a reload after the
+// snapshot, and one before it).
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "scheduler/match.h"
+#include "tools/play.h"
+#include "tools/trace_jsonl.h"
+
+using namespace simbot;
+
+namespace {
+
+const std::string kShared = SIMBOT_SHARED_DIR;
+const std::string kSource = SIMBOT_SOURCE_DIR;
+
+scheduler::MatchConfig configFor(const std::vector<std::string>& programs, double seconds,
+                                 bool reload) {
+  tools::RunOptions o;
+  o.seconds = seconds;
+  o.profile = "default";
+  o.seed = 3;
+  o.reloadOnFault = reload;
+  return tools::buildConfig(programs, o, tools::ScenarioUse::Match);
+}
+
+// What a result says, without the host's wall times.
+std::string summary(const scheduler::MatchResult& r) {
+  std::string s = r.winner + " " + std::to_string(r.endTick) + " " +
+                  std::to_string(r.integrator.steps) + " " + std::to_string(r.integrator.rhs_evals);
+  for (const auto& rr : r.robots)
+    s += " | " + std::to_string(rr.hits) + " " + std::to_string(rr.shots) + " " +
+         std::to_string(rr.framesLatched) + " " + std::to_string(rr.cycles) + " " +
+         std::to_string(rr.vmInstructions) + " " + std::to_string(rr.reloads);
+  return s;
+}
+
+void expectSnapshotsContinue(const std::vector<std::string>& programs, double seconds, bool reload,
+                             const std::vector<double>& at) {
+  tools::JsonlLines whole;
+  scheduler::MatchConfig plain = configFor(programs, seconds, reload);
+  plain.sinks = {&whole};
+  const scheduler::MatchResult uninterrupted = scheduler::runMatch(plain);
+
+  for (const double t : at) {
+    SCOPED_TRACE("snapshot at " + std::to_string(t) + " s");
+    tools::JsonlLines lines;
+    scheduler::MatchConfig c = configFor(programs, seconds, reload);
+    c.snapshots = true;
+    c.sinks = {&lines};
+    scheduler::MatchRun run(c);
+    ASSERT_TRUE(run.runUntil(timebase::ticksFromSeconds(t)));
+    EXPECT_GE(run.now(), timebase::ticksFromSeconds(t));
+    const size_t before = lines.lines.size();
+    const scheduler::MatchRun snapshot(run);
+
+    const scheduler::MatchResult first = run.finish();
+    const std::vector<std::string> firstRest(lines.lines.begin() + static_cast<long>(before),
+                                             lines.lines.end());
+    // Paused or not, the same run.
+    EXPECT_EQ(lines.lines, whole.lines);
+    EXPECT_EQ(summary(first), summary(uninterrupted));
+
+    lines.lines.resize(before);
+    scheduler::MatchRun restored(snapshot);
+    const scheduler::MatchResult second = restored.finish();
+    const std::vector<std::string> secondRest(lines.lines.begin() + static_cast<long>(before),
+                                              lines.lines.end());
+    ASSERT_GT(firstRest.size(), 100u);
+    EXPECT_EQ(firstRest.size(), secondRest.size());
+    EXPECT_TRUE(firstRest == secondRest);
+    EXPECT_EQ(summary(second), summary(first));
+  }
+}
+
+TEST(MatchSnapshot, IcemanVsFig92GoesOnByteForByte) {
+  expectSnapshotsContinue({kShared + "/programs/iceman.dc", kShared + "/programs/fig92.dc"}, 60,
+                          false, {0.5, 17.3, 44.0});
+}
+
+TEST(MatchSnapshot, AReloadBeforeOrAfterTheSnapshot) {
+  // The faulting program faults well inside a second; the profile's reload
+  // delay is 20 s.
+  expectSnapshotsContinue(
+      {kSource + "/tests/faulting/unbound_vector.dc", kSource + "/programs/turret.dc"}, 50, true,
+      {0.1, 10.0, 30.0});
+}
+
+}  // namespace
