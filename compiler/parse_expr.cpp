@@ -62,6 +62,8 @@ Node* Parser::assign() {
 //   shift          = additive (("<<" | ">>") additive)*
 //   additive       = multiplicative (("+" | "-") multiplicative)*
 //   multiplicative = cast (("*" | "/" | "%") cast)*
+namespace {
+
 struct BinaryOperator {
   std::string_view spelling;
   NodeKind kind;
@@ -75,6 +77,8 @@ constexpr BinaryOperator kBinaryOperators[] = {
     {">>", NodeKind::Shr, 8},   {"+", NodeKind::Add, 9},     {"-", NodeKind::Sub, 9},
     {"*", NodeKind::Mul, 10},   {"/", NodeKind::Div, 10},    {"%", NodeKind::Mod, 10}};
 constexpr int kLoosestBinary = 1;
+
+}  // namespace
 
 // conditional = binary ("?" expr ":" conditional)?
 Node* Parser::conditional() {

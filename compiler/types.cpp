@@ -1,6 +1,8 @@
 // C types of Dynamic C on the Z180: char is 8-bit unsigned, short and int
 // 16-bit, long 32-bit, float IEEE single, pointers 16-bit. Helpers to classify
-// them and to spell them in symbols and messages.
+// them and to spell them in symbols and messages; then the type rules of
+// expressions the parser builds every typed node through (conversions,
+// folding, operand checks, pointer arithmetic, assignment).
 #include <string>
 
 #include "compiler/ast.h"

@@ -49,7 +49,7 @@ def sandbox(source, simbot, work):
         shutil.rmtree(work)
     os.makedirs(os.path.join(main, "build", "bin"))
     os.symlink(os.path.abspath(simbot), os.path.join(main, "build", "bin", "simbot"))
-    # The benchmark binaries beside it, for the README's Benchmarks section.
+    # The benchmark binaries beside it, for docs/benchmarks.md.
     for name in ("match_bench", "vm_bench"):
         built = os.path.join(os.path.dirname(os.path.abspath(simbot)), name)
         if os.path.exists(built):
@@ -58,7 +58,7 @@ def sandbox(source, simbot, work):
     page = os.path.join(os.path.dirname(os.path.abspath(simbot)), "..", "simbot.1")
     if os.path.exists(page):
         os.symlink(os.path.abspath(page), os.path.join(main, "build", "simbot.1"))
-    # The Python module beside it (the README's Python section).
+    # The Python module beside it (docs/tools.md, "Python and sweeps").
     module = os.path.join(os.path.dirname(os.path.abspath(simbot)), "..", "python")
     if os.path.isdir(module):
         os.symlink(os.path.abspath(module), os.path.join(main, "build", "python"))
@@ -102,6 +102,7 @@ def main():
                 if script:  # what comes before it runs first
                     done = subprocess.run(["bash", "-e", "-c", "\n".join(script)], cwd=cwd,
                                           capture_output=True, text=True)
+                    ran += len(script)
                     script = []
                     if done.returncode != 0:
                         problem = f"status {done.returncode}: {done.stderr[-600:]}"

@@ -13,6 +13,7 @@
 
 using namespace simbot;
 using testkit::TestHost;
+using vm::Tick;
 
 namespace {
 
@@ -105,6 +106,10 @@ TEST(VmReset, IsTheMachineOfAVmPoweredOnThenWithTheCountersCarriedOn) {
     fresh.setBreakpoint(mainReturn);
     EXPECT_EQ(v.now(), t);
     EXPECT_TRUE(v.sameMachine(fresh));
+    // A run that runs nothing builds the fast path's tables, a cache: still
+    // the same machine.
+    fresh.run(t);
+    EXPECT_TRUE(v.sameMachine(fresh));
     // The counters are the whole run's.
     EXPECT_FALSE(v == fresh);
     EXPECT_EQ(v.stats().instructions, instructions);
@@ -124,6 +129,40 @@ TEST(VmReset, IsTheMachineOfAVmPoweredOnThenWithTheCountersCarriedOn) {
     expectSameRun(resetHost, freshHost);
     EXPECT_EQ(reloaded.stats().instructions, instructions + fresh.stats().instructions);
   }
+}
+
+// The first timer acceptance at or after `from`.
+Tick firstTimerAcceptance(const TestHost& host, Tick from) {
+  for (const auto& e : host.events)
+    if (e.accepted && e.irq == vm::Irq::Timer && e.tick >= from) return e.tick;
+  return -1;
+}
+
+// PRT0 ticks every kPrtTicks = 9,216,000 / 1,024 = 9,000 ticks from the
+// power-on: the first timer request of a VM powered on at 0 is at 9,000,
+// of one reset at t at t + 9,000, and each is accepted at the first
+// instruction boundary at or after it (here within 200 ticks: two steps of
+// at most 100 T-states, or one instruction).
+TEST(VmReset, PrtTicksFromTheReset) {
+  const vm::Image image =
+      testkit::compileFileOrDie(SIMBOT_SOURCE_DIR "/programs/costate_hunter.dc");
+  ASSERT_TRUE(image.timer.used());
+  TestHost host;
+  vm::Vm v(image, host, costs());
+  host.runUntil(v, 20'000);
+  const Tick first = firstTimerAcceptance(host, 0);
+  EXPECT_GE(first, 9'000);
+  EXPECT_LT(first, 9'200);
+
+  host.runUntil(v, kSecond / 3);
+  const Tick t = v.now();
+  v.reset(t);
+  TestHost afterReset;
+  vm::Vm reloaded(v, afterReset);
+  afterReset.runUntil(reloaded, t + 20'000);
+  const Tick again = firstTimerAcceptance(afterReset, t);
+  EXPECT_GE(again, t + 9'000);
+  EXPECT_LT(again, t + 9'200);
 }
 
 }  // namespace

@@ -1483,15 +1483,24 @@ void Vm::State::powerOn(Tick start) {
 Vm::Vm(const Vm& other, Bus& bus) : s_(std::make_unique<State>(*other.s_)) {
   s_->bus = &bus;
   s_->self = this;
+  s_->costateEvents = bus.wantCostateEvents();
+  // A copy of a vector keeps its size, not its room: the hot path's pushes
+  // must not allocate.
+  s_->calls.reserve(kMemorySize / kCallFrameBytes);
+  s_->ints.reserve(kMaxInterruptNesting);
 }
 
 Vm::~Vm() = default;
 
 void Vm::restore(const Vm& snapshot) {
   Bus* const bus = s_->bus;
+  const bool costateEvents = s_->costateEvents;
   *s_ = *snapshot.s_;
   s_->bus = bus;
   s_->self = this;
+  s_->costateEvents = costateEvents;
+  s_->calls.reserve(kMemorySize / kCallFrameBytes);
+  s_->ints.reserve(kMaxInterruptNesting);
 }
 
 void Vm::reset(Tick t) {
@@ -1510,17 +1519,36 @@ void Vm::reset(Tick t) {
     if (breakpoints[a]) setBreakpoint(a);
 }
 
-bool Vm::operator==(const Vm& other) const {
-  State mine = *s_;
-  mine.bus = other.s_->bus;
-  mine.self = other.s_->self;
-  return mine == *other.s_;
+namespace {
+
+// A copy of `mine` for comparing with `other`: what is not the machine's
+// state taken from `other`. The bus it talks to, and the caches a run
+// builds from the image, the breakpoints and run()'s labels (the fast
+// path's tables, built at the first run of each kind: a VM that has not
+// run yet is the same machine as one that has run nothing).
+Vm::State comparable(const Vm::State& mine, const Vm::State& other) {
+  Vm::State copy = mine;
+  copy.bus = other.bus;
+  copy.self = other.self;
+  copy.costateEvents = other.costateEvents;
+  copy.fast = other.fast;
+  copy.fastLabels = other.fastLabels;
+  copy.fusedLabels = other.fusedLabels;
+  copy.idiomLabels = other.idiomLabels;
+  copy.dbgIdiomLabels = other.dbgIdiomLabels;
+  copy.joinLabels = other.joinLabels;
+  copy.longLabels = other.longLabels;
+  copy.joinEntries = other.joinEntries;
+  copy.idiomCosts = other.idiomCosts;
+  return copy;
 }
 
+}  // namespace
+
+bool Vm::operator==(const Vm& other) const { return comparable(*s_, *other.s_) == *other.s_; }
+
 bool Vm::sameMachine(const Vm& other) const {
-  State mine = *s_;
-  mine.bus = other.s_->bus;
-  mine.self = other.s_->self;
+  State mine = comparable(*s_, *other.s_);
   mine.stats = other.s_->stats;
   mine.profile = other.s_->profile;
   mine.serialIsrCycles = other.s_->serialIsrCycles;

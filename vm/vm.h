@@ -19,8 +19,8 @@
 // them, and IFF1 after them is what it was before.
 //
 // The timer: when the program uses the timer library (Image::timer) or the
-// knob says always, PRT0 requests Irq::Timer at every multiple of
-// kPrtTicks of the VM's clock (9.216 MHz / 20 / 450 = 1,024 Hz). The BIOS
+// knob says always, PRT0 requests Irq::Timer every kPrtTicks from the VM's
+// power-on (or reset) tick (9.216 MHz / 20 / 450 = 1,024 Hz). The BIOS
 // service runs atomically at acceptance like the serial library's ISR, costs
 // CostTable::timerIsr and advances TICK_TIMER, MS_TIMER and SEC_TIMER in
 // robot memory. A request not yet accepted when the next tick comes is the
@@ -127,8 +127,9 @@ class Vm {
   // on at t; its breakpoints, its profile switch and its counters (stats,
   // profile, interrupt service cycles) carry on over the whole run.
   void reset(Tick t);
-  // Same state: every part of the machine and the counters (the bus it
-  // talks to aside); sameMachine leaves the counters out.
+  // Same state: every part of the machine and the counters, for the same
+  // image (by address); the bus it talks to and the caches a run builds
+  // aside. sameMachine leaves the counters out.
   bool operator==(const Vm& other) const;
   bool sameMachine(const Vm& other) const;
 
