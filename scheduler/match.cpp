@@ -837,26 +837,6 @@ Injection parseInjection(const std::string& text, int robotCount) {
   return in;
 }
 
-std::optional<uint32_t> loopHead(const vm::Image& image, int line) {
-  std::optional<uint32_t> head;
-  const auto& code = image.code;
-  for (uint32_t at = 0; at < code.size();) {
-    if (code[at] >= vm::kOpCount) return head;  // not code: the walk cannot go on
-    const auto op = static_cast<vm::Op>(code[at]);
-    const auto size = static_cast<uint32_t>(vm::instructionSize(op));
-    if (at + size > code.size()) break;
-    if (vm::info(op).shape == vm::Shape::REL16 && image.lineAt(at) == line) {
-      const auto rel = static_cast<int16_t>(code[at + 1] | (code[at + 2] << 8));
-      const int64_t target = int64_t{at} + size + rel;
-      if (target >= 0 && target <= at && image.lineAt(static_cast<uint32_t>(target)) == line &&
-          (!head || target < *head))
-        head = static_cast<uint32_t>(target);
-    }
-    at += size;
-  }
-  return head;
-}
-
 uint64_t streamSeed(uint64_t seed, const std::string& purpose) {
   // FNV-1a of the purpose, mixed with the master seed through SplitMix64.
   uint64_t h = 1469598103934665603ull;

@@ -110,12 +110,6 @@ inline constexpr Tick kInjectedEdgePulse = kTicksPerSecond / 20;  // 50 ms
 // Throws std::invalid_argument with a message naming what is wrong.
 Injection parseInjection(const std::string& text, int robotCount);
 
-// The head of the loop written on source line N: the target of a backward
-// jump whose jump and target both belong to line N (the outermost such loop
-// when there are several: the lowest target). It runs once per pass, and
-// once more for the test that ends the loop. None: no loop lies on line N.
-std::optional<uint32_t> loopHead(const vm::Image& image, int line);
-
 // Optional hooks for measurements (simbot bench). Called from the round loop
 // at the exact tick of each happening; an observer only reads, so a run with
 // one gives the same results as one without. Per robot, eye reads and frames

@@ -182,7 +182,7 @@ class Match {
         if (at == lines.end())
           throw std::invalid_argument(
               fmt::format("{}: line {} of {} has no code", in.text, in.line, r.spec.program));
-        const std::optional<uint32_t> head = loopHead(r.spec.image, in.line);
+        const std::optional<uint32_t> head = r.spec.image.loopHead(in.line);
         if (in.pass && !head)
           throw std::invalid_argument(fmt::format(
               "{}: line {} of {} holds no whole loop (pass:N#K counts the passes of a loop "

@@ -299,8 +299,8 @@ TEST(Inject, LineOnALineHoldingALoopCountsEntriesAndSaysSo) {
 
 TEST(Inject, PassNeedsALoopOnTheLine) {
   const auto img = testkit::compileOrDie(kOneLine, "oneline.dc");
-  EXPECT_TRUE(scheduler::loopHead(img, kOneLineLoop).has_value());
-  EXPECT_FALSE(scheduler::loopHead(img, 17).has_value());  // the printf
+  EXPECT_TRUE(img.loopHead(kOneLineLoop).has_value());
+  EXPECT_FALSE(img.loopHead(17).has_value());  // the printf
   EXPECT_THROW(oneLine({"A:edge_aft@pass:17#1"}), std::invalid_argument);
   EXPECT_THROW(scheduler::parseInjection("A:edge_aft@pass:16", 1), std::invalid_argument);
   EXPECT_TRUE(scheduler::parseInjection("A:edge_aft@pass:16#3", 1).pass);

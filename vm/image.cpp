@@ -1,5 +1,7 @@
 #include "vm/image.h"
 
+#include "vm/bytecode.h"
+
 namespace simbot::vm {
 
 const Symbol* Image::functionAt(uint32_t codeAddress) const {
@@ -10,6 +12,25 @@ const Symbol* Image::functionAt(uint32_t codeAddress) const {
     if (s.address <= codeAddress && (!best || s.address > best->address)) best = &s;
   }
   return best;
+}
+
+std::optional<uint32_t> Image::loopHead(int line) const {
+  std::optional<uint32_t> head;
+  for (uint32_t at = 0; at < code.size();) {
+    if (code[at] >= kOpCount) return head;  // not code: the walk cannot go on
+    const auto op = static_cast<Op>(code[at]);
+    const auto size = static_cast<uint32_t>(instructionSize(op));
+    if (at + size > code.size()) break;
+    if (info(op).shape == Shape::REL16 && lineAt(at) == line) {
+      const auto rel = static_cast<int16_t>(code[at + 1] | (code[at + 2] << 8));
+      const int64_t target = int64_t{at} + size + rel;
+      if (target >= 0 && target <= at && lineAt(static_cast<uint32_t>(target)) == line &&
+          (!head || target < *head))
+        head = static_cast<uint32_t>(target);
+    }
+    at += size;
+  }
+  return head;
 }
 
 }  // namespace simbot::vm

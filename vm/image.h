@@ -4,6 +4,7 @@
 // interrupt vector table and the symbol table.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -118,6 +119,12 @@ struct Image {
   int lineAt(uint32_t codeAddress) const {
     return codeAddress < lines.size() ? lines[codeAddress] : 0;
   }
+  // The head of the loop written on source line N: the target of a
+  // backward jump whose jump and target both belong to line N (the
+  // outermost such loop when there are several: the lowest target). It
+  // runs once per pass, and once more for the test that ends the loop.
+  // None: no loop lies on line N (or the code cannot be walked).
+  std::optional<uint32_t> loopHead(int line) const;
 };
 
 }  // namespace simbot::vm
