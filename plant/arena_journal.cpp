@@ -10,15 +10,14 @@ namespace simbot::plant {
 
 namespace arena_detail {
 
-Journal::Entry::Entry(Journal* journal, const Call& call)
-    : journal_(journal), exceptions_(std::uncaught_exceptions()) {
-  if (!journal_) return;
+void Journal::Entry::open(const Call& call) {
+  exceptions_ = std::uncaught_exceptions();
   draws_ = journal_->draws.size();
   journal_->calls.push_back(call);
 }
 
-Journal::Entry::~Entry() {
-  if (!journal_ || std::uncaught_exceptions() == exceptions_) return;
+void Journal::Entry::close() {
+  if (std::uncaught_exceptions() == exceptions_) return;
   journal_->calls.pop_back();
   journal_->draws.resize(draws_);
 }

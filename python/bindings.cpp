@@ -93,9 +93,8 @@ py::tuple playRun(const std::vector<std::string>& programs, bool keepTrace,
 #include "tools/run_options.def"
 #undef RUN_OPTION
   if (used != options.size())
-    for (const auto& [key, value] : options) {
+    for (const auto known = runOptionKeywords(); const auto& [key, value] : options) {
       const auto name = key.cast<std::string>();
-      const auto known = runOptionKeywords();
       if (std::none_of(known.begin(), known.end(), [&](const auto& k) { return k.first == name; }))
         throw py::type_error("unexpected keyword argument '" + name + "'");
     }

@@ -276,6 +276,12 @@ struct Vm::State {
   // The machine at power-on at tick `start` (the constructor's and a
   // reset's): image, bus and costs as they are.
   void powerOn(Tick start);
+  // Points a copied State at its VM and that VM's bus.
+  void attach(Vm* vm, Bus& to);
+  void reserveStacks();
+  // The run's counters (stats, profile, interrupt service cycles): they
+  // carry on over a reset.
+  void copyCounters(const State& from);
   bool operator==(const State&) const = default;
 
   // ---- faults and memory ----

@@ -1470,8 +1470,7 @@ void Vm::State::powerOn(Tick start) {
   now = start;
   handlerFor.fill(-1);
   for (const auto& v : image->vectors) handlerFor[v.vector] = v.handler;
-  calls.reserve(kMemorySize / kCallFrameBytes);
-  ints.reserve(kMaxInterruptNesting);
+  reserveStacks();
   const TimerService service = costs.knobs.timerService;
   if (service == TimerService::Always || (service == TimerService::Auto && image->timer.used()))
     nextTimer = start + kPrtTicks;
@@ -1481,26 +1480,36 @@ void Vm::State::powerOn(Tick start) {
 }
 
 Vm::Vm(const Vm& other, Bus& bus) : s_(std::make_unique<State>(*other.s_)) {
-  s_->bus = &bus;
-  s_->self = this;
-  s_->costateEvents = bus.wantCostateEvents();
-  // A copy of a vector keeps its size, not its room: the hot path's pushes
-  // must not allocate.
-  s_->calls.reserve(kMemorySize / kCallFrameBytes);
-  s_->ints.reserve(kMaxInterruptNesting);
+  s_->attach(this, bus);
+}
+
+void Vm::State::attach(Vm* vm, Bus& to) {
+  self = vm;
+  bus = &to;
+  costateEvents = to.wantCostateEvents();
+  // A copied vector keeps its size, not its room.
+  reserveStacks();
+}
+
+// Room for the deepest nesting, so that no push on the hot path allocates.
+void Vm::State::reserveStacks() {
+  calls.reserve(kMemorySize / kCallFrameBytes);
+  ints.reserve(kMaxInterruptNesting);
+}
+
+void Vm::State::copyCounters(const State& from) {
+  stats = from.stats;
+  profile = from.profile;
+  serialIsrCycles = from.serialIsrCycles;
+  timerIsrCycles = from.timerIsrCycles;
 }
 
 Vm::~Vm() = default;
 
 void Vm::restore(const Vm& snapshot) {
-  Bus* const bus = s_->bus;
-  const bool costateEvents = s_->costateEvents;
+  Bus& bus = *s_->bus;
   *s_ = *snapshot.s_;
-  s_->bus = bus;
-  s_->self = this;
-  s_->costateEvents = costateEvents;
-  s_->calls.reserve(kMemorySize / kCallFrameBytes);
-  s_->ints.reserve(kMaxInterruptNesting);
+  s_->attach(this, bus);
 }
 
 void Vm::reset(Tick t) {
@@ -1508,11 +1517,8 @@ void Vm::reset(Tick t) {
   auto fresh = std::make_unique<State>(*old.image, *old.bus, old.costs);
   fresh->self = this;
   fresh->powerOn(t);
-  fresh->stats = old.stats;
   fresh->profiling = old.profiling;
-  fresh->profile = old.profile;
-  fresh->serialIsrCycles = old.serialIsrCycles;
-  fresh->timerIsrCycles = old.timerIsrCycles;
+  fresh->copyCounters(old);
   const std::vector<uint8_t> breakpoints = old.breakpoints;
   s_ = std::move(fresh);
   for (uint32_t a = 0; a < breakpoints.size(); ++a)
@@ -1549,10 +1555,7 @@ bool Vm::operator==(const Vm& other) const { return comparable(*s_, *other.s_) =
 
 bool Vm::sameMachine(const Vm& other) const {
   State mine = comparable(*s_, *other.s_);
-  mine.stats = other.s_->stats;
-  mine.profile = other.s_->profile;
-  mine.serialIsrCycles = other.s_->serialIsrCycles;
-  mine.timerIsrCycles = other.s_->timerIsrCycles;
+  mine.copyCounters(*other.s_);
   // A delay loop's measured pass keeps the counters at its start.
   mine.measure.instructions = other.s_->measure.instructions;
   mine.measure.profile = other.s_->measure.profile;
