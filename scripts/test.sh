@@ -37,18 +37,17 @@ phase "sanitizer build"
 # fast-forward (fast_forward.identical: 31 s), explain the 180-s match again
 # from its JSONL file (Explain.FromTheJsonlFile: 76 s), kill and resume
 # batch runs from Python, drive the replay page in Chromium, compare
-# numbers with statsmodels, or run every idiom of the VM against its
-# unfused run at each of 2,100 horizons and interrupt ticks (75 s each
-# under ASan), and every join at each of 1,200 (1.6 and 1.1 s in the normal
-# build, where the idioms' take 2.5 s each; not timed under ASan). The code
+# numbers with statsmodels, or run every superinstruction of the VM against
+# its unfused run at each of 3,000 horizons and interrupt ticks (each a copy
+# of two VMs: 2 s each in the normal build). The code
 # they run is exercised under the sanitizers by the gtest suites (Match.*,
 # Stats.*, FastForward.*, Trace.* reading JSONL back, the other Explain.*,
-# VmIdiom.* and VmJoin.* checks: faulting pieces, the stack guard, PRT0
+# the other VmSuperinstruction.* checks: faulting pieces, the stack guard, PRT0
 # ticks, breakpoints) and hostile.inputs (which also writes replay pages),
 # and the checks themselves ran in the normal build above.
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-asan --output-on-failure --parallel "$jobs" --timeout 1800 \
-  -E '^(cli\.match\.deterministic|cli\.variation|fast_forward\.identical|Explain\.FromTheJsonlFile|batch\.kill_and_resume|browser\.viewer|stats\.oracle|VmIdiom\.EveryHorizonStopsWhereTheUnfusedRunStops|VmIdiom\.AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused|VmJoin\.EveryHorizonStopsWhereTheUnfusedRunStops|VmJoin\.AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused)$'
+  -E '^(cli\.match\.deterministic|cli\.variation|fast_forward\.identical|Explain\.FromTheJsonlFile|batch\.kill_and_resume|browser\.viewer|stats\.oracle|VmSuperinstruction\.EveryHorizonStopsWhereTheUnfusedRunStops|VmSuperinstruction\.AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused)$'
 phase "sanitizer tests"
 # ThreadSanitizer: only the suite that runs work on several threads.
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \

@@ -13,9 +13,10 @@
 #include <cstring>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "vm/idioms.h"
+#include "vm/superinstructions.h"
 #include "vm/vm.h"
 
 namespace simbot::vm {
@@ -80,15 +81,17 @@ struct InterruptFrame {
   bool operator==(const InterruptFrame&) const = default;
 };
 
-inline float asFloat(uint32_t bits) { return std::bit_cast<float>(bits); }
-inline uint32_t fromFloat(float f) { return std::bit_cast<uint32_t>(f); }
-inline int16_t asInt16(uint32_t v) { return static_cast<int16_t>(static_cast<uint16_t>(v)); }
+[[gnu::always_inline]] inline float asFloat(uint32_t bits) { return std::bit_cast<float>(bits); }
+[[gnu::always_inline]] inline uint32_t fromFloat(float f) { return std::bit_cast<uint32_t>(f); }
+[[gnu::always_inline]] inline int16_t asInt16(uint32_t v) {
+  return static_cast<int16_t>(static_cast<uint16_t>(v));
+}
 static_assert(Tick{kPrtTicks} * kTimerHz == kTicksPerSecond,
               "PRT0's period must divide the clock into Dynamic C's 1,024 Hz tick");
 
 // A little-endian 16-bit word at p (code operands, memory): one load on a
 // little-endian host, where byte loads cost the dispatch loop instructions.
-inline uint32_t le16(const uint8_t* p) {
+[[gnu::always_inline]] inline uint32_t le16(const uint8_t* p) {
   if constexpr (std::endian::native == std::endian::little) {
     uint16_t v;
     std::memcpy(&v, p, 2);
@@ -97,7 +100,7 @@ inline uint32_t le16(const uint8_t* p) {
     return static_cast<uint32_t>(p[0] | (p[1] << 8));
   }
 }
-inline void setLe16(uint8_t* p, uint32_t v) {
+[[gnu::always_inline]] inline void setLe16(uint8_t* p, uint32_t v) {
   if constexpr (std::endian::native == std::endian::little) {
     const auto h = static_cast<uint16_t>(v);
     std::memcpy(p, &h, 2);
@@ -107,12 +110,12 @@ inline void setLe16(uint8_t* p, uint32_t v) {
   }
 }
 // A word of the 64 KiB memory m at a; its last byte's word wraps to 0.
-inline uint32_t memRd16(const uint8_t* m, uint32_t a) {
+[[gnu::always_inline]] inline uint32_t memRd16(const uint8_t* m, uint32_t a) {
   a &= 0xFFFF;
   if (__builtin_expect(a == 0xFFFF, 0)) return static_cast<uint32_t>(m[0xFFFF] | (m[0] << 8));
   return le16(m + a);
 }
-inline void memWr16(uint8_t* m, uint32_t a, uint32_t v) {
+[[gnu::always_inline]] inline void memWr16(uint8_t* m, uint32_t a, uint32_t v) {
   a &= 0xFFFF;
   if (__builtin_expect(a == 0xFFFF, 0)) {
     m[0xFFFF] = static_cast<uint8_t>(v);
@@ -122,7 +125,7 @@ inline void memWr16(uint8_t* m, uint32_t a, uint32_t v) {
   }
 }
 
-inline uint32_t w(int32_t v) { return static_cast<uint32_t>(v) & 0xFFFFu; }
+[[gnu::always_inline]] inline uint32_t w(int32_t v) { return static_cast<uint32_t>(v) & 0xFFFFu; }
 
 inline int64_t truncToRange(float f, double lo, double hi) {
   if (std::isnan(f)) return 0;
@@ -134,6 +137,78 @@ inline int64_t truncToRange(float f, double lo, double hi) {
 
 // The VM's parts all work inside it.
 using namespace detail;
+
+// The fast path's registers (vm.cpp "Fast path"): locals of run(), which
+// the compiler keeps in machine registers while ordinary instructions run
+// (nothing takes their address: every function that works on them is
+// inlined). The State's now, pc, sp and stats.instructions hold them only
+// on the slow path (State::save). The helpers read operands from the
+// padded code and memory through the pointers here.
+struct Regs {
+  Tick clk;        // the clock
+  Tick limit;      // the first tick at which a boundary has anything to do, or 0
+  uint64_t count;  // instructions run
+  // The next instruction (the handler sets it past its own) and the one
+  // being run: code addresses, as wide as a pointer so that an operand's
+  // address folds into its load.
+  size_t ip;
+  size_t opPc;
+  uint32_t pc() const { return static_cast<uint32_t>(opPc); }
+  int esp;              // the expression stack's next free slot
+  uint32_t* e;          // the expression stack
+  uint8_t* m;           // memory
+  const uint8_t* code;  // the padded code
+  uint64_t* profile;    // cycles per code address, null unless profiling
+
+  [[gnu::always_inline]] uint32_t& top() { return e[esp - 1]; }
+  [[gnu::always_inline]] uint32_t pop() { return e[--esp]; }
+  // A push past the guard makes the next boundary slow, where the guard
+  // faults (no instruction pushes more than two slots, so the array's last
+  // kEvalGuard slots are never passed).
+  [[gnu::always_inline]] void push(uint32_t v) {
+    e[esp++] = v;
+    if (__builtin_expect(esp > kEvalSlots - kEvalGuard, 0)) limit = 0;
+  }
+  template <class F>
+  [[gnu::always_inline]] bool binary(F f) {
+    const uint32_t b = pop();
+    top() = f(top(), b);
+    return true;
+  }
+  // Operands, at offsets from the opcode that instructionSize() counts.
+  [[gnu::always_inline]] uint32_t u16() const { return le16(code + opPc + 1); }
+  [[gnu::always_inline]] uint32_t i32() const { return u16() | (le16(code + opPc + 3) << 16); }
+  // A REL16 target, from the end of the instruction (ip).
+  [[gnu::always_inline]] uint32_t relTarget() const {
+    return static_cast<uint32_t>(ip) + static_cast<uint32_t>(static_cast<int16_t>(u16()));
+  }
+  // A CO-shape instruction's: its REL16 after the CoData address.
+  [[gnu::always_inline]] uint32_t coTarget() const {
+    return static_cast<uint32_t>(ip) +
+           static_cast<uint32_t>(static_cast<int16_t>(le16(code + opPc + 3)));
+  }
+  [[gnu::always_inline]] void charge(int32_t delta) {
+    clk += delta;
+    if (profile) profile[opPc] += static_cast<uint64_t>(int64_t{delta});
+  }
+  [[gnu::always_inline]] uint32_t rd8(uint32_t a) const { return m[a & 0xFFFF]; }
+  [[gnu::always_inline]] uint32_t rd16(uint32_t a) const { return memRd16(m, a); }
+  [[gnu::always_inline]] uint32_t rd32(uint32_t a) const { return rd16(a) | (rd16(a + 2) << 16); }
+  [[gnu::always_inline]] void wr8(uint32_t a, uint32_t v) {
+    m[a & 0xFFFF] = static_cast<uint8_t>(v);
+  }
+  [[gnu::always_inline]] void wr16(uint32_t a, uint32_t v) { memWr16(m, a, v); }
+  [[gnu::always_inline]] void wr32(uint32_t a, uint32_t v) {
+    wr16(a, v);
+    wr16(a + 2, v >> 16);
+  }
+  template <int kBytes>
+  [[gnu::always_inline]] void write(uint32_t a, uint32_t v) {
+    if constexpr (kBytes == 1) wr8(a, v);
+    if constexpr (kBytes == 2) wr16(a, v);
+    if constexpr (kBytes == 4) wr32(a, v);
+  }
+};
 
 struct Vm::State {
   State(const Image& img, Bus& b, const CostTable& c) : image(&img), bus(&b), costs(c) {}
@@ -189,39 +264,30 @@ struct Vm::State {
     const void* label;
     uint32_t cost;
     uint8_t op;
-    uint8_t size;
     bool operator==(const Fast&) const = default;
   };
   std::array<std::vector<Fast>, 2> fast;
   std::array<const void* const*, 2> fastLabels{};
-  // The superinstructions' labels (vm.cpp SIMBOT_FUSED_PAIRS), set by
-  // run<false>: its entry for a pair's first half jumps to them.
-  const void* const* fusedLabels = nullptr;
-  // The idioms' labels (idioms.h), set by run<false>, and their pieces'
-  // costs (idioms.cpp).
-  const void* const* idiomLabels = nullptr;
-  const void* const* dbgIdiomLabels = nullptr;  // DBG, then the idiom
-  std::array<IdiomCost, kIdiomCount> idiomCosts{};
-  void setIdiomCosts();
-  // The idiom whose pieces start at `address` (all ordinary and none a trap
-  // in `dispatch`), or -1.
-  int idiomAt(uint32_t address) const;
-  // The instruction at `address` (LDGW, STGW, INCGW) addresses the word at
-  // 0xFFFF.
-  bool wrapsAt(uint32_t address) const;
-  // The joins' labels (idioms.h), set by run<false>, and per join the most
-  // its boundaries can lie after its entry's clock (idioms.cpp).
-  const void* const* joinLabels = nullptr;
-  std::array<uint32_t, kJoinEnd> joinSpans{};
-  // The join whose closer starts at `address` (all its pieces and its
-  // target's ordinary and none a trap in `dispatch`), or -1; `idiom` is
-  // idiomAt(address).
-  int joinAt(uint32_t address, int idiom) const;
-  // The addresses whose entry was ever a join's: a breakpoint anywhere may
-  // be on its target, so setBreakpoint re-decodes them all.
-  std::vector<uint32_t> joinEntries;
+  // The superinstructions' labels (superinstructions.def), set by
+  // run<false>: its entry for a superinstruction's first piece jumps there.
+  const void* const* superLabels = nullptr;
+  // The superinstruction whose pieces start at `address` (each where the
+  // one before leads, all ordinary and none a trap in `dispatch`), or -1.
+  int superinstructionAt(uint32_t address) const;
+  // Per superinstruction, the most ticks its inner boundaries can lie after
+  // its first piece's dispatch (every piece at its slowest path), under
+  // this VM's cost table: when they all lie before the limit, nothing can
+  // happen at them (vm.cpp State::superinstruction).
+  std::array<uint32_t, kSuperCount> superSpan{};
+  // Per superinstruction and piece k, what the pieces after k cost on their
+  // not-taken paths ([0]: all but the first).
+  std::array<std::array<uint32_t, kMaxPieces>, kSuperCount> superAfter{};
+  void setSuperSpans();
+  // A piece k of an unchecked run faulted: take back the time and count
+  // charged in advance for the pieces after it.
+  void unwindSuperinstruction(int kind, int k);
   // The handler that starts an instruction longer than kMaxStepTstates on
-  // the fast path (null: such instructions go to the slow boundary).
+  // the fast path.
   std::array<const void*, 2> longLabels{};
   void setFast(int k, uint32_t address);
   std::vector<uint8_t> breakpoints;  // one flag per code byte
@@ -371,6 +437,43 @@ struct Vm::State {
 
   template <bool kProfile>
   Stop run(Tick until);
+  // ---- instructions (instructions.h) and superinstructions (vm.cpp) ----
+  template <Op O>
+  bool exec(Regs& r);
+  template <Op O>
+  bool step(Regs& r);
+  template <Op O>
+  bool piece(Regs& r);
+  template <int kKind, Op First, Op... Rest>
+  bool superinstruction(Regs& r);
+  template <int kKind, int kPiece, Op O>
+  bool uncheckedPiece(Regs& r);
+  template <int kKind, Op First, Op... Rest, size_t... kPieces>
+  bool unchecked(Regs& r, std::index_sequence<kPieces...>);
+  void save(const Regs& r);
+  bool fail(const Regs& r, const char* message);
+  bool access(const Regs& r, uint32_t address, uint32_t bytes);
+  template <Op O>
+  void branch(Regs& r, unsigned path);
+  template <Op C>
+  bool compare16(Regs& r);
+  template <Op O, class Shift>
+  bool shift16(Regs& r, Shift shifted);
+  template <class Divide>
+  bool divide(Regs& r, bool byZero, Divide quotient);
+  template <class F>
+  bool unary(Regs& r, F f);
+  template <int kBytes>
+  bool loadLocal(Regs& r);
+  template <int kBytes>
+  bool storeLocal(Regs& r);
+  template <int kBytes>
+  bool loadIndirect(Regs& r);
+  template <int kBytes, bool kKeep>
+  bool storeIndirect(Regs& r);
+  template <bool kIfZero>
+  bool branchIf(Regs& r);
+  bool coEnd(Regs& r, bool done);
 };
 
 }  // namespace simbot::vm

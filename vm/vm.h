@@ -179,6 +179,9 @@ class Vm {
   // program-point injection and for tests). The next run() executes it.
   // Breakpoints are kept across reset().
   void setBreakpoint(uint32_t codeAddress, bool enabled = true);
+  // The superinstruction (vm/superinstructions.def, by its index there) the
+  // fast path runs from `codeAddress` when not profiling, or -1: for tests.
+  int superinstructionAt(uint32_t codeAddress) const;
 
   // Profile: cycles charged at each code address (instruction start), when
   // enabled before running. Interrupt acceptance is charged to the handler's
