@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "compiler/compiler.h"
+#include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
 
@@ -37,8 +38,8 @@ void BM_IcemanVsFig92(benchmark::State& state, const char* profile, bool fastFor
   const std::string a = SIMBOT_SHARED_DIR "/programs/iceman.dc";
   const std::string b = SIMBOT_SHARED_DIR "/programs/fig92.dc";
   scheduler::MatchConfig config;
-  config.arena = plant::makeArenaConfig(
-      plant::loadProfile(std::string(SIMBOT_SOURCE_DIR "/profiles/") + profile + ".toml"), 2);
+  config.arena = config::makeArenaConfig(
+      config::loadProfile(std::string(SIMBOT_SOURCE_DIR "/profiles/") + profile + ".toml"), 2);
   config.robots = {{"A", a, compileFile(a)}, {"B", b, compileFile(b)}};
   config.endTick = 180 * scheduler::kTicksPerSecond;
   config.knobs.fastForward = fastForward;

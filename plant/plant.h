@@ -8,9 +8,9 @@
 // advance(), and samples sensors at exact ticks. Time in this interface is
 // always integer ticks of the 9.216 MHz clock; seconds exist only inside the
 // integrator (see DESIGN.md "Time and determinism"). Every physical number
-// comes from a TOML profile (profiles/*.toml) that the loader checks key by
-// key; per-robot hardware files bind port B bits and may override the
-// robot's own values.
+// comes from a TOML profile (profiles/*.toml) that config/ reads and checks
+// key by key into the structures below; per-robot hardware files bind port
+// B bits and may override the robot's own values.
 #pragma once
 
 #include <algorithm>
@@ -39,7 +39,7 @@ std::int64_t eventTickFromSeconds(double t);
 // The double nearest to tick / 9,216,000 (used to hand times to CVODE).
 double secondsFromTick(std::int64_t tick);
 
-// ---------------------------------------------------------------- profiles
+// ---------------------------------------------------------------- parameters
 // Internal units: feet, seconds, feet per second, degrees for angles that
 // the user sees (headings, turn angle), dimensionless ratios, A/D readings.
 struct Pose {
@@ -93,11 +93,6 @@ struct RobotParams {
   double jam_probability = 0, misfire_probability = 0;
   // controller
   bool random_memory = false;  // power-on RAM from a seeded stream, not zeros
-  // The BIOS timer service (PRT0): 0 auto (only in programs that use the
-  // timer library), 1 always, 2 never (vm::TimerService's order).
-  int timer_service = 0;
-  // Delay loops run in one exact step (vm CostKnobs::fastForward).
-  bool fast_forward = true;
 };
 
 struct FieldParams {
@@ -129,28 +124,11 @@ struct RefereeParams {
   double turn_deg = 45;
 };
 
-struct Profile {
-  std::string name;
-  std::string file;  // where it was loaded from
-  FieldParams field;
-  RefereeParams referee;
-  double round_length_s = 180;
-  // --reload-on-fault: from a robot's fault to its program's restart (s).
-  double reload_delay_s = 20;
-  RobotParams robot;
-};
-
 // Port B bindings of one robot (bits 0..7).
 struct Hardware {
   std::array<int, 2> gun_motor_bit{3, 7};
   std::array<int, 2> gun_solenoid_bit{4, 5};
   int disc_shooter_bit = 6;  // logged only
-};
-
-// Any loader error; what() is "FILE:LINE:COL: error: MESSAGE".
-class ConfigError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
 };
 
 // The integrator failed (a SUNDIALS call returned an error). The profile
@@ -160,21 +138,6 @@ class SolverError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
-
-// Checks a TOML file's text before toml++ (3.3.0) parses it: well-formed
-// UTF-8, no non-ASCII character outside strings and comments (where TOML
-// allows none anyway), and no line-ending backslash in a multi-line string
-// followed by a non-ASCII character. toml++ 3.3.0 reaches an "unreachable"
-// state (undefined behaviour) on the last two (toml++ issues 190 and 295).
-// Throws ConfigError naming the place.
-void checkTomlText(std::string_view text, const std::string& sourceName);
-
-Profile loadProfile(const std::string& path);
-Profile parseProfile(std::string_view text, const std::string& sourceName);
-// Reads a hardware file: port bindings, plus overrides of per-robot profile
-// values (sections [robot], [bumper], [eyes], [gun]) applied to `params`.
-Hardware loadHardware(const std::string& path, RobotParams& params);
-Hardware parseHardware(std::string_view text, const std::string& sourceName, RobotParams& params);
 
 // ---------------------------------------------------------------- motor frames
 struct WheelCommand {
@@ -370,9 +333,6 @@ struct ArenaConfig {
   RefereeParams referee;
   std::vector<RobotSetup> robots;  // 1 (solo: no beacon to see) or 2
 };
-// Config with both (or one) robots from one profile, default hardware and
-// the profile's start poses.
-ArenaConfig makeArenaConfig(const Profile& profile, int robotCount);
 
 // ---------------------------------------------------------------- seeded variation
 // DESIGN.md: the default profile's robots differ from match to match. Every

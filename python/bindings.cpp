@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "compiler/compiler.h"
+#include "config/config.h"
 #include "tools/bench.h"
 #include "tools/json_text.h"
 #include "tools/play.h"
@@ -125,7 +126,7 @@ py::tuple benchRuns(const std::vector<std::string>& programs, const std::string&
   c.opponent = opponent;
   c.threads = threads;
   c.progress = false;
-  const plant::Profile loaded = tools::loadNamedProfile(profile);
+  const config::Profile loaded = tools::loadNamedProfile(profile);
   const tools::BenchResult r = tools::runBench(c, loaded);
   py::gil_scoped_acquire acquire;
   return py::make_tuple(tools::dumpJson(tools::summaryJson(r), 2), tools::runsCsv(r));
@@ -135,7 +136,7 @@ struct Sweep {
   tools::SweepSpec spec;
   std::vector<tools::SweepRun> runs;
   explicit Sweep(const std::string& path)
-      : spec(tools::loadSweep(path)), runs(tools::expandSweep(spec)) {}
+      : spec(config::loadSweep(path, tools::benchFamilies())), runs(tools::expandSweep(spec)) {}
   tools::CsvRow row(size_t index) const {
     if (index >= runs.size()) throw py::index_error("no run " + std::to_string(index));
     py::gil_scoped_release release;
@@ -153,7 +154,7 @@ PYBIND11_MODULE(_simbot, m) {
       if (p) std::rethrow_exception(p);
     } catch (const tools::ToolError& e) {
       error(withoutNewline(e.what()).c_str());
-    } catch (const plant::ConfigError& e) {
+    } catch (const config::ConfigError& e) {
       error(withoutNewline(e.what()).c_str());
     }
   });

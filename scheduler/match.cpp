@@ -110,10 +110,10 @@ namespace {
 
 // The match's cost table with this robot's controller's settings (profile
 // [controller]): its timer service, and fast-forward unless it turns it off.
-vm::CostTable robotCosts(const vm::CostTable& costs, const plant::RobotParams& params) {
+vm::CostTable robotCosts(const vm::CostTable& costs, const ControllerKnobs& controller) {
   vm::CostTable table = costs;
-  table.knobs.timerService = static_cast<vm::TimerService>(params.timer_service);
-  table.knobs.fastForward = costs.knobs.fastForward && params.fast_forward;
+  table.knobs.timerService = controller.timerService;
+  table.knobs.fastForward = costs.knobs.fastForward && controller.fastForward;
   return table;
 }
 
@@ -123,7 +123,7 @@ Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs, ui
     : spec(s),
       index(i),
       match(m),
-      board(s.image, *this, robotCosts(costs, m.robotParams(i)),
+      board(s.image, *this, robotCosts(costs, s.controller),
             board::StreamSeeds{
                 streamSeed(seed, "memory-fill-" + s.name), streamSeed(seed, "eye-noise-" + s.name),
                 streamSeed(seed, "gun-" + s.name), streamSeed(seed, "muzzle-" + s.name)},
@@ -763,79 +763,6 @@ void Match::finish(MatchResult& result) {
 }
 
 }  // namespace detail
-
-namespace {
-
-// A non-negative decimal number of `unit`s as an exact tick count, read by
-// the one parser of durations (timebase::ticksFromDecimal): "12.5s" is
-// exactly 115,200,000 ticks, "1e-3s" 9,216; an injection is at a tick, so a
-// time between two ticks is refused rather than rounded.
-Tick parseDuration(const std::string& digits, int64_t ticksPerUnit, const std::string& whole) {
-  const auto ticks = timebase::ticksFromDecimal(digits, ticksPerUnit);
-  if (!ticks)
-    throw std::invalid_argument("'" + whole +
-                                "': WHEN must be a time (12.5s, 800ms), a tick (115200000t) "
-                                "or a program point (line:N#K, pass:N#K)");
-  if (!ticks->exact) throw std::invalid_argument("'" + whole + "' is not a whole number of ticks");
-  return ticks->ticks;
-}
-
-int parsePositive(const std::string& s, const std::string& whole, const char* what) {
-  if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos ||
-      std::stoi(s) <= 0)
-    throw std::invalid_argument("'" + whole + "': " + what + " must be a positive integer");
-  return std::stoi(s);
-}
-
-}  // namespace
-
-Injection parseInjection(const std::string& text, int robotCount) {
-  Injection in;
-  in.text = text;
-  const auto colon = text.find(':');
-  const auto at = text.find('@');
-  if (colon == std::string::npos || at == std::string::npos || at < colon)
-    throw std::invalid_argument("'" + text + "': expected ROBOT:SOURCE@WHEN");
-  const std::string robot = text.substr(0, colon);
-  const std::string source = text.substr(colon + 1, at - colon - 1);
-  const std::string when = text.substr(at + 1);
-  if (robot == "A")
-    in.robot = 0;
-  else if (robot == "B" && robotCount > 1)
-    in.robot = 1;
-  else
-    throw std::invalid_argument("'" + text + "': no robot '" + robot + "' in this run");
-  if (source == "edge_fore")
-    in.source = InjectSource::EdgeFore;
-  else if (source == "edge_aft")
-    in.source = InjectSource::EdgeAft;
-  else if (source == "bumper_front")
-    in.source = InjectSource::BumperFront;
-  else if (source == "bumper_back")
-    in.source = InjectSource::BumperBack;
-  else
-    throw std::invalid_argument("'" + text +
-                                "': SOURCE must be edge_fore, edge_aft, "
-                                "bumper_front or bumper_back");
-  const bool pass = when.rfind("pass:", 0) == 0;
-  if (when.rfind("line:", 0) == 0 || pass) {
-    const auto hash = when.find('#');
-    if (hash == std::string::npos)
-      throw std::invalid_argument("'" + text + "': a program point is line:N#K or pass:N#K");
-    in.pass = pass;
-    in.line = parsePositive(when.substr(5, hash - 5), text, "the line N");
-    in.count = parsePositive(when.substr(hash + 1), text, "the execution count K");
-  } else if (when.size() > 2 && when.compare(when.size() - 2, 2, "ms") == 0) {
-    in.tick = parseDuration(when.substr(0, when.size() - 2), kTicksPerSecond / 1000, text);
-  } else if (!when.empty() && when.back() == 's') {
-    in.tick = parseDuration(when.substr(0, when.size() - 1), kTicksPerSecond, text);
-  } else if (!when.empty() && when.back() == 't') {
-    in.tick = parseDuration(when.substr(0, when.size() - 1), 1, text);
-  } else {
-    parseDuration("", 1, text);  // throws the WHEN message
-  }
-  return in;
-}
 
 uint64_t streamSeed(uint64_t seed, const std::string& purpose) {
   // FNV-1a of the purpose, mixed with the master seed through SplitMix64.

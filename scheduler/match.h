@@ -69,6 +69,15 @@ struct DriveLeg {
   double leftFps = 0, rightFps = 0;
 };
 
+// A robot's controller settings that reach its VM (the profile's
+// [controller] timer_service and fast_forward; config/ reads them).
+struct ControllerKnobs {
+  vm::TimerService timerService = vm::TimerService::Auto;
+  // Delay loops run in one exact step; with MatchConfig::knobs.fastForward
+  // off no robot's do.
+  bool fastForward = true;
+};
+
 struct RobotSpec {
   RobotSpec() = default;
   RobotSpec(std::string name_, std::string program_, vm::Image image_)
@@ -82,9 +91,11 @@ struct RobotSpec {
   // the robot stops, or the path starts over with `repeatPath`.
   std::vector<DriveLeg> path;
   bool repeatPath = false;
+  ControllerKnobs controller;
 };
 
-// An interrupt source injected by the user (DESIGN.md tool contract).
+// An interrupt source injected by the user (DESIGN.md tool contract;
+// config::parseInjection reads --inject's text).
 enum class InjectSource : uint8_t { EdgeFore, EdgeAft, BumperFront, BumperBack };
 
 struct Injection {
@@ -104,11 +115,6 @@ struct Injection {
 
 // An injected edge holds its detector low for this long (assumption, DESIGN).
 inline constexpr Tick kInjectedEdgePulse = kTicksPerSecond / 20;  // 50 ms
-
-// Parses ROBOT:SOURCE@WHEN (WHEN: 12.5s, 800ms, 115200000t, line:N#K,
-// pass:N#K).
-// Throws std::invalid_argument with a message naming what is wrong.
-Injection parseInjection(const std::string& text, int robotCount);
 
 // Optional hooks for measurements (simbot bench). Called from the round loop
 // at the exact tick of each happening; an observer only reads, so a run with

@@ -17,7 +17,7 @@ phase() {
   mark=$SECONDS
 }
 mark=$SECONDS
-mapfile -t sources < <(find compiler vm board plant scheduler trace tools tests bench fuzz \
+mapfile -t sources < <(find compiler vm board plant scheduler config trace tools tests bench fuzz \
   -path tests/browser/node_modules -prune -o \( -name '*.cpp' -o -name '*.h' \) -print | sort)
 clang-format --dry-run --Werror "${sources[@]}"
 phase "set-up and layout check"

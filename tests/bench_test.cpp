@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "config/config.h"
 #include "stats/stats.h"
 #include "support/traced.h"
 #include "tools/bench_metrics.h"
@@ -206,7 +207,7 @@ TEST(Bench, AimThresholdIsAnOption) {
 
 TEST(Bench, ObserverDoesNotChangeTheMatch) {
   scheduler::MatchConfig c;
-  c.arena = plant::makeArenaConfig(tools::loadNamedProfile(kSource + "/profiles/default.toml"), 2);
+  c.arena = config::makeArenaConfig(tools::loadNamedProfile(kSource + "/profiles/default.toml"), 2);
   c.robots.push_back({"A", "iceman", tools::compileProgramFile(kShared + "/programs/iceman.dc")});
   c.robots.push_back({"B", "fig92", tools::compileProgramFile(kShared + "/programs/fig92.dc")});
   c.endTick = 10 * scheduler::kTicksPerSecond;

@@ -6,6 +6,7 @@
 // tests/programs/costate_*.dc and timer_counters.dc.
 #include <gtest/gtest.h>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "support/test_host.h"
@@ -197,12 +198,14 @@ main()
 
 namespace {
 
-scheduler::MatchConfig soloConfig(const std::string& file, int timerService, double seconds) {
-  auto profile = plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
-  profile.robot.timer_service = timerService;
+scheduler::MatchConfig soloConfig(const std::string& file, vm::TimerService timerService,
+                                  double seconds) {
+  auto profile = config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
+  profile.controller.timerService = timerService;
   scheduler::MatchConfig c;
-  c.arena = plant::makeArenaConfig(profile, 1);
+  c.arena = config::makeArenaConfig(profile, 1);
   c.robots.push_back({"A", file, testkit::compileFileOrDie(file)});
+  c.robots.back().controller = profile.controller;
   c.endTick = timebase::ticksFromSeconds(seconds);
   return c;
 }
@@ -214,16 +217,16 @@ scheduler::MatchConfig soloConfig(const std::string& file, int timerService, dou
 TEST(Timer, ProfileKnobDecidesWhetherTheServiceRuns) {
   const std::string iceman = SIMBOT_SHARED_DIR "/programs/iceman.dc";
   const std::string toggler = SIMBOT_SOURCE_DIR "/tests/programs/costate_delayms.dc";
-  const auto autoIceman = scheduler::runMatch(soloConfig(iceman, 0, 2));
+  const auto autoIceman = scheduler::runMatch(soloConfig(iceman, vm::TimerService::Auto, 2));
   EXPECT_EQ(autoIceman.robots[0].interrupts.at("timer"), 0u);
-  auto always = soloConfig(iceman, 1, 2);
+  auto always = soloConfig(iceman, vm::TimerService::Always, 2);
   always.profile = true;  // the service's cycles are a profile figure
   const auto alwaysIceman = scheduler::runMatch(always);
   EXPECT_EQ(alwaysIceman.robots[0].interrupts.at("timer"), 2047u);
   EXPECT_GT(alwaysIceman.robots[0].timerIsrCycles, 0u);
-  const auto autoToggler = scheduler::runMatch(soloConfig(toggler, 0, 2));
+  const auto autoToggler = scheduler::runMatch(soloConfig(toggler, vm::TimerService::Auto, 2));
   EXPECT_TRUE(autoToggler.robots[0].exited);
-  const auto neverToggler = scheduler::runMatch(soloConfig(toggler, 2, 2));
+  const auto neverToggler = scheduler::runMatch(soloConfig(toggler, vm::TimerService::Never, 2));
   EXPECT_FALSE(neverToggler.robots[0].exited);
   EXPECT_EQ(neverToggler.robots[0].interrupts.at("timer"), 0u);
 }

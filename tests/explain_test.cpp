@@ -9,6 +9,7 @@
 #include <fstream>
 #include <string>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "support/records.h"
@@ -28,9 +29,9 @@ constexpr double kTps = static_cast<double>(scheduler::kTicksPerSecond);
 scheduler::MatchConfig config(const std::vector<std::string>& programs, double seconds,
                               const std::string& profile = "default") {
   scheduler::MatchConfig c;
-  c.arena =
-      plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/" + profile + ".toml"),
-                             static_cast<int>(programs.size()));
+  c.arena = config::makeArenaConfig(
+      config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/" + profile + ".toml"),
+      static_cast<int>(programs.size()));
   c.profileName = profile;
   const char* names[] = {"A", "B"};
   for (size_t i = 0; i < programs.size(); ++i)
@@ -306,8 +307,8 @@ TEST(Explain, OverwrittenSend) {
       "  ser_send_z1(buf, &cc);\n"
       "}\n";
   scheduler::MatchConfig c;
-  c.arena =
-      plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/thesis-1997.toml"), 1);
+  c.arena = config::makeArenaConfig(
+      config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/thesis-1997.toml"), 1);
   c.robots.push_back({"A", "twice.dc", testkit::compileOrDie(source)});
   c.endTick = scheduler::kTicksPerSecond / 2;  // 0.5 s
   const Traced r = run(c);
@@ -345,7 +346,7 @@ TEST(Explain, OverwrittenSend) {
 // with the frames latched in between.
 TEST(Explain, HandlerRunFromAnInjectedEdge) {
   auto c = config({SIMBOT_SHARED_DIR "/programs/iceman.dc"}, 12);
-  c.injections.push_back(scheduler::parseInjection("A:edge_fore@5s", 1));
+  c.injections.push_back(config::parseInjection("A:edge_fore@5s", 1));
   const Traced r = run(c);
   const auto accepted = r.all<rec::InterruptAccepted>(0);
   const auto returned = r.all<rec::InterruptReturned>(0);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "support/test_host.h"
@@ -27,13 +28,13 @@ const std::string kFaulting = SIMBOT_SOURCE_DIR "/tests/faulting/unbound_vector.
 const std::string kTurret = SIMBOT_SOURCE_DIR "/programs/turret.dc";
 constexpr scheduler::Tick kSecond = scheduler::kTicksPerSecond;
 
-plant::Profile defaultProfile() {
-  return plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
+config::Profile defaultProfile() {
+  return config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
 }
 
 scheduler::MatchConfig soloConfig(scheduler::Tick end) {
   scheduler::MatchConfig c;
-  c.arena = plant::makeArenaConfig(defaultProfile(), 1);
+  c.arena = config::makeArenaConfig(defaultProfile(), 1);
   c.robots.push_back({"A", kFaulting, tools::compileProgramFile(kFaulting)});
   c.endTick = end;
   return c;
@@ -144,7 +145,7 @@ TEST(Fault, ReloadDelayMustCoverTheSerialPort) {
 
 TEST(Fault, InAMatchTheOtherRobotPlaysOnAndTheFaultedOneLosesATie) {
   scheduler::MatchConfig c;
-  c.arena = plant::makeArenaConfig(defaultProfile(), 2);
+  c.arena = config::makeArenaConfig(defaultProfile(), 2);
   c.robots.push_back({"A", kFaulting, tools::compileProgramFile(kFaulting)});
   c.robots.push_back({"B", kTurret, tools::compileProgramFile(kTurret)});
   c.endTick = 30 * kSecond;
@@ -226,7 +227,7 @@ std::string sender(int sends, bool delayLoop) {
 
 scheduler::RobotResult sendAndWait(int sends, bool delayLoop) {
   scheduler::MatchConfig c;
-  c.arena = plant::makeArenaConfig(defaultProfile(), 1);
+  c.arena = config::makeArenaConfig(defaultProfile(), 1);
   c.robots.push_back({"A", "sender.dc", testkit::compileOrDie(sender(sends, delayLoop))});
   // Long after main returns: every byte still in the port has gone out.
   c.endTick = kSecond;

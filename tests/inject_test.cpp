@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "support/test_host.h"
@@ -52,11 +53,11 @@ struct SoloRun {
 scheduler::MatchConfig soloConfig(const std::vector<std::string>& injections) {
   scheduler::MatchConfig c;
   c.arena =
-      plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml"), 1);
+      config::makeArenaConfig(config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml"), 1);
   c.robots.push_back({"A", "delay.dc", testkit::compileOrDie(kDelay, "delay.dc")});
   c.endTick = 10 * scheduler::kTicksPerSecond;
   c.stopWhenAllExited = true;
-  for (const auto& text : injections) c.injections.push_back(scheduler::parseInjection(text, 1));
+  for (const auto& text : injections) c.injections.push_back(config::parseInjection(text, 1));
   return c;
 }
 
@@ -123,12 +124,12 @@ TEST(Inject, InjectedEdgeIsAPulse) {
 
 TEST(Inject, BumpTriggersTheReflexAtItsTick) {
   scheduler::MatchConfig c;
-  const auto profile = plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/thesis-1997.toml");
-  c.arena = plant::makeArenaConfig(profile, 1);
+  const auto profile = config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/thesis-1997.toml");
+  c.arena = config::makeArenaConfig(profile, 1);
   c.arena.robots[0].start = {0, 0, 0};  // field centre, facing north
   c.robots.push_back({"A", "idle.dc", testkit::compileOrDie("main()\n{\n    while (1);\n}\n")});
   c.endTick = 5 * scheduler::kTicksPerSecond;
-  c.injections.push_back(scheduler::parseInjection("A:bumper_front@1s", 1));
+  c.injections.push_back(config::parseInjection("A:bumper_front@1s", 1));
   const auto r = testkit::runTraced(c);
   vm::Tick start = -1, end = -1;
   for (const auto& line : r.trace) {
@@ -211,16 +212,16 @@ TEST(Inject, WatchedValuesAsTheirTypesReadThem) {
 }
 
 TEST(Inject, ParsesWhenForms) {
-  EXPECT_EQ(scheduler::parseInjection("A:edge_fore@12.5s", 1).tick, 115'200'000);
-  EXPECT_EQ(scheduler::parseInjection("A:edge_aft@800ms", 1).tick, 7'372'800);
-  EXPECT_EQ(scheduler::parseInjection("B:bumper_back@115200000t", 2).tick, 115'200'000);
-  const auto p = scheduler::parseInjection("A:edge_fore@line:42#3", 1);
+  EXPECT_EQ(config::parseInjection("A:edge_fore@12.5s", 1).tick, 115'200'000);
+  EXPECT_EQ(config::parseInjection("A:edge_aft@800ms", 1).tick, 7'372'800);
+  EXPECT_EQ(config::parseInjection("B:bumper_back@115200000t", 2).tick, 115'200'000);
+  const auto p = config::parseInjection("A:edge_fore@line:42#3", 1);
   EXPECT_EQ(p.line, 42);
   EXPECT_EQ(p.count, 3);
   for (const char* bad :
        {"A:edge_fore", "C:edge_fore@1s", "B:edge_fore@1s", "A:laser@1s", "A:edge_fore@soon",
         "A:edge_fore@line:4", "A:edge_fore@line:0#1", "A:edge_fore@0.00000001s", "A:edge_fore@-1s"})
-    EXPECT_THROW(scheduler::parseInjection(bad, 1), std::invalid_argument) << bad;
+    EXPECT_THROW(config::parseInjection(bad, 1), std::invalid_argument) << bad;
 }
 
 }  // namespace
@@ -253,7 +254,7 @@ constexpr int kOneLineLoop = 16;
 scheduler::MatchResult oneLine(const std::vector<std::string>& injections) {
   scheduler::MatchConfig c = soloConfig({});
   c.robots[0] = {"A", "oneline.dc", testkit::compileOrDie(kOneLine, "oneline.dc")};
-  for (const auto& text : injections) c.injections.push_back(scheduler::parseInjection(text, 1));
+  for (const auto& text : injections) c.injections.push_back(config::parseInjection(text, 1));
   return scheduler::runMatch(c);
 }
 
@@ -302,8 +303,8 @@ TEST(Inject, PassNeedsALoopOnTheLine) {
   EXPECT_TRUE(img.loopHead(kOneLineLoop).has_value());
   EXPECT_FALSE(img.loopHead(17).has_value());  // the printf
   EXPECT_THROW(oneLine({"A:edge_aft@pass:17#1"}), std::invalid_argument);
-  EXPECT_THROW(scheduler::parseInjection("A:edge_aft@pass:16", 1), std::invalid_argument);
-  EXPECT_TRUE(scheduler::parseInjection("A:edge_aft@pass:16#3", 1).pass);
+  EXPECT_THROW(config::parseInjection("A:edge_aft@pass:16", 1), std::invalid_argument);
+  EXPECT_TRUE(config::parseInjection("A:edge_aft@pass:16#3", 1).pass);
 }
 
 TEST(Inject, InjectionsThatNeverFiredAreNamed) {

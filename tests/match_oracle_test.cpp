@@ -49,6 +49,7 @@
 #include <variant>
 
 #include "compiler/compiler.h"
+#include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "trace/trace.h"
@@ -103,10 +104,10 @@ constexpr double kPlantAccuracyFt = 2e-9;
 
 TEST(MatchOracle, EveryRootEventOfTheIcemanFig92MatchFallsOnTheOraclesTick) {
   const auto t0 = std::chrono::steady_clock::now();
-  const plant::Profile profile = plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
+  const config::Profile profile = config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
   scheduler::MatchConfig c;
   c.robots = {{"A", kIceman, compile(kIceman)}, {"B", kFig92, compile(kFig92)}};
-  c.arena = plant::makeArenaConfig(profile, 2);
+  c.arena = config::makeArenaConfig(profile, 2);
   c.endTick = timebase::ticksFromSeconds(profile.round_length_s);
   ASSERT_EQ(c.seed, 1u);
   ASSERT_EQ(c.endTick, 180 * timebase::kTicksPerSecond);

@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "compiler/compiler.h"
+#include "config/config.h"
 #include "plant/plant.h"
 #include "support/records.h"
 #include "support/traced.h"
@@ -38,9 +39,9 @@ const std::string kFig92 = SIMBOT_SHARED_DIR "/programs/fig92.dc";
 scheduler::MatchConfig matchConfig(std::vector<scheduler::RobotSpec> robots, double seconds,
                                    const std::string& profile = "default") {
   scheduler::MatchConfig c;
-  c.arena =
-      plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/" + profile + ".toml"),
-                             static_cast<int>(robots.size()));
+  c.arena = config::makeArenaConfig(
+      config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/" + profile + ".toml"),
+      static_cast<int>(robots.size()));
   c.robots = std::move(robots);
   c.endTick = timebase::ticksFromSeconds(seconds);
   return c;
@@ -480,7 +481,7 @@ main()
     if (inject)
       for (int k = 1; k <= 6; ++k)
         c.injections.push_back(
-            scheduler::parseInjection("A:edge_fore@" + std::to_string(1.2 * k) + "s", 1));
+            config::parseInjection("A:edge_fore@" + std::to_string(1.2 * k) + "s", 1));
     KeepSink<trace::rec::InterruptAccepted, trace::rec::RefereeTurn> keep;
     c.sinks.push_back(&keep);
     auto r = scheduler::runMatch(c);
@@ -539,7 +540,7 @@ main()
 TEST(Match, IcemanAgainstFig92For180SecondsPinsItsKeyFigures) {
   auto c =
       matchConfig({{"A", kIceman, compileFile(kIceman)}, {"B", kFig92, compileFile(kFig92)}},
-                  plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml").round_length_s);
+                  config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml").round_length_s);
   ASSERT_EQ(c.seed, 1u);  // simbot match's default
   ASSERT_EQ(c.endTick, 180 * timebase::kTicksPerSecond);
   KeepSink<trace::rec::SerialSend, trace::rec::FrameLatched, trace::rec::SolenoidStroke,
@@ -592,7 +593,7 @@ TEST(Match, IcemanAgainstFig92For180SecondsPinsItsKeyFigures) {
 // 0.75 in inside the north wall at 9.85 s) and seed 7 (A and B overlapping
 // by 0.062 ft).
 TEST(Match, NoBodyEntersAWallTheDividerOrTheOtherRobot) {
-  const plant::Profile prof = plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
+  const config::Profile prof = config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
   const double r = prof.robot.body_diameter_ft / 2, half = prof.field.size_ft / 2;
   constexpr double kTolerance = 1e-6;  // ft
   for (const std::uint64_t seed : {1u, 7u, 11u, 19u}) {
@@ -648,7 +649,7 @@ TEST(Match, DefaultProfileGivesEachSeedItsOwnMatchAndTheSameSeedTheSameOne) {
   EXPECT_EQ(icemanFig92("default", 1, 20).trace, traces[0]);
   // The trace's set-up records give the poses the hand chose: within the
   // profile's radius and heading spread of the marks, and not the marks.
-  const plant::Profile d = plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
+  const config::Profile d = config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
   for (const auto& trace : traces) {
     int setups = 0;
     // The set-up records lead the trace: parse up to the second robot's.

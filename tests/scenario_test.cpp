@@ -8,6 +8,7 @@
 #include <numbers>
 #include <string>
 
+#include "config/config.h"
 #include "scheduler/match.h"
 #include "support/traced.h"
 #include "tools/bench.h"
@@ -20,15 +21,15 @@ using namespace simbot;
 const std::string kSource = SIMBOT_SOURCE_DIR;
 const std::string kShared = SIMBOT_SHARED_DIR;
 
-tools::Scenario parse(const std::string& text) {
-  return tools::parseScenario(text, "s.toml", kSource);
+config::Scenario parse(const std::string& text) {
+  return config::parseScenario(text, "s.toml", kSource);
 }
 
 // The message a scenario's text gets, or "" if it loads.
 std::string errorOf(const std::string& text) {
   try {
     parse(text);
-  } catch (const plant::ConfigError& e) {
+  } catch (const config::ConfigError& e) {
     return e.what();
   }
   return "";
@@ -64,9 +65,9 @@ repeat = true
   ASSERT_EQ(s.a.inject.size(), 2u);
   EXPECT_EQ(s.a.inject[1].what, "bumper_front@line:220#3");
   EXPECT_EQ(s.a.inject[1].pos.line, 7);
-  EXPECT_EQ(s.opponent, tools::Scenario::Opponent::Beacon);
+  EXPECT_EQ(s.opponent, config::Scenario::Opponent::Beacon);
   ASSERT_EQ(s.path.size(), 4u);
-  EXPECT_EQ(s.path[1].kind, tools::PathLeg::Kind::Arc);
+  EXPECT_EQ(s.path[1].kind, config::PathLeg::Kind::Arc);
   EXPECT_EQ(s.path[1].turnDeg, -90);
   EXPECT_EQ(s.path[3].pos.line, 15);
   EXPECT_TRUE(s.repeatPath);
@@ -165,25 +166,25 @@ TEST(Scenario, EveryMistakeNamesItsLine) {
   }
 }
 
-scheduler::MatchConfig soloConfig(const std::string& program, const plant::Profile& profile) {
+scheduler::MatchConfig soloConfig(const std::string& program, const config::Profile& profile) {
   scheduler::MatchConfig c;
-  c.arena = plant::makeArenaConfig(profile, 1);
+  c.arena = config::makeArenaConfig(profile, 1);
   c.robots.push_back({"A", program, tools::compileProgramFile(program)});
   return c;
 }
 
-plant::Profile defaults() { return tools::loadNamedProfile("default"); }
+config::Profile defaults() { return tools::loadNamedProfile("default"); }
 
 std::string applyError(const std::string& text, tools::ScenarioUse use, int programs = 1) {
   const auto profile = defaults();
   auto c = soloConfig(kSource + "/programs/spiral.dc", profile);
   if (programs == 2) {
-    c.arena = plant::makeArenaConfig(profile, 2);
+    c.arena = config::makeArenaConfig(profile, 2);
     c.robots.push_back({"B", "turret", tools::compileProgramFile(kSource + "/programs/turret.dc")});
   }
   try {
     tools::applyScenario(parse(text), use, profile, c);
-  } catch (const plant::ConfigError& e) {
+  } catch (const config::ConfigError& e) {
     return e.what();
   }
   return "";
@@ -260,7 +261,7 @@ path = [ { arc_radius_ft = 3, turn_deg = 90, speed_fps = 0.5 },
 TEST(Scenario, BenchRunsItsOwnScenarioWhateverTheThreadCount) {
   tools::BenchConfig c;
   c.programs = {kShared + "/programs/iceman.dc"};
-  c.scenario = tools::loadScenario(kSource + "/scenarios/circle.toml");
+  c.scenario = config::loadScenario(kSource + "/scenarios/circle.toml");
   c.seeds = 3;
   c.seconds = 8;
   c.progress = false;

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "support/assembler.h"
@@ -82,12 +83,11 @@ TEST(SerialAtomic, EdgeDuringSerSendIsAcceptedAfterItAndTheFrameLatchesIntact) {
 
   scheduler::MatchConfig c;
   c.arena =
-      plant::makeArenaConfig(plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml"), 1);
+      config::makeArenaConfig(config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml"), 1);
   c.robots.push_back({"A", "send.dc", img});
   c.endTick = 2 * scheduler::kTicksPerSecond;
   c.stopWhenAllExited = true;
-  c.injections.push_back(
-      scheduler::parseInjection("A:edge_fore@" + std::to_string(request) + "t", 1));
+  c.injections.push_back(config::parseInjection("A:edge_fore@" + std::to_string(request) + "t", 1));
   const testkit::TracedRun r = testkit::runTraced(c);
   Tick sendT = -1, acceptedT = -1, injectionT = -1;
   std::vector<std::string> latched;

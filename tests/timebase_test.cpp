@@ -10,6 +10,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/event_queue.h"
 #include "scheduler/match.h"
@@ -122,15 +123,15 @@ TEST(Timebase, DecimalsAsWritten) {
 TEST(Timebase, InjectionTimesAgreeWithTheConversion) {
   // An injection's WHEN is parsed as an exact decimal (a non-whole tick is
   // refused); a whole tick is the same tick ticksFromSeconds gives.
-  EXPECT_EQ(scheduler::parseInjection("A:edge_fore@12.5s", 1).tick, ticksFromSeconds(12.5));
-  EXPECT_EQ(scheduler::parseInjection("A:edge_fore@0.043s", 1).tick, 396'288);
-  EXPECT_EQ(scheduler::parseInjection("A:edge_fore@800ms", 1).tick, ticksFromSeconds(0.8));
+  EXPECT_EQ(config::parseInjection("A:edge_fore@12.5s", 1).tick, ticksFromSeconds(12.5));
+  EXPECT_EQ(config::parseInjection("A:edge_fore@0.043s", 1).tick, 396'288);
+  EXPECT_EQ(config::parseInjection("A:edge_fore@800ms", 1).tick, ticksFromSeconds(0.8));
   // The same decimals as --seconds: 1e-3 s = 9,216 ticks.
-  EXPECT_EQ(scheduler::parseInjection("A:edge_fore@1e-3s", 1).tick, ticksFromSeconds(1e-3));
-  EXPECT_EQ(scheduler::parseInjection("A:edge_fore@2.5E3t", 1).tick, 2'500);
+  EXPECT_EQ(config::parseInjection("A:edge_fore@1e-3s", 1).tick, ticksFromSeconds(1e-3));
+  EXPECT_EQ(config::parseInjection("A:edge_fore@2.5E3t", 1).tick, 2'500);
   // 1e-7 s is 0.9216 ticks: an injection is at a tick, so it is refused.
-  EXPECT_THROW(scheduler::parseInjection("A:edge_fore@1e-7s", 1), std::invalid_argument);
-  EXPECT_THROW(scheduler::parseInjection("A:edge_fore@-1s", 1), std::invalid_argument);
+  EXPECT_THROW(config::parseInjection("A:edge_fore@1e-7s", 1), std::invalid_argument);
+  EXPECT_THROW(config::parseInjection("A:edge_fore@-1s", 1), std::invalid_argument);
 }
 
 }  // namespace

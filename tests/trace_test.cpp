@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "support/records.h"
@@ -21,8 +22,8 @@ namespace {
 
 namespace rec = trace::rec;
 
-plant::Profile profile(const std::string& name) {
-  return plant::loadProfile(SIMBOT_SOURCE_DIR "/profiles/" + name + ".toml");
+config::Profile profile(const std::string& name) {
+  return config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/" + name + ".toml");
 }
 
 // A run with the typed trace collected.
@@ -46,7 +47,7 @@ Traced run(scheduler::MatchConfig c) {
 scheduler::MatchConfig solo(const std::string& source, double seconds,
                             const std::string& profileName = "thesis-1997") {
   scheduler::MatchConfig c;
-  c.arena = plant::makeArenaConfig(profile(profileName), 1);
+  c.arena = config::makeArenaConfig(profile(profileName), 1);
   c.robots.push_back({"A", "test.dc", testkit::compileOrDie(source)});
   c.endTick = timebase::ticksFromSeconds(seconds);
   return c;
@@ -56,7 +57,7 @@ scheduler::MatchConfig solo(const std::string& source, double seconds,
 scheduler::MatchConfig duel(const std::string& shooter, plant::Pose a, plant::Pose b,
                             double seconds) {
   scheduler::MatchConfig c;
-  c.arena = plant::makeArenaConfig(profile("thesis-1997"), 2);
+  c.arena = config::makeArenaConfig(profile("thesis-1997"), 2);
   c.arena.robots[0].start = a;
   c.arena.robots[1].start = b;
   c.robots.push_back({"A", "shooter.dc", testkit::compileOrDie(shooter)});
@@ -131,7 +132,7 @@ const char* kHandler =
 
 TEST(Trace, SamplesSayWhenAHandlerIsInService) {
   auto c = solo(kHandler, 1);
-  c.injections.push_back(scheduler::parseInjection("A:edge_fore@0.2s", 1));
+  c.injections.push_back(config::parseInjection("A:edge_fore@0.2s", 1));
   const Traced t = run(c);
   const auto samples = t.all<rec::Sample>();
   ASSERT_GE(samples.size(), 17u);
@@ -275,7 +276,7 @@ TEST(Trace, ContactsSayWhatTheBodyTouched) {
 // with the result; the JSONL form reads back to the same JSON.
 TEST(Trace, RecordsAreInTickOrderAndReadBack) {
   scheduler::MatchConfig c;
-  c.arena = plant::makeArenaConfig(profile("default"), 2);
+  c.arena = config::makeArenaConfig(profile("default"), 2);
   const std::string iceman = SIMBOT_SHARED_DIR "/programs/iceman.dc";
   const std::string fig92 = SIMBOT_SHARED_DIR "/programs/fig92.dc";
   auto read = [](const std::string& path) {

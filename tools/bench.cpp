@@ -10,6 +10,7 @@
 #include <fstream>
 #include <numbers>
 
+#include "config/config.h"
 #include "scheduler/match.h"
 #include "timebase/tick.h"
 #include "tools/json_text.h"
@@ -40,7 +41,7 @@ struct Geometry {
   }
 };
 
-Geometry geometryOf(const plant::Profile& profile) {
+Geometry geometryOf(const config::Profile& profile) {
   Geometry g{};
   g.field = &profile.field;
   g.wire = profile.field.size_ft / 2 - profile.field.wire_inset_ft;
@@ -64,7 +65,7 @@ struct Placement {
 };
 
 Placement samplePlacement(const std::string& family, plant::RandomBits& bits,
-                          const plant::Profile& profile) {
+                          const config::Profile& profile) {
   const Geometry g = geometryOf(profile);
   Placement s;
   if (family == "stationary") {
@@ -142,13 +143,14 @@ namespace {
 
 // The set-up every run of one program shares: its robots, arena and
 // injections; the runs differ in poses (a family's) and seeds.
-scheduler::MatchConfig baseConfig(const BenchConfig& config, const plant::Profile& profile,
+scheduler::MatchConfig baseConfig(const BenchConfig& config, const config::Profile& profile,
                                   const std::string& program, const vm::Image& image,
                                   const std::optional<scheduler::RobotSpec>& opponent) {
   scheduler::MatchConfig mc;
-  mc.arena = plant::makeArenaConfig(profile, opponent ? 2 : 1);
+  mc.arena = config::makeArenaConfig(profile, opponent ? 2 : 1);
   mc.robots.push_back({"A", program, image});
   if (opponent) mc.robots.push_back(*opponent);
+  for (scheduler::RobotSpec& robot : mc.robots) robot.controller = profile.controller;
   if (config.scenario)
     applyScenario(*config.scenario,
                   config.family.empty() ? ScenarioUse::BenchOwn : ScenarioUse::Bench, profile, mc);
@@ -169,7 +171,7 @@ CsvRow benchHeader() {
   return header;
 }
 
-nlohmann::json benchSettings(const BenchConfig& c, const plant::Profile& profile) {
+nlohmann::json benchSettings(const BenchConfig& c, const config::Profile& profile) {
   return {{"command", "bench"},
           {"programs", c.programs},
           {"family", c.family},
@@ -301,7 +303,7 @@ void checkBenchConfig(const BenchConfig& config) {
   if (config.programs.empty()) throw ToolError("simbot: bench needs at least one program\n");
 }
 
-BenchResult runBench(const BenchConfig& config, const plant::Profile& profile, const BenchIo& io) {
+BenchResult runBench(const BenchConfig& config, const config::Profile& profile, const BenchIo& io) {
   checkBenchConfig(config);
   std::optional<scheduler::RobotSpec> opponent;
   if (config.family == "stationary") {

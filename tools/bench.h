@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "stats/stats.h"
 #include "tools/bench_metrics.h"
@@ -81,12 +82,12 @@ std::string benchLabel(const BenchConfig& config);
 void checkBenchConfig(const BenchConfig& config);
 // runs.csv's columns, and the settings that identify a bench (batch.json).
 CsvRow benchHeader();
-nlohmann::json benchSettings(const BenchConfig& config, const plant::Profile& profile);
+nlohmann::json benchSettings(const BenchConfig& config, const config::Profile& profile);
 
 // Runs every run not already in io.table (resume); each finished run goes
 // to the table as it completes. A run that faults or fails is recorded as
 // such; the others go on.
-BenchResult runBench(const BenchConfig& config, const plant::Profile& profile,
+BenchResult runBench(const BenchConfig& config, const config::Profile& profile,
                      const BenchIo& io = {});
 
 // The finished runs, in order (the final runs.csv).

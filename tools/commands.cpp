@@ -8,6 +8,7 @@
 #include <iostream>
 #include <memory>
 
+#include "config/config.h"
 #include "tools/bench.h"
 #include "tools/compare.h"
 #include "tools/json_text.h"
@@ -24,7 +25,7 @@ int guarded(const std::function<int()>& body) {
   } catch (const ToolError& e) {
     std::cerr << e.what();
     return 1;
-  } catch (const plant::ConfigError& e) {
+  } catch (const config::ConfigError& e) {
     std::cerr << e.what() << '\n';
     return 1;
   }
@@ -102,13 +103,13 @@ Subcommand addBenchCommand(CLI::App& app) {
           BenchConfig& c = o->config;
           std::string profile = o->profile;
           if (!o->scenario.empty()) {
-            c.scenario = loadScenario(o->scenario);
+            c.scenario = config::loadScenario(o->scenario);
             profile =
                 preferCommandLine(o->profileOption->count() > 0, c.scenario->profile, profile);
             c.seconds = preferCommandLine(o->seconds->count() > 0, c.scenario->seconds, c.seconds);
             c.masterSeed = preferCommandLine(o->seed->count() > 0, c.scenario->seed, c.masterSeed);
           }
-          const plant::Profile loaded = loadNamedProfile(profile);
+          const config::Profile loaded = loadNamedProfile(profile);
           checkBenchConfig(c);
           std::string label = benchLabel(c);
           std::replace(label.begin(), label.end(), ' ', '-');
@@ -180,8 +181,8 @@ Subcommand addCompareCommand(CLI::App& app) {
           a.programs = {o->programs[0]};
           b.programs = {o->programs.back()};
           CompareResult r;
-          const plant::Profile pa = loadNamedProfile(o->profile);
-          const plant::Profile pb = loadNamedProfile(profileB);
+          const config::Profile pa = loadNamedProfile(o->profile);
+          const config::Profile pb = loadNamedProfile(profileB);
           r.profileA = pa.name;
           r.profileB = pb.name;
           checkBenchConfig(a);
@@ -233,7 +234,7 @@ Subcommand addTournamentCommand(CLI::App& app) {
                 "again from main with its memory as at load (thesis Appendix A)");
   return {cmd, [o] {
             return guarded([&] {
-              const plant::Profile profile = loadNamedProfile(o->profile);
+              const config::Profile profile = loadNamedProfile(o->profile);
               if (o->secondsOption->count() > 0) o->config.seconds = o->seconds;
               checkTournamentConfig(o->config);
               RunTable table(o->out, "games.csv", tournamentHeader(),

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "compiler/compiler.h"
+#include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "timebase/tick.h"
@@ -335,7 +336,7 @@ int main(int argc, char** argv) {
   } catch (const tools::ToolError& e) {
     std::cerr << e.what();
     return kExitBadInput;
-  } catch (const plant::ConfigError& e) {
+  } catch (const config::ConfigError& e) {
     std::cerr << e.what() << '\n';
     return kExitBadInput;
   } catch (const std::exception& e) {

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <optional>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "timebase/tick.h"
 #include "tools/json_text.h"
@@ -83,8 +84,8 @@ bool reportFaults(const scheduler::MatchResult& r) {
 scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, const RunOptions& o,
                                    ScenarioUse use) {
   std::optional<Scenario> scenario;
-  if (!o.scenario.empty()) scenario = loadScenario(o.scenario);
-  const plant::Profile profile = loadNamedProfile(
+  if (!o.scenario.empty()) scenario = config::loadScenario(o.scenario);
+  const config::Profile profile = loadNamedProfile(
       preferCommandLine(o.profile.has_value(), scenario ? scenario->profile : std::nullopt,
                         o.profile.value_or("default")));
   // Without --seconds or a scenario's, a run lasts its default: the
@@ -95,11 +96,13 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
   if (!(seconds > 0) || seconds > 1e6)
     throw ToolError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", seconds));
   scheduler::MatchConfig config;
-  config.arena = plant::makeArenaConfig(profile, static_cast<int>(programs.size()));
+  config.arena = config::makeArenaConfig(profile, static_cast<int>(programs.size()));
   config.profileName = profile.name;
   const char* names[] = {"A", "B"};
-  for (size_t i = 0; i < programs.size(); ++i)
+  for (size_t i = 0; i < programs.size(); ++i) {
     config.robots.push_back({names[i], programs[i], compileProgramFile(programs[i])});
+    config.robots.back().controller = profile.controller;
+  }
   std::array<bool, 2> hwGiven{};
   std::vector<std::pair<int, std::string>> hwFiles;
   for (const auto& spec : o.hw) {
@@ -118,12 +121,13 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
   if (scenario) applyScenario(*scenario, use, profile, config, hwGiven);
   for (const auto& [robot, file] : hwFiles) {
     auto& setup = config.arena.robots[static_cast<size_t>(robot)];
-    setup.hardware = plant::loadHardware(file, setup.params);
+    setup.hardware = config::loadHardware(file, setup.params,
+                                          config.robots[static_cast<size_t>(robot)].controller);
   }
   for (const auto& text : o.injections) {
     try {
       config.injections.push_back(
-          scheduler::parseInjection(text, static_cast<int>(config.robots.size())));
+          config::parseInjection(text, static_cast<int>(config.robots.size())));
     } catch (const std::invalid_argument& e) {
       throw ToolError(fmt::format("simbot: --inject {}\n", e.what()));
     }

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "compiler/compiler.h"
+#include "config/config.h"
 
 namespace simbot::tools {
 
@@ -59,20 +60,13 @@ vm::Image compileProgramText(const std::string& source, const std::string& name)
   return imageOrThrow(compiler::compile(source, name));
 }
 
-std::optional<std::string> shippedProfilePath(const std::string& name) {
-  const std::filesystem::path p = std::filesystem::path(SIMBOT_PROFILES_DIR) / (name + ".toml");
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(p, ec)) return std::nullopt;
-  return p.string();
-}
-
-plant::Profile loadNamedProfile(const std::string& nameOrPath) {
-  if (std::filesystem::exists(nameOrPath)) return plant::loadProfile(nameOrPath);
-  const auto shipped = shippedProfilePath(nameOrPath);
+config::Profile loadNamedProfile(const std::string& nameOrPath) {
+  if (std::filesystem::exists(nameOrPath)) return config::loadProfile(nameOrPath);
+  const auto shipped = config::shippedProfilePath(nameOrPath);
   if (!shipped)
     throw ToolError(
         fmt::format("simbot: no profile '{}' (a file, or one of profiles/*.toml)\n", nameOrPath));
-  return plant::loadProfile(*shipped);
+  return config::loadProfile(*shipped);
 }
 
 int resolveThreads(int threads) {

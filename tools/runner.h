@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "vm/image.h"
 
@@ -22,9 +23,7 @@ struct ToolError : std::runtime_error {
 vm::Image compileProgramFile(const std::string& path);
 vm::Image compileProgramText(const std::string& source, const std::string& name);
 // A profile by name (profiles/NAME.toml) or by path.
-plant::Profile loadNamedProfile(const std::string& nameOrPath);
-// The file of the shipped profile NAME (profiles/NAME.toml), if there is one.
-std::optional<std::string> shippedProfilePath(const std::string& name);
+config::Profile loadNamedProfile(const std::string& nameOrPath);
 // threads <= 0: the hardware concurrency (at least 1).
 int resolveThreads(int threads);
 

@@ -3,7 +3,8 @@
 // the profile, the run's length and seed, robot A's start pose, hardware
 // file and injections, and robot B: another program, or a beacon that
 // stands still or drives a scripted path. The schema is in docs/tools.md
-// ("Scenarios"); every key is checked, and every error is reported as
+// ("Scenarios"). config/ reads and checks the file (config::loadScenario);
+// this part applies it to a run. Every error is reported as
 // FILE:LINE:COL: error: MESSAGE.
 //
 // What the command line says explicitly wins over the scenario (--profile,
@@ -12,55 +13,19 @@
 #include <cstdint>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
 
 namespace simbot::tools {
 
-// Where something is in the scenario file, for the errors found when the
-// run is set up.
-struct SourcePos {
-  int line = 0;
-  int column = 0;
-};
-
-// One leg of a beacon's path, as the scenario file states it.
-struct PathLeg {
-  enum class Kind : uint8_t { Forward, Arc, Spin, Wait } kind = Kind::Wait;
-  double forwardFt = 0;  // Forward: signed distance (negative: backwards)
-  double radiusFt = 0;   // Arc: radius of the centre's path
-  double turnDeg = 0;    // Arc, Spin: signed turn, + clockwise (to the right)
-  double speedFps = 0;   // Forward, Arc: centre speed; Spin: wheel speed
-  double waitS = 0;      // Wait
-  SourcePos pos;
-};
-
-struct ScenarioRobot {
-  std::optional<plant::Pose> start;
-  SourcePos startPos;
-  std::string hardware;  // resolved path; empty: the default bindings
-  struct Inject {
-    std::string what;  // SOURCE@WHEN as written
-    SourcePos pos;
-  };
-  std::vector<Inject> inject;
-};
-
-struct Scenario {
-  std::string file;
-  std::optional<std::string> profile;  // a profile name, or a resolved path
-  std::optional<double> seconds;
-  std::optional<uint64_t> seed;
-  ScenarioRobot a, b;
-  enum class Opponent : uint8_t { None, Program, Beacon } opponent = Opponent::None;
-  SourcePos opponentPos;  // [B]'s program or beacon key
-  std::string program;    // B's program (resolved path)
-  std::vector<PathLeg> path;
-  bool repeatPath = false;
-};
+// The scenario file as config/ reads it (config.h).
+using config::PathLeg;
+using config::Scenario;
+using config::ScenarioRobot;
+using config::SourcePos;
 
 // A run's setting: the command line's value if the option was given there,
 // else the scenario's if it sets one, else the command's default.
@@ -70,15 +35,9 @@ T preferCommandLine(bool givenOnCommandLine, const std::optional<T>& fromScenari
   return !givenOnCommandLine && fromScenario ? *fromScenario : fromCommand;
 }
 
-// Throws plant::ConfigError ("FILE:LINE:COL: error: ..."). Relative paths in the
-// file (profile, hardware, program) are taken from the file's directory.
-Scenario loadScenario(const std::string& path);
-Scenario parseScenario(std::string_view text, const std::string& sourceName,
-                       const std::string& baseDir);
-
 // A beacon's path as wheel speeds and exact tick durations, with the
 // beacon's own track (the scheduler follows a path exactly: no motor lag). Throws
-// plant::ConfigError naming the leg's place if a leg is shorter than a tick.
+// config::ConfigError naming the leg's place if a leg is shorter than a tick.
 std::vector<scheduler::DriveLeg> driveLegs(const std::string& sourceName,
                                            const std::vector<PathLeg>& legs,
                                            const plant::RobotParams& params);
@@ -100,9 +59,9 @@ enum class ScenarioUse : uint8_t {
 // `config` and whose arena was made from `profile` for those robots: start
 // poses, hardware (unless `keepHardware[i]`: given on the command line),
 // B when the scenario adds one, and injections (appended). Throws
-// plant::ConfigError naming the place in the scenario of anything that does
+// config::ConfigError naming the place in the scenario of anything that does
 // not fit.
-void applyScenario(const Scenario& s, ScenarioUse use, const plant::Profile& profile,
+void applyScenario(const Scenario& s, ScenarioUse use, const config::Profile& profile,
                    scheduler::MatchConfig& config, std::array<bool, 2> keepHardware = {});
 
 }  // namespace simbot::tools

@@ -1,10 +1,9 @@
-// simbot sweep (sweep.h): the sweep file, its expansion into runs, one
-// run's row, the ordered writer, and the command (local threads, or the
-// Python module's Dask driver for --dask).
+// simbot sweep (sweep.h): the sweep file's expansion into runs (config/
+// reads the file), one run's row, the ordered writer, and the command
+// (local threads, or the Python module's Dask driver for --dask).
 #include "tools/sweep.h"
 
 #include <fmt/format.h>
-#include <toml++/toml.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -14,8 +13,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <sstream>
 
+#include "config/config.h"
 #include "tools/bench.h"
 #include "tools/runner.h"
 
@@ -24,71 +23,6 @@ namespace simbot::tools {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string sweepError(const std::string& file, const toml::source_region& at,
-                       const std::string& msg) {
-  return fmt::format("{}:{}:{}: error: {}\n", file, std::max<int>(1, at.begin.line),
-                     std::max<int>(1, at.begin.column), msg);
-}
-
-std::string dirOf(const std::string& file) {
-  const fs::path dir = fs::path(file).parent_path();
-  return dir.empty() ? "." : dir.string();
-}
-
-// A path as written in the sweep file, made usable from here.
-std::string resolved(const SweepSpec& spec, const std::string& path) {
-  if (path.empty() || fs::path(path).is_absolute()) return path;
-  return (fs::path(dirOf(spec.file)) / path).string();
-}
-
-std::string baseProfilePath(const SweepSpec& spec) {
-  const std::string asFile = resolved(spec, spec.profile);
-  std::error_code ec;
-  if (fs::is_regular_file(asFile, ec)) return asFile;
-  if (const auto shipped = shippedProfilePath(spec.profile)) return *shipped;
-  throw ToolError(fmt::format("simbot: {}: no profile '{}' (a file, or one of profiles/*.toml)\n",
-                              spec.file, spec.profile));
-}
-
-std::string tomlText(const toml::node& node) {
-  std::ostringstream out;
-  node.visit([&out](const auto& n) { out << n; });
-  return out.str();
-}
-
-std::vector<std::string> stringArray(const SweepSpec& spec, const toml::table& doc, const char* key,
-                                     bool required) {
-  std::vector<std::string> out;
-  const toml::node* node = doc.get(key);
-  if (!node) {
-    if (required)
-      throw ToolError(sweepError(spec.file, doc.source(), fmt::format("missing key '{}'", key)));
-    return out;
-  }
-  const toml::array* array = node->as_array();
-  if (!array || array->empty())
-    throw ToolError(
-        sweepError(spec.file, node->source(), fmt::format("'{}' must be a list of strings", key)));
-  for (const toml::node& e : *array) {
-    const auto s = e.value<std::string>();
-    if (!s || !e.is_string())
-      throw ToolError(
-          sweepError(spec.file, e.source(), fmt::format("'{}' must be a list of strings", key)));
-    out.push_back(*s);
-  }
-  return out;
-}
-
-// The values of grid point `point`: the last key varies fastest.
-std::vector<size_t> pointValues(const SweepSpec& spec, size_t point) {
-  std::vector<size_t> at(spec.grid.size());
-  for (size_t k = spec.grid.size(); k-- > 0;) {
-    at[k] = point % spec.grid[k].second.size();
-    point /= spec.grid[k].second.size();
-  }
-  return at;
-}
 
 struct Pair {
   std::string family, opponent;
@@ -107,147 +41,10 @@ std::vector<Pair> familyPairs(const SweepSpec& spec) {
 
 }  // namespace
 
-size_t sweepPoints(const SweepSpec& spec) {
-  size_t n = 1;
-  for (const auto& [key, values] : spec.grid) n *= values.size();
-  return n;
-}
-
-plant::Profile sweepProfile(const SweepSpec& spec, size_t point) {
-  const std::string base = baseProfilePath(spec);
-  toml::table doc;
-  try {
-    doc = toml::parse_file(base);
-  } catch (const toml::parse_error& e) {
-    // The profile's own checker words the error (FILE:LINE:COL).
-    return plant::loadProfile(base);
-  }
-  const std::vector<size_t> at = pointValues(spec, point);
-  for (size_t k = 0; k < spec.grid.size(); ++k) {
-    const std::string& key = spec.grid[k].first;
-    const auto dot = key.find('.');
-    toml::table* section = doc.get_as<toml::table>(key.substr(0, dot));
-    toml::node* entry = section ? section->get(key.substr(dot + 1)) : nullptr;
-    if (!entry)
-      throw ToolError(fmt::format("simbot: {}: no profile key '{}' in {}\n", spec.file, key, base));
-    const toml::table value = toml::parse("v = " + spec.grid[k].second[at[k]]);
-    if (toml::table* described = entry->as_table())
-      described->insert_or_assign("value", *value.get("v"));
-    else
-      section->insert_or_assign(key.substr(dot + 1), *value.get("v"));
-  }
-  std::ostringstream text;
-  text << doc;
-  return plant::parseProfile(text.str(),
-                             fmt::format("{} (grid point {} of {})", base, point, spec.file));
-}
-
-SweepSpec loadSweep(const std::string& path) {
-  SweepSpec spec;
-  spec.file = path;
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw ToolError(fmt::format("simbot: no sweep file '{}'\n", path));
-  toml::table doc;
-  try {
-    doc = toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    throw ToolError(sweepError(path, e.source(), std::string(e.description())));
-  }
-  for (auto&& [key, node] : doc) {
-    static const std::vector<std::string> known = {"programs", "opponents", "families", "seeds",
-                                                   "seconds",  "profile",   "grid"};
-    if (std::find(known.begin(), known.end(), std::string(key.str())) == known.end())
-      throw ToolError(sweepError(
-          path, key.source(),
-          fmt::format("unknown key '{}' (programs, opponents, families, seeds, seconds, profile, "
-                      "grid)",
-                      key.str())));
-  }
-  spec.programs = stringArray(spec, doc, "programs", true);
-  spec.opponents = stringArray(spec, doc, "opponents", false);
-  spec.families = stringArray(spec, doc, "families", true);
-  const auto& families = benchFamilies();
-  for (const auto& f : spec.families)
-    if (std::find(families.begin(), families.end(), f) == families.end())
-      throw ToolError(sweepError(
-          path, doc.get("families")->source(),
-          fmt::format("unknown family '{}' (stationary, circle, head-to-head, edge)", f)));
-  const bool headToHead =
-      std::find(spec.families.begin(), spec.families.end(), "head-to-head") != spec.families.end();
-  if (headToHead && spec.opponents.empty())
-    throw ToolError(sweepError(path, doc.get("families")->source(),
-                               "the head-to-head family needs 'opponents'"));
-  if (!headToHead && !spec.opponents.empty())
-    throw ToolError(sweepError(path, doc.get("opponents")->source(),
-                               "'opponents' play only in the head-to-head family"));
-  for (const auto* list : {&spec.programs, &spec.opponents})
-    for (const auto& p : *list)
-      if (!fs::is_regular_file(resolved(spec, p), ec))
-        throw ToolError(fmt::format("simbot: {}: no such program '{}'\n", path, p));
-  if (const toml::node* s = doc.get("seconds")) {
-    const auto v = s->value<double>();
-    if (!v || !(*v > 0) || *v > 1e6)
-      throw ToolError(sweepError(path, s->source(), "'seconds' must be a number in (0, 1e6]"));
-    spec.seconds = *v;
-  }
-  if (const toml::node* p = doc.get("profile")) {
-    if (!p->is_string()) throw ToolError(sweepError(path, p->source(), "'profile' is a string"));
-    spec.profile = *p->value<std::string>();
-  }
-  const toml::table* seeds = doc.get_as<toml::table>("seeds");
-  if (!seeds)
-    throw ToolError(sweepError(path, doc.source(), "missing table [seeds] (first, count)"));
-  for (auto&& [key, node] : *seeds) {
-    const auto v = node.value<int64_t>();
-    const bool first = key.str() == "first";
-    if ((!first && key.str() != "count") || !node.is_integer() || *v < (first ? 0 : 1) ||
-        (!first && *v > 1'000'000))
-      throw ToolError(sweepError(
-          path, node.source(),
-          "[seeds] holds first (an integer >= 0) and count (an integer from 1 to 1000000)"));
-    (first ? spec.firstSeed : spec.seedCount) = static_cast<uint64_t>(*v);
-  }
-  if (const toml::node* g = doc.get("grid")) {
-    const toml::table* grid = g->as_table();
-    if (!grid) throw ToolError(sweepError(path, g->source(), "'grid' is a table"));
-    for (auto&& [key, node] : *grid) {
-      const toml::array* values = node.as_array();
-      const std::string name(key.str());
-      if (name.find('.') == std::string::npos || !values || values->empty())
-        throw ToolError(
-            sweepError(path, node.source(),
-                       "a grid entry is \"section.key\" = [values...] (a key of the profile)"));
-      std::vector<std::string> texts;
-      for (const toml::node& v : *values) texts.push_back(tomlText(v));
-      spec.grid.emplace_back(name, std::move(texts));
-    }
-    if (sweepPoints(spec) > 100'000)
-      throw ToolError(sweepError(path, g->source(), "the grid has more than 100000 points"));
-    // Every point's profile now: a bad value is an error before any run.
-    for (size_t point = 0; point < sweepPoints(spec); ++point) {
-      try {
-        sweepProfile(spec, point);
-      } catch (const plant::ConfigError& e) {
-        // The profile checker's words, without its FILE:LINE:COL (the
-        // profile as rewritten for this point).
-        std::string what = e.what();
-        const auto at = what.find("error: ");
-        if (at != std::string::npos) what = what.substr(at + 7);
-        throw ToolError(
-            sweepError(path, g->source(), fmt::format("grid point {}: {}", point, what)));
-      }
-    }
-  } else {
-    sweepProfile(spec, 0);
-  }
-  return spec;
-}
-
 std::vector<SweepRun> expandSweep(const SweepSpec& spec) {
   std::vector<SweepRun> runs;
   const auto pairs = familyPairs(spec);
-  for (size_t point = 0; point < sweepPoints(spec); ++point)
+  for (size_t point = 0; point < config::sweepPoints(spec); ++point)
     for (const auto& program : spec.programs)
       for (const auto& pair : pairs)
         for (uint64_t s = 0; s < spec.seedCount; ++s)
@@ -277,15 +74,15 @@ CsvRow sweepHeader(const SweepSpec& spec) {
 
 CsvRow runSweepRow(const SweepSpec& spec, const SweepRun& run) {
   BenchConfig c;
-  c.programs = {resolved(spec, run.program)};
+  c.programs = {config::sweepPath(spec, run.program)};
   c.family = run.family;
-  c.opponent = resolved(spec, run.opponent);
+  c.opponent = config::sweepPath(spec, run.opponent);
   c.seeds = 1;
   c.seconds = spec.seconds;
   c.masterSeed = run.seed;
   c.threads = 1;
   c.progress = false;
-  const BenchResult result = runBench(c, sweepProfile(spec, run.point));
+  const BenchResult result = runBench(c, config::sweepProfile(spec, run.point));
   // The bench's own row, through its own CSV (one header line, one row).
   const std::string csv = runsCsv(result);
   // Line ends may be LF or CRLF (RFC 4180's).
@@ -302,7 +99,7 @@ CsvRow runSweepRow(const SweepSpec& spec, const SweepRun& run) {
   const CsvRow benchRow = parseCsvLine(body);
   CsvRow row = {std::to_string(run.index), run.program, run.family, run.opponent,
                 std::to_string(run.seed)};
-  const std::vector<size_t> at = pointValues(spec, run.point);
+  const std::vector<size_t> at = config::sweepPointValues(spec, run.point);
   for (size_t k = 0; k < spec.grid.size(); ++k) row.push_back(spec.grid[k].second[at[k]]);
   for (size_t i = 0; i < names.size() && i < benchRow.size(); ++i)
     if (keptBenchColumn(names[i])) row.push_back(benchRow[i]);
@@ -473,7 +270,7 @@ std::string defaultOut(const SweepOptions& o) {
 int runSweepCommand(SweepOptions& o) {
   if (o.out.empty()) o.out = defaultOut(o);
   const auto [k, n] = parseShard(o.shard);
-  const SweepSpec spec = loadSweep(o.file);
+  const SweepSpec spec = config::loadSweep(o.file, benchFamilies());
   if (!o.dask.empty()) execDaskDriver(o);
   const std::vector<SweepRun> runs = expandSweep(spec);
   const auto [begin, end] = shardRange(runs.size(), k, n);

@@ -17,24 +17,15 @@
 #include <utility>
 #include <vector>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "tools/commands.h"
 #include "tools/run_table.h"
 
 namespace simbot::tools {
 
-struct SweepSpec {
-  std::string file;                   // the sweep file; relative paths in it are from its directory
-  std::vector<std::string> programs;  // as written (the table's program column)
-  std::vector<std::string> opponents;  // head-to-head's robot B, as written
-  std::vector<std::string> families;
-  uint64_t firstSeed = 1;  // [seeds] first, count: each a bench master seed
-  uint64_t seedCount = 1;
-  double seconds = 60;
-  std::string profile = "default";  // a shipped profile's name, or a file
-  // [grid] "section.key" = [values]: each value's TOML text, keys in file order.
-  std::vector<std::pair<std::string, std::vector<std::string>>> grid;
-};
+// The sweep file as config/ reads it (config.h).
+using config::SweepSpec;
 
 struct SweepRun {
   size_t index = 0;
@@ -43,16 +34,10 @@ struct SweepRun {
   uint64_t seed = 0;
 };
 
-// Reads and checks a sweep file (every grid point's profile is built and
-// checked too); ToolError "FILE:LINE:COL: error: ..." on bad input.
-SweepSpec loadSweep(const std::string& path);
-size_t sweepPoints(const SweepSpec& spec);
 // Run index = ((point x programs + program) x family/opponent pairs + pair)
 // x seeds + seed: seeds vary fastest.
 std::vector<SweepRun> expandSweep(const SweepSpec& spec);
 CsvRow sweepHeader(const SweepSpec& spec);
-// The profile of a grid point: the sweep's profile with the point's values.
-plant::Profile sweepProfile(const SweepSpec& spec, size_t point);
 // Runs one row; deterministic from the row.
 CsvRow runSweepRow(const SweepSpec& spec, const SweepRun& run);
 

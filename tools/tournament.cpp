@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "config/config.h"
 #include "scheduler/match.h"
 #include "timebase/tick.h"
 #include "tools/json_text.h"
@@ -20,7 +21,7 @@ CsvRow tournamentHeader() {
           "fault_a", "fault_b", "plant_fault", "reloads_a", "reloads_b"};
 }
 
-nlohmann::json tournamentSettings(const TournamentConfig& c, const plant::Profile& profile) {
+nlohmann::json tournamentSettings(const TournamentConfig& c, const config::Profile& profile) {
   return {{"command", "tournament"},
           {"programs", c.programs},
           {"rounds", c.rounds},
@@ -96,11 +97,11 @@ void checkTournamentConfig(const TournamentConfig& config) {
         fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", *config.seconds));
 }
 
-double roundSeconds(const TournamentConfig& config, const plant::Profile& profile) {
+double roundSeconds(const TournamentConfig& config, const config::Profile& profile) {
   return config.seconds.value_or(profile.round_length_s);
 }
 
-TournamentResult runTournament(const TournamentConfig& config, const plant::Profile& profile,
+TournamentResult runTournament(const TournamentConfig& config, const config::Profile& profile,
                                RunTable* table, const std::atomic<bool>* stop) {
   checkTournamentConfig(config);
   std::vector<vm::Image> images;
@@ -149,10 +150,11 @@ TournamentResult runTournament(const TournamentConfig& config, const plant::Prof
   auto job = [&](size_t k) {
     TournamentGame& g = result.games[todo[k]];
     scheduler::MatchConfig mc;
-    mc.arena = plant::makeArenaConfig(profile, 2);
+    mc.arena = config::makeArenaConfig(profile, 2);
     const auto ua = static_cast<size_t>(g.a), ub = static_cast<size_t>(g.b);
     mc.robots.push_back({"A", config.programs[ua], images[ua]});
     mc.robots.push_back({"B", config.programs[ub], images[ub]});
+    for (scheduler::RobotSpec& robot : mc.robots) robot.controller = profile.controller;
     mc.endTick = endTick;
     mc.seed = g.seed;
     mc.stop = stop;

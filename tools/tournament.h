@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "config/config.h"
 #include "plant/plant.h"
 #include "tools/run_table.h"
 
@@ -61,14 +62,14 @@ struct TournamentResult {
 // ToolError if the configuration cannot run.
 void checkTournamentConfig(const TournamentConfig& config);
 // The round length: --seconds if given, else the profile's round_length.
-double roundSeconds(const TournamentConfig& config, const plant::Profile& profile);
+double roundSeconds(const TournamentConfig& config, const config::Profile& profile);
 // games.csv's columns, and the settings that identify a tournament.
 CsvRow tournamentHeader();
-nlohmann::json tournamentSettings(const TournamentConfig& config, const plant::Profile& profile);
+nlohmann::json tournamentSettings(const TournamentConfig& config, const config::Profile& profile);
 
 // Plays every game not already in `table` (resume); each finished game goes
 // to the table as it completes. `stop` (may be null) stops the tournament.
-TournamentResult runTournament(const TournamentConfig& config, const plant::Profile& profile,
+TournamentResult runTournament(const TournamentConfig& config, const config::Profile& profile,
                                RunTable* table = nullptr, const std::atomic<bool>* stop = nullptr);
 // Rewrites games.csv in order and writes standings.json and standings.md
 // beside it.

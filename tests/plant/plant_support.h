@@ -1,5 +1,5 @@
-// Shared helpers for the plant tests: shipped profiles, small arenas, and
-// driving an arena until a kind of event shows up.
+// Shared helpers for the plant tests: shipped profiles (read by config/),
+// small arenas, and driving an arena until a kind of event shows up.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -8,11 +8,16 @@
 #include <optional>
 #include <string>
 
+#include "config/config.h"
 #include "plant/plant.h"
 
 namespace plant_test {
 
 using namespace simbot::plant;
+using simbot::config::ConfigError;
+using simbot::config::loadProfile;
+using simbot::config::makeArenaConfig;
+using simbot::config::Profile;
 
 inline std::string profilePath(const char* name) {
   return std::string(SIMBOT_PROFILES_DIR) + "/" + name + ".toml";

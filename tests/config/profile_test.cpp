@@ -1,59 +1,20 @@
-// Motor frames and the TOML profile and hardware loaders.
+// The profile and hardware-file loaders (config/profile.cpp): the shipped
+// profiles, errors at their place, units, hostile numbers, the text
+// toml++ mishandles, hardware overrides, and the controller's knobs.
 #include <fstream>
 #include <numbers>
 #include <regex>
 
-#include "plant_support.h"
+#include "tests/plant/plant_support.h"
 
 using namespace plant_test;
+using simbot::config::checkTomlText;
+using simbot::config::parseHardware;
+using simbot::config::parseProfile;
+using simbot::scheduler::ControllerKnobs;
+using simbot::vm::TimerService;
 
 namespace {
-
-TEST(MotorFrame, ValidFrames) {
-  auto f = parseMotorFrame("ffgrffgr");
-  ASSERT_TRUE(f);
-  EXPECT_EQ(f->left.speed, 15);
-  EXPECT_TRUE(f->left.forward);
-  EXPECT_TRUE(f->left.go);
-  EXPECT_EQ(f->left.counter, 'r');
-  f = parseMotorFrame("0rs 9fgx");
-  ASSERT_TRUE(f);
-  EXPECT_EQ(f->left.speed, 0);
-  EXPECT_FALSE(f->left.forward);
-  EXPECT_FALSE(f->left.go);
-  EXPECT_EQ(f->right.speed, 9);
-  f = parseMotorFrame(
-      "arg\xff"
-      "cfs1");
-  ASSERT_TRUE(f);
-  EXPECT_EQ(f->left.speed, 10);
-  EXPECT_EQ(f->right.speed, 12);
-}
-
-TEST(MotorFrame, InvalidFramesAreRejected) {
-  EXPECT_FALSE(parseMotorFrame("gfgrffgr"));                        // speed out of 0-f
-  EXPECT_FALSE(parseMotorFrame("Ffgrffgr"));                        // uppercase hex
-  EXPECT_FALSE(parseMotorFrame("fxgrffgr"));                        // direction
-  EXPECT_FALSE(parseMotorFrame("ffqrffgr"));                        // go/stop
-  EXPECT_FALSE(parseMotorFrame("ffgrffg"));                         // too short
-  EXPECT_FALSE(parseMotorFrame("ffgrffgrr"));                       // too long
-  EXPECT_FALSE(parseMotorFrame(std::string_view("ffg\0ffgr", 8)));  // NUL counter
-  EXPECT_FALSE(parseMotorFrame("ffgrff r"));
-}
-
-TEST(MotorFrame, SpeedTableTrimDirectionAndStop) {
-  const Profile d = defaults();
-  auto f = *parseMotorFrame("7fg0crg0");
-  EXPECT_DOUBLE_EQ(wheelSpeedFps(f.left, d.robot, true),
-                   d.robot.speed_table_fps[7] * d.robot.left_trim);
-  EXPECT_DOUBLE_EQ(wheelSpeedFps(f.right, d.robot, false),
-                   -d.robot.speed_table_fps[12] * d.robot.right_trim);
-  f = *parseMotorFrame("ffs0ffs0");
-  EXPECT_EQ(wheelSpeedFps(f.left, d.robot, true), 0.0);
-  const Profile t = thesis();
-  for (int k = 0; k < 16; ++k)
-    EXPECT_NEAR(t.robot.speed_table_fps[static_cast<std::size_t>(k)], 1.5 * k / 15, 1e-12);
-}
 
 TEST(Profiles, BothShippedProfilesLoad) {
   const Profile t = thesis();
@@ -251,6 +212,7 @@ TEST(Profiles, MissingFileIsAnError) {
 
 TEST(Hardware, BindsPortsAndOverridesRobotValues) {
   RobotParams params = thesis().robot;
+  ControllerKnobs controller;
   const Hardware h = parseHardware(R"(
 [ports]
 gun1_motor = { value = 0, unit = "bit", source = "our wiring" }
@@ -261,8 +223,11 @@ muzzle_speed = { value = 30, unit = "m/s", source = "measured" }
 
 [eyes]
 max = { value = 2040, unit = "reading", source = "other circuit" }
+
+[controller]
+timer_service = { value = "never", source = "our BIOS" }
 )",
-                                   "hw.toml", params);
+                                   "hw.toml", params, controller);
   EXPECT_EQ(h.gun_motor_bit[0], 0);
   EXPECT_EQ(h.gun_solenoid_bit[0], 1);
   EXPECT_EQ(h.gun_motor_bit[1], 7);  // default kept
@@ -270,13 +235,34 @@ max = { value = 2040, unit = "reading", source = "other circuit" }
   EXPECT_NEAR(params.muzzle_speed_fps, 30 / 0.3048, 1e-9);
   EXPECT_EQ(params.eye_max, 2040);
   EXPECT_EQ(params.balls_per_gun, 15);
+  EXPECT_EQ(controller.timerService, TimerService::Never);
+  EXPECT_TRUE(controller.fastForward);  // default kept
+}
+
+// [controller]'s knobs are the VM's, typed: the timer service's word and
+// fast-forward's flag.
+TEST(Profiles, ControllerKnobsAreTheVmsTyped) {
+  EXPECT_EQ(thesis().controller.timerService, TimerService::Auto);
+  EXPECT_TRUE(defaults().controller.fastForward);
+  std::string text =
+      edit("timer_service = { value = \"auto\"", "timer_service = { value = \"always\"");
+  text.replace(text.find("fast_forward  = { value = true"), 30, "fast_forward  = { value = false");
+  const Profile p = parseProfile(text, "x.toml");
+  EXPECT_EQ(p.controller.timerService, TimerService::Always);
+  EXPECT_FALSE(p.controller.fastForward);
+  const std::string msg =
+      errorOf(edit("timer_service = { value = \"auto\"", "timer_service = { value = \"often\""));
+  EXPECT_NE(msg.find("'controller.timer_service' must be \"auto\", \"always\" or \"never\""),
+            std::string::npos)
+      << msg;
 }
 
 TEST(Hardware, ErrorsArePositioned) {
   RobotParams params = thesis().robot;
+  ControllerKnobs controller;
   auto err = [&](const char* text) {
     try {
-      parseHardware(text, "hw.toml", params);
+      parseHardware(text, "hw.toml", params, controller);
     } catch (const ConfigError& e) {
       return std::string(e.what());
     }

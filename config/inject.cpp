@@ -1,0 +1,90 @@
+// config/inject.cpp -- the --inject specification (config.h
+// parseInjection): ROBOT:SOURCE@WHEN into the scheduler's Injection. Scenario
+// files' [A]/[B] inject lists are read by the same parser, so a spec means
+// the same wherever it is written.
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "config/config.h"
+#include "timebase/tick.h"
+
+namespace simbot::config {
+
+using timebase::kTicksPerSecond;
+
+namespace {
+
+// A non-negative decimal number of `unit`s as an exact tick count, read by
+// the one parser of durations (timebase::ticksFromDecimal): "12.5s" is
+// exactly 115,200,000 ticks, "1e-3s" 9,216; an injection is at a tick, so a
+// time between two ticks is refused rather than rounded.
+scheduler::Tick parseDuration(const std::string& digits, int64_t ticksPerUnit,
+                              const std::string& whole) {
+  const auto ticks = timebase::ticksFromDecimal(digits, ticksPerUnit);
+  if (!ticks)
+    throw std::invalid_argument("'" + whole +
+                                "': WHEN must be a time (12.5s, 800ms), a tick (115200000t) "
+                                "or a program point (line:N#K, pass:N#K)");
+  if (!ticks->exact) throw std::invalid_argument("'" + whole + "' is not a whole number of ticks");
+  return ticks->ticks;
+}
+
+int parsePositive(const std::string& s, const std::string& whole, const char* what) {
+  if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos ||
+      std::stoi(s) <= 0)
+    throw std::invalid_argument("'" + whole + "': " + what + " must be a positive integer");
+  return std::stoi(s);
+}
+
+}  // namespace
+
+scheduler::Injection parseInjection(const std::string& text, int robotCount) {
+  scheduler::Injection in;
+  in.text = text;
+  const auto colon = text.find(':');
+  const auto at = text.find('@');
+  if (colon == std::string::npos || at == std::string::npos || at < colon)
+    throw std::invalid_argument("'" + text + "': expected ROBOT:SOURCE@WHEN");
+  const std::string robot = text.substr(0, colon);
+  const std::string source = text.substr(colon + 1, at - colon - 1);
+  const std::string when = text.substr(at + 1);
+  if (robot == "A")
+    in.robot = 0;
+  else if (robot == "B" && robotCount > 1)
+    in.robot = 1;
+  else
+    throw std::invalid_argument("'" + text + "': no robot '" + robot + "' in this run");
+  if (source == "edge_fore")
+    in.source = scheduler::InjectSource::EdgeFore;
+  else if (source == "edge_aft")
+    in.source = scheduler::InjectSource::EdgeAft;
+  else if (source == "bumper_front")
+    in.source = scheduler::InjectSource::BumperFront;
+  else if (source == "bumper_back")
+    in.source = scheduler::InjectSource::BumperBack;
+  else
+    throw std::invalid_argument("'" + text +
+                                "': SOURCE must be edge_fore, edge_aft, "
+                                "bumper_front or bumper_back");
+  const bool pass = when.rfind("pass:", 0) == 0;
+  if (when.rfind("line:", 0) == 0 || pass) {
+    const auto hash = when.find('#');
+    if (hash == std::string::npos)
+      throw std::invalid_argument("'" + text + "': a program point is line:N#K or pass:N#K");
+    in.pass = pass;
+    in.line = parsePositive(when.substr(5, hash - 5), text, "the line N");
+    in.count = parsePositive(when.substr(hash + 1), text, "the execution count K");
+  } else if (when.size() > 2 && when.compare(when.size() - 2, 2, "ms") == 0) {
+    in.tick = parseDuration(when.substr(0, when.size() - 2), kTicksPerSecond / 1000, text);
+  } else if (!when.empty() && when.back() == 's') {
+    in.tick = parseDuration(when.substr(0, when.size() - 1), kTicksPerSecond, text);
+  } else if (!when.empty() && when.back() == 't') {
+    in.tick = parseDuration(when.substr(0, when.size() - 1), 1, text);
+  } else {
+    parseDuration("", 1, text);  // throws the WHEN message
+  }
+  return in;
+}
+
+}  // namespace simbot::config

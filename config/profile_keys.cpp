@@ -1,0 +1,282 @@
+// config/profile_keys.cpp -- the profile and hardware-file keys
+// (profile_keys.h): every key with its section, kind, bounds and target,
+// and the units each kind accepts with their factors to internal units.
+#include "config/profile_keys.h"
+
+#include <cmath>
+
+namespace simbot::config::keys {
+
+using plant::Hardware;
+using plant::kMaxBallsPerGun;
+using plant::kMaxRefereeLimit;
+
+#define D(expr)                 \
+  [](Profile& p, Hardware& h) { \
+    (void)p;                    \
+    (void)h;                    \
+    Target t;                   \
+    t.d = &(expr);              \
+    return t;                   \
+  }
+#define I(expr)                 \
+  [](Profile& p, Hardware& h) { \
+    (void)p;                    \
+    (void)h;                    \
+    Target t;                   \
+    t.i = &(expr);              \
+    return t;                   \
+  }
+#define B(expr)                 \
+  [](Profile& p, Hardware& h) { \
+    (void)p;                    \
+    (void)h;                    \
+    Target t;                   \
+    t.b = &(expr);              \
+    return t;                   \
+  }
+
+const std::vector<KeyDef>& keyTable() {
+  static const std::vector<KeyDef> keys = {
+      {"field", "size", Kind::Length, {1, 100}, false, D(p.field.size_ft)},
+      {"field", "wire_inset", Kind::Length, {0, 10}, false, D(p.field.wire_inset_ft)},
+      {"field", "wire_sensitivity", Kind::Length, {0.01, 1}, false, D(p.field.wire_sensitivity_ft)},
+      {"field", "field_walls", Kind::Bool, {0, 0}, false, B(p.field.field_walls)},
+      {"field", "divider_x", Kind::Length, {-50, 50}, false, D(p.field.divider_x_ft)},
+      {"field", "divider_south", Kind::Length, {-50, 50}, false, D(p.field.divider_south_ft)},
+      {"field", "divider_north", Kind::Length, {-50, 50}, false, D(p.field.divider_north_ft)},
+      {"field", "divider_thickness", Kind::Length, {0, 2}, false, D(p.field.divider_thickness_ft)},
+      {"field", "divider_height", Kind::Length, {0, 20}, false, D(p.field.divider_height_ft)},
+      {"start", "a_x", Kind::Length, {-50, 50}, false, D(p.field.start[0].x_ft)},
+      {"start", "a_y", Kind::Length, {-50, 50}, false, D(p.field.start[0].y_ft)},
+      {"start", "a_heading", Kind::Angle, {-360, 360}, false, D(p.field.start[0].heading_deg)},
+      {"start", "b_x", Kind::Length, {-50, 50}, false, D(p.field.start[1].x_ft)},
+      {"start", "b_y", Kind::Length, {-50, 50}, false, D(p.field.start[1].y_ft)},
+      {"start", "b_heading", Kind::Angle, {-360, 360}, false, D(p.field.start[1].heading_deg)},
+      // Hand placement: a few inches, a few degrees (profiles/default.toml);
+      // placeByHand keeps every body inside the field whatever the radius.
+      {"start", "placement_radius", Kind::Length, {0, 2}, false, D(p.field.placement_radius_ft)},
+      {"start", "placement_heading", Kind::Angle, {0, 45}, false, D(p.field.placement_heading_deg)},
+      {"robot", "body_diameter", Kind::Length, {0.1, 5}, true, D(p.robot.body_diameter_ft)},
+      {"robot", "target_height", Kind::Length, {0.1, 10}, true, D(p.robot.target_height_ft)},
+      {"robot",
+       "edge_detector_inset",
+       Kind::Length,
+       {0, 2.5},
+       true,
+       D(p.robot.edge_detector_inset_ft)},
+      {"robot", "wheel_diameter", Kind::Length, {0.05, 2}, true, D(p.robot.wheel_diameter_ft)},
+      {"robot", "track", Kind::Length, {0.05, 5}, true, D(p.robot.track_ft)},
+      {"robot",
+       "speed_table",
+       Kind::SpeedTable,
+       {0, 20},
+       true,
+       [](Profile& p, Hardware&) {
+         Target t;
+         t.table = &p.robot.speed_table_fps;
+         return t;
+       }},
+      {"robot", "left_trim", Kind::Ratio, {0.5, 2}, true, D(p.robot.left_trim)},
+      {"robot", "right_trim", Kind::Ratio, {0.5, 2}, true, D(p.robot.right_trim)},
+      // At most 0.25: a drawn trim stays within 0.75..1.25 of the given one
+      // (crossChecks keeps it within left_trim/right_trim's own range).
+      {"robot", "trim_spread", Kind::Ratio, {0, 0.25}, true, D(p.robot.trim_spread)},
+      {"robot", "motor_lag", Kind::Time, {0.001, 10, true}, true, D(p.robot.motor_lag_s)},
+      // Only the ratio of the two robots' masses matters (contact.h: how
+      // one pushes the other); the range spans any robot a student builds.
+      {"robot", "mass", Kind::Mass, {0.5, 500}, true, D(p.robot.mass_lb)},
+      {"bumper", "reflex_distance", Kind::Length, {0.05, 20}, true, D(p.robot.reflex_distance_ft)},
+      {"bumper", "reflex_speed_step", Kind::Step, {0, 15}, true, I(p.robot.reflex_speed_step)},
+      {"eyes", "max", Kind::Reading, {16, 65535}, true, D(p.robot.eye_max)},
+      {"eyes", "background", Kind::Reading, {0, 65535}, true, D(p.robot.eye_background)},
+      {"eyes", "saturation_distance", Kind::Length, {0.1, 50}, true, D(p.robot.eye_saturation_ft)},
+      {"eyes", "left_width", Kind::Length, {0.001, 1}, true, D(p.robot.left_eye_width)},
+      {"eyes", "right_width", Kind::Length, {0.001, 1}, true, D(p.robot.right_eye_width)},
+      {"eyes", "nose", Kind::Length, {0.001, 1}, true, D(p.robot.eye_nose)},
+      {"eyes", "noise_sigma", Kind::Reading, {0, 4096}, true, D(p.robot.noise_sigma)},
+      {"eyes",
+       "bad_reading_probability",
+       Kind::Probability,
+       {0, 1},
+       true,
+       D(p.robot.bad_reading_probability)},
+      {"eyes", "thesis_swapped_eyes", Kind::Bool, {0, 0}, true, B(p.robot.thesis_swapped_eyes)},
+      {"gun", "wheel_lag", Kind::Time, {0.001, 10, true}, true, D(p.robot.gun_wheel_lag_s)},
+      {"gun", "wheel_coast", Kind::Time, {0.001, 60, true}, true, D(p.robot.gun_wheel_coast_s)},
+      {"gun", "motors_always_on", Kind::Bool, {0, 0}, true, B(p.robot.gun_motors_always_on)},
+      {"gun", "stroke_time", Kind::Time, {0, 2}, true, D(p.robot.stroke_s)},
+      {"gun", "muzzle_speed", Kind::Speed, {1, 1000}, true, D(p.robot.muzzle_speed_fps)},
+      // Below 1, so every drawn speed is positive.
+      {"gun", "muzzle_speed_spread", Kind::Ratio, {0, 0.5}, true, D(p.robot.muzzle_speed_spread)},
+      {"gun", "launch_height", Kind::Length, {0.05, 10}, true, D(p.robot.launch_height_ft)},
+      {"gun", "balls_per_gun", Kind::Count, {0, kMaxBallsPerGun}, true, I(p.robot.balls_per_gun)},
+      {"gun", "jam_probability", Kind::Probability, {0, 1}, true, D(p.robot.jam_probability)},
+      {"gun",
+       "misfire_probability",
+       Kind::Probability,
+       {0, 1},
+       true,
+       D(p.robot.misfire_probability)},
+      {"controller", "random_memory", Kind::Bool, {0, 0}, true, B(p.robot.random_memory)},
+      {"controller",
+       "timer_service",
+       Kind::Choice,
+       {0, 0},
+       true,
+       [](Profile& p, Hardware&) {
+         Target t;
+         t.choice = &p.controller.timerService;
+         return t;
+       }},
+      {"controller", "fast_forward", Kind::Bool, {0, 0}, true, B(p.controller.fastForward)},
+      {"projectile", "gravity", Kind::Accel, {1, 1000}, false, D(p.field.gravity_fps2)},
+      {"projectile", "count_floor_skips", Kind::Bool, {0, 0}, false, B(p.field.count_floor_skips)},
+      {"referee",
+       "reflex_limit",
+       Kind::Count,
+       {0, kMaxRefereeLimit},
+       false,
+       I(p.referee.reflex_limit)},
+      {"referee",
+       "event_limit",
+       Kind::Count,
+       {0, kMaxRefereeLimit},
+       false,
+       I(p.referee.event_limit)},
+      {"referee", "window", Kind::Time, {0.1, 3600}, false, D(p.referee.window_s)},
+      {"referee", "putback", Kind::Length, {0, 10}, false, D(p.referee.putback_ft)},
+      {"referee", "turn", Kind::Angle, {-360, 360}, false, D(p.referee.turn_deg)},
+      {"match", "round_length", Kind::Time, {1, 1e6}, false, D(p.round_length_s)},
+      // At least the serial port's last two characters (2.1 ms): the port
+      // is reset at the reload (scheduler kMinReloadDelay).
+      {"match", "reload_delay", Kind::Time, {0.01, 3600}, false, D(p.reload_delay_s)},
+  };
+  return keys;
+}
+
+const std::vector<KeyDef>& portTable() {
+  static const std::vector<KeyDef> keys = {
+      {"ports", "gun1_motor", Kind::Bit, {0, 7}, true, I(h.gun_motor_bit[0])},
+      {"ports", "gun1_solenoid", Kind::Bit, {0, 7}, true, I(h.gun_solenoid_bit[0])},
+      {"ports", "gun2_motor", Kind::Bit, {0, 7}, true, I(h.gun_motor_bit[1])},
+      {"ports", "gun2_solenoid", Kind::Bit, {0, 7}, true, I(h.gun_solenoid_bit[1])},
+      {"ports", "disc_shooter", Kind::Bit, {0, 7}, true, I(h.disc_shooter_bit)},
+  };
+  return keys;
+}
+
+#undef D
+#undef I
+#undef B
+
+double unitFactor(Kind k, std::string_view u) {
+  switch (k) {
+    case Kind::Length:
+      if (u == "ft") return 1.0;
+      if (u == "in") return 1.0 / 12.0;
+      if (u == "m") return 1.0 / 0.3048;
+      if (u == "cm") return 1.0 / 30.48;
+      if (u == "mm") return 1.0 / 304.8;
+      break;
+    case Kind::Speed:
+    case Kind::SpeedTable:
+      if (u == "ft/s") return 1.0;
+      if (u == "in/s") return 1.0 / 12.0;
+      if (u == "m/s") return 1.0 / 0.3048;
+      break;
+    case Kind::Time:
+      if (u == "s") return 1.0;
+      if (u == "ms") return 1e-3;
+      break;
+    case Kind::Angle:
+      if (u == "deg") return 1.0;
+      if (u == "rad") return 180.0 / 3.14159265358979323846;
+      break;
+    case Kind::Accel:
+      if (u == "ft/s^2") return 1.0;
+      if (u == "m/s^2") return 1.0 / 0.3048;
+      break;
+    case Kind::Mass:
+      if (u == "lb") return 1.0;
+      if (u == "kg") return 1.0 / 0.45359237;
+      break;
+    case Kind::Ratio:
+    case Kind::Probability:
+      if (u == "1") return 1.0;
+      break;
+    case Kind::Reading:
+      if (u == "reading") return 1.0;
+      break;
+    case Kind::Count:
+      if (u == "count") return 1.0;
+      break;
+    case Kind::Step:
+      if (u == "step") return 1.0;
+      break;
+    case Kind::Bit:
+      if (u == "bit") return 1.0;
+      break;
+    case Kind::Bool:
+    case Kind::Choice:
+      break;
+  }
+  return std::nan("");
+}
+
+const char* allowedUnits(Kind k) {
+  switch (k) {
+    case Kind::Length:
+      return "ft, in, m, cm, mm";
+    case Kind::Speed:
+    case Kind::SpeedTable:
+      return "ft/s, in/s, m/s";
+    case Kind::Time:
+      return "s, ms";
+    case Kind::Angle:
+      return "deg, rad";
+    case Kind::Accel:
+      return "ft/s^2, m/s^2";
+    case Kind::Mass:
+      return "lb, kg";
+    case Kind::Ratio:
+    case Kind::Probability:
+      return "1";
+    case Kind::Reading:
+      return "reading";
+    case Kind::Count:
+      return "count";
+    case Kind::Step:
+      return "step";
+    case Kind::Bit:
+      return "bit";
+    case Kind::Bool:
+    case Kind::Choice:
+      return "(none)";
+  }
+  return "";
+}
+
+const char* internalUnit(Kind k) {
+  switch (k) {
+    case Kind::Length:
+      return "ft";
+    case Kind::Speed:
+    case Kind::SpeedTable:
+      return "ft/s";
+    case Kind::Time:
+      return "s";
+    case Kind::Angle:
+      return "deg";
+    case Kind::Accel:
+      return "ft/s^2";
+    case Kind::Mass:
+      return "lb";
+    default:
+      return allowedUnits(k);
+  }
+}
+
+// A TOML number as a double. toml++ gives no double for an integer it
+
+}  // namespace simbot::config::keys

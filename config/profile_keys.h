@@ -1,0 +1,87 @@
+// config/profile_keys.h -- inside config/: the table of every profile and
+// hardware-file key, and the units each kind of value accepts.
+//
+// One table lists every key once: its section, kind (which fixes the
+// accepted units and the range check), bounds, whether a hardware file may
+// override it per robot, and where it lands in a Profile or Hardware. The
+// loader (profile.cpp) walks a parsed document against it; this file only
+// describes the keys, so a key is added in one place.
+#pragma once
+
+#include <array>
+#include <functional>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "config/config.h"
+
+namespace simbot::config::keys {
+
+enum class Kind {
+  Length,       // ft, in, m, cm, mm
+  Speed,        // ft/s, in/s, m/s
+  Time,         // s, ms
+  Angle,        // deg, rad  (stored in degrees)
+  Accel,        // ft/s^2, m/s^2
+  Mass,         // lb, kg
+  Ratio,        // "1"
+  Probability,  // "1", in [0, 1]
+  Reading,      // "reading" (A/D reading units)
+  Count,        // "count", integer >= 0
+  Step,         // "step", integer 0..15
+  Bit,          // "bit", integer 0..7
+  Bool,         // no unit
+  Choice,       // no unit; one of the words in kChoices
+  SpeedTable,   // array of 16 speeds
+};
+
+// The physically sensible values of a key, in internal units (ft, s,
+// ft/s, ft/s^2, deg, readings, counts): wide enough for any real robot of
+// the kind, narrow enough that the integrator never meets a value that
+// breaks it. `orZero`: 0 is allowed too (an instant motor or gun wheel),
+// else the value must be at least `lo`.
+struct Bounds {
+  double lo, hi;
+  bool orZero = false;
+};
+
+// The words a Choice key accepts (only [controller] timer_service) and the
+// timer service each one means.
+inline constexpr std::array<std::pair<const char*, vm::TimerService>, 3> kChoices = {{
+    {"auto", vm::TimerService::Auto},
+    {"always", vm::TimerService::Always},
+    {"never", vm::TimerService::Never},
+}};
+
+// Where one key's value lands: exactly one pointer is set, by the kind.
+struct Target {
+  double* d = nullptr;
+  int* i = nullptr;
+  bool* b = nullptr;
+  vm::TimerService* choice = nullptr;
+  std::array<double, 16>* table = nullptr;
+};
+
+struct KeyDef {
+  const char* section;
+  const char* key;
+  Kind kind;
+  Bounds bounds;
+  bool perRobot;
+  std::function<Target(Profile&, plant::Hardware&)> target;
+};
+
+// Every profile key, in file order.
+const std::vector<KeyDef>& keyTable();
+// A hardware file's [ports] keys.
+const std::vector<KeyDef>& portTable();
+
+// Conversion factor to the internal unit, or NaN if the unit is not allowed.
+double unitFactor(Kind k, std::string_view u);
+// The units a kind accepts, for messages.
+const char* allowedUnits(Kind k);
+// The internal unit of a kind, for messages about its range.
+const char* internalUnit(Kind k);
+
+}  // namespace simbot::config::keys

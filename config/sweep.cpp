@@ -1,0 +1,219 @@
+// config/sweep.cpp -- sweep files (config.h loadSweep): the grid of bench
+// runs a sweep file describes, checked, and each grid point's profile (the
+// sweep's profile with the point's values written into its TOML). Running
+// the grid is tools/' job (tools/sweep.cpp).
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <sstream>
+
+#include "config/config.h"
+#include "config/text.h"
+
+namespace simbot::config {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// A profile or a profile key the sweep names that is not there: reported
+// as it is, not as a grid point's error.
+struct NotInTheSweep : ConfigError {
+  using ConfigError::ConfigError;
+};
+
+std::string dirOf(const std::string& file) {
+  const fs::path dir = fs::path(file).parent_path();
+  return dir.empty() ? "." : dir.string();
+}
+
+}  // namespace
+
+std::string sweepPath(const SweepSpec& spec, const std::string& path) {
+  if (path.empty() || fs::path(path).is_absolute()) return path;
+  return (fs::path(dirOf(spec.file)) / path).string();
+}
+
+namespace {
+
+std::string baseProfilePath(const SweepSpec& spec) {
+  const std::string asFile = sweepPath(spec, spec.profile);
+  std::error_code ec;
+  if (fs::is_regular_file(asFile, ec)) return asFile;
+  if (const auto shipped = shippedProfilePath(spec.profile)) return *shipped;
+  throw NotInTheSweep(fmt::format("simbot: {}: no profile '{}' (a file, or one of profiles/*.toml)",
+                                  spec.file, spec.profile));
+}
+
+std::string tomlText(const toml::node& node) {
+  std::ostringstream out;
+  node.visit([&out](const auto& n) { out << n; });
+  return out.str();
+}
+
+std::vector<std::string> stringArray(const SweepSpec& spec, const toml::table& doc, const char* key,
+                                     bool required) {
+  std::vector<std::string> out;
+  const toml::node* node = doc.get(key);
+  if (!node) {
+    if (required) failAt(spec.file, doc.source(), fmt::format("missing key '{}'", key));
+    return out;
+  }
+  const toml::array* array = node->as_array();
+  if (!array || array->empty())
+    failAt(spec.file, node->source(), fmt::format("'{}' must be a list of strings", key));
+  for (const toml::node& e : *array) {
+    const auto s = e.value<std::string>();
+    if (!s || !e.is_string())
+      failAt(spec.file, e.source(), fmt::format("'{}' must be a list of strings", key));
+    out.push_back(*s);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<size_t> sweepPointValues(const SweepSpec& spec, size_t point) {
+  std::vector<size_t> at(spec.grid.size());
+  for (size_t k = spec.grid.size(); k-- > 0;) {
+    at[k] = point % spec.grid[k].second.size();
+    point /= spec.grid[k].second.size();
+  }
+  return at;
+}
+
+size_t sweepPoints(const SweepSpec& spec) {
+  size_t n = 1;
+  for (const auto& [key, values] : spec.grid) n *= values.size();
+  return n;
+}
+
+Profile sweepProfile(const SweepSpec& spec, size_t point) {
+  const std::string base = baseProfilePath(spec);
+  toml::table doc;
+  try {
+    doc = toml::parse_file(base);
+  } catch (const toml::parse_error& e) {
+    // The profile's own checker words the error (FILE:LINE:COL).
+    return loadProfile(base);
+  }
+  const std::vector<size_t> at = sweepPointValues(spec, point);
+  for (size_t k = 0; k < spec.grid.size(); ++k) {
+    const std::string& key = spec.grid[k].first;
+    const auto dot = key.find('.');
+    toml::table* section = doc.get_as<toml::table>(key.substr(0, dot));
+    toml::node* entry = section ? section->get(key.substr(dot + 1)) : nullptr;
+    if (!entry)
+      throw NotInTheSweep(
+          fmt::format("simbot: {}: no profile key '{}' in {}", spec.file, key, base));
+    const toml::table value = toml::parse("v = " + spec.grid[k].second[at[k]]);
+    if (toml::table* described = entry->as_table())
+      described->insert_or_assign("value", *value.get("v"));
+    else
+      section->insert_or_assign(key.substr(dot + 1), *value.get("v"));
+  }
+  std::ostringstream text;
+  text << doc;
+  return parseProfile(text.str(), fmt::format("{} (grid point {} of {})", base, point, spec.file));
+}
+
+SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& families) {
+  SweepSpec spec;
+  spec.file = path;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw ConfigError(fmt::format("simbot: no sweep file '{}'", path));
+  toml::table doc;
+  try {
+    doc = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    failAt(path, e.source(), std::string(e.description()));
+  }
+  for (auto&& [key, node] : doc) {
+    static const std::vector<std::string> known = {"programs", "opponents", "families", "seeds",
+                                                   "seconds",  "profile",   "grid"};
+    if (std::find(known.begin(), known.end(), std::string(key.str())) == known.end())
+      failAt(
+          path, key.source(),
+          fmt::format("unknown key '{}' (programs, opponents, families, seeds, seconds, profile, "
+                      "grid)",
+                      key.str()));
+  }
+  spec.programs = stringArray(spec, doc, "programs", true);
+  spec.opponents = stringArray(spec, doc, "opponents", false);
+  spec.families = stringArray(spec, doc, "families", true);
+  for (const auto& f : spec.families)
+    if (std::find(families.begin(), families.end(), f) == families.end())
+      failAt(path, doc.get("families")->source(),
+             fmt::format("unknown family '{}' (stationary, circle, head-to-head, edge)", f));
+  const bool headToHead =
+      std::find(spec.families.begin(), spec.families.end(), "head-to-head") != spec.families.end();
+  if (headToHead && spec.opponents.empty())
+    failAt(path, doc.get("families")->source(), "the head-to-head family needs 'opponents'");
+  if (!headToHead && !spec.opponents.empty())
+    failAt(path, doc.get("opponents")->source(),
+           "'opponents' play only in the head-to-head family");
+  for (const auto* list : {&spec.programs, &spec.opponents})
+    for (const auto& p : *list)
+      if (!fs::is_regular_file(sweepPath(spec, p), ec))
+        throw ConfigError(fmt::format("simbot: {}: no such program '{}'", path, p));
+  if (const toml::node* s = doc.get("seconds")) {
+    const auto v = s->value<double>();
+    if (!v || !(*v > 0) || *v > 1e6)
+      failAt(path, s->source(), "'seconds' must be a number in (0, 1e6]");
+    spec.seconds = *v;
+  }
+  if (const toml::node* p = doc.get("profile")) {
+    if (!p->is_string()) failAt(path, p->source(), "'profile' is a string");
+    spec.profile = *p->value<std::string>();
+  }
+  const toml::table* seeds = doc.get_as<toml::table>("seeds");
+  if (!seeds) failAt(path, doc.source(), "missing table [seeds] (first, count)");
+  for (auto&& [key, node] : *seeds) {
+    const auto v = node.value<int64_t>();
+    const bool first = key.str() == "first";
+    if ((!first && key.str() != "count") || !node.is_integer() || *v < (first ? 0 : 1) ||
+        (!first && *v > 1'000'000))
+      failAt(path, node.source(),
+             "[seeds] holds first (an integer >= 0) and count (an integer from 1 to 1000000)");
+    (first ? spec.firstSeed : spec.seedCount) = static_cast<uint64_t>(*v);
+  }
+  if (const toml::node* g = doc.get("grid")) {
+    const toml::table* grid = g->as_table();
+    if (!grid) failAt(path, g->source(), "'grid' is a table");
+    for (auto&& [key, node] : *grid) {
+      const toml::array* values = node.as_array();
+      const std::string name(key.str());
+      if (name.find('.') == std::string::npos || !values || values->empty())
+        failAt(path, node.source(),
+               "a grid entry is \"section.key\" = [values...] (a key of the profile)");
+      std::vector<std::string> texts;
+      for (const toml::node& v : *values) texts.push_back(tomlText(v));
+      spec.grid.emplace_back(name, std::move(texts));
+    }
+    if (sweepPoints(spec) > 100'000)
+      failAt(path, g->source(), "the grid has more than 100000 points");
+    // Every point's profile now: a bad value is an error before any run.
+    for (size_t point = 0; point < sweepPoints(spec); ++point) {
+      try {
+        sweepProfile(spec, point);
+      } catch (const NotInTheSweep&) {
+        throw;
+      } catch (const ConfigError& e) {
+        // The profile checker's words, without its FILE:LINE:COL (the
+        // profile as rewritten for this point).
+        std::string what = e.what();
+        const auto at = what.find("error: ");
+        if (at != std::string::npos) what = what.substr(at + 7);
+        failAt(path, g->source(), fmt::format("grid point {}: {}", point, what));
+      }
+    }
+  } else {
+    sweepProfile(spec, 0);
+  }
+  return spec;
+}
+
+}  // namespace simbot::config

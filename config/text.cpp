@@ -1,0 +1,143 @@
+// config/text.cpp -- what every configuration loader shares: the error's
+// FILE:LINE:COL format, reading a file, and the check of TOML text that
+// keeps toml++ 3.3.0 away from input it mishandles (config.h).
+#include "config/text.h"
+
+#include <fmt/format.h>
+
+#include <cstdint>
+#include <cstdio>
+
+namespace simbot::config {
+
+ConfigError::ConfigError(const std::string& file, int line, int column, const std::string& message)
+    : std::runtime_error(fmt::format("{}:{}:{}: error: {}", file, line < 1 ? 1 : line,
+                                     column < 1 ? 1 : column, message)) {}
+
+std::string readFile(const std::string& path) {
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw ConfigError(path, 1, 1, "cannot open file");
+  std::string s;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) s.append(buf, n);
+  std::fclose(f);
+  return s;
+}
+
+void failAt(const std::string& file, const toml::source_region& where, const std::string& message) {
+  throw ConfigError(file, static_cast<int>(where.begin.line), static_cast<int>(where.begin.column),
+                    message);
+}
+
+toml::table parseToml(std::string_view text, const std::string& file) {
+  checkTomlText(text, file);
+  try {
+    return toml::parse(text, file);
+  } catch (const toml::parse_error& e) {
+    failAt(file, e.source(), std::string(e.description()));
+  }
+}
+
+void checkTomlText(std::string_view text, const std::string& sourceName) {
+  int line = 1, column = 1;
+  const auto fail = [&](const std::string& msg) {
+    throw ConfigError(sourceName, line, column, msg);
+  };
+  enum class In : std::uint8_t { Code, Comment, Basic, Literal, MultiBasic, MultiLiteral };
+  In in = In::Code;
+  bool escaped = false;  // the character after a backslash in a basic string
+  const auto at = [&](std::size_t i) { return i < text.size() ? text[i] : '\0'; };
+  const auto starts = [&](std::size_t i, std::string_view s) {
+    return text.substr(i, s.size()) == s;
+  };
+  for (std::size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    // A UTF-8 sequence: its length, checked strictly (no overlongs, no surrogates).
+    std::size_t len = 1;
+    if (c >= 0x80) {
+      unsigned lo = 0x80, hi = 0xBF;
+      if (c >= 0xC2 && c <= 0xDF) {
+        len = 2;
+      } else if (c >= 0xE0 && c <= 0xEF) {
+        len = 3;
+        if (c == 0xE0) lo = 0xA0;
+        if (c == 0xED) hi = 0x9F;
+      } else if (c >= 0xF0 && c <= 0xF4) {
+        len = 4;
+        if (c == 0xF0) lo = 0x90;
+        if (c == 0xF4) hi = 0x8F;
+      } else {
+        fail(fmt::format("the file is not valid UTF-8 (byte 0x{:02x})", c));
+      }
+      for (std::size_t k = 1; k < len; ++k) {
+        const auto b = static_cast<unsigned char>(at(i + k));
+        if (k == 1 ? (b < lo || b > hi) : (b & 0xC0) != 0x80)
+          fail(fmt::format("the file is not valid UTF-8 (byte 0x{:02x})", c));
+      }
+      if (in == In::Code)
+        fail("a non-ASCII character outside a string or comment (TOML allows none there)");
+    }
+    std::size_t next = i + len;
+    switch (in) {
+      case In::Code:
+        if (c == '#') in = In::Comment;
+        if (c == '"') in = starts(i, "\"\"\"") ? In::MultiBasic : In::Basic;
+        if (c == '\'') in = starts(i, "'''") ? In::MultiLiteral : In::Literal;
+        if (in == In::MultiBasic || in == In::MultiLiteral) next = i + 3;
+        break;
+      case In::Comment:
+        if (c == '\n') in = In::Code;
+        break;
+      case In::Basic:
+        if (escaped)
+          escaped = false;
+        else if (c == '\\')
+          escaped = true;
+        else if (c == '"' || c == '\n')
+          in = In::Code;
+        break;
+      case In::Literal:
+        if (c == '\'' || c == '\n') in = In::Code;
+        break;
+      case In::MultiBasic:
+        if (escaped) {
+          escaped = false;
+        } else if (c == '\\') {
+          // A line-ending backslash: what follows the blank space after it
+          // must be ASCII.
+          std::size_t k = i + 1;
+          while (at(k) == ' ' || at(k) == '\t') ++k;
+          if (at(k) == '\r' || at(k) == '\n') {
+            while (at(k) == ' ' || at(k) == '\t' || at(k) == '\r' || at(k) == '\n') ++k;
+            if (static_cast<unsigned char>(at(k)) >= 0x80)
+              fail(
+                  "a line-ending backslash in a multi-line string is followed by a non-ASCII "
+                  "character, which toml++ 3.3.0 cannot parse safely: put the character on "
+                  "the backslash's line");
+          }
+          escaped = true;
+        } else if (starts(i, "\"\"\"")) {
+          in = In::Code;
+          next = i + 3;
+        }
+        break;
+      case In::MultiLiteral:
+        if (starts(i, "'''")) {
+          in = In::Code;
+          next = i + 3;
+        }
+        break;
+    }
+    for (; i < next && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        column = 1;
+      } else if ((static_cast<unsigned char>(text[i]) & 0xC0) != 0x80) {
+        ++column;  // columns count characters, as toml++'s do
+      }
+    }
+  }
+}
+
+}  // namespace simbot::config
