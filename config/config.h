@@ -7,7 +7,7 @@
 // and robot parameters, the scheduler's injections, and each robot's VM
 // knobs (timer service, fast-forward). It includes their headers, never
 // the other way round (plant/, vm/ and scheduler/ do not include config/);
-// tools/ applies what it reads to a run. Durations in text are read by
+// runs/ and batch/ apply what it reads to a run. Durations in text are read by
 // timebase/tick.h's one parser (ticksFromDecimal), not here.
 //
 // Every error in a file is a ConfigError whose what() is "FILE:LINE:COL:
@@ -85,7 +85,7 @@ std::optional<std::string> shippedProfilePath(const std::string& name);
 // ---------------------------------------------------------------- scenarios
 // A scenario file (--scenario FILE.toml): the set-up of a run that is not
 // the programs themselves; docs/tools.md ("Scenarios") has the schema.
-// tools/ applies it to a run (tools/scenario.h).
+// runs/ applies it to a run (runs/scenario.h).
 
 // Where something is in the scenario file, for the errors found when the
 // run is set up.
@@ -138,8 +138,8 @@ Scenario parseScenario(std::string_view text, const std::string& sourceName,
 
 // ---------------------------------------------------------------- sweeps
 // A sweep file (simbot sweep): a grid of bench runs, programs x families x
-// opponents x profile values x seeds. tools/ expands and runs it
-// (tools/sweep.h).
+// opponents x profile values x seeds. batch/ expands and runs it
+// (batch/sweep.h).
 struct SweepSpec {
   std::string file;                   // the sweep file; relative paths in it are from its directory
   std::vector<std::string> programs;  // as written (the table's program column)

@@ -7,8 +7,8 @@
 // while loading, so that the error names the scenario's line; the files
 // they name (profiles, hardware files, programs) report their own errors.
 // Things that depend on the profile or the program (a start pose inside
-// the field, a line that has code) are checked when tools/ applies the
-// scenario to a run (tools/scenario.cpp), still naming the scenario's line.
+// the field, a line that has code) are checked when runs/ applies the
+// scenario to a run (runs/scenario.cpp), still naming the scenario's line.
 #include <fmt/format.h>
 #include <toml++/toml.h>
 

@@ -1,7 +1,7 @@
 // config/sweep.cpp -- sweep files (config.h loadSweep): the grid of bench
 // runs a sweep file describes, checked, and each grid point's profile (the
 // sweep's profile with the point's values written into its TOML). Running
-// the grid is tools/' job (tools/sweep.cpp).
+// the grid is batch/'s job (batch/sweep.cpp).
 #include <fmt/format.h>
 #include <toml++/toml.h>
 

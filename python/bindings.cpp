@@ -1,6 +1,6 @@
 // _simbot: the C++ side of the Python module `simbot` (python/simbot/).
-// Every entry point is the CLI's own code (tools/play.h for solo and match,
-// tools/bench.h, tools/sweep.h), so a result here is the CLI's result:
+// Every entry point is the CLI's own code (runs/play.h for solo and match,
+// batch/bench.h, batch/sweep.h), so a result here is the CLI's result:
 // simbot.match(A, B) is `simbot match A B --json`, parsed. JSON and CSV
 // cross as text and are parsed on the Python side. Runs release the GIL,
 // so Python threads (a Dask worker's) run them in parallel.
@@ -14,14 +14,14 @@
 #include <utility>
 #include <vector>
 
+#include "batch/bench.h"
+#include "batch/sweep.h"
 #include "compiler/compiler.h"
 #include "config/config.h"
-#include "tools/bench.h"
-#include "tools/json_text.h"
-#include "tools/play.h"
-#include "tools/runner.h"
-#include "tools/sweep.h"
-#include "tools/trace_jsonl.h"
+#include "runs/play.h"
+#include "sinks/json_text.h"
+#include "sinks/trace_jsonl.h"
+#include "sinks/user_error.h"
 #include "vm/vm.h"
 
 namespace py = pybind11;
@@ -50,7 +50,7 @@ py::dict compileProgram(const std::string& path, bool disasm) {
   return out;
 }
 
-// A run option from its Python keyword (tools/run_options.def): None
+// A run option from its Python keyword (runs/run_options.def): None
 // leaves it unset, as an option not given on the command line.
 template <class T>
 void setRunOption(T& member, py::handle value) {
@@ -69,11 +69,11 @@ constexpr const char* runOptionKind() {
 // The Python keywords of the run options and their kinds, in their order:
 // the package builds simbot.solo's and simbot.match's signatures from them.
 std::vector<std::pair<std::string, std::string>> runOptionKeywords() {
-  using enum tools::RunOptionUse;
+  using enum runs::RunOptionUse;
   std::vector<std::pair<std::string, std::string>> keywords;
 #define RUN_OPTION(member, Type, flag, keyword, where, help) \
-  if ((where)&tools::kPython) keywords.emplace_back(keyword, runOptionKind<Type>());
-#include "tools/run_options.def"
+  if ((where)&runs::kPython) keywords.emplace_back(keyword, runOptionKind<Type>());
+#include "runs/run_options.def"
 #undef RUN_OPTION
   return keywords;
 }
@@ -83,15 +83,15 @@ std::vector<std::pair<std::string, std::string>> runOptionKeywords() {
 // warnings.
 py::tuple playRun(const std::vector<std::string>& programs, bool keepTrace,
                   const py::kwargs& options) {
-  using enum tools::RunOptionUse;
-  tools::RunOptions o;
+  using enum runs::RunOptionUse;
+  runs::RunOptions o;
   size_t used = 0;
-#define RUN_OPTION(member, Type, flag, keyword, where, help)   \
-  if (((where)&tools::kPython) && options.contains(keyword)) { \
-    setRunOption(o.member, options[keyword]);                  \
-    ++used;                                                    \
+#define RUN_OPTION(member, Type, flag, keyword, where, help)  \
+  if (((where)&runs::kPython) && options.contains(keyword)) { \
+    setRunOption(o.member, options[keyword]);                 \
+    ++used;                                                   \
   }
-#include "tools/run_options.def"
+#include "runs/run_options.def"
 #undef RUN_OPTION
   if (used != options.size())
     for (const auto known = runOptionKeywords(); const auto& [key, value] : options) {
@@ -99,15 +99,15 @@ py::tuple playRun(const std::vector<std::string>& programs, bool keepTrace,
       if (std::none_of(known.begin(), known.end(), [&](const auto& k) { return k.first == name; }))
         throw py::type_error("unexpected keyword argument '" + name + "'");
     }
-  tools::JsonlLines lines;
+  sinks::JsonlLines lines;
   if (keepTrace) o.sinks.push_back(&lines);
   const bool solo = programs.size() == 1;
   std::string json;
   std::vector<std::string> warnings;
   {
     py::gil_scoped_release release;
-    const tools::Played played = tools::play(programs, o, solo);
-    json = tools::dumpJson(solo ? tools::soloJson(played) : tools::matchJson(played), 2);
+    const runs::Played played = runs::play(programs, o, solo);
+    json = sinks::dumpJson(solo ? runs::soloJson(played) : runs::matchJson(played), 2);
     warnings = played.result.warnings;
   }
   return py::make_tuple(json, lines.lines, warnings);
@@ -117,7 +117,7 @@ py::tuple benchRuns(const std::vector<std::string>& programs, const std::string&
                     double seconds, uint64_t seed, const std::string& profile,
                     const std::string& opponent, int threads) {
   py::gil_scoped_release release;
-  tools::BenchConfig c;
+  batch::BenchConfig c;
   c.programs = programs;
   c.family = family;
   c.seeds = seeds;
@@ -126,21 +126,21 @@ py::tuple benchRuns(const std::vector<std::string>& programs, const std::string&
   c.opponent = opponent;
   c.threads = threads;
   c.progress = false;
-  const config::Profile loaded = tools::loadNamedProfile(profile);
-  const tools::BenchResult r = tools::runBench(c, loaded);
+  const config::Profile loaded = runs::loadNamedProfile(profile);
+  const batch::BenchResult r = batch::runBench(c, loaded);
   py::gil_scoped_acquire acquire;
-  return py::make_tuple(tools::dumpJson(tools::summaryJson(r), 2), tools::runsCsv(r));
+  return py::make_tuple(sinks::dumpJson(batch::summaryJson(r), 2), batch::runsCsv(r));
 }
 
 struct Sweep {
-  tools::SweepSpec spec;
-  std::vector<tools::SweepRun> runs;
+  batch::SweepSpec spec;
+  std::vector<batch::SweepRun> runs;
   explicit Sweep(const std::string& path)
-      : spec(config::loadSweep(path, tools::benchFamilies())), runs(tools::expandSweep(spec)) {}
-  tools::CsvRow row(size_t index) const {
+      : spec(config::loadSweep(path, batch::benchFamilies())), runs(batch::expandSweep(spec)) {}
+  batch::CsvRow row(size_t index) const {
     if (index >= runs.size()) throw py::index_error("no run " + std::to_string(index));
     py::gil_scoped_release release;
-    return tools::runSweepRow(spec, runs[index]);
+    return batch::runSweepRow(spec, runs[index]);
   }
 };
 
@@ -152,7 +152,7 @@ PYBIND11_MODULE(_simbot, m) {
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
-    } catch (const tools::ToolError& e) {
+    } catch (const sinks::UserError& e) {
       error(withoutNewline(e.what()).c_str());
     } catch (const config::ConfigError& e) {
       error(withoutNewline(e.what()).c_str());
@@ -167,16 +167,16 @@ PYBIND11_MODULE(_simbot, m) {
   py::class_<Sweep>(m, "Sweep")
       .def(py::init<const std::string&>(), py::arg("path"))
       .def("__len__", [](const Sweep& s) { return s.runs.size(); })
-      .def("header", [](const Sweep& s) { return tools::sweepHeader(s.spec); })
+      .def("header", [](const Sweep& s) { return batch::sweepHeader(s.spec); })
       .def("row", &Sweep::row, py::arg("index"));
-  m.def("parse_shard", &tools::parseShard, py::arg("text"));
-  m.def("shard_range", &tools::shardRange, py::arg("runs"), py::arg("k"), py::arg("n"));
-  py::class_<tools::SweepWriter>(m, "SweepWriter")
-      .def(py::init<const std::string&, const tools::CsvRow&, bool, size_t, size_t, bool>(),
+  m.def("parse_shard", &batch::parseShard, py::arg("text"));
+  m.def("shard_range", &batch::shardRange, py::arg("runs"), py::arg("k"), py::arg("n"));
+  py::class_<batch::SweepWriter>(m, "SweepWriter")
+      .def(py::init<const std::string&, const batch::CsvRow&, bool, size_t, size_t, bool>(),
            py::arg("path"), py::arg("header"), py::arg("write_header"), py::arg("begin"),
            py::arg("end"), py::arg("resume"))
-      .def("next", &tools::SweepWriter::next)
-      .def("put", &tools::SweepWriter::put, py::arg("index"), py::arg("row"))
-      .def("pending", &tools::SweepWriter::pending)
-      .def("finish", &tools::SweepWriter::finish);
+      .def("next", &batch::SweepWriter::next)
+      .def("put", &batch::SweepWriter::put, py::arg("index"), py::arg("row"))
+      .def("pending", &batch::SweepWriter::pending)
+      .def("finish", &batch::SweepWriter::finish);
 }

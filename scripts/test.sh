@@ -17,7 +17,7 @@ phase() {
   mark=$SECONDS
 }
 mark=$SECONDS
-mapfile -t sources < <(find compiler vm board plant scheduler config trace tools tests bench fuzz \
+mapfile -t sources < <(find compiler vm board plant scheduler config trace sinks reports runs batch cli tests bench fuzz \
   -path tests/browser/node_modules -prune -o \( -name '*.cpp' -o -name '*.h' \) -print | sort)
 clang-format --dry-run --Werror "${sources[@]}"
 phase "set-up and layout check"
@@ -27,7 +27,7 @@ ctest --test-dir build --output-on-failure --parallel "$jobs" --timeout 900
 phase "normal tests"
 # The sanitizer builds keep line tables only (-g1): their reports still give
 # FILE:LINE, and compiling takes less time (ThreadSanitizer at -O1 -g1: 14 s
-# for tools/explain.cpp where -O2 -g takes 22).
+# for reports/explain.cpp where -O2 -g takes 22).
 ./scripts/build.sh build-asan -DSIMBOT_SANITIZE=ON -DSIMBOT_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=Debug \
   -DCMAKE_CXX_FLAGS_DEBUG=-g1 -DSIMBOT_WERROR=ON
 phase "sanitizer build"

@@ -1,18 +1,18 @@
 // simbot bench and tournament: statistics, determinism across thread counts.
-#include "tools/bench.h"
+#include "batch/bench.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
+#include "batch/bench_metrics.h"
+#include "batch/run_table.h"
+#include "batch/tournament.h"
 #include "config/config.h"
+#include "runs/play.h"
 #include "stats/stats.h"
 #include "support/traced.h"
-#include "tools/bench_metrics.h"
-#include "tools/run_table.h"
-#include "tools/runner.h"
-#include "tools/tournament.h"
 
 namespace {
 
@@ -26,17 +26,17 @@ using namespace simbot;
 // RFC 4180, section 2: records end in CRLF; a field holding a comma, a quote
 // or a line break is quoted, its quotes doubled.
 TEST(RunTable, RecordsFollowRfc4180) {
-  EXPECT_EQ(tools::csvRecord({"a,b", "say \"hi\"", "x"}), "\"a,b\",\"say \"\"hi\"\"\",x\r\n");
+  EXPECT_EQ(batch::csvRecord({"a,b", "say \"hi\"", "x"}), "\"a,b\",\"say \"\"hi\"\"\",x\r\n");
   // Two records, the second with a line break inside quotes, then a third
   // cut short by a kill (no line end): the third is not a record yet.
   const std::string text = "h1,h2\r\n\"two\r\nlines\",2\r\n3,3";
-  const auto records = tools::csvRecords(text);
+  const auto records = batch::csvRecords(text);
   ASSERT_EQ(records.size(), 2u);
   EXPECT_EQ(records[0], "h1,h2");
   EXPECT_EQ(records[1], "\"two\r\nlines\",2");
-  EXPECT_EQ(tools::parseCsvLine(records[1]), (tools::CsvRow{"two\r\nlines", "2"}));
+  EXPECT_EQ(batch::parseCsvLine(records[1]), (batch::CsvRow{"two\r\nlines", "2"}));
   // LF line ends (tables written before CRLF) still read.
-  EXPECT_EQ(tools::csvRecords("a\nb\n"), (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(batch::csvRecords("a\nb\n"), (std::vector<std::string>{"a", "b"}));
 }
 
 TEST(Stats, KaplanMeierByHand) {
@@ -109,7 +109,7 @@ const std::string kShared = SIMBOT_SHARED_DIR;
 const std::string kSource = SIMBOT_SOURCE_DIR;
 
 std::string benchJson(const std::string& family, int threads) {
-  tools::BenchConfig c;
+  batch::BenchConfig c;
   c.programs = {kShared + "/programs/iceman.dc"};
   c.family = family;
   c.seeds = 4;
@@ -117,9 +117,9 @@ std::string benchJson(const std::string& family, int threads) {
   c.threads = threads;
   c.progress = false;
   if (family == "head-to-head") c.opponent = kShared + "/programs/fig92.dc";
-  const auto profile = tools::loadNamedProfile(kSource + "/profiles/default.toml");
-  const auto r = tools::runBench(c, profile);
-  return tools::summaryJson(r).dump(2) + tools::runsCsv(r);
+  const auto profile = runs::loadNamedProfile(kSource + "/profiles/default.toml");
+  const auto r = batch::runBench(c, profile);
+  return batch::summaryJson(r).dump(2) + batch::runsCsv(r);
 }
 
 TEST(Bench, SameSummaryWhateverTheThreadCount) {
@@ -136,15 +136,15 @@ TEST(Bench, CircleAndHeadToHeadFamiliesRun) {
 }
 
 TEST(Bench, HeadToHeadPutsTheRobotsDownByHand) {
-  tools::BenchConfig c;
+  batch::BenchConfig c;
   c.programs = {kShared + "/programs/iceman.dc"};
   c.family = "head-to-head";
   c.opponent = kShared + "/programs/fig92.dc";
   c.seeds = 6;
   c.seconds = 0.5;
   c.progress = false;
-  const auto profile = tools::loadNamedProfile(kSource + "/profiles/default.toml");
-  const auto r = tools::runBench(c, profile);
+  const auto profile = runs::loadNamedProfile(kSource + "/profiles/default.toml");
+  const auto r = batch::runBench(c, profile);
   const plant::Pose mark = profile.field.start[0];
   for (size_t i = 0; i < r.runs.size(); ++i) {
     const plant::Pose& p = r.runs[i].startA;
@@ -161,27 +161,27 @@ TEST(Bench, HeadToHeadPutsTheRobotsDownByHand) {
 // Head-to-head measures both robots and counts the games each won: the
 // summary's wins are the runs' winners.
 TEST(Bench, HeadToHeadReportsBothRobotsAndTheWinRate) {
-  tools::BenchConfig c;
+  batch::BenchConfig c;
   c.programs = {kShared + "/programs/iceman.dc"};
   c.family = "head-to-head";
   c.opponent = kShared + "/programs/fig92.dc";
   c.seeds = 4;
   c.seconds = 5;
   c.progress = false;
-  const auto r = tools::runBench(c, tools::loadNamedProfile(kSource + "/profiles/default.toml"));
+  const auto r = batch::runBench(c, runs::loadNamedProfile(kSource + "/profiles/default.toml"));
   int winsA = 0;
   for (const auto& run : r.runs) {
     ASSERT_TRUE(run.metricsB);
     ASSERT_TRUE(run.winner == "A" || run.winner == "B");
     winsA += run.winner == "A";
   }
-  const auto s = tools::summarize(r);
+  const auto s = batch::summarize(r);
   ASSERT_EQ(s[0].robots.size(), 2u);
   EXPECT_EQ(s[0].robots[1].program, c.opponent);
   EXPECT_EQ(s[0].games, 4);
   EXPECT_EQ(s[0].winsA, winsA);
   EXPECT_NEAR(*s[0].winRate, winsA / 4.0, 1e-15);
-  const auto json = tools::summaryJson(r);
+  const auto json = batch::summaryJson(r);
   EXPECT_EQ(json["programs"][0]["games"]["won_by_a"], winsA);
   EXPECT_EQ(json["programs"][0]["robots"][1]["robot"], "B");
 }
@@ -189,17 +189,17 @@ TEST(Bench, HeadToHeadReportsBothRobotsAndTheWinRate) {
 // The thresholds are options: no pair of eye readings sums to a million,
 // so with that as the aim sum every run is censored for aim_s.
 TEST(Bench, AimThresholdIsAnOption) {
-  tools::BenchConfig c;
+  batch::BenchConfig c;
   c.programs = {kShared + "/programs/iceman.dc"};
   c.family = "stationary";
   c.seeds = 3;
   c.seconds = 10;
   c.progress = false;
-  const auto profile = tools::loadNamedProfile(kSource + "/profiles/default.toml");
+  const auto profile = runs::loadNamedProfile(kSource + "/profiles/default.toml");
   c.thresholds.aimMinSum = 1'000'000;
-  const auto r = tools::runBench(c, profile);
+  const auto r = batch::runBench(c, profile);
   for (const auto& run : r.runs) EXPECT_FALSE(run.metrics.values[1]) << "aim_s";
-  const auto aim = tools::summarize(r)[0].robots[0].metrics[1];
+  const auto aim = batch::summarize(r)[0].robots[0].metrics[1];
   EXPECT_EQ(aim.metric, "aim_s");
   EXPECT_EQ(aim.events, 0);
   EXPECT_EQ(aim.n, 3);
@@ -207,12 +207,12 @@ TEST(Bench, AimThresholdIsAnOption) {
 
 TEST(Bench, ObserverDoesNotChangeTheMatch) {
   scheduler::MatchConfig c;
-  c.arena = config::makeArenaConfig(tools::loadNamedProfile(kSource + "/profiles/default.toml"), 2);
-  c.robots.push_back({"A", "iceman", tools::compileProgramFile(kShared + "/programs/iceman.dc")});
-  c.robots.push_back({"B", "fig92", tools::compileProgramFile(kShared + "/programs/fig92.dc")});
+  c.arena = config::makeArenaConfig(runs::loadNamedProfile(kSource + "/profiles/default.toml"), 2);
+  c.robots.push_back({"A", "iceman", runs::compileProgramFile(kShared + "/programs/iceman.dc")});
+  c.robots.push_back({"B", "fig92", runs::compileProgramFile(kShared + "/programs/fig92.dc")});
   c.endTick = 10 * scheduler::kTicksPerSecond;
   const auto plain = testkit::runTraced(c);
-  tools::MetricsObserver observer;
+  batch::MetricsObserver observer;
   c.observer = &observer;
   const auto watched = testkit::runTraced(c);
   EXPECT_EQ(plain.trace, watched.trace);
@@ -221,21 +221,21 @@ TEST(Bench, ObserverDoesNotChangeTheMatch) {
 }
 
 TEST(Tournament, SameStandingsOnRerunAndThreadCounts) {
-  tools::TournamentConfig c;
+  batch::TournamentConfig c;
   c.programs = {kSource + "/programs/spiral.dc", kSource + "/programs/turret.dc",
                 kShared + "/programs/fig92.dc"};
   c.rounds = 1;
   c.seconds = 20;
   c.progress = false;
-  const auto profile = tools::loadNamedProfile(kSource + "/profiles/default.toml");
+  const auto profile = runs::loadNamedProfile(kSource + "/profiles/default.toml");
   c.threads = 1;
-  const std::string first = tools::tournamentJson(tools::runTournament(c, profile)).dump();
-  EXPECT_EQ(first, tools::tournamentJson(tools::runTournament(c, profile)).dump());
+  const std::string first = batch::tournamentJson(batch::runTournament(c, profile)).dump();
+  EXPECT_EQ(first, batch::tournamentJson(batch::runTournament(c, profile)).dump());
   c.threads = 2;
-  EXPECT_EQ(first, tools::tournamentJson(tools::runTournament(c, profile)).dump());
+  EXPECT_EQ(first, batch::tournamentJson(batch::runTournament(c, profile)).dump());
   c.threads = 3;
-  const auto r = tools::runTournament(c, profile);
-  EXPECT_EQ(first, tools::tournamentJson(r).dump());
+  const auto r = batch::runTournament(c, profile);
+  EXPECT_EQ(first, batch::tournamentJson(r).dump());
   ASSERT_EQ(r.games.size(), 3u);
   int wins = 0;
   for (const auto& s : r.standings) {
@@ -247,13 +247,13 @@ TEST(Tournament, SameStandingsOnRerunAndThreadCounts) {
 }
 
 TEST(Tournament, SidesSwapEachRound) {
-  tools::TournamentConfig c;
+  batch::TournamentConfig c;
   c.programs = {kSource + "/programs/spiral.dc", kSource + "/programs/turret.dc"};
   c.rounds = 2;
   c.seconds = 2;
   c.progress = false;
   const auto r =
-      tools::runTournament(c, tools::loadNamedProfile(kSource + "/profiles/default.toml"));
+      batch::runTournament(c, runs::loadNamedProfile(kSource + "/profiles/default.toml"));
   ASSERT_EQ(r.games.size(), 2u);
   EXPECT_EQ(r.games[0].a, 0);
   EXPECT_EQ(r.games[1].a, 1);

@@ -1,6 +1,6 @@
-// simbot explain (tools/explain.h), checked against the raw trace records
+// simbot explain (reports/explain.h), checked against the raw trace records
 // with the geometry computed here, independently of the report's code.
-#include "tools/explain.h"
+#include "reports/explain.h"
 
 #include <gtest/gtest.h>
 
@@ -11,15 +11,16 @@
 
 #include "config/config.h"
 #include "plant/plant.h"
+#include "runs/play.h"
 #include "scheduler/match.h"
+#include "sinks/trace_jsonl.h"
+#include "sinks/user_error.h"
 #include "support/records.h"
 #include "support/test_host.h"
-#include "tools/runner.h"
-#include "tools/trace_jsonl.h"
 
 using namespace simbot;
 namespace rec = trace::rec;
-namespace ex = tools::explain;
+namespace ex = reports::explain;
 
 namespace {
 
@@ -35,7 +36,7 @@ scheduler::MatchConfig config(const std::vector<std::string>& programs, double s
   c.profileName = profile;
   const char* names[] = {"A", "B"};
   for (size_t i = 0; i < programs.size(); ++i)
-    c.robots.push_back({names[i], programs[i], tools::compileProgramFile(programs[i])});
+    c.robots.push_back({names[i], programs[i], runs::compileProgramFile(programs[i])});
   c.endTick = timebase::ticksFromSeconds(seconds);
   c.seed = 1;
   return c;
@@ -262,7 +263,7 @@ TEST(Explain, FromTheJsonlFile) {
   const Traced& r = icemanVsFig92();
   const std::string path = ::testing::TempDir() + "explain_test.jsonl";
   {
-    tools::JsonlSink sink(path);
+    sinks::JsonlSink sink(path);
     for (const auto& e : r.entries) sink.write(e);
     sink.close();
   }
@@ -275,12 +276,12 @@ TEST(Explain, FromTheJsonlFile) {
   const std::string bad = ::testing::TempDir() + "explain_bad.jsonl";
   {
     std::ofstream out(bad);
-    out << tools::traceLine(r.entries[0]) << "\n{\"type\": \"sample\"\n";
+    out << sinks::traceLine(r.entries[0]) << "\n{\"type\": \"sample\"\n";
   }
   try {
     ex::explainFile(bad);
     FAIL() << "a malformed trace must be an error";
-  } catch (const tools::ToolError& e) {
+  } catch (const sinks::UserError& e) {
     EXPECT_EQ(std::string(e.what()).rfind(bad + ":2: error: ", 0), 0u) << e.what();
   }
   std::remove(path.c_str());

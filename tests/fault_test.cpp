@@ -8,14 +8,14 @@
 #include <string>
 #include <vector>
 
+#include "batch/bench.h"
+#include "batch/tournament.h"
 #include "config/config.h"
 #include "plant/plant.h"
+#include "runs/play.h"
 #include "scheduler/match.h"
 #include "support/test_host.h"
 #include "support/traced.h"
-#include "tools/bench.h"
-#include "tools/runner.h"
-#include "tools/tournament.h"
 
 using namespace simbot;
 using nlohmann::json;
@@ -35,7 +35,7 @@ config::Profile defaultProfile() {
 scheduler::MatchConfig soloConfig(scheduler::Tick end) {
   scheduler::MatchConfig c;
   c.arena = config::makeArenaConfig(defaultProfile(), 1);
-  c.robots.push_back({"A", kFaulting, tools::compileProgramFile(kFaulting)});
+  c.robots.push_back({"A", kFaulting, runs::compileProgramFile(kFaulting)});
   c.endTick = end;
   return c;
 }
@@ -146,8 +146,8 @@ TEST(Fault, ReloadDelayMustCoverTheSerialPort) {
 TEST(Fault, InAMatchTheOtherRobotPlaysOnAndTheFaultedOneLosesATie) {
   scheduler::MatchConfig c;
   c.arena = config::makeArenaConfig(defaultProfile(), 2);
-  c.robots.push_back({"A", kFaulting, tools::compileProgramFile(kFaulting)});
-  c.robots.push_back({"B", kTurret, tools::compileProgramFile(kTurret)});
+  c.robots.push_back({"A", kFaulting, runs::compileProgramFile(kFaulting)});
+  c.robots.push_back({"B", kTurret, runs::compileProgramFile(kTurret)});
   c.endTick = 30 * kSecond;
   c.reloadOnFault = true;
   c.reloadDelay = 20 * kSecond;
@@ -163,16 +163,16 @@ TEST(Fault, InAMatchTheOtherRobotPlaysOnAndTheFaultedOneLosesATie) {
 }
 
 TEST(Fault, TournamentRecordsFaultsAndReloadsPerGame) {
-  tools::TournamentConfig c;
+  batch::TournamentConfig c;
   c.programs = {kFaulting, kTurret};
   c.rounds = 2;
   c.seconds = 25;
   c.threads = 2;
   c.progress = false;
   c.reloadOnFault = true;
-  const auto r = tools::runTournament(c, defaultProfile());
+  const auto r = batch::runTournament(c, defaultProfile());
   ASSERT_EQ(r.games.size(), 2u);
-  const json j = tools::tournamentJson(r);
+  const json j = batch::tournamentJson(r);
   EXPECT_EQ(j.at("reload_on_fault"), true);
   for (const auto& game : j.at("games")) {
     // The faulting program is A in round 0 and B in round 1; it faults at
@@ -187,19 +187,19 @@ TEST(Fault, TournamentRecordsFaultsAndReloadsPerGame) {
   }
   for (const auto& s : j.at("standings"))
     EXPECT_EQ(s.at("faulted"), s.at("program") == kFaulting ? 2 : 0);
-  EXPECT_NE(tools::tournamentFaults(r).find("which no #INT_VEC binds"), std::string::npos);
+  EXPECT_NE(batch::tournamentFaults(r).find("which no #INT_VEC binds"), std::string::npos);
 }
 
 TEST(Fault, BenchHasAFaultColumnAndCountsFaultsPerProgram) {
-  tools::BenchConfig c;
+  batch::BenchConfig c;
   c.programs = {kFaulting};
   c.family = "stationary";
   c.seeds = 2;
   c.seconds = 20;
   c.threads = 2;
   c.progress = false;
-  const auto r = tools::runBench(c, defaultProfile());
-  const std::string csv = tools::runsCsv(r);
+  const auto r = batch::runBench(c, defaultProfile());
+  const std::string csv = batch::runsCsv(r);
   const auto header = csv.substr(0, csv.find('\n'));
   EXPECT_NE(header.find(",outcome,fault,"), std::string::npos);
   for (const auto& run : r.runs) {
@@ -208,7 +208,7 @@ TEST(Fault, BenchHasAFaultColumnAndCountsFaultsPerProgram) {
     EXPECT_NE(run.fault.find("which no #INT_VEC binds"), std::string::npos);
     EXPECT_NE(csv.find(run.fault), std::string::npos);
   }
-  const json s = tools::summaryJson(r);
+  const json s = batch::summaryJson(r);
   EXPECT_EQ(s.at("programs")[0].at("runs_faulted"), 2);
 }
 

@@ -1,6 +1,6 @@
 // Scenario files: every key checked with FILE:LINE:COL: error: messages, and
 // what a scenario does to a run (poses, a beacon on its path, injections).
-#include "tools/scenario.h"
+#include "runs/scenario.h"
 
 #include <gtest/gtest.h>
 
@@ -8,11 +8,11 @@
 #include <numbers>
 #include <string>
 
+#include "batch/bench.h"
 #include "config/config.h"
+#include "runs/play.h"
 #include "scheduler/match.h"
 #include "support/traced.h"
-#include "tools/bench.h"
-#include "tools/runner.h"
 
 namespace {
 
@@ -169,21 +169,21 @@ TEST(Scenario, EveryMistakeNamesItsLine) {
 scheduler::MatchConfig soloConfig(const std::string& program, const config::Profile& profile) {
   scheduler::MatchConfig c;
   c.arena = config::makeArenaConfig(profile, 1);
-  c.robots.push_back({"A", program, tools::compileProgramFile(program)});
+  c.robots.push_back({"A", program, runs::compileProgramFile(program)});
   return c;
 }
 
-config::Profile defaults() { return tools::loadNamedProfile("default"); }
+config::Profile defaults() { return runs::loadNamedProfile("default"); }
 
-std::string applyError(const std::string& text, tools::ScenarioUse use, int programs = 1) {
+std::string applyError(const std::string& text, runs::ScenarioUse use, int programs = 1) {
   const auto profile = defaults();
   auto c = soloConfig(kSource + "/programs/spiral.dc", profile);
   if (programs == 2) {
     c.arena = config::makeArenaConfig(profile, 2);
-    c.robots.push_back({"B", "turret", tools::compileProgramFile(kSource + "/programs/turret.dc")});
+    c.robots.push_back({"B", "turret", runs::compileProgramFile(kSource + "/programs/turret.dc")});
   }
   try {
-    tools::applyScenario(parse(text), use, profile, c);
+    runs::applyScenario(parse(text), use, profile, c);
   } catch (const config::ConfigError& e) {
     return e.what();
   }
@@ -191,35 +191,34 @@ std::string applyError(const std::string& text, tools::ScenarioUse use, int prog
 }
 
 TEST(Scenario, WhatDoesNotFitTheRunNamesItsLine) {
-  EXPECT_EQ(applyError("\n[B]\nbeacon = true\n", tools::ScenarioUse::Match, 2),
+  EXPECT_EQ(applyError("\n[B]\nbeacon = true\n", runs::ScenarioUse::Match, 2),
             "s.toml:3:10: error: match takes B's program from the command line; B.program and "
             "B.beacon are for solo, profile and bench");
-  EXPECT_EQ(applyError("[B]\nstart = { x_ft = 0, y_ft = 0, heading_deg = 0 }\n",
-                       tools::ScenarioUse::Solo),
-            "s.toml:1:1: error: [B] sets up a robot B but names none: give B.program or B.beacon "
-            "= true");
-  EXPECT_EQ(applyError("[A]\nstart = { x_ft = 9, y_ft = 0, heading_deg = 0 }\n",
-                       tools::ScenarioUse::Solo),
-            "s.toml:2:9: error: start (9, 0) ft puts the body outside the 16-ft field");
+  EXPECT_EQ(
+      applyError("[B]\nstart = { x_ft = 0, y_ft = 0, heading_deg = 0 }\n", runs::ScenarioUse::Solo),
+      "s.toml:1:1: error: [B] sets up a robot B but names none: give B.program or B.beacon "
+      "= true");
+  EXPECT_EQ(
+      applyError("[A]\nstart = { x_ft = 9, y_ft = 0, heading_deg = 0 }\n", runs::ScenarioUse::Solo),
+      "s.toml:2:9: error: start (9, 0) ft puts the body outside the 16-ft field");
   EXPECT_EQ(applyError("[A]\nstart = { x_ft = 0.2, y_ft = -6, heading_deg = 0 }\n",
-                       tools::ScenarioUse::Solo),
+                       runs::ScenarioUse::Solo),
             "s.toml:2:9: error: start (0.2, -6) ft puts the body on the divider");
   EXPECT_EQ(applyError("[A]\nstart = { x_ft = 1, y_ft = 1, heading_deg = 0 }\n[B]\nstart = "
                        "{ x_ft = 1.5, y_ft = 1, heading_deg = 0 }\n",
-                       tools::ScenarioUse::Match, 2),
+                       runs::ScenarioUse::Match, 2),
             "s.toml:4:9: error: the two robots' start poses overlap");
-  EXPECT_EQ(applyError("[A]\ninject = [\"edge_fore@line:1#1\"]\n", tools::ScenarioUse::Solo),
+  EXPECT_EQ(applyError("[A]\ninject = [\"edge_fore@line:1#1\"]\n", runs::ScenarioUse::Solo),
             "s.toml:2:11: error: line 1 of " + kSource + "/programs/spiral.dc has no code");
   EXPECT_EQ(applyError("[A]\nstart = { x_ft = 1, y_ft = 0, heading_deg = 0 }\n",
-                       tools::ScenarioUse::Bench),
+                       runs::ScenarioUse::Bench),
             "s.toml:2:9: error: a bench family places the robots and picks B; leave out --family "
             "to run this scenario's own poses and opponent");
-  EXPECT_EQ(
-      applyError("[B]\nbeacon = true\npath = [{ wait_s = 1e-9 }]\n", tools::ScenarioUse::Solo),
-      "s.toml:3:9: error: this leg lasts 1e-09 s, which is not between one tick and 1e8 s");
+  EXPECT_EQ(applyError("[B]\nbeacon = true\npath = [{ wait_s = 1e-9 }]\n", runs::ScenarioUse::Solo),
+            "s.toml:3:9: error: this leg lasts 1e-09 s, which is not between one tick and 1e8 s");
   // The same B set-up is fine for a match when it names no program.
   EXPECT_EQ(applyError("[B]\nstart = { x_ft = 0, y_ft = 3, heading_deg = 0 }\n",
-                       tools::ScenarioUse::Match, 2),
+                       runs::ScenarioUse::Match, 2),
             "");
 }
 
@@ -227,17 +226,17 @@ TEST(Scenario, WhatDoesNotFitTheRunNamesItsLine) {
 // ends with are the path's closed form, legs starting at exact ticks. Under
 // thesis-1997: the default's hand placement would move the start.
 TEST(Scenario, BeaconFollowsItsPathInAMatch) {
-  const auto profile = tools::loadNamedProfile("thesis-1997");
+  const auto profile = runs::loadNamedProfile("thesis-1997");
   auto c = soloConfig(kSource + "/programs/spiral.dc", profile);
-  c.robots[0].image = tools::compileProgramText("main()\n{\n}\n", "still");  // out of the way
-  tools::applyScenario(parse(R"([B]
+  c.robots[0].image = runs::compileProgramText("main()\n{\n}\n", "still");  // out of the way
+  runs::applyScenario(parse(R"([B]
 beacon = true
 start = { x_ft = 0, y_ft = 3, heading_deg = 90 }
 path = [ { arc_radius_ft = 3, turn_deg = 90, speed_fps = 0.5 },
          { forward_ft = -2, speed_fps = 0.25 },
          { spin_deg = -90, speed_fps = 0.2 } ]
 )"),
-                       tools::ScenarioUse::Solo, profile, c);
+                      runs::ScenarioUse::Solo, profile, c);
   ASSERT_EQ(c.robots.size(), 2u);
   ASSERT_EQ(c.robots[1].path.size(), 3u);
   const double quarter = 3 * std::numbers::pi / 2 / 0.5;  // seconds
@@ -259,7 +258,7 @@ path = [ { arc_radius_ft = 3, turn_deg = 90, speed_fps = 0.5 },
 }
 
 TEST(Scenario, BenchRunsItsOwnScenarioWhateverTheThreadCount) {
-  tools::BenchConfig c;
+  batch::BenchConfig c;
   c.programs = {kShared + "/programs/iceman.dc"};
   c.scenario = config::loadScenario(kSource + "/scenarios/circle.toml");
   c.seeds = 3;
@@ -268,11 +267,11 @@ TEST(Scenario, BenchRunsItsOwnScenarioWhateverTheThreadCount) {
   auto profile = defaults();
   profile.robot.noise_sigma = 3;  // the seeds differ only in the noise
   c.threads = 1;
-  const auto one = tools::runBench(c, profile);
+  const auto one = batch::runBench(c, profile);
   c.threads = 2;
-  const auto two = tools::runBench(c, profile);
-  EXPECT_EQ(tools::runsCsv(one), tools::runsCsv(two));
-  EXPECT_EQ(tools::summaryJson(one)["family"], "scenario circle");
+  const auto two = batch::runBench(c, profile);
+  EXPECT_EQ(batch::runsCsv(one), batch::runsCsv(two));
+  EXPECT_EQ(batch::summaryJson(one)["family"], "scenario circle");
   for (const auto& run : one.runs) EXPECT_EQ(run.startA.x_ft, -5.0);
 }
 

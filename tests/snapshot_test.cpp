@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "runs/play.h"
 #include "scheduler/match.h"
-#include "tools/play.h"
-#include "tools/trace_jsonl.h"
+#include "sinks/trace_jsonl.h"
 
 using namespace simbot;
 
@@ -27,12 +27,12 @@ const std::string kSource = SIMBOT_SOURCE_DIR;
 
 scheduler::MatchConfig configFor(const std::vector<std::string>& programs, double seconds,
                                  bool reload) {
-  tools::RunOptions o;
+  runs::RunOptions o;
   o.seconds = seconds;
   o.profile = "default";
   o.seed = 3;
   o.reloadOnFault = reload;
-  return tools::buildConfig(programs, o, tools::ScenarioUse::Match);
+  return runs::buildConfig(programs, o, runs::ScenarioUse::Match);
 }
 
 // What a result says, without the host's wall times.
@@ -48,14 +48,14 @@ std::string summary(const scheduler::MatchResult& r) {
 
 void expectSnapshotsContinue(const std::vector<std::string>& programs, double seconds, bool reload,
                              const std::vector<double>& at) {
-  tools::JsonlLines whole;
+  sinks::JsonlLines whole;
   scheduler::MatchConfig plain = configFor(programs, seconds, reload);
   plain.sinks = {&whole};
   const scheduler::MatchResult uninterrupted = scheduler::runMatch(plain);
 
   for (const double t : at) {
     SCOPED_TRACE("snapshot at " + std::to_string(t) + " s");
-    tools::JsonlLines lines;
+    sinks::JsonlLines lines;
     scheduler::MatchConfig c = configFor(programs, seconds, reload);
     c.snapshots = true;
     c.sinks = {&lines};

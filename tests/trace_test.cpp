@@ -12,9 +12,9 @@
 #include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
+#include "sinks/trace_jsonl.h"
 #include "support/records.h"
 #include "support/test_host.h"
-#include "tools/trace_jsonl.h"
 
 using namespace simbot;
 
@@ -299,8 +299,8 @@ TEST(Trace, RecordsAreInTickOrderAndReadBack) {
   for (size_t i = 1; i < t.entries.size(); ++i) ASSERT_LE(t.entries[i - 1].t, t.entries[i].t) << i;
   bool watched = false;
   for (const auto& e : t.entries) {
-    const nlohmann::json j = tools::traceJson(e);
-    EXPECT_EQ(tools::traceJson(tools::traceEntry(j)), j);
+    const nlohmann::json j = sinks::traceJson(e);
+    EXPECT_EQ(sinks::traceJson(sinks::traceEntry(j)), j);
     watched = watched || (trace::robotOf(e.record) == 0 && j.contains("watch"));
   }
   EXPECT_TRUE(watched);  // ICEMAN has a global `count`
@@ -308,13 +308,13 @@ TEST(Trace, RecordsAreInTickOrderAndReadBack) {
 
 TEST(Trace, BytesReadBackExactly) {
   trace::Entry e{7, rec::Console{0, std::string("\xff\x01 ok\x80", 6)}, {}};
-  const std::string line = tools::traceLine(e);
+  const std::string line = sinks::traceLine(e);
   EXPECT_NE(line.find("\"text\":\"\xc3\xbf\\u0001 ok\xc2\x80\""), std::string::npos) << line;
-  const trace::Entry back = tools::traceEntry(nlohmann::json::parse(line));
+  const trace::Entry back = sinks::traceEntry(nlohmann::json::parse(line));
   EXPECT_EQ(std::get<rec::Console>(back.record).text, std::string("\xff\x01 ok\x80", 6));
   // A file name that is not UTF-8 is written as Latin-1 instead of failing.
   trace::Entry f{0, rec::Fault{0, std::string("bad \xff name"), 3}, {}};
-  EXPECT_NO_THROW(tools::traceLine(f));
+  EXPECT_NO_THROW(sinks::traceLine(f));
 }
 
 // The manual lists the record kinds as trace/records.def defines them.

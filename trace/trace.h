@@ -5,7 +5,7 @@
 // this header turns that list into one struct per kind (namespace rec), the
 // Record variant, and a table of names and fields that sinks and readers
 // walk. The scheduler emits records through a Tracer; sinks (JSONL, the
-// replay viewer, VCD: tools/) receive them. With no sink attached nothing
+// replay viewer, VCD: sinks/, reports/) receive them. With no sink attached nothing
 // is built: emitters test `tracer.on()` first.
 //
 // Order. A record is emitted when the simulation learns of it, which is not

@@ -35,7 +35,7 @@ def read_trace(path):
         return trace_frame([line for line in f if line.strip()])
 
 
-# The run options, as tools/run_options.def defines them for the command
+# The run options, as runs/run_options.def defines them for the command
 # line too: [(keyword, kind)], kind "value" (None: not given), "list" or
 # "flag". solo's and match's signatures are made from them.
 _RUN_OPTIONS = _simbot.run_options()

@@ -1,7 +1,7 @@
 """simbot sweep on a Dask cluster: python3 -m simbot.sweep SWEEP.toml --dask ADDRESS.
 
 `simbot sweep --dask ...` runs this. The sweep file is expanded by the C++
-code (tools/sweep.h) and each run's row is computed by it on a worker, so a
+code (batch/sweep.h) and each run's row is computed by it on a worker, so a
 row is the same as the local run's; the rows come back in any order and the
 C++ SweepWriter writes them in run-index order as soon as a prefix is
 complete. Workers read the programs and profiles at the paths the sweep

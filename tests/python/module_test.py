@@ -34,7 +34,7 @@ def without_wall(j):
 
 
 # The keywords of solo and match are the command line's run options, from
-# one definition (tools/run_options.def): each is a --flag of `simbot match`
+# one definition (runs/run_options.def): each is a --flag of `simbot match`
 # (reload_on_fault is --reload-on-fault, inject is --inject), and an
 # unknown one is refused.
 import inspect

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "scheduler/match.h"
-#include "tools/trace_jsonl.h"
+#include "sinks/trace_jsonl.h"
 
 namespace simbot::testkit {
 
@@ -15,7 +15,7 @@ struct TracedRun : scheduler::MatchResult {
 };
 
 inline TracedRun runTraced(scheduler::MatchConfig config) {
-  tools::JsonlLines lines;
+  sinks::JsonlLines lines;
   config.sinks.push_back(&lines);
   TracedRun run{scheduler::runMatch(config), {}};
   run.trace = std::move(lines.lines);

@@ -1,0 +1,142 @@
+// The bench's per-run measurements (bench_metrics.h).
+#include "batch/bench_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace simbot::batch {
+
+using scheduler::kTicksPerSecond;
+
+// ---- observer
+
+void MetricsObserver::accumulateStall(Tick t) {
+  if (t <= stallClock_) return;
+  if (seen_) {
+    const Tick from = std::max(stallClock_, lastLatch_ + kTicksPerSecond);
+    if (t > from) stallTicks += t - from;
+  }
+  stallClock_ = t;
+}
+
+void MetricsObserver::onEyeRead(int robot, Tick t, int channel, int value) {
+  if (robot != robot_ || (channel != 0 && channel != 1)) return;
+  accumulateStall(t);
+  if (channel == 0) {
+    lastLeft_ = value;
+    haveLeft_ = true;
+    pairOpen_ = true;
+    pairLeft_ = value;
+  } else {
+    lastRight_ = value;
+    haveRight_ = true;
+    // A pair: this right-eye read follows a left-eye read directly.
+    if (pairOpen_) {
+      const int l = pairLeft_, r = value;
+      const MetricThresholds& th = thresholds_;
+      if (!acquire && l > th.seen && r > th.seen) acquire = t;
+      if (!aim && std::abs(l - r) <= th.aimMaxDiff && l + r >= th.aimMinSum) aim = t;
+    }
+    pairOpen_ = false;
+  }
+  seen_ =
+      (haveLeft_ && lastLeft_ > thresholds_.seen) || (haveRight_ && lastRight_ > thresholds_.seen);
+}
+
+void MetricsObserver::onInterruptAccepted(int robot, Tick t, vm::Irq irq) {
+  if (robot == robot_ && irq == vm::Irq::Pio) pioAccepts_.push_back(t);
+}
+
+void MetricsObserver::onFrame(int robot, Tick t, bool latched) {
+  if (robot != robot_) return;
+  if (!latched) {
+    ++framesRejected;
+    return;
+  }
+  accumulateStall(t);
+  lastLatch_ = t;
+  latches_.push_back(t);
+}
+
+void MetricsObserver::onPlantEvent(Tick t, const plant::Event& e) {
+  if (e.robot != robot_) return;
+  switch (e.kind) {
+    case plant::EventKind::BallLaunch:
+      if (!firstShot || t < *firstShot) firstShot = t;
+      break;
+    case plant::EventKind::BallHit:
+      if (!firstHit || t < *firstHit) firstHit = t;
+      break;
+    case plant::EventKind::EdgeEnter:
+      if (!edgeEnter || t < *edgeEnter) {
+        edgeEnter = t;
+        edgeDetector_ = e.detector;
+      }
+      break;
+    case plant::EventKind::EdgeLeave:
+      // Detector in the low bit so that finish() can filter by detector.
+      leaves_.push_back(t * 2 + (e.detector == plant::Detector::Aft ? 1 : 0));
+      break;
+    default:
+      break;
+  }
+}
+
+void MetricsObserver::finish(Tick endTick) {
+  accumulateStall(endTick);
+  std::sort(pioAccepts_.begin(), pioAccepts_.end());
+  std::sort(latches_.begin(), latches_.end());
+  std::sort(leaves_.begin(), leaves_.end());
+  edgeAccept = edgeLatch = edgeLeave = std::nullopt;
+  if (!edgeEnter) return;
+  const auto accept = std::lower_bound(pioAccepts_.begin(), pioAccepts_.end(), *edgeEnter);
+  if (accept == pioAccepts_.end()) return;
+  edgeAccept = *accept;
+  const auto latch = std::upper_bound(latches_.begin(), latches_.end(), *edgeAccept);
+  if (latch == latches_.end()) return;
+  edgeLatch = *latch;
+  const Tick bit = edgeDetector_ == plant::Detector::Aft ? 1 : 0;
+  for (Tick packed : leaves_)
+    if (packed / 2 >= *edgeLatch && packed % 2 == bit) {
+      edgeLeave = packed / 2;
+      break;
+    }
+}
+
+const std::vector<std::string>& metricNames() {
+  static const std::vector<std::string> names = {
+      "acquire_s",    "aim_s",           "first_shot_s", "first_hit_s",   "shots",
+      "hits",         "hit_ratio",       "edge_enter_s", "edge_accept_s", "edge_latch_s",
+      "edge_leave_s", "frames_rejected", "stall_s"};
+  return names;
+}
+
+RunMetrics collectMetrics(const MetricsObserver& o, const RobotResult& robot) {
+  auto time = [](const std::optional<Tick>& t) -> std::optional<double> {
+    if (!t) return std::nullopt;
+    return timebase::secondsFromTicks(*t);
+  };
+  auto leg = [](const std::optional<Tick>& from,
+                const std::optional<Tick>& to) -> std::optional<double> {
+    if (!from || !to) return std::nullopt;
+    return timebase::secondsFromTicks(*to - *from);
+  };
+  RunMetrics m;
+  m.values = {time(o.acquire),
+              time(o.aim),
+              time(o.firstShot),
+              time(o.firstHit),
+              static_cast<double>(robot.shots),
+              static_cast<double>(robot.hits),
+              robot.shots > 0 ? std::optional<double>(static_cast<double>(robot.hits) / robot.shots)
+                              : std::nullopt,
+              time(o.edgeEnter),
+              leg(o.edgeEnter, o.edgeAccept),
+              leg(o.edgeAccept, o.edgeLatch),
+              leg(o.edgeLatch, o.edgeLeave),
+              static_cast<double>(o.framesRejected),
+              timebase::secondsFromTicks(o.stallTicks)};
+  return m;
+}
+
+}  // namespace simbot::batch

@@ -1,0 +1,73 @@
+// Measurements of one robot's behaviour in a run (simbot bench), taken by a
+// scheduler::MatchObserver at exact ticks (the bench's statistics are in
+// stats/). What they measure is the bench's, not the match's: ICEMAN's own
+// tests of acquiring and aiming, the edge legs, the stall time.
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scheduler/match.h"
+
+namespace simbot::batch {
+
+using scheduler::RobotResult;
+using scheduler::Tick;
+
+// What counts as acquiring and aiming at the beacon, on the eye readings of
+// one left-then-right pair. The defaults are ICEMAN's own tests (thesis
+// program: "seen" above 48, the background being 16; aimed when the eyes
+// differ by at most 50 and sum to at least 800); simbot bench takes others
+// with --seen-threshold, --aim-max-diff and --aim-min-sum.
+struct MetricThresholds {
+  int seen = 48;        // both eyes above this: acquired (and "seen" for stall_s)
+  int aimMaxDiff = 50;  // |left - right| at most this ...
+  int aimMinSum = 800;  // ... and left + right at least this: aimed
+};
+
+// Collects the raw happenings of one robot (by default A) during a run.
+class MetricsObserver final : public scheduler::MatchObserver {
+ public:
+  explicit MetricsObserver(int robot = 0, MetricThresholds thresholds = {})
+      : robot_(robot), thresholds_(thresholds) {}
+  void onEyeRead(int robot, Tick t, int channel, int value) override;
+  void onInterruptAccepted(int robot, Tick t, vm::Irq irq) override;
+  void onFrame(int robot, Tick t, bool latched) override;
+  void onPlantEvent(Tick t, const plant::Event& e) override;
+
+  // Closes the run at `endTick` (the stall time runs to it).
+  void finish(Tick endTick);
+
+  std::optional<Tick> acquire, aim, firstShot, firstHit;
+  std::optional<Tick> edgeEnter, edgeAccept, edgeLatch, edgeLeave;
+  int framesRejected = 0;
+  Tick stallTicks = 0;
+
+ private:
+  void accumulateStall(Tick t);
+  int robot_;
+  MetricThresholds thresholds_;
+  // eyes: the last reading of each channel, whether the previous read was
+  // channel 0 (for the left-then-right pair rule)
+  int lastLeft_ = 16, lastRight_ = 16;
+  bool haveLeft_ = false, haveRight_ = false;
+  bool pairOpen_ = false;
+  int pairLeft_ = 0;
+  // stall: time while the beacon is seen and no frame latched for > 1 s
+  Tick lastLatch_ = 0, stallClock_ = 0;
+  bool seen_ = false;
+  // edge legs, kept raw and resolved in finish()
+  std::optional<plant::Detector> edgeDetector_;
+  std::vector<Tick> pioAccepts_, latches_, leaves_;
+};
+
+// The metric values of one run in a fixed order (names below); nullopt =
+// never reached (censored).
+struct RunMetrics {
+  std::vector<std::optional<double>> values;
+};
+const std::vector<std::string>& metricNames();
+RunMetrics collectMetrics(const MetricsObserver& o, const RobotResult& robot);
+
+}  // namespace simbot::batch

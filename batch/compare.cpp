@@ -1,0 +1,191 @@
+// simbot compare (compare.h).
+#include "batch/compare.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "stats/stats.h"
+
+namespace simbot::batch {
+
+namespace {
+
+// The seed of stall_s's permutation test: fixed, so a comparison is
+// reproducible.
+constexpr uint64_t kPermutationSeed = 0x5eed'9e37;
+
+std::vector<const BenchRun*> measured(const BenchResult& r) {
+  std::vector<const BenchRun*> out;
+  for (const auto& run : r.runs)
+    if (run.done && run.outcome != "error") out.push_back(&run);
+  return out;
+}
+
+std::optional<double> finite(double v) {
+  return std::isfinite(v) ? std::optional<double>(v) : std::nullopt;
+}
+
+size_t indexOf(const std::string& name) {
+  const auto& names = metricNames();
+  return static_cast<size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+}
+
+int64_t total(const std::vector<const BenchRun*>& runs, size_t m) {
+  int64_t sum = 0;
+  for (const BenchRun* run : runs) sum += static_cast<int64_t>(run->metrics.values[m].value_or(0));
+  return sum;
+}
+
+}  // namespace
+
+std::vector<CompareRow> compareRuns(const BenchResult& a, const BenchResult& b) {
+  const auto sa = summarize(a), sb = summarize(b);
+  const auto ra = measured(a), rb = measured(b);
+  const auto& names = metricNames();
+  std::vector<CompareRow> rows;
+  for (size_t m = 0; m < names.size(); ++m) {
+    CompareRow row;
+    row.metric = names[m];
+    row.a = sa[0].robots[0].metrics[m];
+    row.b = sb[0].robots[0].metrics[m];
+    switch (metricKind(names[m])) {
+      case MetricKind::Time: {
+        row.test = "log-rank";
+        const auto t = stats::logRank(timeObservations(ra, false, m, a.config.seconds),
+                                      timeObservations(rb, false, m, b.config.seconds));
+        if (t) {
+          row.statistic = t->statistic;
+          row.p = t->p;
+        }
+        break;
+      }
+      case MetricKind::Ratio: {
+        row.test = "Fisher exact";
+        const int64_t ha = total(ra, indexOf("hits")), na = total(ra, indexOf("shots"));
+        const int64_t hb = total(rb, indexOf("hits")), nb = total(rb, indexOf("shots"));
+        if (na > 0 && nb > 0) {
+          const auto t = stats::fisherExact(ha, na - ha, hb, nb - hb);
+          row.statistic = finite(t.statistic);
+          row.p = t.p;
+        }
+        break;
+      }
+      case MetricKind::Count: {
+        row.test = "exact Poisson rates";
+        const int64_t ta = total(ra, m), tb = total(rb, m);
+        if (ta + tb > 0 && !ra.empty() && !rb.empty()) {
+          const auto t = stats::poissonRatesTest(ta, static_cast<double>(ra.size()), tb,
+                                                 static_cast<double>(rb.size()));
+          row.statistic = finite(t.statistic);
+          row.p = t.p;
+        }
+        break;
+      }
+      case MetricKind::Continuous: {
+        row.test = "permutation";
+        std::vector<double> va, vb;
+        for (const BenchRun* run : ra)
+          if (run->metrics.values[m]) va.push_back(*run->metrics.values[m]);
+        for (const BenchRun* run : rb)
+          if (run->metrics.values[m]) vb.push_back(*run->metrics.values[m]);
+        if (!va.empty() && !vb.empty()) {
+          const auto t = stats::permutationTest(va, vb, kPermutationSeed);
+          row.statistic = t.statistic;
+          row.p = t.p;
+        }
+        break;
+      }
+    }
+    rows.push_back(std::move(row));
+  }
+  // Head-to-head: the win rates against the one opponent.
+  if (a.config.family == "head-to-head" && sa[0].games > 0 && sb[0].games > 0) {
+    CompareRow row;
+    row.metric = "win_rate";
+    row.test = "Fisher exact";
+    const auto winEstimate = [](const ProgramSummary& s) {
+      MetricEstimate e;
+      e.metric = "win_rate";
+      e.estimator = "Wilson";
+      e.n = s.games;
+      e.events = s.winsA;
+      e.trials = s.games;
+      e.estimate = s.winRate;
+      e.low = s.winLow;
+      e.high = s.winHigh;
+      return e;
+    };
+    row.a = winEstimate(sa[0]);
+    row.b = winEstimate(sb[0]);
+    const auto t = stats::fisherExact(sa[0].winsA, sa[0].games - sa[0].winsA, sb[0].winsA,
+                                      sb[0].games - sb[0].winsA);
+    row.statistic = finite(t.statistic);
+    row.p = t.p;
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+namespace {
+
+nlohmann::json optionalJson(const std::optional<double>& v) {
+  return v && std::isfinite(*v) ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json estimateJson(const MetricEstimate& e) {
+  return {{"estimator", e.estimator},
+          {"n", e.n},
+          {"events", e.events},
+          {"estimate", optionalJson(e.estimate)},
+          {"ci95_low", optionalJson(e.low)},
+          {"ci95_high", optionalJson(e.high)}};
+}
+
+std::string number(const std::optional<double>& v) { return v ? fmt::format("{:.4g}", *v) : ""; }
+
+std::string side(const MetricEstimate& e) {
+  if (!e.estimate) return "";
+  if (!e.low) return number(e.estimate);
+  return fmt::format("{} [{:.4g}, {}]", number(e.estimate), *e.low,
+                     std::isfinite(*e.high) ? fmt::format("{:.4g}", *e.high) : "inf");
+}
+
+}  // namespace
+
+nlohmann::json compareJson(const CompareResult& r) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& row : r.rows)
+    rows.push_back({{"metric", row.metric},
+                    {"test", row.test},
+                    {"a", estimateJson(row.a)},
+                    {"b", estimateJson(row.b)},
+                    {"statistic", optionalJson(row.statistic)},
+                    {"p", optionalJson(row.p)}});
+  return {{"family", benchLabel(r.a.config)},
+          {"seeds", r.a.config.seeds},
+          {"seconds", r.a.config.seconds},
+          {"master_seed", r.a.config.masterSeed},
+          {"a", {{"program", r.a.config.programs[0]}, {"profile", r.profileA}}},
+          {"b", {{"program", r.b.config.programs[0]}, {"profile", r.profileB}}},
+          {"rows", rows}};
+}
+
+std::string compareMarkdown(const CompareResult& r) {
+  const auto& c = r.a.config;
+  std::string out = fmt::format(
+      "### compare: A {} (profile {}) vs B {} (profile {}): family {}{}, the same {} seeds x "
+      "{} s\n\n",
+      r.a.config.programs[0], r.profileA, r.b.config.programs[0], r.profileB, benchLabel(c),
+      c.opponent.empty() ? "" : " vs " + c.opponent, c.seeds, c.seconds);
+  out +=
+      "| metric | estimator | A (95% CI) | B (95% CI) | test | statistic | p |\n"
+      "|---|---|---|---|---|---:|---:|\n";
+  for (const auto& row : r.rows)
+    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", row.metric, row.a.estimator,
+                       side(row.a), side(row.b), row.test, number(row.statistic), number(row.p));
+  return out + '\n';
+}
+
+}  // namespace simbot::batch

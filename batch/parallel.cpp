@@ -1,0 +1,87 @@
+#include "batch/parallel.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <iostream>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace simbot::batch {
+
+int resolveThreads(int threads) {
+  if (threads > 0) return threads;
+  const unsigned hw = std::thread::hardware_concurrency();
+  return hw == 0 ? 1 : static_cast<int>(hw);
+}
+
+double uniform(plant::RandomBits& bits, double lo, double hi) {
+  return lo + (hi - lo) * plant::unit53(bits.next());
+}
+
+void parallelFor(size_t count, int threads, const std::function<void(size_t)>& job,
+                 const std::string& label, bool progress, const std::atomic<bool>* stop) {
+  const auto stopped = [stop] { return stop && stop->load(); };
+  const auto start = std::chrono::steady_clock::now();
+  const size_t workers =
+      std::min<size_t>(static_cast<size_t>(resolveThreads(threads)), std::max<size_t>(count, 1));
+  std::atomic<size_t> next{0}, done{0};
+  size_t idle = 0;  // workers that took their last job (under `mutex`)
+  std::vector<std::exception_ptr> errors(count);
+  std::mutex mutex;
+  std::condition_variable finished;
+  auto work = [&] {
+    for (size_t i; !stopped() && (i = next.fetch_add(1)) < count;) {
+      try {
+        job(i);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+      done.fetch_add(1);
+      std::lock_guard lock(mutex);
+      finished.notify_all();
+    }
+    std::lock_guard lock(mutex);
+    ++idle;
+    finished.notify_all();
+  };
+  std::vector<std::thread> pool;
+  for (size_t w = 0; w < workers; ++w) pool.emplace_back(work);
+  const bool tty = progress && isatty(STDERR_FILENO);
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  if (tty) {
+    std::unique_lock lock(mutex);
+    while (true) {
+      const size_t d = done.load();
+      constexpr size_t kWidth = 30;
+      const size_t filled = count ? d * kWidth / count : kWidth;
+      const double t = elapsed();
+      const std::string eta =
+          d > 0 && d < count
+              ? fmt::format(", ETA {:.0f} s", t / static_cast<double>(d) * (count - d))
+              : "";
+      std::cerr << fmt::format("\r{} [{}{}] {}/{}  {:.0f} s{}   ", label, std::string(filled, '#'),
+                               std::string(kWidth - filled, '.'), d, count, t, eta)
+                << std::flush;
+      if (d == count || idle == workers) break;
+      finished.wait_for(lock, std::chrono::milliseconds(250));
+    }
+    std::cerr << '\n';
+  }
+  for (auto& th : pool) th.join();
+  if (progress && !tty)
+    std::cerr << fmt::format("{}: {}/{} done in {:.1f} s on {} threads\n", label, done.load(),
+                             count, elapsed(), workers);
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+}  // namespace simbot::batch

@@ -1,0 +1,34 @@
+// The bench and tournament subcommands, kept out of main.cpp. Private to
+// cli/ (namespace simbot::cli, the simbot executable), the top of the
+// parts: it uses batch/, runs/, reports/ and sinks/; nothing uses it.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <functional>
+
+#include "batch/bench_metrics.h"
+
+namespace simbot::cli {
+
+struct Subcommand {
+  CLI::App* app = nullptr;
+  std::function<int()> run;  // prints its own errors; returns the exit status
+};
+
+// Runs a subcommand's body: a UserError or a profile's ConfigError is
+// printed on stderr and gives exit status 1.
+int guarded(const std::function<int()>& body);
+
+// A seed: a decimal integer from 0 to 2^64 - 1 (not wrapped, not signed).
+CLI::Validator seedValidator();
+
+Subcommand addBenchCommand(CLI::App& app);
+// simbot compare (batch/compare.cpp): the same seeded runs for two programs
+// or two profiles, and a test of each metric.
+Subcommand addCompareCommand(CLI::App& app);
+// --seen-threshold, --aim-max-diff, --aim-min-sum (bench and compare).
+void addThresholdOptions(CLI::App& cmd, batch::MetricThresholds& thresholds);
+Subcommand addTournamentCommand(CLI::App& app);
+Subcommand addExplainCommand(CLI::App& app);  // cli/explain_command.cpp
+Subcommand addSweepCommand(CLI::App& app);    // cli/sweep_command.cpp
+
+}  // namespace simbot::cli

@@ -1,0 +1,237 @@
+// Solo runs and matches from run options (play.h).
+#include "runs/play.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <chrono>
+#include <iostream>
+#include <optional>
+
+#include "config/config.h"
+#include "plant/plant.h"
+#include "reports/viewer.h"
+#include "sinks/json_text.h"
+#include "sinks/trace_jsonl.h"
+#include "sinks/user_error.h"
+#include "sinks/vcd.h"
+#include "timebase/tick.h"
+
+namespace simbot::runs {
+
+using nlohmann::json;
+
+namespace {
+
+json poseJson(const plant::Pose& p) {
+  return {{"x_ft", p.x_ft}, {"y_ft", p.y_ft}, {"heading_deg", p.heading_deg}};
+}
+
+// Console lines are bytes the robot printed: one character per byte.
+json consoleJson(const std::vector<std::string>& lines) {
+  json out = json::array();
+  for (const auto& line : lines) out.push_back(sinks::jsonString(line, true));
+  return out;
+}
+
+json faultsJson(const std::vector<scheduler::FaultInfo>& faults) {
+  json out = json::array();
+  for (const auto& f : faults) out.push_back(faultJson(f));
+  return out;
+}
+
+}  // namespace
+
+json faultJson(const std::optional<scheduler::FaultInfo>& f) {
+  if (!f) return nullptr;
+  return {{"message", f->message}, {"time_s", f->timeS}, {"line", f->line}};
+}
+
+// Findings that did not stop the run (injections that never fired, ...).
+void reportWarnings(const scheduler::MatchResult& r) {
+  for (const auto& w : r.warnings) std::cerr << "simbot: warning: " << w << '\n';
+}
+
+// A robot's fault in one line: robot, time, source line, message.
+std::string faultText(const scheduler::RobotResult& rr, const scheduler::FaultInfo& f) {
+  return fmt::format("{}:{}: fault: robot {} at {:.6f} s: {}", rr.program, f.line, rr.name, f.timeS,
+                     f.message);
+}
+
+// One loud line per fault, on stderr; true if any robot faulted.
+bool reportFaults(const scheduler::MatchResult& r) {
+  bool any = false;
+  if (r.plantFault) {
+    any = true;
+    std::cerr << fmt::format(
+        "simbot: fault: the plant's integrator failed at {:.6f} s: {}; the "
+        "run ended there\n",
+        r.plantFault->timeS, r.plantFault->message);
+  }
+  for (const auto& rr : r.robots) {
+    for (size_t k = 0; k < rr.faults.size(); ++k) {
+      any = true;
+      std::cerr << faultText(rr, rr.faults[k])
+                << (k < static_cast<size_t>(rr.reloads) ? " (reloaded)" : "") << '\n';
+    }
+  }
+  return any;
+}
+
+// The run's configuration from the command line and the scenario: the
+// programs given (A, and B for match), then the scenario (start poses,
+// hardware, B for solo and profile, injections), then --hw and --inject.
+scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, const RunOptions& o,
+                                   ScenarioUse use) {
+  std::optional<Scenario> scenario;
+  if (!o.scenario.empty()) scenario = config::loadScenario(o.scenario);
+  const config::Profile profile = loadNamedProfile(
+      preferCommandLine(o.profile.has_value(), scenario ? scenario->profile : std::nullopt,
+                        o.profile.value_or("default")));
+  // Without --seconds or a scenario's, a run lasts its default: the
+  // profile's round.
+  const double seconds = preferCommandLine(
+      o.seconds.has_value(), scenario ? scenario->seconds : std::nullopt,
+      o.seconds.value_or(o.defaultSeconds > 0 ? o.defaultSeconds : profile.round_length_s));
+  if (!(seconds > 0) || seconds > 1e6)
+    throw sinks::UserError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", seconds));
+  scheduler::MatchConfig config;
+  config.arena = config::makeArenaConfig(profile, static_cast<int>(programs.size()));
+  config.profileName = profile.name;
+  const char* names[] = {"A", "B"};
+  for (size_t i = 0; i < programs.size(); ++i) {
+    config.robots.push_back({names[i], programs[i], compileProgramFile(programs[i])});
+    config.robots.back().controller = profile.controller;
+  }
+  std::array<bool, 2> hwGiven{};
+  std::vector<std::pair<int, std::string>> hwFiles;
+  for (const auto& spec : o.hw) {
+    int robot = 0;
+    std::string file = spec;
+    if (use == ScenarioUse::Match) {
+      const auto eq = spec.find('=');
+      if (eq == std::string::npos || (spec.substr(0, eq) != "A" && spec.substr(0, eq) != "B"))
+        throw sinks::UserError("simbot: --hw takes A=FILE or B=FILE\n");
+      robot = spec[0] == 'A' ? 0 : 1;
+      file = spec.substr(eq + 1);
+    }
+    hwGiven[static_cast<size_t>(robot)] = true;
+    hwFiles.emplace_back(robot, file);
+  }
+  if (scenario) applyScenario(*scenario, use, profile, config, hwGiven);
+  for (const auto& [robot, file] : hwFiles) {
+    auto& setup = config.arena.robots[static_cast<size_t>(robot)];
+    setup.hardware = config::loadHardware(file, setup.params,
+                                          config.robots[static_cast<size_t>(robot)].controller);
+  }
+  for (const auto& text : o.injections) {
+    try {
+      config.injections.push_back(
+          config::parseInjection(text, static_cast<int>(config.robots.size())));
+    } catch (const std::invalid_argument& e) {
+      throw sinks::UserError(fmt::format("simbot: --inject {}\n", e.what()));
+    }
+  }
+  config.endTick = timebase::ticksFromSeconds(seconds);
+  config.seed = preferCommandLine(o.seed.has_value(), scenario ? scenario->seed : std::nullopt,
+                                  o.seed.value_or(1));
+  config.reloadOnFault = o.reloadOnFault;
+  config.reloadDelay = timebase::ticksFromSeconds(profile.reload_delay_s);
+  return config;
+}
+
+Played play(const std::vector<std::string>& programs, const RunOptions& o, bool solo) {
+  // Watched values are written only into trace records.
+  if (!o.watches.empty() && o.trace.empty() && o.replay.empty() && o.sinks.empty())
+    throw sinks::UserError(
+        "simbot: --watch needs --trace FILE (or --replay FILE): watched values are written "
+        "only into the trace's records\n");
+  scheduler::MatchConfig config =
+      buildConfig(programs, o, solo ? ScenarioUse::Solo : ScenarioUse::Match);
+  config.stopWhenAllExited = solo;
+  config.watches = o.watches;
+  if (o.traceCostate && o.trace.empty() && o.replay.empty() && o.sinks.empty())
+    throw sinks::UserError("simbot: --trace-costate needs --trace FILE (or --replay FILE)\n");
+  config.traceCostate = o.traceCostate;
+  if (o.noFastForward) config.knobs.fastForward = false;
+  // Sinks open their files before the run: a bad path costs nothing.
+  std::optional<sinks::JsonlSink> jsonl;
+  std::optional<sinks::VcdSink> vcd;
+  std::optional<reports::ReplaySink> replay;
+  if (!o.trace.empty()) config.sinks.push_back(&jsonl.emplace(o.trace));
+  if (!o.vcd.empty()) config.sinks.push_back(&vcd.emplace(o.vcd));
+  if (!o.replay.empty()) config.sinks.push_back(&replay.emplace(o.replay));
+  config.sinks.insert(config.sinks.end(), o.sinks.begin(), o.sinks.end());
+  Played played;
+  played.seed = config.seed;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    played.result = scheduler::runMatch(config);
+  } catch (const std::invalid_argument& e) {
+    throw sinks::UserError(fmt::format("simbot: {}\n", e.what()));
+  }
+  played.wallSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return played;
+}
+
+json soloJson(const Played& played) {
+  const auto& r = played.result;
+  const double wall = played.wallSeconds;
+  const auto& a = r.robots[0];
+  json j = {
+      {"exited", a.exited},
+      {"exit_time_s", a.exited ? json(timebase::secondsFromTicks(a.exitTick)) : json(nullptr)},
+      {"cycles", a.cycles},
+      {"vm_instructions", a.vmInstructions},
+      {"sim_seconds", timebase::secondsFromTicks(r.endTick)},
+      {"wall_seconds", wall},
+      {"console", consoleJson(a.console)},
+      {"fault", faultJson(a.fault)},
+      {"faults", faultsJson(a.faults)},
+      {"reloads", a.reloads},
+      {"plant_fault", faultJson(r.plantFault)},
+      {"motor_frames_latched", a.framesLatched},
+      {"motor_frames_rejected", a.framesRejected},
+      {"motor_frames_overwritten", a.framesOverwritten},
+      {"interrupts", a.interrupts},
+      {"final_pose", poseJson(a.finalPose)}};
+  return j;
+}
+
+json matchJson(const Played& played) {
+  const auto& r = played.result;
+  const double wall = played.wallSeconds;
+  json robots = json::array();
+  for (const auto& rr : r.robots)
+    robots.push_back({{"name", rr.name},
+                      {"program", rr.program},
+                      {"hits", rr.hits},
+                      {"shots", rr.shots},
+                      {"motor_frames_latched", rr.framesLatched},
+                      {"motor_frames_rejected", rr.framesRejected},
+                      {"motor_frames_overwritten", rr.framesOverwritten},
+                      {"interrupts", rr.interrupts},
+                      {"cycles", rr.cycles},
+                      {"vm_instructions", rr.vmInstructions},
+                      {"fault", faultJson(rr.fault)},
+                      {"faults", faultsJson(rr.faults)},
+                      {"reloads", rr.reloads},
+                      {"final_pose", poseJson(rr.finalPose)},
+                      {"console_lines", rr.console.size()}});
+  json j = {{"sim_seconds", timebase::secondsFromTicks(r.endTick)},
+            {"wall_seconds", wall},
+            {"seed", played.seed},
+            {"winner", r.winner},
+            {"tie_broken_by_coin", r.tieBrokenByCoin},
+            {"plant_fault", faultJson(r.plantFault)},
+            {"integrator",
+             {{"steps", r.integrator.steps},
+              {"rhs_evals", r.integrator.rhs_evals},
+              {"reinits", r.integrator.reinits},
+              {"roots", r.integrator.roots}}},
+            {"robots", robots}};
+  return j;
+}
+
+}  // namespace simbot::runs

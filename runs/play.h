@@ -1,0 +1,78 @@
+// runs/ (namespace simbot::runs): one run set up and played. Programs
+// are compiled, a profile found, a scenario applied (scenario.h), the
+// trace's sinks attached (sinks/, and reports/' replay page), the match
+// played and summarised. batch/ runs many of these; cli/ and the Python
+// module are its two front ends.
+//
+// One solo run or match from run options, and its JSON summary: the CLI's
+// solo, match and profile commands and the Python module (python/) share
+// these, so `simbot match A B --json` and simbot.match(A, B) give the same
+// JSON.
+#pragma once
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "config/config.h"
+#include "runs/scenario.h"
+#include "scheduler/match.h"
+#include "trace/trace.h"
+#include "vm/image.h"
+
+namespace simbot::runs {
+
+// A program compiled for a run; its warnings go to stderr once per program
+// per process (bench and tournament compile each program many times).
+// UserError with the compiler's diagnostics if it does not compile.
+vm::Image compileProgramFile(const std::string& path);
+vm::Image compileProgramText(const std::string& source, const std::string& name);
+// A profile by name (profiles/NAME.toml) or by path.
+config::Profile loadNamedProfile(const std::string& nameOrPath);
+
+// Where a run option is offered (runs/run_options.def).
+enum RunOptionUse : unsigned { kSolo = 1, kMatch = 2, kProfile = 4, kPython = 8 };
+
+struct RunOptions {
+#define RUN_OPTION(member, Type, flag, keyword, where, help) Type member{};
+#include "runs/run_options.def"
+#undef RUN_OPTION
+  // A run's length when neither the option nor a scenario gives one (0:
+  // the profile's round_length; simbot profile: 60 s).
+  double defaultSeconds = 0;
+  // More sinks for the trace's records (the Python module's in-memory
+  // trace); each counts as a trace for --watch and --trace-costate.
+  std::vector<trace::Sink*> sinks;
+};
+
+// The run's configuration from the options and the scenario: the programs
+// given (A, and B for match), then the scenario (start poses, hardware, B
+// for solo and profile, injections), then --hw and --inject.
+scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, const RunOptions& o,
+                                   ScenarioUse use);
+
+struct Played {
+  scheduler::MatchResult result;
+  double wallSeconds = 0;
+  uint64_t seed = 0;  // the one used (--seed, the scenario's, or 1)
+};
+
+// A solo run (one program) or a match (two); UserError on bad options.
+Played play(const std::vector<std::string>& programs, const RunOptions& o, bool solo);
+
+// `simbot solo --json` and `simbot match --json`.
+nlohmann::json soloJson(const Played& played);
+nlohmann::json matchJson(const Played& played);
+// A fault as JSON (null when there is none).
+nlohmann::json faultJson(const std::optional<scheduler::FaultInfo>& f);
+
+// Findings that did not stop the run (injections that never fired, ...),
+// one line each, on stderr.
+void reportWarnings(const scheduler::MatchResult& r);
+// A robot's fault in one line: robot, time, source line, message.
+std::string faultText(const scheduler::RobotResult& rr, const scheduler::FaultInfo& f);
+// One loud line per fault, on stderr; true if any robot faulted.
+bool reportFaults(const scheduler::MatchResult& r);
+
+}  // namespace simbot::runs
