@@ -1,5 +1,5 @@
 // explain.js -- the Explain panel: the report of `simbot explain`, written
-// by the same C++ code (tools/explain.cpp) into the page's data as lines,
+// by the same C++ code (reports/explain.cpp) into the page's data as lines,
 // each with the tick it is about; a click on such a line seeks there.
 
 function createExplainPanel(container, lines, seek) {

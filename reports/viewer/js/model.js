@@ -1,6 +1,6 @@
 // model.js -- the run, from the page's data, in the shapes the views need.
 //
-// The data (tools/viewer.cpp) holds the trace's records as columns per kind
+// The data (reports/viewer.cpp) holds the trace's records as columns per kind
 // (trace/records.def), each sorted by tick. The model is built once when
 // the page opens: per robot, samples as typed arrays, handler and reflex
 // spans, eye-reading steps, serial bytes, frames; balls paired with their
