@@ -195,7 +195,7 @@ template <int kBytes>
 [[gnu::always_inline]] inline bool Vm::State::loadLocal(Regs& r) {
   const uint32_t a = mfp + r.u16();
   if (!access(r, a, kBytes)) return false;
-  r.push(kBytes == 1 ? r.rd8(a) : kBytes == 2 ? r.rd16(a) : r.rd32(a));
+  r.push(r.read<kBytes>(a));
   return true;
 }
 template <int kBytes>
@@ -223,7 +223,7 @@ template <int kBytes>
 [[gnu::always_inline]] inline bool Vm::State::loadIndirect(Regs& r) {
   const uint32_t a = r.top() & 0xFFFF;
   if (!access(r, a, kBytes)) return false;
-  r.top() = kBytes == 1 ? r.rd8(a) : kBytes == 2 ? r.rd16(a) : r.rd32(a);
+  r.top() = r.read<kBytes>(a);
   return true;
 }
 // addr value -- ; or, keeping the value: addr value -- value

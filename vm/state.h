@@ -203,6 +203,12 @@ struct Regs {
     wr16(a + 2, v >> 16);
   }
   template <int kBytes>
+  [[gnu::always_inline]] uint32_t read(uint32_t a) const {
+    if constexpr (kBytes == 1) return rd8(a);
+    if constexpr (kBytes == 2) return rd16(a);
+    return rd32(a);
+  }
+  template <int kBytes>
   [[gnu::always_inline]] void write(uint32_t a, uint32_t v) {
     if constexpr (kBytes == 1) wr8(a, v);
     if constexpr (kBytes == 2) wr16(a, v);
@@ -290,6 +296,8 @@ struct Vm::State {
   // the fast path.
   std::array<const void*, 2> longLabels{};
   void setFast(int k, uint32_t address);
+  // A REL16 instruction's target, from its start (in the padded code).
+  int64_t relTargetAt(uint32_t address) const;
   std::vector<uint8_t> breakpoints;  // one flag per code byte
   bool anyBreakpoint = false;
   bool resumeAtBreakpoint = false;
@@ -451,6 +459,7 @@ struct Vm::State {
   template <int kKind, Op First, Op... Rest, size_t... kPieces>
   bool unchecked(Regs& r, std::index_sequence<kPieces...>);
   void save(const Regs& r);
+  void burnTail(Regs& r);
   bool fail(const Regs& r, const char* message);
   bool access(const Regs& r, uint32_t address, uint32_t bytes);
   template <Op O>

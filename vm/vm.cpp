@@ -161,21 +161,23 @@ void Vm::State::timerService(uint32_t interruptedPc) {
 // calls out of the code are kTrap at decode, and a return address is at
 // most kCodePad - 1 past its end.
 
+int64_t Vm::State::relTargetAt(uint32_t address) const {
+  return int64_t{address} + 3 + static_cast<int16_t>(le16(&padded[address + 1]));
+}
+
 void Vm::State::decode() {
   const auto& code = image->code;
   const auto size = static_cast<uint32_t>(code.size());
   padded = code;
   padded.resize(size + kCodePad, 0);
   baseDispatch.assign(size + kCodePad, kTrap);
-  auto rel = [&](uint32_t a) {  // a REL16 instruction's target, from its start
-    return int64_t{a} + 3 + static_cast<int16_t>(padded[a + 1] | (padded[a + 2] << 8));
-  };
   for (uint32_t a = 0; a < size; ++a) {
     const uint8_t b = code[a];
     if (b >= kOpCount) continue;
     const Op op = static_cast<Op>(b);
     if (a + static_cast<uint32_t>(instructionSize(op)) > size) continue;
-    if ((op == Op::JMP || op == Op::JZ || op == Op::JNZ) && (rel(a) < 0 || rel(a) >= size))
+    if ((op == Op::JMP || op == Op::JZ || op == Op::JNZ) &&
+        (relTargetAt(a) < 0 || relTargetAt(a) >= size))
       continue;
     if (op == Op::CALL && static_cast<uint32_t>(padded[a + 1] | (padded[a + 2] << 8)) >= size)
       continue;
@@ -199,7 +201,7 @@ int Vm::State::superinstructionAt(uint32_t address) const {
       if (a >= end || dispatch[a] != o || (k == 0 && costs.op[o] > kMaxStepTstates)) break;
       // decode() made a JMP or CALL out of the code a trap: its target is in it.
       if (shape.pieces[k] == Op::JMP)
-        a = static_cast<uint32_t>(a + 3 + static_cast<int16_t>(le16(&padded[a + 1])));
+        a = static_cast<uint32_t>(relTargetAt(a));
       else if (shape.pieces[k] == Op::CALL)
         a = le16(&padded[a + 1]);
       else
@@ -255,6 +257,16 @@ void Vm::State::unwindSuperinstruction(int kind, int k) {
   stats.instructions -= static_cast<uint64_t>(kSuperShapes[kind].n - 1 - k);
 }
 
+// A long instruction's tail on the fast path: its steps while they start
+// before the limit (nothing else can be due inside it).
+[[gnu::always_inline]] inline void Vm::State::burnTail(Regs& r) {
+  while (burn && r.clk < r.limit) {
+    const uint32_t s = std::min(kMaxStepTstates, burn);
+    r.clk += s;
+    burn -= s;
+  }
+}
+
 // A superinstruction's piece after the first: the boundary before it, as
 // NEXT tests it, then the piece as NEXT would dispatch it. A piece longer
 // than kMaxStepTstates runs as L_Long_ and slowNext run it: its first
@@ -279,11 +291,7 @@ template <Op O>
   if (!step<O>(r)) return false;
   // As slowNext: the step's own limit = 0 is forgotten for the tail.
   r.limit = limit;
-  while (burn && r.clk < r.limit) {
-    const uint32_t s = std::min(kMaxStepTstates, burn);
-    r.clk += s;
-    burn -= s;
-  }
+  burnTail(r);
   if (burn) {
     save(r);
     return false;
@@ -502,11 +510,7 @@ slowNext:
   if (longLimit >= 0) {  // the tail of a long instruction (L_Long_)
     r.limit = longLimit;
     longLimit = -1;
-    while (burn && r.clk < r.limit) {
-      const uint32_t s = std::min(kMaxStepTstates, burn);
-      r.clk += s;
-      burn -= s;
-    }
+    burnTail(r);
     if (!burn && r.clk < r.limit) DISPATCH_NEXT;
   }
   save(r);
