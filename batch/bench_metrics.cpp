@@ -10,26 +10,13 @@ using scheduler::kTicksPerSecond;
 
 // ---- observer
 
-void MetricsObserver::accumulateStall(Tick t) {
-  if (t <= stallClock_) return;
-  if (seen_) {
-    const Tick from = std::max(stallClock_, lastLatch_ + kTicksPerSecond);
-    if (t > from) stallTicks += t - from;
-  }
-  stallClock_ = t;
-}
-
 void MetricsObserver::onEyeRead(int robot, Tick t, int channel, int value) {
   if (robot != robot_ || (channel != 0 && channel != 1)) return;
-  accumulateStall(t);
+  stall_.eyeRead(t, channel, value);
   if (channel == 0) {
-    lastLeft_ = value;
-    haveLeft_ = true;
     pairOpen_ = true;
     pairLeft_ = value;
   } else {
-    lastRight_ = value;
-    haveRight_ = true;
     // A pair: this right-eye read follows a left-eye read directly.
     if (pairOpen_) {
       const int l = pairLeft_, r = value;
@@ -39,8 +26,6 @@ void MetricsObserver::onEyeRead(int robot, Tick t, int channel, int value) {
     }
     pairOpen_ = false;
   }
-  seen_ =
-      (haveLeft_ && lastLeft_ > thresholds_.seen) || (haveRight_ && lastRight_ > thresholds_.seen);
 }
 
 void MetricsObserver::onInterruptAccepted(int robot, Tick t, vm::Irq irq) {
@@ -53,8 +38,7 @@ void MetricsObserver::onFrame(int robot, Tick t, bool latched) {
     ++framesRejected;
     return;
   }
-  accumulateStall(t);
-  lastLatch_ = t;
+  stall_.frameLatched(t);
   latches_.push_back(t);
 }
 
@@ -83,7 +67,8 @@ void MetricsObserver::onPlantEvent(Tick t, const plant::Event& e) {
 }
 
 void MetricsObserver::finish(Tick endTick) {
-  accumulateStall(endTick);
+  stall_.finish(endTick);
+  stallTicks = stall_.total();
   std::sort(pioAccepts_.begin(), pioAccepts_.end());
   std::sort(latches_.begin(), latches_.end());
   std::sort(leaves_.begin(), leaves_.end());

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "reports/stall.h"
 #include "scheduler/match.h"
 
 namespace simbot::batch {
@@ -21,7 +22,7 @@ using scheduler::Tick;
 // differ by at most 50 and sum to at least 800); simbot bench takes others
 // with --seen-threshold, --aim-max-diff and --aim-min-sum.
 struct MetricThresholds {
-  int seen = 48;        // both eyes above this: acquired (and "seen" for stall_s)
+  int seen = 48;        // both eyes above this: acquired (either: seeing, for stall_s)
   int aimMaxDiff = 50;  // |left - right| at most this ...
   int aimMinSum = 800;  // ... and left + right at least this: aimed
 };
@@ -30,33 +31,30 @@ struct MetricThresholds {
 class MetricsObserver final : public scheduler::MatchObserver {
  public:
   explicit MetricsObserver(int robot = 0, MetricThresholds thresholds = {})
-      : robot_(robot), thresholds_(thresholds) {}
+      : robot_(robot),
+        thresholds_(thresholds),
+        stall_(reports::StallRule{.seen = thresholds.seen}) {}
   void onEyeRead(int robot, Tick t, int channel, int value) override;
   void onInterruptAccepted(int robot, Tick t, vm::Irq irq) override;
   void onFrame(int robot, Tick t, bool latched) override;
   void onPlantEvent(Tick t, const plant::Event& e) override;
 
-  // Closes the run at `endTick` (the stall time runs to it).
+  // Closes the run at `endTick` (a stall still open runs to it).
   void finish(Tick endTick);
 
   std::optional<Tick> acquire, aim, firstShot, firstHit;
   std::optional<Tick> edgeEnter, edgeAccept, edgeLatch, edgeLeave;
   int framesRejected = 0;
-  Tick stallTicks = 0;
+  Tick stallTicks = 0;  // the stalls' total (reports/stall.h), set by finish()
 
  private:
-  void accumulateStall(Tick t);
   int robot_;
   MetricThresholds thresholds_;
-  // eyes: the last reading of each channel, whether the previous read was
-  // channel 0 (for the left-then-right pair rule)
-  int lastLeft_ = 16, lastRight_ = 16;
-  bool haveLeft_ = false, haveRight_ = false;
+  // whether the previous read was channel 0, and its reading (for the
+  // left-then-right pair rule)
   bool pairOpen_ = false;
   int pairLeft_ = 0;
-  // stall: time while the beacon is seen and no frame latched for > 1 s
-  Tick lastLatch_ = 0, stallClock_ = 0;
-  bool seen_ = false;
+  reports::StallWatch stall_;
   // edge legs, kept raw and resolved in finish()
   std::optional<plant::Detector> edgeDetector_;
   std::vector<Tick> pioAccepts_, latches_, leaves_;

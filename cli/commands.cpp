@@ -49,8 +49,8 @@ CLI::Validator seedValidator() {
 
 void addThresholdOptions(CLI::App& cmd, batch::MetricThresholds& t) {
   cmd.add_option("--seen-threshold", t.seen,
-                 "eye reading above which the beacon counts as seen, both eyes for acquire_s "
-                 "(default 48, ICEMAN's)")
+                 "eye reading above which the beacon counts as seen: both eyes for acquire_s, "
+                 "either for stall_s (default 48, ICEMAN's)")
       ->check(CLI::Range(0, 1'000'000));
   cmd.add_option("--aim-max-diff", t.aimMaxDiff,
                  "aim_s: largest |left - right| eye difference (default 50, ICEMAN's)")

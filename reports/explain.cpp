@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "plant/plant.h"
+#include "reports/stall.h"
 #include "sinks/json_text.h"
 #include "sinks/trace_jsonl.h"
 
@@ -74,7 +75,8 @@ struct Explainer::State {
     std::string function;
     bool inHandler = false;
   };
-  // Stall window: the opponent in view and nothing latched since `start`.
+  // The open stall window's samples (stall.h decides when it opens and
+  // closes; this collects what the report says about it).
   struct Window {
     std::optional<Tick> start;
     std::vector<int> left, right;
@@ -88,9 +90,8 @@ struct Explainer::State {
     int eyeBackground = 16;
     std::vector<std::string> source;  // the program's lines
     std::optional<Sample> last, previous;
-    Tick lastLatch = 0;
     std::string lastFrame;
-    std::optional<Tick> visibleSince;
+    StallWatch stall;
     Window window;
     std::string halted;
     std::vector<std::size_t> handlers;                       // open handler runs
@@ -128,27 +129,26 @@ struct Explainer::State {
     });
   }
 
-  bool inView(const Pose& self, const Pose& other) const {
-    const double dx = other.x - self.x, dy = other.y - self.y;
-    const double gamma = wrap180(degrees(std::atan2(dx, dy)) - self.heading);
-    return std::abs(gamma) < 90.0 && !plant::dividerBlocks(self.x, self.y, other.x, other.y, field);
-  }
-
-  void closeWindow(int robot, Tick end, bool atEnd) {
+  // After the robot's StallWatch was fed at `t`: the window that closed
+  // there becomes a Stall if it was one, and a window opened there starts
+  // collecting.
+  void stallFed(int robot, std::optional<StallSpan> ended, Tick t, bool atEnd) {
     Window& w = r[robot].window;
-    if (w.start && static_cast<double>(end - *w.start) > tps() && !w.left.empty()) {
+    if (ended) {
       Stall s;
       s.robot = robot;
-      s.from = *w.start;
-      s.to = end;
-      s.to_end = atEnd;
+      s.from = ended->from;
+      s.to = ended->to;
+      s.to_end = atEnd && ended->to == t;
       s.samples = static_cast<int>(w.left.size());
-      s.eye_left_median = median(w.left);
-      s.eye_right_median = median(w.right);
-      s.eye_left_min = *std::min_element(w.left.begin(), w.left.end());
-      s.eye_left_max = *std::max_element(w.left.begin(), w.left.end());
-      s.eye_right_min = *std::min_element(w.right.begin(), w.right.end());
-      s.eye_right_max = *std::max_element(w.right.begin(), w.right.end());
+      if (!w.left.empty()) {
+        s.eye_left_median = median(w.left);
+        s.eye_right_median = median(w.right);
+        s.eye_left_min = *std::min_element(w.left.begin(), w.left.end());
+        s.eye_left_max = *std::max_element(w.left.begin(), w.left.end());
+        s.eye_right_min = *std::min_element(w.right.begin(), w.right.end());
+        s.eye_right_max = *std::max_element(w.right.begin(), w.right.end());
+      }
       for (const auto& [where, n] : w.lines) {
         const auto& src = r[robot].source;
         const int line = where.first;
@@ -169,38 +169,27 @@ struct Explainer::State {
       s.one_eye = 2 * w.oneEye > s.samples;
       report.stalls.push_back(std::move(s));
     }
-    w = Window{};
+    const std::optional<Tick> start = r[robot].stall.windowStart();
+    if (w.start != start) {
+      w = Window{};
+      w.start = start;
+    }
   }
 
-  // Both robots' samples at one tick: who sees whom.
-  void judge(Tick t) {
-    for (int i = 0; i < 2; ++i) {
-      Robot& me = r[i];
-      if (report.robots[static_cast<size_t>(i)].scripted) continue;
-      const Sample& s = *me.last;
-      if (!inView(s.pose, r[1 - i].last->pose)) {
-        closeWindow(i, t, false);
-        me.visibleSince.reset();
-        continue;
-      }
-      if (!me.visibleSince) me.visibleSince = t;
-      const Tick start = std::max(*me.visibleSince, me.lastLatch);
-      Window& w = me.window;
-      if (!w.start || *w.start != start) {
-        w = Window{};
-        w.start = start;
-      }
-      const int bg = me.eyeBackground;
-      if ((s.eyeLeft <= bg) != (s.eyeRight <= bg)) ++w.oneEye;
-      w.left.push_back(s.eyeLeft);
-      w.right.push_back(s.eyeRight);
-      ++w.lines[{s.line, s.function}];
-      if (w.last) {
-        w.moved += std::hypot(s.pose.x - w.last->x, s.pose.y - w.last->y);
-        w.turned += wrap180(s.pose.heading - w.last->heading);
-      }
-      w.last = s.pose;
+  // A sample inside the robot's open stall window.
+  void collect(Robot& me, const Sample& s) {
+    Window& w = me.window;
+    if (!w.start) return;
+    const int bg = me.eyeBackground;
+    if ((s.eyeLeft <= bg) != (s.eyeRight <= bg)) ++w.oneEye;
+    w.left.push_back(s.eyeLeft);
+    w.right.push_back(s.eyeRight);
+    ++w.lines[{s.line, s.function}];
+    if (w.last) {
+      w.moved += std::hypot(s.pose.x - w.last->x, s.pose.y - w.last->y);
+      w.turned += wrap180(s.pose.heading - w.last->heading);
     }
+    w.last = s.pose;
   }
 
   void sample(Tick t, const rec::Sample& x) {
@@ -219,7 +208,7 @@ struct Explainer::State {
       if (last) report.handler_runs[run].moved_ft += std::hypot(x.x_ft - last->x, x.y_ft - last->y);
       last = s.pose;
     }
-    if (robots == 2 && r[1 - x.robot].last && r[1 - x.robot].last->pose.t == t) judge(t);
+    collect(me, s);
   }
 
   template <class F>
@@ -286,9 +275,15 @@ struct Explainer::State {
     ++info.serial_isr_runs;
     info.serial_isr_total += x.end_t - t;
   }
+  void on(Tick t, const rec::AdRead& x) {
+    if (x.robot >= robots) return;
+    const int channel = static_cast<int>(x.channel);
+    stallFed(x.robot, r[x.robot].stall.eyeRead(t, channel, static_cast<int>(x.value)), t, false);
+  }
   void on(Tick t, const rec::FrameLatched& x) {
-    closeWindow(x.robot, t, false);
-    r[x.robot].lastLatch = t;
+    if (x.robot >= robots) return;
+    // The stall that ends here still had the previous command in force.
+    stallFed(x.robot, r[x.robot].stall.frameLatched(t), t, false);
     r[x.robot].lastFrame = x.bytes;
     eachOpenRun(x.robot, [&](HandlerRun& h) { h.frames.push_back(x.bytes); });
   }
@@ -430,7 +425,7 @@ struct Explainer::State {
     for (const PendingShot& p : pending)
       if (const auto& target = r[p.target].last) aim(p, target->pose);
     pending.clear();
-    for (int i = 0; i < robots; ++i) closeWindow(i, end, true);
+    for (int i = 0; i < robots; ++i) stallFed(i, r[i].stall.finish(end), end, true);
     std::map<std::pair<int, std::string>, HandlerTotal> totals;
     for (const HandlerRun& h : report.handler_runs) {
       HandlerTotal& total = totals[{h.robot, h.handler}];
@@ -571,9 +566,9 @@ struct Fmt {
   }
 };
 
-constexpr const char* kInView =
-    "in view: the opponent within 90 deg of the heading and the line between the centres clear "
-    "of the divider (the eye rule), at every 20-Hz sample";
+constexpr const char* kSeeing =
+    "seeing: the program's latest reading of either eye above 48, ICEMAN's own test; eye "
+    "readings below are the 20-Hz samples'; simbot bench's stall_s is the total";
 
 }  // namespace
 
@@ -606,9 +601,11 @@ std::vector<TextLine> textLines(const Report& r) {
         x.t);
 
   add("");
-  add(fmt::format("Stalls: the opponent in view and no motor frame latched for more than 1 s ({})",
+  add(
+      fmt::format("Stalls: the program seeing the opponent and no motor frame latched for more "
+                  "than 1 s ({})",
                   r.stalls.size()));
-  add(fmt::format("  ({})", kInView));
+  add(fmt::format("  ({})", kSeeing));
   if (const Stall* x = Fmt::longest(r))
     add(fmt::format("  longest: {} {} s .. {} ({}), {}", f.name(x->robot), f.s(x->from),
                     f.until(*x), f.dur(x->to - x->from), f.eyes(*x)),
@@ -718,9 +715,9 @@ std::string markdown(const Report& r) {
   }
 
   o += fmt::format(
-      "\n## Stalls ({})\n\nThe opponent in view and no motor frame latched for more than 1 s; "
-      "{}.\n\n",
-      r.stalls.size(), kInView);
+      "\n## Stalls ({})\n\nThe program seeing the opponent and no motor frame latched for more "
+      "than 1 s; {}.\n\n",
+      r.stalls.size(), kSeeing);
   if (const Stall* x = Fmt::longest(r))
     o += fmt::format("Longest: **{}** {} s .. {} ({}), {}.\n\n", f.name(x->robot), f.s(x->from),
                      f.until(*x), f.dur(x->to - x->from), f.eyes(*x));

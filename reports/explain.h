@@ -6,8 +6,9 @@
 //
 // `simbot explain`: a report a student can read, made from a run's trace
 // records alone (trace/records.def): each shot (range, bearing error, muzzle
-// speed, hit or miss distance), stalls (the opponent in view and no motor
-// frame latched for more than 1 s: thesis chapter X's one-eye dead-lock),
+// speed, hit or miss distance), stalls (the program seeing the opponent and
+// no motor frame latched for more than 1 s, stall.h: thesis chapter X's
+// one-eye dead-lock is one),
 // overwritten sends, time inside handlers and what the robot did meanwhile,
 // contacts, referee actions and faults.
 //
@@ -44,16 +45,19 @@ struct Shot {
   // interpolated linearly between its 20-Hz samples around the launch.
   std::optional<double> range_ft, bearing_error_deg;
   double muzzle_fps = 0;
-  bool target_in_view = false;  // by the eye rule (see Stall)
-  std::optional<Tick> end_t;    // ball_hit or ball_miss (none: still flying at the end)
+  // DESIGN.md's eye rule: the target within 90 deg of the heading and the
+  // segment between the centres clear of the divider.
+  bool target_in_view = false;
+  std::optional<Tick> end_t;  // ball_hit or ball_miss (none: still flying at the end)
   bool hit = false;
   std::string ended;              // robot, floor, divider or wall
   std::optional<double> miss_ft;  // ball_miss's closest_ft
 };
 
-// A stall: the opponent in view (|gamma| < 90 deg and the segment between
-// the centres clear of the divider, at every 20-Hz sample: DESIGN.md's eye
-// rule) and no motor frame latched, for more than 1 s.
+// A stall (reports/stall.h, the one definition): the program seeing the
+// opponent (its latest reading of either eye above 48) and no motor frame
+// latched, for more than 1 s. What follows `to_end` describes it from the
+// 20-Hz samples inside it.
 struct Stall {
   int robot = 0;
   Tick from = 0, to = 0;

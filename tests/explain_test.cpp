@@ -9,8 +9,10 @@
 #include <fstream>
 #include <string>
 
+#include "batch/bench_metrics.h"
 #include "config/config.h"
 #include "plant/plant.h"
+#include "reports/stall.h"
 #include "runs/play.h"
 #include "scheduler/match.h"
 #include "sinks/trace_jsonl.h"
@@ -45,6 +47,7 @@ scheduler::MatchConfig config(const std::vector<std::string>& programs, double s
 struct Traced {
   std::vector<trace::Entry> entries;
   ex::Report report;
+  trace::Tick benchStallTicks = 0;  // simbot bench's stall_s of robot A, in ticks
   template <class R>
   std::vector<std::pair<trace::Tick, R>> all(int robot = -1) const {
     return testkit::recordsOf<R>(entries, robot);
@@ -54,10 +57,13 @@ struct Traced {
 Traced run(scheduler::MatchConfig c) {
   trace::Collector collector;
   ex::Explainer explainer;
+  batch::MetricsObserver bench;  // simbot bench's measurements of A
   c.sinks.push_back(&collector);
   c.sinks.push_back(&explainer);
+  c.observer = &bench;
   scheduler::runMatch(c);
-  return {std::move(collector.entries), explainer.report()};
+  bench.finish(c.endTick);
+  return {std::move(collector.entries), explainer.report(), bench.stallTicks};
 }
 
 // The 180-s match of the issue, run once for all the tests here (~1 s).
@@ -78,25 +84,6 @@ double wrap(double d) {
   while (d > 180) d -= 360;
   while (d <= -180) d += 360;
   return d;
-}
-
-// The opponent is in view of `self` (DESIGN.md, eyes): its bearing off
-// self's heading, gamma = atan2(dx, dy) - heading (headings clockwise from
-// +y), within 90 deg, and the segment between the centres misses the
-// divider, the rectangle |x - divider_x| <= thickness / 2, south <= y <=
-// north (checked by sampling the segment finely: independent of the
-// plant's slab clipping).
-bool inView(const rec::Sample& self, const rec::Sample& other, const rec::Run& run) {
-  const double dx = other.x_ft - self.x_ft, dy = other.y_ft - self.y_ft;
-  const double gamma = wrap(std::atan2(dx, dy) * 180 / kPi - self.heading_deg);
-  if (!(std::abs(gamma) < 90)) return false;
-  for (int i = 0; i <= 10000; ++i) {
-    const double s = i / 10000.0, x = self.x_ft + s * dx, y = self.y_ft + s * dy;
-    if (std::abs(x - run.divider_x_ft) <= run.divider_thickness_ft / 2 &&
-        y >= run.divider_south_ft && y <= run.divider_north_ft)
-      return false;
-  }
-  return true;
 }
 
 TEST(Explain, IcemanShotsAgainstTheTraceRecords) {
@@ -188,52 +175,60 @@ TEST(Explain, OneShotsRangeAndBearingFromThePoses) {
   EXPECT_LT(std::abs(bearing), 90);
 }
 
-// Stalls recomputed from the records: at each pair of samples, ICEMAN
-// either sees fig92 (inView) or not; a stall runs from the later of the
-// first sample of the current in-view run and the latest frame latched, to
-// the next frame latched, the next sample out of view, or the end; those
-// longer than 1 s count.
+// Stalls recomputed from the records, with the rule of reports/stall.h
+// written out again here: ICEMAN's latest reading of either eye (its
+// ad_read records: one whenever a reading differs from that eye's previous
+// one) above 48 means it sees fig92; a window opens when it starts seeing,
+// or at a frame latched while it sees; it closes at the next latch, at the
+// reading after which it sees nothing, or at the end; windows longer than
+// 1 s (9,216,000 ticks) are the stalls. simbot bench's stall_s, measured
+// on line by its observer during the same run, is their total.
 TEST(Explain, IcemanStallsAgainstTheRecords) {
   const Traced& r = icemanVsFig92();
-  const auto runs = r.all<rec::Run>();
-  const auto a = r.all<rec::Sample>(0), b = r.all<rec::Sample>(1);
-  const auto latches = r.all<rec::FrameLatched>(0);
-  ASSERT_EQ(a.size(), b.size());
+  struct Step {
+    trace::Tick t;
+    int channel;  // -1: a frame latched
+    int value;
+  };
+  std::vector<Step> events;
+  for (const auto& e : r.entries) {
+    if (const auto* read = std::get_if<rec::AdRead>(&e.record); read && read->robot == 0)
+      events.push_back({e.t, static_cast<int>(read->channel), static_cast<int>(read->value)});
+    if (const auto* latch = std::get_if<rec::FrameLatched>(&e.record); latch && latch->robot == 0)
+      events.push_back({e.t, -1, 0});
+  }
   const trace::Tick end = r.entries.back().t;
   std::vector<std::pair<trace::Tick, trace::Tick>> want;
-  trace::Tick visibleSince = -1, lastLatch = 0;
-  bool sampled = false;  // a sample in view since the window's start
-  size_t next = 0;       // next latch
+  int left = -1, right = -1;  // no reading yet
+  trace::Tick opened = -1;    // -1: no window open
   auto close = [&](trace::Tick to) {
-    const trace::Tick from = std::max(visibleSince, lastLatch);
-    if (visibleSince >= 0 && sampled && static_cast<double>(to - from) > kTps)
-      want.emplace_back(from, to);
-    sampled = false;
+    if (opened >= 0 && to - opened > scheduler::kTicksPerSecond) want.emplace_back(opened, to);
+    opened = -1;
   };
-  for (size_t i = 0; i < a.size(); ++i) {
-    const trace::Tick t = a[i].first;
-    ASSERT_EQ(b[i].first, t);
-    for (; next < latches.size() && latches[next].first < t; ++next) {
-      close(latches[next].first);
-      lastLatch = latches[next].first;
+  for (const Step& e : events) {
+    if (e.channel == -1) {
+      close(e.t);
+      if (left > 48 || right > 48) opened = e.t;
+      continue;
     }
-    if (!inView(a[i].second, b[i].second, runs[0].second)) {
-      close(t);
-      visibleSince = -1;
+    (e.channel == 0 ? left : right) = e.value;
+    if (left > 48 || right > 48) {
+      if (opened < 0) opened = e.t;
     } else {
-      if (visibleSince < 0) visibleSince = t;
-      sampled = true;
+      close(e.t);
     }
-  }
-  for (; next < latches.size(); ++next) {
-    close(latches[next].first);
-    lastLatch = latches[next].first;
   }
   close(end);
   std::vector<std::pair<trace::Tick, trace::Tick>> got;
+  trace::Tick total = 0;
   for (const auto& s : r.report.stalls)
-    if (s.robot == 0) got.emplace_back(s.from, s.to);
+    if (s.robot == 0) {
+      got.emplace_back(s.from, s.to);
+      total += s.to - s.from;
+    }
   EXPECT_EQ(got, want);
+  EXPECT_FALSE(want.empty());
+  EXPECT_EQ(r.benchStallTicks, total);
 
   // Thesis chapter X: the longest one-eye stall (seed 15: at 3.2 s), with
   // the far (left) eye at background (16) and the near eye above ICEMAN's
@@ -375,3 +370,52 @@ TEST(Explain, HandlerRunFromAnInjectedEdge) {
 }
 
 }  // namespace
+
+// The stall rule itself (reports/stall.h) on hand-made timelines, in ticks
+// (1 s = 9,216,000).
+TEST(StallWatch, AWindowLongerThanASecondIsAStallCountedWhole) {
+  reports::StallWatch w;
+  constexpr trace::Tick s = scheduler::kTicksPerSecond;
+  EXPECT_FALSE(w.eyeRead(10, 0, 16));  // background: sees nothing
+  EXPECT_FALSE(w.windowStart());
+  EXPECT_FALSE(w.eyeRead(100, 1, 49));  // one eye above 48: sees
+  EXPECT_EQ(w.windowStart(), 100);
+  EXPECT_FALSE(w.eyeRead(200, 1, 300));  // still sees: the window runs on
+  // A latch 2 s after the window opened ends a stall of 2 s and, still
+  // seeing, opens the next window there.
+  const auto first = w.frameLatched(100 + 2 * s);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->from, 100);
+  EXPECT_EQ(first->to, 100 + 2 * s);
+  EXPECT_EQ(w.windowStart(), 100 + 2 * s);
+  // Exactly 1 s later the eye falls to 48 (not above): a window of exactly
+  // 1 s is not a stall.
+  EXPECT_FALSE(w.eyeRead(100 + 3 * s, 1, 48));
+  EXPECT_FALSE(w.windowStart());
+  // Seeing again from 5 s to the run's end at 6.5 s: a stall of 1.5 s.
+  EXPECT_FALSE(w.eyeRead(5 * s, 0, 400));
+  const auto last = w.finish(6 * s + s / 2);
+  ASSERT_TRUE(last);
+  EXPECT_EQ(last->from, 5 * s);
+  EXPECT_EQ(last->to, 6 * s + s / 2);
+  EXPECT_EQ(w.total(), 2 * s + s + s / 2);
+}
+
+TEST(StallWatch, LatchesWithinASecondAndOtherChannelsAreNoStall) {
+  reports::StallWatch w;
+  constexpr trace::Tick s = scheduler::kTicksPerSecond;
+  EXPECT_FALSE(w.eyeRead(0, 0, 500));
+  for (trace::Tick t = s / 2; t <= 10 * s; t += s / 2) EXPECT_FALSE(w.frameLatched(t));
+  EXPECT_FALSE(w.eyeRead(10 * s + 1, 2, 0));  // channel 2 is no eye
+  EXPECT_EQ(w.windowStart(), 10 * s);
+  EXPECT_FALSE(w.finish(10 * s + s / 2));
+  EXPECT_EQ(w.total(), 0);
+  // A latch while seeing nothing opens no window.
+  reports::StallWatch blind;
+  EXPECT_FALSE(blind.frameLatched(5));
+  EXPECT_FALSE(blind.windowStart());
+  // A threshold of bench's --seen-threshold.
+  reports::StallWatch strict(reports::StallRule{.seen = 600});
+  EXPECT_FALSE(strict.eyeRead(0, 0, 500));
+  EXPECT_FALSE(strict.windowStart());
+}
