@@ -62,10 +62,7 @@ void runProgram(benchmark::State& state, const char* source, bool debug) {
     vm::Vm v(*result.image, bus, costs);
     // Stop where main returns to the start-up stub (CALL main; POP; HALT).
     v.setBreakpoint(result.image->entry + vm::instructionSize(vm::Op::CALL));
-    vm::Stop stop;
-    while ((stop = v.run(INT64_MAX / 2)) == vm::Stop::Io) {
-    }
-    if (stop != vm::Stop::Breakpoint) state.SkipWithError("main did not return");
+    if (v.run(INT64_MAX / 2) != vm::Stop::Breakpoint) state.SkipWithError("main did not return");
     instructions += v.stats().instructions;
     ticks = v.now();
   }

@@ -170,10 +170,7 @@ TEST(Vm, LongShiftIsInterruptibleAndItsTimeIsKept) {
   v.setBreakpoint(a.label("end"));
   EXPECT_EQ(v.run(1000), Stop::Horizon);
   v.request(Irq::Pio, vm::kVecPIOA);
-  Stop stop;
-  while ((stop = v.run(1'000'000)) == Stop::Io) {
-  }
-  EXPECT_EQ(stop, Stop::Breakpoint);
+  EXPECT_EQ(v.run(1'000'000), Stop::Breakpoint);
   EXPECT_EQ(v.read16(counter), 1u);
   const vm::Tick shiftEnd = cost(Op::EI) + 2 * cost(Op::PUSHW) + 48 + 254 * 18;
   ASSERT_FALSE(host.events.empty());
@@ -550,7 +547,7 @@ TEST(Vm, BusAccessNeverHappensAtOrAfterTheHorizon) {
   // next run, and happens at the end of the sequence.
   EXPECT_EQ(v.run(callEnd - 1), Stop::Horizon);
   EXPECT_TRUE(host.outs.empty());
-  EXPECT_EQ(v.run(callEnd + 1), Stop::Io);
+  EXPECT_EQ(v.run(callEnd + 1), Stop::Halted);
   ASSERT_EQ(host.outs.size(), 1u);
   EXPECT_EQ(host.outs[0].tick, callEnd);
   EXPECT_EQ(host.outs[0].value, 0x88);

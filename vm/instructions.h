@@ -592,7 +592,6 @@ SIMBOT_INSTRUCTION(RETI) {
   // The epilogue's EI: IFF1 is set when the RETI after it ends.
   if (costs.knobs.epilogueEi && !iff1) bus->iffChanged(now, true);
   if (costs.knobs.epilogueEi) iff1 = iff2 = true;
-  busTouched = true;
   return false;
 }
 SIMBOT_INSTRUCTION(HALT) {

@@ -165,31 +165,25 @@ void Vm::State::libBegin() {
       // Sampled at the start of the conversion, which then takes its time.
       lib.result = w(bus->adSample(now, static_cast<int>(asInt16(a[0]))));
       lib.remaining = costs.adConversion;
-      busTouched = true;
       lib.active = lib.remaining > 0;
       if (!lib.active) eval[sp++] = lib.result;
       return;
     case Lib::OUTPORT:
       bus->out(now, static_cast<uint16_t>(a[0]), static_cast<uint8_t>(a[1]));
-      busTouched = true;
       return;
     case Lib::INPORT:
       eval[sp++] = bus->in(now, static_cast<uint16_t>(a[0]));
-      busTouched = true;
       return;
     case Lib::SER_INIT_Z1:
       // The routine restores the caller's interrupt state (JP PO; EI): IFF1
       // is as it was before the call.
       bus->serialInit(now, asInt16(a[0]), asInt16(a[1]));
-      busTouched = true;
       return;
     case Lib::SER_SEND_Z1:
       bus->serialSend(now, static_cast<uint16_t>(a[0]), static_cast<uint16_t>(a[1]));
-      busTouched = true;
       return;
     case Lib::HV_ENB:
       bus->hvEnable(now);
-      busTouched = true;
       return;
     case Lib::ABS: {
       int16_t v = asInt16(a[0]);
@@ -293,7 +287,6 @@ void Vm::State::libStep() {
         if (lib.id == Lib::PRINTF) {
           emitConsole(lib.text);
           lib.text.clear();
-          busTouched = true;
         }
         libFinish(true);
       }

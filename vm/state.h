@@ -238,7 +238,7 @@ struct Vm::State {
   bool iff2 = true;
   bool eiShadow = false;
   bool halted = false;
-  bool busTouched = false;
+  bool hostStop = false;  // Vm::stopAtNextBoundary, during a run
   std::array<bool, kIrqCount> pend{};
   std::array<uint8_t, kIrqCount> vec{};
   bool anyPending = false;

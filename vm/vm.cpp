@@ -68,7 +68,6 @@ void Vm::State::accept() {
     serialIsrCycles += costs.serialIsr;
     bus->serialTxService(now, *self);
     bus->interruptReturned(now, irq);
-    busTouched = true;
     return;
   }
   const int32_t handler = handlerFor[vec[i]];
@@ -388,7 +387,7 @@ Stop Vm::State::run(Tick until) {
          sp,  eval.data(), mem.data(),         code, kProfile ? profile.data() : nullptr};
   Tick longLimit = -1;  // L_Long_: the limit its instruction's tail runs to
   uint8_t op = 0;
-  busTouched = false;
+  hostStop = false;
 
 #define NEXT                                   \
   if (__builtin_expect(r.clk >= r.limit, 0)) { \
@@ -413,9 +412,9 @@ boundary:
     raiseFault("expression stack overflow (too many arguments or values pending)", pc);
     goto boundary;
   }
-  if (busTouched) {
-    busTouched = false;
-    return Stop::Io;
+  if (hostStop) {
+    hostStop = false;
+    return Stop::Host;
   }
   if (now >= nextTimer) timerTick();
   if (now >= until) return halted ? Stop::Halted : Stop::Horizon;
@@ -665,6 +664,8 @@ void Vm::request(Irq irq, uint8_t vector) {
   s_->vec[i] = vector;
   s_->anyPending = true;
 }
+
+void Vm::stopAtNextBoundary() { s_->hostStop = true; }
 
 void Vm::cancelRequest(Irq irq) {
   s_->pend[static_cast<int>(irq)] = false;

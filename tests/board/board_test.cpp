@@ -46,10 +46,15 @@ class Host : public vm::Bus {
   uint8_t in(Tick, uint16_t port) override {
     return port == vm::kPortPIODA ? board->pio.read() : 0xFF;
   }
+  // Each changes when the next byte is done: runUntil looks again.
   void serialSend(Tick t, uint16_t buf, uint16_t cc) override {
     if (const auto o = board->serialSend(t, buf, cc)) overwritten.emplace_back(t, o->fetched);
+    board->cpu.stopAtNextBoundary();
   }
-  void serialTxService(Tick t, vm::Vm&) override { board->serialService(t); }
+  void serialTxService(Tick t, vm::Vm&) override {
+    board->serialService(t);
+    board->cpu.stopAtNextBoundary();
+  }
   void interruptAccepted(Tick, vm::Irq irq, uint32_t) override {
     ++board->interruptCounts[static_cast<size_t>(irq)];
     if (irq == vm::Irq::Pio) board->pio.accepted();

@@ -44,7 +44,12 @@ class TestHost : public vm::Bus {
   std::vector<std::string> sentBytes;  // bytes fetched per send
   uint8_t pioVector = vm::kVecPIOA;
 
-  void schedule(Tick tick, Irq irq) { scheduled_.emplace(tick, irq); }
+  // A request at `tick`; from inside a bus call the run stops at the next
+  // boundary so that runUntil raises it on time.
+  void schedule(Tick tick, Irq irq) {
+    scheduled_.emplace(tick, irq);
+    if (running_) running_->stopAtNextBoundary();
+  }
 
   void out(Tick t, uint16_t port, uint8_t value) override { outs.push_back({t, port, value}); }
   uint8_t in(Tick, uint16_t port) override { return port == vm::kPortPIODA ? pioA : 0xFF; }
@@ -81,7 +86,9 @@ class TestHost : public vm::Bus {
     for (;;) {
       Tick horizon = end;
       if (!scheduled_.empty()) horizon = std::min(horizon, scheduled_.begin()->first);
+      running_ = &v;
       const vm::Stop stop = v.run(horizon);
+      running_ = nullptr;
       if (stop == vm::Stop::Fault || stop == vm::Stop::Breakpoint) return stop;
       while (!scheduled_.empty() && scheduled_.begin()->first <= v.now()) {
         const Irq irq = scheduled_.begin()->second;
@@ -98,6 +105,7 @@ class TestHost : public vm::Bus {
 
  private:
   std::multimap<Tick, Irq> scheduled_;
+  vm::Vm* running_ = nullptr;  // the VM in run() (for schedule())
   uint16_t buf_ = 0, cc_ = 0;
   uint32_t next_ = 1;
 };
