@@ -42,6 +42,7 @@ const std::vector<WarningInfo>& warningList() {
       {"unreachable-code", "a statement after return, break, continue or goto"},
       {"send-without-delay", "a serial send that can follow another with no delay between"},
       {"implicit-function-declaration", "a call to a function not yet declared"},
+      {"unknown-pragma", "a #pragma simbot does not know (ignored, as C89 says)"},
   };
   return list;
 }

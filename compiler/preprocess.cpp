@@ -61,21 +61,34 @@ std::string quote(const std::string& s) {
   return out + "\"";
 }
 
-// #if expressions: C's constant expressions over intmax_t (chibicc's
-// const_expr, reduced to integers). Identifiers left after macro expansion
-// are 0.
+// #if expressions, by C89's rules (3.8.1): every value is a long or an
+// unsigned long, Dynamic C's 32 bits, with the usual arithmetic conversions
+// (an unsigned operand makes the operation unsigned, so (0u - 1) < 0 is
+// false) and wrapping arithmetic. The right operand of && and ||, and the
+// branch of ?: not taken, are parsed but not evaluated: 0 && 1 / 0 is 0,
+// not a division by zero. Identifiers left after macro expansion are 0.
+// (chibicc's const_expr, reduced to integers.)
 class IfEval {
  public:
   IfEval(const std::vector<Token>& toks, Pos end) : toks_(toks), end_(end) {}
 
-  int64_t run() {
-    int64_t v = cond();
+  bool run() {
+    const Value v = cond();
     if (i_ < toks_.size())
       fail(toks_[i_].pos, "missing binary operator before '" + toks_[i_].text + "' in #if");
-    return v;
+    return v.bits != 0;
   }
 
  private:
+  struct Value {
+    uint32_t bits = 0;
+    bool isUnsigned = false;
+    int32_t asSigned() const { return static_cast<int32_t>(bits); }
+  };
+  static Value truth(bool b) { return {b ? 1u : 0u, false}; }
+  // The usual arithmetic conversions: either operand unsigned, both are.
+  static bool unsignedPair(Value a, Value b) { return a.isUnsigned || b.isUnsigned; }
+
   const Token* peek() const { return i_ < toks_.size() ? &toks_[i_] : nullptr; }
   bool accept(std::string_view s) {
     if (i_ < toks_.size() && toks_[i_].kind == TokKind::Punct && toks_[i_].text == s) {
@@ -85,166 +98,206 @@ class IfEval {
     return false;
   }
   Pos here() const { return i_ < toks_.size() ? toks_[i_].pos : end_; }
+  // Parses an operand that is not evaluated (its value is not used).
+  template <class F>
+  Value unevaluated(F parse) {
+    const bool was = evaluating_;
+    evaluating_ = false;
+    const Value v = parse();
+    evaluating_ = was;
+    return v;
+  }
 
   // cond = logor ("?" cond ":" cond)?
-  int64_t cond() {
+  Value cond() {
     if (++depth_ > 200) fail(here(), "nesting too deep");
-    int64_t c = logor();
+    Value c = logor();
     if (accept("?")) {
-      int64_t a = cond();
+      const bool first = c.bits != 0;
+      const Value a = first ? cond() : unevaluated([&] { return cond(); });
       if (!accept(":")) fail(here(), "expected ':' in #if");
-      int64_t b = cond();
-      c = c ? a : b;
+      const Value b = first ? unevaluated([&] { return cond(); }) : cond();
+      c = {first ? a.bits : b.bits, unsignedPair(a, b)};
     }
     --depth_;
     return c;
   }
   // logor = logand ("||" logand)*
-  int64_t logor() {
-    int64_t v = logand();
+  Value logor() {
+    Value v = logand();
     while (accept("||")) {
-      int64_t r = logand();
-      v = v || r;
+      const bool left = v.bits != 0;
+      const Value r = left ? unevaluated([&] { return logand(); }) : logand();
+      v = truth(left || r.bits != 0);
     }
     return v;
   }
   // logand = bitor ("&&" bitor)*
-  int64_t logand() {
-    int64_t v = bitor_();
+  Value logand() {
+    Value v = bitor_();
     while (accept("&&")) {
-      int64_t r = bitor_();
-      v = v && r;
+      const bool left = v.bits != 0;
+      const Value r = left ? bitor_() : unevaluated([&] { return bitor_(); });
+      v = truth(left && r.bits != 0);
     }
     return v;
   }
   // bitor = bitxor ("|" bitxor)*
-  int64_t bitor_() {
-    int64_t v = bitxor_();
-    while (accept("|")) v |= bitxor_();
+  Value bitor_() {
+    Value v = bitxor_();
+    while (accept("|")) {
+      const Value r = bitxor_();
+      v = {v.bits | r.bits, unsignedPair(v, r)};
+    }
     return v;
   }
   // bitxor = bitand ("^" bitand)*
-  int64_t bitxor_() {
-    int64_t v = bitand_();
-    while (accept("^")) v ^= bitand_();
+  Value bitxor_() {
+    Value v = bitand_();
+    while (accept("^")) {
+      const Value r = bitand_();
+      v = {v.bits ^ r.bits, unsignedPair(v, r)};
+    }
     return v;
   }
   // bitand = equality ("&" equality)*
-  int64_t bitand_() {
-    int64_t v = equality();
-    while (accept("&")) v &= equality();
+  Value bitand_() {
+    Value v = equality();
+    while (accept("&")) {
+      const Value r = equality();
+      v = {v.bits & r.bits, unsignedPair(v, r)};
+    }
     return v;
   }
   // equality = relational (("==" | "!=") relational)*
-  int64_t equality() {
-    int64_t v = relational();
+  Value equality() {
+    Value v = relational();
     for (;;) {
       if (accept("=="))
-        v = v == relational();
+        v = truth(v.bits == relational().bits);
       else if (accept("!="))
-        v = v != relational();
+        v = truth(v.bits != relational().bits);
       else
         return v;
     }
   }
   // relational = shift (("<" | "<=" | ">" | ">=") shift)*
-  int64_t relational() {
-    int64_t v = shift();
+  Value relational() {
+    Value v = shift();
     for (;;) {
-      if (accept("<"))
-        v = v < shift();
-      else if (accept("<="))
-        v = v <= shift();
-      else if (accept(">"))
-        v = v > shift();
-      else if (accept(">="))
-        v = v >= shift();
-      else
-        return v;
+      std::string_view op;
+      for (std::string_view o : {"<", "<=", ">", ">="})
+        if (accept(o)) {
+          op = o;
+          break;
+        }
+      if (op.empty()) return v;
+      const Value r = shift();
+      const bool u = unsignedPair(v, r);
+      const bool less = u ? v.bits < r.bits : v.asSigned() < r.asSigned();
+      const bool greater = u ? v.bits > r.bits : v.asSigned() > r.asSigned();
+      v = truth(op == "<" ? less : op == ">" ? greater : op == "<=" ? !greater : !less);
     }
   }
   // shift = add (("<<" | ">>") add)*
-  int64_t shift() {
-    int64_t v = add();
+  // The result has the left operand's type; a count of 32 or more (or a
+  // negative one, undefined in C) shifts every bit out.
+  Value shift() {
+    Value v = add();
     for (;;) {
-      if (accept("<<"))
-        v = static_cast<int64_t>(static_cast<uint64_t>(v) << (add() & 63));
-      else if (accept(">>"))
-        v = v >> (add() & 63);
+      const bool left = accept("<<");
+      if (!left && !accept(">>")) return v;
+      const Value r = add();
+      const bool outOfRange = r.isUnsigned ? r.bits >= 32 : r.asSigned() < 0 || r.asSigned() >= 32;
+      if (left)
+        v.bits = outOfRange ? 0 : v.bits << r.bits;
+      else if (v.isUnsigned)
+        v.bits = outOfRange ? 0 : v.bits >> r.bits;
       else
-        return v;
+        v.bits = static_cast<uint32_t>(outOfRange ? (v.asSigned() < 0 ? -1 : 0)
+                                                  : v.asSigned() >> r.bits);
     }
   }
   // add = mul (("+" | "-") mul)*
-  int64_t add() {
-    int64_t v = mul();
+  Value add() {
+    Value v = mul();
     for (;;) {
-      if (accept("+"))
-        v = static_cast<int64_t>(static_cast<uint64_t>(v) + static_cast<uint64_t>(mul()));
-      else if (accept("-"))
-        v = static_cast<int64_t>(static_cast<uint64_t>(v) - static_cast<uint64_t>(mul()));
-      else
-        return v;
+      const bool plus = accept("+");
+      if (!plus && !accept("-")) return v;
+      const Value r = mul();
+      v = {plus ? v.bits + r.bits : v.bits - r.bits, unsignedPair(v, r)};
     }
   }
   // mul = unary (("*" | "/" | "%") unary)*
-  int64_t mul() {
-    int64_t v = unary();
+  Value mul() {
+    Value v = unary();
     for (;;) {
-      Pos at = here();
+      const Pos at = here();
       if (accept("*")) {
-        v = static_cast<int64_t>(static_cast<uint64_t>(v) * static_cast<uint64_t>(unary()));
-      } else if (accept("/") || accept("%")) {
-        bool div = toks_[i_ - 1].text == "/";
-        int64_t r = unary();
-        if (r == 0) fail(at, "division by zero in #if");
-        if (r == -1)
-          v = div ? static_cast<int64_t>(0 - static_cast<uint64_t>(v)) : 0;
-        else
-          v = div ? v / r : v % r;
+        const Value r = unary();
+        v = {v.bits * r.bits, unsignedPair(v, r)};
+        continue;
+      }
+      const bool div = accept("/");
+      if (!div && !accept("%")) return v;
+      const Value r = unary();
+      const bool isUnsigned = unsignedPair(v, r);
+      if (r.bits == 0) {
+        if (evaluating_) fail(at, "division by zero in #if");
+        v = {0, isUnsigned};
+      } else if (isUnsigned) {
+        v = {div ? v.bits / r.bits : v.bits % r.bits, true};
+      } else if (r.asSigned() == -1) {  // LONG_MIN / -1 wraps
+        v = {div ? 0u - v.bits : 0u, false};
       } else {
-        return v;
+        v = {static_cast<uint32_t>(div ? v.asSigned() / r.asSigned() : v.asSigned() % r.asSigned()),
+             false};
       }
     }
   }
   // unary = ("+" | "-" | "!" | "~") unary | primary
-  int64_t unary() {
+  Value unary() {
     if (++depth_ > 200) fail(here(), "nesting too deep");
-    int64_t v;
-    if (accept("+"))
+    Value v;
+    if (accept("+")) {
       v = unary();
-    else if (accept("-"))
-      v = static_cast<int64_t>(0 - static_cast<uint64_t>(unary()));
-    else if (accept("!"))
-      v = !unary();
-    else if (accept("~"))
-      v = ~unary();
-    else
+    } else if (accept("-")) {
+      v = unary();
+      v.bits = 0u - v.bits;
+    } else if (accept("!")) {
+      v = truth(unary().bits == 0);
+    } else if (accept("~")) {
+      v = unary();
+      v.bits = ~v.bits;
+    } else {
       v = primary();
+    }
     --depth_;
     return v;
   }
   // primary = "(" cond ")" | number | char | ident
-  int64_t primary() {
+  Value primary() {
     const Token* t = peek();
     if (!t) fail(end_, "expected value in #if expression");
     if (accept("(")) {
-      int64_t v = cond();
+      const Value v = cond();
       if (!accept(")")) fail(here(), "missing ')' in #if expression");
       return v;
     }
     ++i_;
     switch (t->kind) {
       case TokKind::Number: {
-        NumberValue n = parseNumber(*t);
+        const NumberValue n = parseNumber(*t);
         if (n.isFloat) fail(t->pos, "floating constant in preprocessor expression");
-        return static_cast<int64_t>(n.value);
+        // Past LONG_MAX a constant is an unsigned long (the lexer refuses
+        // anything past 32 bits).
+        return {static_cast<uint32_t>(n.value), n.suffixU || n.value > 0x7FFFFFFFu};
       }
       case TokKind::Char:
         if (t->str.empty()) fail(t->pos, "empty character constant");
-        return static_cast<unsigned char>(t->str.back());
+        return {static_cast<unsigned char>(t->str.back()), false};
       case TokKind::Ident:
-        return 0;
+        return {0, false};
       default:
         fail(t->pos, "token '" + t->text + "' is not valid in #if expression");
     }
@@ -254,6 +307,7 @@ class IfEval {
   Pos end_;
   size_t i_ = 0;
   int depth_ = 0;
+  bool evaluating_ = true;  // false inside an operand whose value is not used
 };
 
 }  // namespace
@@ -402,6 +456,13 @@ void Preprocessor::directive(const Token& hash) {
     std::string msg;
     for (const Token& t : line) msg += (msg.empty() || !t.space ? "" : " ") + t.text;
     fail(hash.pos, "#error " + msg);
+  } else if (name == "pragma") {
+    // C89 (3.8.6): a pragma the implementation does not know is ignored.
+    std::vector<Token> line = readLine();
+    std::string text;
+    for (const Token& t : line) text += (text.empty() || !t.space ? "" : " ") + t.text;
+    diags_.warn(hash.pos, "unknown-pragma",
+                "'#pragma " + text + "' ignored (simbot knows no pragmas)");
   } else {
     fail(hash.pos, "directive '#" + name + "' is not supported");
   }
@@ -528,7 +589,7 @@ bool Preprocessor::evalIf(const Token& dirTok, std::vector<Token> line) {
   if (toks.empty()) fail(after(dirTok.pos), "#" + dirTok.text + " with no expression");
   Pos end = after(toks.back().pos);
   std::vector<Token> expanded = expandList(std::move(toks), dirTok);
-  return IfEval(expanded, end).run() != 0;
+  return IfEval(expanded, end).run();
 }
 
 // The library named by #include "x" / #include <x> / #use x / #use "x".

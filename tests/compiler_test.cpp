@@ -824,6 +824,22 @@ TEST(CompilerWarnings, SendWithoutDelay) {
             Strings{});
 }
 
+// C89 (3.8.6): an unknown pragma is ignored; simbot says so.
+TEST(CompilerWarnings, UnknownPragma) {
+  EXPECT_EQ(warned("#pragma pack(1)\nmain() { }\n"), Strings{"1:1 unknown-pragma"});
+}
+
+// #if evaluates the operands C evaluates: a division by zero in the right
+// operand of && is not done, one in an evaluated operand is an error.
+TEST(CompilerErrors, IfDividesOnlyWhatItEvaluates) {
+  EXPECT_TRUE(compile("#if 0 && 1 / 0\n#endif\nmain() { }\n", "i.dc").image);
+  EXPECT_TRUE(compile("#if 1 ? 1 : 1 % 0\n#endif\nmain() { }\n", "i.dc").image);
+  const auto r = compile("#if 1 && 1 / 0\n#endif\nmain() { }\n", "i.dc");
+  expectError(r);
+  EXPECT_EQ(r.errors[0].format().rfind("i.dc:1:12: error: division by zero in #if", 0), 0u)
+      << r.errors[0].format();
+}
+
 TEST(CompilerWarnings, ImplicitFunctionDeclaration) {
   EXPECT_EQ(warned("main() { f(); }\nf() { }\n"), Strings{"1:10 implicit-function-declaration"});
   EXPECT_EQ(warned("int f();\nmain() { f(); }\nf() { }\n"), Strings{});
