@@ -211,7 +211,11 @@ void Parser::run() {
                              {"PIOCA", vm::kPortPIOCA},
                              {"PIOCB", vm::kPortPIOCB},
                              {"ENB485", vm::kPortENB485},
-                             {"PIOA_VEC", vm::kVecPIOA}}) {
+                             {"PIOA_VEC", vm::kVecPIOA},
+                             // C's null pointer constant, an integer 0 (a
+                             // name, not a macro: a program's own #define
+                             // NULL or #ifndef NULL still works).
+                             {"NULL", 0}}) {
     ScopeEntry e;
     e.isConst = true;
     e.value = value;
