@@ -124,6 +124,7 @@ class CodeGen {
 
   // ---- expressions ----
   Loc addr(Node* n);
+  Loc accessible(Loc l, const Type* t, int line);
   void pushAddress(const Loc& l, int line);
   void load(const Loc& l, const Type* t, int line);
   void store(const Loc& l, const Type* t, bool keep, int line);

@@ -55,13 +55,13 @@ Loc CodeGen::addr(Node* n) {
       staticLoc(n, l);
       return l;
     case NodeKind::Deref:
-      if (staticPtr(n->lhs, l)) return l;
+      if (staticPtr(n->lhs, l)) return accessible(l, n->type, line);
       value(n->lhs);
       return Loc{Loc::Stack, 0};
     case NodeKind::Member: {
       Loc b = addr(n->lhs);
       if (b.kind != Loc::Stack && b.addr + n->offset <= 0xFFFF)
-        return Loc{b.kind, b.addr + n->offset};
+        return accessible(Loc{b.kind, b.addr + n->offset}, n->type, line);
       pushAddress(b, line);
       if (n->offset) {
         emitU16(Op::PUSHW, n->offset, line);
@@ -74,6 +74,17 @@ Loc CodeGen::addr(Node* n) {
       value(n);
       return Loc{Loc::Stack, 0};
   }
+}
+
+// A constant address that an access of `t` would fault at (the null page,
+// or past the end of memory: *(char *)5, *(int *)0xFFFF) goes the
+// pointer's way, whose access faults at run time as a pointer variable's
+// does; an absolute LDG/STG would read or write it without a word.
+Loc CodeGen::accessible(Loc l, const Type* t, int line) {
+  if (l.kind != Loc::Global || isAggregate(t)) return l;
+  if (l.addr >= vm::kNullPageEnd && l.addr + t->size <= static_cast<int>(vm::kMemorySize)) return l;
+  pushAddress(l, line);
+  return Loc{Loc::Stack, 0};
 }
 
 // Representation change between two types' slots.

@@ -39,6 +39,18 @@ std::vector<std::string> expectations(const std::string& source) {
   return out;
 }
 
+// A program that must fault: `// expect fault: MESSAGE` on the line where
+// the robot faults (0: none expected).
+std::pair<int, std::string> expectedFault(const std::string& source) {
+  std::istringstream in(source);
+  std::string line;
+  const std::string marker = "// expect fault: ";
+  for (int number = 1; std::getline(in, line); ++number)
+    if (const auto at = line.find(marker); at != std::string::npos)
+      return {number, line.substr(at + marker.size())};
+  return {0, ""};
+}
+
 class ProgramTest : public ::testing::TestWithParam<fs::path> {};
 
 TEST_P(ProgramTest, ConsoleMatchesExpectations) {
@@ -52,10 +64,17 @@ TEST_P(ProgramTest, ConsoleMatchesExpectations) {
   vm::Vm v(*result.image, host, vm::makeCostTable(vm::calibratedKnobs()));
   const vm::Tick limit = 600 * vm::kTicksPerSecond;
   const auto stop = host.runUntil(v, limit);
-  ASSERT_EQ(v.fault(), nullptr) << v.fault()->message << " at line " << v.fault()->line;
-  ASSERT_EQ(stop, vm::Stop::Halted) << "main did not return within 600 simulated seconds";
+  const auto [faultLine, faultMessage] = expectedFault(source);
+  if (faultLine > 0) {
+    ASSERT_NE(v.fault(), nullptr) << "no fault; expected '" << faultMessage << "'";
+    EXPECT_EQ(v.fault()->message, faultMessage);
+    EXPECT_EQ(v.fault()->line, faultLine);
+  } else {
+    ASSERT_EQ(v.fault(), nullptr) << v.fault()->message << " at line " << v.fault()->line;
+    ASSERT_EQ(stop, vm::Stop::Halted) << "main did not return within 600 simulated seconds";
+  }
   const auto expected = expectations(source);
-  ASSERT_FALSE(expected.empty()) << "no // expect: lines";
+  ASSERT_TRUE(!expected.empty() || faultLine > 0) << "no // expect: lines";
   for (size_t i = 0; i < std::max(expected.size(), host.consoleLines.size()); ++i) {
     const std::string want = i < expected.size() ? expected[i] : "<nothing>";
     std::string got = i < host.consoleLines.size() ? host.consoleLines[i] : "<nothing>";
