@@ -179,9 +179,16 @@ void Vm::State::libBegin() {
       // is as it was before the call.
       bus->serialInit(now, asInt16(a[0]), asInt16(a[1]));
       return;
-    case Lib::SER_SEND_Z1:
+    case Lib::SER_SEND_Z1: {
+      // The library reads *cc now and buf[0] .. buf[*cc - 1] as it sends:
+      // a pointer into the null page or past memory faults the robot here,
+      // as the program's own access through it would.
+      if (!checkAccess(a[1], 1, instructionPc)) return;
+      const uint8_t count = rd8(a[1]);
+      if (count > 0 && !checkAccess(a[0], count, instructionPc)) return;
       bus->serialSend(now, static_cast<uint16_t>(a[0]), static_cast<uint16_t>(a[1]));
       return;
+    }
     case Lib::HV_ENB:
       bus->hvEnable(now);
       return;
