@@ -249,6 +249,13 @@ Type* Parser::structDecl(bool isUnion) {
     VarAttr attr;
     Type* base = declspec(&attr);
     if (attr.sawStorage || attr.isInterrupt) fail(cur().pos, "storage class in a struct member");
+    // C89's member declaration names at least one member; C11's anonymous
+    // struct or union member (which Dynamic C did not have) would vanish.
+    if (is(";")) {
+      if (isStructLike(base) && base->tag.empty())
+        fail(cur().pos, "anonymous struct or union members are not supported; name the member");
+      fail(cur().pos, "expected member name");
+    }
     for (bool first = true; !accept(";"); first = false) {
       if (!first) expect(",");
       Declarator d;
@@ -259,7 +266,7 @@ Type* Parser::structDecl(bool isUnion) {
         fail(d.pos, "member '" + d.name + "' declared as a function");
       if (d.type->kind == TypeKind::Void || (isStructLike(d.type) && !d.type->complete) ||
           (d.type->kind == TypeKind::Array && d.type->arrayLen < 0))
-        fail(d.pos, "member '" + d.name + "' has incomplete type");
+        incomplete(d.pos, d.type, "member '" + d.name + "' has incomplete type");
       if (t->members.size() >= kMaxMembers)
         fail(d.pos, fmt::format("too many members in one {} (at most {})", word, kMaxMembers));
       for (const Member& m : t->members)
@@ -614,7 +621,7 @@ void Parser::checkComplete(Obj* obj) {
   if (t->kind == TypeKind::Array && t->arrayLen < 0)
     fail(obj->pos, "array size missing in '" + obj->name + "'");
   if (isStructLike(t) && !t->complete)
-    fail(obj->pos, "storage size of '" + obj->name + "' is not known");
+    incomplete(obj->pos, t, "storage size of '" + obj->name + "' is not known");
 }
 
 // global-variable = declarator ("=" initializer)?
@@ -830,7 +837,8 @@ void Parser::arrayInitializer(Init* init, bool braced) {
 // struct-initializer = the members in order (a union: its first member)
 void Parser::structInitializer(Init* init, bool braced) {
   Type* ty = init->type;
-  if (!ty->complete) fail(cur().pos, "initializing an incomplete type '" + typeName(ty) + "'");
+  if (!ty->complete)
+    incomplete(cur().pos, ty, "initializing an incomplete type '" + typeName(ty) + "'");
   size_t n =
       ty->kind == TypeKind::Union ? std::min<size_t>(1, ty->members.size()) : ty->members.size();
   for (size_t i = 0;; ++i) {

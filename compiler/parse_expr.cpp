@@ -274,7 +274,8 @@ Node* Parser::unary() {
     }
     if (ty->kind == TypeKind::Void || ty->kind == TypeKind::Func ||
         (isStructLike(ty) && !ty->complete) || (ty->kind == TypeKind::Array && ty->arrayLen < 0))
-      fail(pos, "invalid application of 'sizeof' to an incomplete type '" + typeName(ty) + "'");
+      incomplete(pos, ty,
+                 "invalid application of 'sizeof' to an incomplete type '" + typeName(ty) + "'");
     return num(ty->size, tyUInt(), pos);
   }
   return postfix();

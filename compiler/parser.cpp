@@ -171,7 +171,7 @@ Type* Parser::arrayOf(Type* base, int len, Pos pos) {
   if (base->kind == TypeKind::Func) fail(pos, "array of functions is not allowed");
   if (base->kind == TypeKind::Void) fail(pos, "array has incomplete element type 'void'");
   if (isStructLike(base) && !base->complete)
-    fail(pos, "array has incomplete element type '" + typeName(base) + "'");
+    incomplete(pos, base, "array has incomplete element type '" + typeName(base) + "'");
   if (base->kind == TypeKind::Array && base->arrayLen < 0)
     fail(pos, "array has incomplete element type '" + typeName(base) + "'");
   int64_t size = static_cast<int64_t>(base->size) * (len < 0 ? 0 : len);
@@ -364,6 +364,11 @@ void Parser::poisonSince(size_t token) {
     if (depth == 0 && !inInit && t.kind == TokKind::Ident && !isKeyword(t))
       poisoned_.insert(t.text);
   }
+}
+
+void Parser::incomplete(Pos pos, const Type* t, std::string message) {
+  const bool followsAnError = isStructLike(t) && !t->tag.empty() && poisoned_.count(t->tag) > 0;
+  throw CompileError{pos, std::move(message), followsAnError};
 }
 
 // Reported once per function, as gcc does: the other uses say nothing new.

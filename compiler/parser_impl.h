@@ -173,6 +173,9 @@ class Parser {
   void skipStatement(const Resume& r);
   void skipExternalDeclaration();
   void poisonSince(size_t token);
+  // An error about `t` being incomplete; silent when `t` is a struct or
+  // union whose own declaration failed (reported there already).
+  [[noreturn]] void incomplete(Pos pos, const Type* t, std::string message);
   bool atFunctionDefinition();
   [[noreturn]] void undeclared(Pos pos, const std::string& name, const std::string& message);
 

@@ -557,7 +557,8 @@ bool Parser::isLvalue(const Node* n) const {
 
 Node* Parser::newAssign(Node* l, Node* r, Pos pos) {
   if (!isLvalue(l) || l->type->kind == TypeKind::Array) fail(pos, "expression is not assignable");
-  if (isStructLike(l->type) && !l->type->complete) fail(pos, "assignment to an incomplete type");
+  if (isStructLike(l->type) && !l->type->complete)
+    incomplete(pos, l->type, "assignment to an incomplete type");
   Node* n = newNode(NodeKind::Assign, pos, l->type);
   n->lhs = l;
   n->rhs = assignConvert(r, l->type, pos, "assignment");
@@ -643,7 +644,7 @@ Node* Parser::member(Node* base, const Token& name, Pos pos) {
   Type* t = base->type;
   if (!isStructLike(t))
     fail(pos, "member reference base type '" + typeName(t) + "' is not a struct or union");
-  if (!t->complete) fail(pos, "incomplete definition of type '" + typeName(t) + "'");
+  if (!t->complete) incomplete(pos, t, "incomplete definition of type '" + typeName(t) + "'");
   if (name.kind != TokKind::Ident) fail(name.pos, "expected member name");
   for (const Member& m : t->members) {
     if (m.name == name.text) {

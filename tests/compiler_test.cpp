@@ -704,6 +704,27 @@ TEST(CompilerDiagnostics, NoCascadeAfterAFailedDeclaration) {
   EXPECT_TRUE(r.warnings.empty());
 }
 
+TEST(CompilerDiagnostics, AnonymousMemberIsRefusedOnceAndItsStructNotAgain) {
+  // C11's anonymous struct member (Dynamic C had none) is refused where it
+  // is, col 36 (the ';' after its '}'), and the struct it was in, which
+  // stays incomplete, is not reported again at each use: the object of its
+  // type (line 2), sizeof and a member access (line 3). A struct never
+  // declared still is (line 4, col 10).
+  Result r = compile(
+      "struct s { int a; struct { int b; }; };\n"
+      "struct s v;\n"
+      "main() { v.a = 1; printf(\"%d\", sizeof(struct s)); }\n"
+      "struct q w;\n",
+      "a.dc");
+  ASSERT_EQ(r.errors.size(), 2u);
+  EXPECT_EQ(r.errors[0].format().rfind(
+                "a.dc:1:36: error: anonymous struct or union members are not supported", 0),
+            0u)
+      << r.errors[0].format();
+  EXPECT_EQ(r.errors[1].format().rfind("a.dc:4:10: error: storage size of 'w' is not known", 0), 0u)
+      << r.errors[1].format();
+}
+
 TEST(CompilerDiagnostics, MissingCloseBraceEndsAtTheNextFunction) {
   // main's '}' is missing: one error, just after the last '}' read (line 6,
   // col 2), and platform() and the handler parse as functions of their own.
