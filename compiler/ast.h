@@ -65,6 +65,10 @@ struct Type {
   std::vector<Param> params;
   bool hasProto = false;  // parameter types known
   bool krNames = false;   // K&R identifier list: types come after ")"
+  // "..." after the parameters: accepted in declarations of the library's
+  // variadic routines only (printf); ellipsisPos says where, for the error.
+  bool variadic = false;
+  Pos ellipsisPos;
 };
 
 // The basic types are shared immutable singletons.

@@ -45,7 +45,7 @@ void Parser::externalDeclaration() {
       }
       if (d.type->krNames && !d.type->params.empty())
         fail(d.pos, "parameter names without types in a function declaration");
-      declareFunction(d, attr);
+      if (!libraryDeclaration(d)) declareFunction(d, attr);
     } else {
       if (attr.isInterrupt) fail(d.pos, "'interrupt' applies only to functions");
       globalVariable(d, attr);
@@ -419,7 +419,14 @@ Type* Parser::funcParams(Type* ret) {
   }
   fn->hasProto = true;
   for (;;) {
-    if (is("...")) fail(cur().pos, "variadic functions are not supported");
+    if (is("...")) {
+      if (fn->params.empty()) fail(cur().pos, "expected a named parameter before '...'");
+      fn->variadic = true;
+      fn->ellipsisPos = cur().pos;
+      advance();
+      expect(")");
+      return fn;
+    }
     Pos ppos = cur().pos;
     if (fn->params.size() >= kMaxParameters)
       fail(ppos, fmt::format("too many parameters (at most {})", kMaxParameters));
@@ -480,7 +487,92 @@ void Parser::typedefs(Type* base, Declarator& first) {
 
 // A function declaration or the head of its definition: finds or creates the
 // one Function object for the name (file scope) and checks compatibility.
+namespace {
+
+// A type as one of builtins.def's type letters ('?': none fits).
+char typeLetter(const Type* t) {
+  switch (t->kind) {
+    case TypeKind::Void:
+      return 'v';
+    case TypeKind::Char:
+      return 'c';
+    case TypeKind::Int:
+      return 'i';
+    case TypeKind::UInt:
+      return 'u';
+    case TypeKind::Long:
+      return 'l';
+    case TypeKind::Float:
+      return 'f';
+    case TypeKind::Ptr:
+    case TypeKind::Array:
+      return 'p';
+    default:
+      return '?';
+  }
+}
+
+// int and unsigned are the same 16-bit word to a routine.
+bool lettersAgree(char declared, char library) {
+  const auto word = [](char c) { return c == 'i' || c == 'u'; };
+  return declared == library || (word(declared) && word(library));
+}
+
+std::string letterName(char c) {
+  switch (c) {
+    case 'v':
+      return "void";
+    case 'c':
+      return "char";
+    case 'i':
+      return "int";
+    case 'u':
+      return "unsigned";
+    case 'l':
+      return "long";
+    case 'f':
+      return "float";
+    default:
+      return "a pointer";
+  }
+}
+
+}  // namespace
+
+// A declaration of a library routine without a body: K&R's "char
+// *strcpy();", or a prototype, "extern int printf(const char *, ...);". It
+// declares nothing new (calls still reach the routine) when it agrees with
+// the routine: the same result and, for a prototype, the same parameters
+// (int and unsigned alike, any pointer for a pointer, "..." where the
+// routine is variadic). Otherwise an error naming both. False if `d` names
+// no library routine.
+bool Parser::libraryDeclaration(const Declarator& d) {
+  const vm::LibInfo* info = nullptr;
+  for (int i = 0; i < vm::kLibCount; ++i)
+    if (vm::kLibInfo[i].name == d.name) info = &vm::kLibInfo[i];
+  if (!info) return false;
+  const Type* fn = d.type;
+  std::string_view args = info->args;
+  const bool variadic = !args.empty() && args.back() == '.';
+  if (variadic) args.remove_suffix(1);
+  bool agrees = lettersAgree(typeLetter(fn->base), info->result);
+  if (fn->hasProto) {
+    agrees = agrees && fn->params.size() == args.size() && fn->variadic == variadic;
+    for (size_t k = 0; agrees && k < args.size(); ++k)
+      agrees = lettersAgree(typeLetter(fn->params[k].type), args[k]);
+  }
+  if (!agrees) {
+    std::string takes;
+    for (size_t k = 0; k < args.size(); ++k) takes += (k ? ", " : "") + letterName(args[k]);
+    if (variadic) takes += ", ...";
+    fail(d.pos, "declaration of '" + d.name + "' does not agree with the library's " + d.name +
+                    ": returns " + letterName(info->result) + ", takes (" + takes + ")");
+  }
+  return true;
+}
+
 Function* Parser::declareFunction(Declarator& d, const VarAttr& attr) {
+  if (d.type->variadic) fail(d.type->ellipsisPos, "variadic functions are not supported");
   Scope& file = scopes_[1];
   auto it = file.vars.find(d.name);
   if (it != file.vars.end()) {
@@ -676,7 +768,7 @@ void Parser::localDeclaration(std::vector<Node*>& out) {
   for (;;) {
     if (!d.hasName) fail(d.pos, "expected identifier");
     if (d.type->kind == TypeKind::Func) {
-      declareFunction(d, attr);
+      if (!libraryDeclaration(d)) declareFunction(d, attr);
     } else if (attr.isExtern) {
       // Refers to the global of that name.
       ScopeEntry* g = nullptr;

@@ -173,6 +173,7 @@ class Parser {
   void skipStatement(const Resume& r);
   void skipExternalDeclaration();
   void poisonSince(size_t token);
+  bool libraryDeclaration(const Declarator& d);
   // An error about `t` being incomplete; silent when `t` is a struct or
   // union whose own declaration failed (reported there already).
   [[noreturn]] void incomplete(Pos pos, const Type* t, std::string message);

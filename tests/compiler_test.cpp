@@ -845,6 +845,32 @@ TEST(CompilerWarnings, SendWithoutDelay) {
             Strings{});
 }
 
+// A declaration of a library routine must agree with it (the program
+// tests/programs/library_declarations.dc shows the ones that do); "..." is
+// for the library's printf only.
+TEST(CompilerErrors, LibraryDeclarationsMustAgree) {
+  const auto first = [](const std::string& source) {
+    const auto r = compile(source, "l.dc");
+    return r.errors.empty() ? std::string("<none>") : r.errors[0].format();
+  };
+  EXPECT_EQ(first("int strcpy();\nmain() { }\n")
+                .rfind("l.dc:1:5: error: declaration of 'strcpy' does not agree with the library's "
+                       "strcpy: returns a pointer, takes (a pointer, a pointer)",
+                       0),
+            0u);
+  EXPECT_EQ(first("int printf(char *);\nmain() { }\n")
+                .rfind("l.dc:1:5: error: declaration of 'printf' does not agree with the library's "
+                       "printf: returns int, takes (a pointer, ...)",
+                       0),
+            0u);
+  EXPECT_EQ(first("int f(int a, ...);\nmain() { }\n")
+                .rfind("l.dc:1:14: error: variadic functions are not supported", 0),
+            0u);
+  EXPECT_EQ(first("int g(...);\nmain() { }\n")
+                .rfind("l.dc:1:7: error: expected a named parameter before '...'", 0),
+            0u);
+}
+
 // C89 (3.8.6): an unknown pragma is ignored; simbot says so.
 TEST(CompilerWarnings, UnknownPragma) {
   EXPECT_EQ(warned("#pragma pack(1)\nmain() { }\n"), Strings{"1:1 unknown-pragma"});
