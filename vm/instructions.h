@@ -639,9 +639,11 @@ SIMBOT_INSTRUCTION(COSTATE) {
   wr8(cd + kCoState, state & ~kCoInit);
   const uint32_t resume = rd16(cd + kCoLastLoc);
   if (resume == 0) {
-    // JR Z taken over JP (HL). (The clock was saved before this delta: it
-    // reaches the profile only. Issue 24: the documented cost is charged.)
+    // JR Z taken over JP (HL): the documented 84 T-states of a fresh entry.
+    // (save(r) above copied the clock out of the registers: the delta goes
+    // to `now`, which the boundary after this instruction runs on.)
     const int32_t d = costs.branchDelta[static_cast<int>(Op::COSTATE)][2];
+    now += d;
     if (r.profile) r.profile[r.opPc] += static_cast<uint64_t>(int64_t{d});
   } else {
     if (coChecksum(resume, rd8(cd + kCoLastLocCbr)) != rd8(cd + kCoChkSum)) {
