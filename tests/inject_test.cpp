@@ -94,9 +94,11 @@ TEST(Inject, EdgeAtATickInterruptsTheDelayLoopExactly) {
   const vm::Tick handlerTime = returned->at("t").get<vm::Tick>() - acceptedAt;
   const std::string line = "20000 " + std::to_string(zAtBoundary) + " 1";
   EXPECT_EQ(injected.result.robots[0].console, std::vector<std::string>{line});
+  // Per character: the debug port's 1,600 T-states and printf's own 52 (see
+  // DelayLoop.PrintfChargesEachCharacter in timing_test.cpp).
   const vm::Tick longerPrintf =
       static_cast<vm::Tick>(line.size() - std::string("20000 0 0").size()) *
-      vm::calibratedKnobs().printfCharTstates;
+      (vm::calibratedKnobs().printfCharTstates + 52);
   EXPECT_EQ(injected.result.robots[0].exitTick,
             plain.result.robots[0].exitTick + handlerTime + longerPrintf);
   EXPECT_EQ(injected.result.robots[0].interrupts.at("pio_a"), 1u);

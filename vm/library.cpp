@@ -255,7 +255,10 @@ void Vm::State::libBegin() {
       lib.text = formatPrintf(instructionPc);
       if (fault) return;
       lib.result = w(static_cast<int32_t>(lib.text.size()));
-      lib.remaining = static_cast<uint32_t>(lib.text.size()) * costs.printfChar;
+      // Per character: the routine's own loop (builtins.def's step sequence)
+      // and the debug port's time for it (knob printf_char_tstates).
+      lib.remaining = static_cast<uint32_t>(lib.text.size()) *
+                      (costs.libStep[static_cast<int>(Lib::PRINTF)] + costs.printfChar);
       lib.active = true;
       return;
     case Lib::Count_:
