@@ -219,6 +219,26 @@ TEST(Disasm, ShowsEveryPathsTstates) {
   EXPECT_NE(text.find("        46/72  LIB      abs, 1 args"), std::string::npos) << text;
 }
 
+// The listing gives a RET what the VM charges it (RetPopsIxOnlyAfterEnter
+// below): in a function that began with ENTER (#class auto) RET also pops
+// IX, POP IX 12 + (12 x 2 + 10) / 20 = 13 and RET 9 + (9 x 2 + 10) / 20 =
+// 10 under the calibrated refresh: 23; in a static-class function 10. (It
+// listed 10 for both; issue 24.)
+TEST(Disasm, ARetAfterEnterShowsItsPopIx) {
+  const std::string text =
+      vm::disassemble(testkit::compileOrDie("int s(int a) { return a; }\n"
+                                            "#class auto\n"
+                                            "int f(int a) { int b; b = a; return b; }\n"
+                                            "main() { s(1); f(2); }\n"));
+  const auto retOf = [&](const std::string& function) {
+    const auto from = text.find("\n" + function + ":\n");
+    const auto ret = text.find("  RET", from);
+    return text.substr(text.rfind(' ', ret - 1) + 1, ret - text.rfind(' ', ret - 1) - 1);
+  };
+  EXPECT_EQ(retOf("s"), "10") << text;
+  EXPECT_EQ(retOf("f"), "23") << text;
+}
+
 TEST(Vm, RetPopsIxOnlyAfterEnter) {
   // CALL 16; RET 9 for a static-class function.
   {

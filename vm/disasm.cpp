@@ -132,8 +132,14 @@ std::string disassemble(const Image& img) {
   out += fmt::format("; {:<4}  {:>11}  {:<8} {}\n", "addr", "T-st", "op", "operands");
   int lastLine = -1;
   uint32_t at = 0;
+  // The function being listed began with ENTER (a #class auto frame): its
+  // RETs also pop IX, as the VM charges them.
+  bool autoFrame = false;
   while (at < img.code.size()) {
-    if (auto it = labels.find(at); it != labels.end()) out += fmt::format("\n{}:\n", it->second);
+    if (auto it = labels.find(at); it != labels.end()) {
+      out += fmt::format("\n{}:\n", it->second);
+      autoFrame = img.code[at] == static_cast<uint8_t>(Op::ENTER);
+    }
     const int line = img.lineAt(at);
     if (line != lastLine && line > 0) {
       const std::string text = line <= static_cast<int>(img.sourceLines.size())
@@ -157,7 +163,10 @@ std::string disassemble(const Image& img) {
     std::string operands = operandText(info(op).shape, img, at + 1);
     const std::string note = annotate(img, op, at + 1);
     if (!note.empty()) operands += fmt::format("  ({})", note);
-    const std::string cost = costText(costs, op, img, at + 1);
+    const std::string cost =
+        op == Op::RET && autoFrame
+            ? fmt::format("{}", costs.op[static_cast<int>(op)] + costs.autoFrameRet)
+            : costText(costs, op, img, at + 1);
     out += fmt::format("  {:04x}  {:>11}  {:<8} {}\n", at, cost, info(op).name, operands);
     at += static_cast<uint32_t>(size);
   }
