@@ -23,7 +23,8 @@ namespace simbot::compiler {
 
 enum class TypeKind : uint8_t {
   Void,
-  Char,
+  Char,   // plain and unsigned char: 8-bit unsigned, as in Dynamic C
+  SChar,  // signed char: 8-bit two's complement
   Int,
   UInt,
   Long,
@@ -74,6 +75,7 @@ struct Type {
 // The basic types are shared immutable singletons.
 Type* tyVoid();
 Type* tyChar();
+Type* tySChar();
 Type* tyInt();
 Type* tyUInt();
 Type* tyLong();

@@ -25,6 +25,8 @@ inline vm::Symbol::Value symbolValue(const Type* t) {
   switch (t->kind) {
     case TypeKind::Char:
       return V::Char;
+    case TypeKind::SChar:
+      return V::SChar;
     case TypeKind::Int:
       return V::Int;
     case TypeKind::UInt:
@@ -56,12 +58,16 @@ struct Loc {
 };
 
 // How a value is represented for conversions.
-enum class Rep { Byte, WordS, WordU, LongS, LongU, Float, Other };
+// A signed char's slot holds its value sign-extended to 16 bits (SXB after
+// every load), a char's zero-extended: both promote to int for free.
+enum class Rep { Byte, ByteS, WordS, WordU, LongS, LongU, Float, Other };
 
 inline Rep repOf(const Type* t) {
   switch (t->kind) {
     case TypeKind::Char:
       return Rep::Byte;
+    case TypeKind::SChar:
+      return Rep::ByteS;
     case TypeKind::Int:
       return Rep::WordS;
     case TypeKind::UInt:
@@ -77,6 +83,12 @@ inline Rep repOf(const Type* t) {
     default:
       return Rep::Other;
   }
+}
+
+// Which of a load or store family's byte, word and long forms fits `r`.
+inline int widthIndex(Rep r) {
+  if (r == Rep::Byte || r == Rep::ByteS) return 0;
+  return r == Rep::WordS || r == Rep::WordU ? 1 : 2;
 }
 
 inline bool isAggregate(const Type* t) { return t->kind == TypeKind::Array || isStructLike(t); }

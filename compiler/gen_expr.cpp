@@ -18,7 +18,7 @@ void CodeGen::load(const Loc& l, const Type* t, int line) {
     return;
   }
   Rep r = repOf(t);
-  int w = r == Rep::Byte ? 0 : (r == Rep::WordS || r == Rep::WordU) ? 1 : 2;
+  int w = widthIndex(r);
   static constexpr Op g[] = {Op::LDGB, Op::LDGW, Op::LDGL};
   static constexpr Op f[] = {Op::LDLB, Op::LDLW, Op::LDLL};
   static constexpr Op s[] = {Op::LDIB, Op::LDIW, Op::LDIL};
@@ -28,12 +28,13 @@ void CodeGen::load(const Loc& l, const Type* t, int line) {
     emitU16(f[w], l.addr, line);
   else
     emit(s[w], line);
+  if (r == Rep::ByteS) emit(Op::SXB, line);
 }
 
 // Stores the value on top; `keep` leaves it there (DUP or the STIxK form).
 void CodeGen::store(const Loc& l, const Type* t, bool keep, int line) {
   Rep r = repOf(t);
-  int w = r == Rep::Byte ? 0 : (r == Rep::WordS || r == Rep::WordU) ? 1 : 2;
+  int w = widthIndex(r);
   static constexpr Op g[] = {Op::STGB, Op::STGW, Op::STGL};
   static constexpr Op f[] = {Op::STLB, Op::STLW, Op::STLL};
   static constexpr Op s[] = {Op::STIB, Op::STIW, Op::STIL};
@@ -93,24 +94,24 @@ void CodeGen::convert(const Type* from, const Type* to, int line) {
   if (a == b || a == Rep::Other || b == Rep::Other) return;
   auto isWord = [](Rep r) { return r == Rep::WordS || r == Rep::WordU; };
   auto isLong = [](Rep r) { return r == Rep::LongS || r == Rep::LongU; };
-  if (b == Rep::Byte) {
+  if (b == Rep::Byte || b == Rep::ByteS) {
     if (isLong(a)) emit(Op::L2W, line);
     if (a == Rep::Float) emit(Op::F2W, line);
-    emit(Op::W2B, line);
+    emit(b == Rep::Byte ? Op::W2B : Op::SXB, line);
   } else if (isWord(b)) {
     if (isLong(a))
       emit(Op::L2W, line);
     else if (a == Rep::Float)
       emit(Op::F2W, line);
   } else if (isLong(b)) {
-    if (a == Rep::WordS)
+    if (a == Rep::WordS || a == Rep::ByteS)
       emit(Op::W2L, line);
     else if (a == Rep::Byte || a == Rep::WordU)
       emit(Op::UW2L, line);
     else if (a == Rep::Float)
       emit(b == Rep::LongS ? Op::F2L : Op::F2UL, line);
   } else if (b == Rep::Float) {
-    if (a == Rep::WordS)
+    if (a == Rep::WordS || a == Rep::ByteS)
       emit(Op::W2F, line);
     else if (a == Rep::Byte || a == Rep::WordU)
       emit(Op::UW2F, line);
@@ -124,7 +125,7 @@ void CodeGen::convert(const Type* from, const Type* to, int line) {
 // The value to be stored into `target`. A byte store truncates by itself, so
 // the W2B of a conversion to char is dropped unless the value is kept.
 void CodeGen::storeValue(Node* rhs, const Type* target, bool keep) {
-  if (!keep && target->kind == TypeKind::Char && rhs->kind == NodeKind::Cast &&
+  if (!keep && slotOf(target) == Slot::Byte && rhs->kind == NodeKind::Cast &&
       (repOf(rhs->lhs->type) == Rep::WordS || repOf(rhs->lhs->type) == Rep::WordU)) {
     value(rhs->lhs);
     return;
@@ -464,7 +465,7 @@ void CodeGen::opAssign(Node* n, bool keep) {
   convert(t, n->opType, line);
   value(n->rhs);
   arithOp(n->op, n->opType, line);
-  if (!(t->kind == TypeKind::Char && !keep && repOf(n->opType) != Rep::Float &&
+  if (!(slotOf(t) == Slot::Byte && !keep && repOf(n->opType) != Rep::Float &&
         repOf(n->opType) != Rep::LongS && repOf(n->opType) != Rep::LongU))
     convert(n->opType, t, line);
   store(l, t, keep, line);
@@ -491,6 +492,7 @@ void CodeGen::incDec(Node* n, bool keep) {
     load(l, t, line);
     step();
     if (keep && r == Rep::Byte) emit(Op::W2B, line);
+    if (keep && r == Rep::ByteS) emit(Op::SXB, line);
     store(l, t, keep, line);
     return;
   }

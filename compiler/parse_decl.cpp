@@ -158,9 +158,11 @@ Type* Parser::declspec(VarAttr* attr) {
         ty = tyVoid();
         break;
       case CHAR:
-      case SIGNED + CHAR:
       case UNSIGNED + CHAR:
         ty = tyChar();
+        break;
+      case SIGNED + CHAR:
+        ty = tySChar();
         break;
       case SHORT:
       case SHORT + INT:
@@ -849,7 +851,7 @@ void Parser::initializer2(Init* init) {
   DepthGuard guard(*this);
   Type* ty = init->type;
   if (ty->kind == TypeKind::Array) {
-    bool charArray = ty->base->kind == TypeKind::Char;
+    bool charArray = ty->base->kind == TypeKind::Char || ty->base->kind == TypeKind::SChar;
     bool braced = is("{");
     if (charArray && (cur().kind == TokKind::String ||
                       (braced && peek(1).kind == TokKind::String &&

@@ -19,6 +19,7 @@ Type makeBasic(TypeKind k, int size) {
 }
 Type gVoid = makeBasic(TypeKind::Void, 1);
 Type gChar = makeBasic(TypeKind::Char, 1);
+Type gSChar = makeBasic(TypeKind::SChar, 1);
 Type gInt = makeBasic(TypeKind::Int, 2);
 Type gUInt = makeBasic(TypeKind::UInt, 2);
 Type gLong = makeBasic(TypeKind::Long, 4);
@@ -28,6 +29,7 @@ Type gFloat = makeBasic(TypeKind::Float, 4);
 
 Type* tyVoid() { return &gVoid; }
 Type* tyChar() { return &gChar; }
+Type* tySChar() { return &gSChar; }
 Type* tyInt() { return &gInt; }
 Type* tyUInt() { return &gUInt; }
 Type* tyLong() { return &gLong; }
@@ -37,6 +39,7 @@ Type* tyFloat() { return &gFloat; }
 bool isInteger(const Type* t) {
   switch (t->kind) {
     case TypeKind::Char:
+    case TypeKind::SChar:
     case TypeKind::Int:
     case TypeKind::UInt:
     case TypeKind::Long:
@@ -84,6 +87,7 @@ bool sameType(const Type* a, const Type* b) {
 Slot slotOf(const Type* t) {
   switch (t->kind) {
     case TypeKind::Char:
+    case TypeKind::SChar:
       return Slot::Byte;
     case TypeKind::Int:
     case TypeKind::UInt:
@@ -123,6 +127,8 @@ std::string typeName(const Type* t) {
       return "void";
     case TypeKind::Char:
       return "char";
+    case TypeKind::SChar:
+      return "signed char";
     case TypeKind::Int:
       return "int";
     case TypeKind::UInt:
@@ -172,6 +178,8 @@ int64_t wrapTo(int64_t v, const Type* t) {
   switch (t->kind) {
     case TypeKind::Char:
       return v & 0xFF;
+    case TypeKind::SChar:
+      return static_cast<int8_t>(static_cast<uint8_t>(v & 0xFF));
     case TypeKind::Int:
       return static_cast<int16_t>(static_cast<uint16_t>(v & 0xFFFF));
     case TypeKind::Long:
@@ -183,7 +191,9 @@ int64_t wrapTo(int64_t v, const Type* t) {
   }
 }
 
-Type* promote(Type* t) { return t->kind == TypeKind::Char ? tyInt() : t; }
+Type* promote(Type* t) {
+  return t->kind == TypeKind::Char || t->kind == TypeKind::SChar ? tyInt() : t;
+}
 
 // The usual arithmetic conversions.
 Type* commonType(Type* a, Type* b) {
@@ -450,6 +460,8 @@ void Parser::checkTypeLimits(NodeKind k, const Node* l, const Node* r, Pos pos) 
     switch (t->kind) {
       case TypeKind::Char:
         return {0, 0xFF};
+      case TypeKind::SChar:
+        return {-0x80, 0x7F};
       case TypeKind::Int:
         return {-0x8000, 0x7FFF};
       case TypeKind::UInt:

@@ -127,6 +127,9 @@ trace::Watch Robot::watchedValues() const {
       case V::Char:
         v = std::int64_t{board.cpu.read8(w.address)};
         break;
+      case V::SChar:
+        v = std::int64_t{static_cast<int8_t>(board.cpu.read8(w.address))};
+        break;
       case V::Int:
         v = std::int64_t{static_cast<int16_t>(board.cpu.read16(w.address))};
         break;

@@ -74,7 +74,18 @@ struct Symbol {
   // must take it: one of the scalars (Dynamic C's char is unsigned, int 16
   // bits, long 32, float IEEE single, pointers 16), or an aggregate (array,
   // struct, union); a function's is Code.
-  enum class Value : uint8_t { Char, Int, UInt, Long, ULong, Float, Pointer, Aggregate, Code };
+  enum class Value : uint8_t {
+    Char,
+    Int,
+    UInt,
+    Long,
+    ULong,
+    Float,
+    Pointer,
+    Aggregate,
+    Code,
+    SChar
+  };
   std::string name;  // for statics and autos: "function.name"
   Kind kind;
   uint32_t address;  // code address (functions), memory address (data),

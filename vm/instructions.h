@@ -321,6 +321,10 @@ SIMBOT_INSTRUCTION(W2B) {
   r.top() &= 0xFF;
   return true;
 }
+SIMBOT_INSTRUCTION(SXB) {
+  r.top() = static_cast<uint16_t>(static_cast<int8_t>(r.top() & 0xFF));
+  return true;
+}
 SIMBOT_INSTRUCTION(EQW) { return compare16<Op::EQW>(r); }
 SIMBOT_INSTRUCTION(NEW) { return compare16<Op::NEW>(r); }
 SIMBOT_INSTRUCTION(LTW) { return compare16<Op::LTW>(r); }
