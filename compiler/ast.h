@@ -188,7 +188,8 @@ enum class NodeKind : uint8_t {
   Deref,
   Addr,
   Member,
-  Call,
+  Call,     // callee: a direct call; else lhs: the function pointer called through
+  FuncRef,  // callee: a function designator, its value the function's address
   LibCall,
   Intrinsic,
   // statements
@@ -242,7 +243,7 @@ struct Node {
   bool prefix = false;          // IncDec
   bool parenthesized = false;   // written inside "( )" (no parentheses warning)
   int delta = 1;                // IncDec: +1 or -1
-  Function* callee = nullptr;   // Call
+  Function* callee = nullptr;   // Call (direct), FuncRef
   int lib = 0;                  // LibCall: builtin id; Intrinsic: 0 EI, 1 DI
   bool isDefault = false;       // Case
   std::vector<Node*> cases;     // Switch: its case and default labels

@@ -154,6 +154,12 @@ void CodeGen::writeInit(const Init* init, int a) {
     writeData(a, bits, 4);
     return;
   }
+  const Node* f = e;
+  while (f->kind == NodeKind::Cast && isPtrLike(f->type) && isPtrLike(f->lhs->type)) f = f->lhs;
+  if (t->size == 2 && f->kind == NodeKind::FuncRef) {  // written once functions are laid out
+    dataFixups_.emplace_back(a, f->callee);
+    return;
+  }
   Loc l;
   if (t->size == 2 && staticPtr(e, l) && l.kind == Loc::Global) {
     writeData(a, static_cast<uint64_t>(l.addr), 2);
@@ -255,6 +261,16 @@ vm::Image CodeGen::run() {
     img_.code[static_cast<size_t>(at)] = static_cast<uint8_t>(f->address & 0xFF);
     img_.code[static_cast<size_t>(at) + 1] = static_cast<uint8_t>(f->address >> 8);
   }
+  for (auto [at, f] : dataFixups_) writeData(at, static_cast<uint64_t>(f->address), 2);
+  // What a call through a pointer may reach: each function's entry and how
+  // many arguments its prologue pops (handlers are not callable).
+  for (Function* f : prog_.functions)
+    if (!f->isHandler)
+      img_.entries.push_back(vm::Image::Entry{static_cast<uint16_t>(f->address),
+                                              static_cast<uint8_t>(f->params.size())});
+  std::sort(
+      img_.entries.begin(), img_.entries.end(),
+      [](const vm::Image::Entry& a, const vm::Image::Entry& b) { return a.address < b.address; });
 
   for (const IntVecBinding& b : prog_.vectors)
     img_.vectors.push_back(vm::VectorBinding{static_cast<uint8_t>(b.vector),

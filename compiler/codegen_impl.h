@@ -165,6 +165,7 @@ class CodeGen {
   };
   std::vector<Label> labels_;
   std::vector<std::pair<int, Function*>> callFixups_;
+  std::vector<std::pair<int, Function*>> dataFixups_;  // function addresses in initialisers
   Function* fn_ = nullptr;
   Pos curPos_;
   std::vector<int> breaks_;

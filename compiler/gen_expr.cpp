@@ -329,6 +329,10 @@ void CodeGen::value(Node* n) {
     case NodeKind::Call:
       call(n);
       return;
+    case NodeKind::FuncRef:
+      emitU16(Op::PUSHW, 0, line);  // the address once functions are laid out
+      callFixups_.emplace_back(static_cast<int>(img_.code.size()) - 2, n->callee);
+      return;
     case NodeKind::LibCall:
       libCall(n);
       return;
@@ -346,6 +350,7 @@ void CodeGen::effect(Node* n) {
     case NodeKind::FNum:
     case NodeKind::Str:
     case NodeKind::Var:
+    case NodeKind::FuncRef:
       return;
     case NodeKind::Assign:
       assign(n, false);
@@ -542,6 +547,13 @@ void CodeGen::call(Node* n) {
   for (Node* a : n->list) value(a);
   int line = n->pos.line;
   curPos_ = n->pos;
+  if (!n->callee) {  // through a pointer: its value last, on top
+    value(n->lhs);
+    curPos_ = n->pos;
+    emit(Op::CALLI, line);
+    emitByte(static_cast<uint8_t>(n->list.size()), line);
+    return;
+  }
   emitU16(Op::CALL, 0, line);
   callFixups_.emplace_back(static_cast<int>(img_.code.size()) - 2, n->callee);
 }

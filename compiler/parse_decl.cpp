@@ -445,7 +445,7 @@ Type* Parser::funcParams(Type* ret) {
     declarator(base, d);
     Type* t = d.type;
     if (t->kind == TypeKind::Array) t = pointerTo(t->base, d.pos);
-    if (t->kind == TypeKind::Func) fail(d.pos, "function pointers are not supported");
+    if (t->kind == TypeKind::Func) t = pointerTo(t, d.pos);  // C89 3.7.1: adjusted
     if (t->kind == TypeKind::Void) fail(d.hasName ? d.pos : ppos, "parameter has void type");
     if (isStructLike(t))
       fail(d.hasName ? d.pos : ppos, "passing a struct by value is not supported");
@@ -549,10 +549,9 @@ std::string letterName(char c) {
 // routine is variadic). Otherwise an error naming both. False if `d` names
 // no library routine.
 bool Parser::libraryDeclaration(const Declarator& d) {
-  const vm::LibInfo* info = nullptr;
-  for (int i = 0; i < vm::kLibCount; ++i)
-    if (vm::kLibInfo[i].name == d.name) info = &vm::kLibInfo[i];
-  if (!info) return false;
+  const int lib = vm::libraryIndex(d.name);
+  if (lib < 0) return false;
+  const vm::LibInfo* info = &vm::kLibInfo[lib];
   const Type* fn = d.type;
   std::string_view args = info->args;
   const bool variadic = !args.empty() && args.back() == '.';
@@ -633,7 +632,7 @@ void Parser::functionDefinition(Declarator& d, const VarAttr& attr) {
           fail(pd.pos, "declaration for parameter '" + pd.name + "' but no such parameter");
         Type* t = pd.type;
         if (t->kind == TypeKind::Array) t = pointerTo(t->base, pd.pos);
-        if (t->kind == TypeKind::Func) fail(pd.pos, "function pointers are not supported");
+        if (t->kind == TypeKind::Func) t = pointerTo(t, pd.pos);
         if (t->kind == TypeKind::Void) fail(pd.pos, "parameter has void type");
         if (isStructLike(t)) fail(pd.pos, "passing a struct by value is not supported");
         p->type = t;

@@ -257,8 +257,7 @@ Node* Parser::unary() {
   if (accept("*")) return newDeref(cast(), pos);
   if (accept("&")) {
     Node* e = cast();
-    if (e->kind == NodeKind::Var && e->var->storage == Storage::Function)
-      fail(pos, "function pointers are not supported");
+    if (e->kind == NodeKind::FuncRef) return e;  // &f is f's address, as f is
     return newAddr(e, pos);
   }
   if (accept("++")) return newIncDec(unary(), 1, true, pos);
@@ -318,7 +317,22 @@ Node* Parser::postfix() {
       advance();
       n = newIncDec(n, -1, false, pos);
     } else if (t.is("(")) {
-      fail(pos, "called object is not a function");
+      // (f)(x), (*f)(x), (&f)(x): a direct call; anything else of
+      // pointer-to-function type is called through.
+      Node* target = n;
+      while (target->kind == NodeKind::Cast && target->type == target->lhs->type)
+        target = target->lhs;
+      if (target->kind == NodeKind::FuncRef) {
+        Token nameTok = t;
+        nameTok.text = target->callee->name;
+        nameTok.pos = n->pos;
+        n = funcall(nameTok, target->callee);
+      } else {
+        value(n);
+        if (n->type->kind != TypeKind::Ptr || n->type->base->kind != TypeKind::Func)
+          fail(pos, "called object of type '" + typeName(n->type) + "' is not a function");
+        n = callThrough(n, pos);
+      }
     } else {
       return n;
     }
@@ -398,15 +412,12 @@ Node* Parser::primary() {
     if (e->typeDef) fail(pos, "unexpected type name '" + nameTok.text + "'");
     if (e->isConst) return num(e->value, tyInt(), pos);
     Obj* o = e->var;
-    if (o->storage == Storage::Function) {
-      if (!is("("))
-        fail(pos, "function '" + nameTok.text +
-                      "' used as a value (function pointers are not supported)");
-      return funcall(nameTok, o->fn);
-    }
+    if (o->storage == Storage::Function)
+      return is("(") ? funcall(nameTok, o->fn) : funcRef(o->fn, pos);
     Node* n = newNode(NodeKind::Var, pos, o->type);
     n->var = o;
-    if (is("(")) fail(cur().pos, "called object '" + nameTok.text + "' is not a function");
+    if (is("(") && !(o->type->kind == TypeKind::Ptr && o->type->base->kind == TypeKind::Func))
+      fail(cur().pos, "called object '" + nameTok.text + "' is not a function");
     if (o->biosTimer) useTimer();
     return n;
   }
@@ -420,8 +431,7 @@ Node* Parser::primary() {
       n->lib = nameTok.text == "EI" ? 0 : 1;
       return n;
     }
-    for (int i = 0; i < vm::kLibCount; ++i)
-      if (vm::kLibInfo[i].name == nameTok.text) return libcall(nameTok, i);
+    if (const int lib = vm::libraryIndex(nameTok.text); lib >= 0) return libcall(nameTok, lib);
     // K&R: an undeclared function is "int f()".
     Declarator d;
     d.name = nameTok.text;
@@ -437,6 +447,10 @@ Node* Parser::primary() {
                       nameTok.text + "()'; declare it before this call)");
     return funcall(nameTok, f);
   }
+  if (vm::libraryIndex(nameTok.text) >= 0)
+    fail(pos, "library routine '" + nameTok.text +
+                  "' has no address in simbot (it is built into the VM); call it from a "
+                  "function of your own and take that one's address");
   undeclared(pos, nameTok.text, "undeclared identifier '" + nameTok.text + "'");
 }
 
@@ -445,27 +459,79 @@ Node* Parser::funcall(const Token& nameTok, Function* f) {
   Pos pos = nameTok.pos;
   if (f->isHandler) fail(pos, "cannot call interrupt function '" + f->name + "'");
   DepthGuard guard(*this);
-  advance();  // "("
   Node* n = newNode(NodeKind::Call, pos, f->type->base);
   n->callee = f;
-  if (!accept(")")) {
-    for (;;) {
-      n->argPos.push_back(cur().pos);
-      n->list.push_back(assign());
-      if (accept(")")) break;
-      if (cur().kind == TokKind::Eof) fail(after(prevPos_), "expected ')' at end of input");
-      expect(",");
-    }
-  }
+  callArguments(n);
   Type* ft = f->type;
   if (ft->hasProto) {
     checkCallAgainstDefinition(f, n, false);  // counts; arguments are converted below
   }
+  convertArguments(n, ft, "'" + f->name + "'");
+  if (!ft->hasProto) f->uncheckedCalls.push_back(n);
+  if (!f->called) {
+    f->called = true;
+    f->firstCall = pos;
+  }
+  return n;
+}
+
+// call-through = postfix "(" (assign ("," assign)*)? ")"   (postfix: a
+// pointer to a function). The callee is known only at run time: the VM
+// checks that the address is a function's first instruction and that it
+// takes as many arguments as were passed (a fault of the robot if not).
+Node* Parser::callThrough(Node* fp, Pos pos) {
+  DepthGuard guard(*this);
+  Type* ft = fp->type->base;
+  Node* n = newNode(NodeKind::Call, pos, ft->base);
+  n->lhs = fp;
+  n->depth = fp->depth + 1;
+  callArguments(n);
+  if (ft->hasProto && n->list.size() != ft->params.size())
+    fail(pos, fmt::format("too {} arguments in a call through '{}' (expected {}, got {})",
+                          n->list.size() > ft->params.size() ? "many" : "few", typeName(fp->type),
+                          ft->params.size(), n->list.size()));
+  if (n->list.size() > kMaxParameters)
+    fail(pos, fmt::format("too many arguments (at most {})", kMaxParameters));
+  convertArguments(n, ft, "the call through '" + typeName(fp->type) + "'");
+  if (n->depth > kMaxTreeDepth) fail(pos, "expression too complex");
+  return n;
+}
+
+// A function designator not called: its address (C89 3.2.2.1).
+Node* Parser::funcRef(Function* f, Pos pos) {
+  if (f->isHandler)
+    fail(pos, "cannot take the address of interrupt function '" + f->name +
+                  "' (it returns with RETI; bind it to a vector with #INT_VEC)");
+  Node* n = newNode(NodeKind::FuncRef, pos, pointerTo(f->type, pos));
+  n->callee = f;
+  if (!f->called) {  // it must be defined, as a called one must
+    f->called = true;
+    f->firstCall = pos;
+  }
+  return n;
+}
+
+// "(" (assign ("," assign)*)? ")" into n->list, with each one's position.
+void Parser::callArguments(Node* n) {
+  advance();  // "("
+  if (accept(")")) return;
+  for (;;) {
+    n->argPos.push_back(cur().pos);
+    n->list.push_back(assign());
+    if (accept(")")) return;
+    if (cur().kind == TokKind::Eof) fail(after(prevPos_), "expected ')' at end of input");
+    expect(",");
+  }
+}
+
+// Each argument as if assigned to its parameter (a prototype), or with the
+// default promotions (none).
+void Parser::convertArguments(Node* n, Type* ft, const std::string& to) {
   for (size_t i = 0; i < n->list.size(); ++i) {
     Node* a = value(n->list[i]);
     if (ft->hasProto) {
       n->list[i] = assignConvert(a, ft->params[i].type, n->argPos[i],
-                                 "argument " + std::to_string(i + 1) + " to '" + f->name + "'");
+                                 "argument " + std::to_string(i + 1) + " to " + to);
     } else {
       if (isStructLike(a->type)) fail(n->argPos[i], "passing a struct by value is not supported");
       if (a->type->kind == TypeKind::Array)
@@ -474,12 +540,6 @@ Node* Parser::funcall(const Token& nameTok, Function* f) {
     }
     n->depth = std::max(n->depth, n->list[i]->depth + 1);
   }
-  if (!ft->hasProto) f->uncheckedCalls.push_back(n);
-  if (!f->called) {
-    f->called = true;
-    f->firstCall = pos;
-  }
-  return n;
 }
 
 // libcall = builtin-name "(" (assign ("," assign)*)? ")"

@@ -159,7 +159,8 @@ Type* Parser::newType(TypeKind k, int size) {
 }
 
 Type* Parser::pointerTo(Type* base, Pos pos) {
-  if (base->kind == TypeKind::Func) fail(pos, "function pointers are not supported");
+  if (base->kind == TypeKind::Func && base->variadic)
+    fail(base->ellipsisPos, "variadic functions are not supported");
   Type* t = newType(TypeKind::Ptr, 2);
   t->base = base;
   t->depth = base->depth + 1;

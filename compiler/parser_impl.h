@@ -199,6 +199,10 @@ class Parser {
   Node* postfix();
   Node* primary();
   Node* funcall(const Token& nameTok, Function* f);
+  Node* callThrough(Node* fp, Pos pos);
+  Node* funcRef(Function* f, Pos pos);
+  void callArguments(Node* n);
+  void convertArguments(Node* n, Type* ft, const std::string& to);
   Node* libcall(const Token& nameTok, int lib);
   int64_t constExpr(Type** type = nullptr);
 

@@ -399,7 +399,8 @@ Node* Parser::arith(NodeKind k, Node* l, Node* r, Pos pos) {
 // p + i, p - i: the index is scaled by the element size here.
 Node* Parser::ptrOffset(NodeKind k, Node* p, Node* i, Pos pos) {
   Type* elem = p->type->base;
-  if (elem->kind == TypeKind::Func || (isStructLike(elem) && !elem->complete))
+  if (elem->kind == TypeKind::Func) fail(pos, "arithmetic on a pointer to a function");
+  if (isStructLike(elem) && !elem->complete)
     fail(pos, "arithmetic on a pointer to an incomplete type");
   int size = elem->kind == TypeKind::Void ? 1 : elem->size;
   Node* idx = castTo(i, tyInt(), pos);
@@ -423,6 +424,8 @@ Node* Parser::newSub(Node* l, Node* r, Pos pos) {
   if (isArith(l->type) && isArith(r->type)) return arith(NodeKind::Sub, l, r, pos);
   if (isPtrLike(l->type) && isInteger(r->type)) return ptrOffset(NodeKind::Sub, l, r, pos);
   if (isPtrLike(l->type) && isPtrLike(r->type)) {
+    if (l->type->base->kind == TypeKind::Func || r->type->base->kind == TypeKind::Func)
+      fail(pos, "arithmetic on a pointer to a function");
     int ls = l->type->base->kind == TypeKind::Void ? 1 : l->type->base->size;
     int rs = r->type->base->kind == TypeKind::Void ? 1 : r->type->base->size;
     if (ls != rs) badOperands(NodeKind::Sub, l, r, pos);
@@ -588,6 +591,7 @@ Node* Parser::newOpAssign(NodeKind op, Node* l, Node* r, Pos pos) {
   if ((op == NodeKind::Add || op == NodeKind::Sub) && l->type->kind == TypeKind::Ptr) {
     if (!isInteger(r->type)) badOperands(op, l, r, pos);
     Type* elem = l->type->base;
+    if (elem->kind == TypeKind::Func) fail(pos, "arithmetic on a pointer to a function");
     int size = elem->kind == TypeKind::Void ? 1 : elem->size;
     Node* idx = castTo(r, tyInt(), pos);
     if (size != 1) idx = binary(NodeKind::Mul, idx, num(size, tyInt(), pos), pos, tyInt());
@@ -620,6 +624,7 @@ Node* Parser::newIncDec(Node* e, int delta, bool prefix, Pos pos) {
   n->prefix = prefix;
   if (e->type->kind == TypeKind::Ptr) {
     Type* elem = e->type->base;
+    if (elem->kind == TypeKind::Func) fail(pos, "arithmetic on a pointer to a function");
     if (isStructLike(elem) && !elem->complete)
       fail(pos, "arithmetic on a pointer to an incomplete type");
     delta *= elem->kind == TypeKind::Void ? 1 : elem->size;
@@ -634,6 +639,16 @@ Node* Parser::newDeref(Node* e, Pos pos) {
   if (!isPtrLike(e->type))
     fail(pos, "cannot dereference a non-pointer ('" + typeName(e->type) + "')");
   Type* base = e->type->base;
+  if (base->kind == TypeKind::Func) {
+    // *fp designates the function, which is converted straight back to its
+    // address (C89 3.3.3.2, 3.2.2.1): (*fp)(x) calls fp. An rvalue, so
+    // "*fp = g" is not an assignment to fp.
+    Node* n = newNode(NodeKind::Cast, pos, e->type);
+    n->lhs = e;
+    n->depth = e->depth + 1;
+    if (n->depth > kMaxTreeDepth) fail(pos, "expression too complex");
+    return n;
+  }
   if (base->kind == TypeKind::Void) fail(pos, "dereferencing a 'void *' pointer");
   Node* n = newNode(NodeKind::Deref, pos, base);
   n->lhs = e;

@@ -106,4 +106,11 @@ inline constexpr LibInfo kLibInfo[] = {
 
 constexpr const LibInfo& info(Lib lib) { return kLibInfo[static_cast<int>(lib)]; }
 
+// The library routine a program names, by its C name: its id, or -1.
+constexpr int libraryIndex(std::string_view name) {
+  for (int i = 0; i < kLibCount; ++i)
+    if (kLibInfo[i].name == name) return i;
+  return -1;
+}
+
 }  // namespace simbot::vm

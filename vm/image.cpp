@@ -1,5 +1,7 @@
 #include "vm/image.h"
 
+#include <algorithm>
+
 #include "vm/bytecode.h"
 
 namespace simbot::vm {
@@ -12,6 +14,12 @@ const Symbol* Image::functionAt(uint32_t codeAddress) const {
     if (s.address <= codeAddress && (!best || s.address > best->address)) best = &s;
   }
   return best;
+}
+
+const Image::Entry* Image::entryAt(uint32_t codeAddress) const {
+  auto it = std::lower_bound(entries.begin(), entries.end(), codeAddress,
+                             [](const Entry& e, uint32_t a) { return e.address < a; });
+  return it != entries.end() && it->address == codeAddress ? &*it : nullptr;
 }
 
 std::optional<uint32_t> Image::loopHead(int line) const {

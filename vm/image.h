@@ -125,6 +125,15 @@ struct Image {
     uint16_t exit;
   };
   std::vector<DelayLoop> delayLoops;
+  // The functions a call through a pointer (CALLI) may reach, by address:
+  // each one's first instruction and the arguments its prologue pops.
+  // Interrupt handlers are not among them.
+  struct Entry {
+    uint16_t address;
+    uint8_t params;
+  };
+  std::vector<Entry> entries;
+  const Entry* entryAt(uint32_t codeAddress) const;  // null: no function starts there
   // First code address of each function, for profiles and fault messages.
   const Symbol* functionAt(uint32_t codeAddress) const;
   int lineAt(uint32_t codeAddress) const {

@@ -543,6 +543,18 @@ SIMBOT_INSTRUCTION(CALL) {
   r.ip = r.u16();
   return true;
 }
+SIMBOT_INSTRUCTION(CALLI) {
+  const uint32_t target = r.pop() & 0xFFFF;
+  const uint32_t argc = r.code[r.opPc + 1];
+  const Image::Entry* entry = image->entryAt(target);
+  if (!entry || entry->params != argc) return badCallThrough(r, target, argc);
+  if (msp < stackLimit + kCallFrameBytes) return fail(r, "stack overflow");
+  if (r.esp > kEvalSlots - kEvalHeadroom) return fail(r, "stack overflow (expression stack)");
+  calls.push_back(CallFrame{static_cast<uint32_t>(r.ip), msp, mfp, false});
+  msp -= kCallFrameBytes;
+  r.ip = target;
+  return true;
+}
 SIMBOT_INSTRUCTION(ENTER) {
   const uint32_t size = r.u16();
   if (msp < stackLimit + size) return fail(r, "stack overflow");

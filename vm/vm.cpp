@@ -160,6 +160,28 @@ void Vm::State::timerService(uint32_t interruptedPc) {
 // calls out of the code are kTrap at decode, and a return address is at
 // most kCodePad - 1 past its end.
 
+// A call through a pointer that the chip would have made into the weeds: to
+// no function's first instruction, or with a count of arguments the
+// function's prologue does not pop (its stack would come back unbalanced).
+bool Vm::State::badCallThrough(const Regs& r, uint32_t target, uint32_t argc) {
+  save(r);
+  std::string message;
+  if (target == 0) {
+    message = "call through a null function pointer";
+  } else if (const Image::Entry* entry = image->entryAt(target)) {
+    const Symbol* f = image->functionAt(target);
+    message = fmt::format("call through a pointer to '{}' with {} argument{}; it takes {}",
+                          f ? f->name : "?", argc, argc == 1 ? "" : "s", entry->params);
+  } else {
+    const Symbol* f = image->functionAt(target);
+    message = fmt::format(
+        "call through a pointer to 0x{:04X}, which is not the start of a function", target);
+    if (f && target < f->address + f->size) message += fmt::format(" (it is inside '{}')", f->name);
+  }
+  raiseFault(std::move(message), r.pc());
+  return false;
+}
+
 int64_t Vm::State::relTargetAt(uint32_t address) const {
   return int64_t{address} + 3 + static_cast<int16_t>(le16(&padded[address + 1]));
 }
