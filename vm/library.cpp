@@ -3,9 +3,11 @@
 // one), its effect at the end of it, long routines (strcpy, printf...) one
 // unit per step with a boundary between steps; and the firsttime Delay
 // functions of costatements.
+#include <bit>
 #include <cstdio>
 #include <cstring>
 
+#include "vm/float_math.h"
 #include "vm/state.h"
 
 namespace simbot::vm {
@@ -23,6 +25,44 @@ bool Vm::State::delayDone(uint32_t cd, int32_t interval, uint32_t timerAddress,
 }
 
 // ---- library calls -------------------------------------------------------
+
+namespace {
+
+// MATH.LIB: float_math.h's bit-identical functions (y: the second argument).
+float mathLib(Lib id, float x, float y) {
+  switch (id) {
+    case Lib::SQRT:
+      return mathSqrt(x);
+    case Lib::SIN:
+      return mathSin(x);
+    case Lib::COS:
+      return mathCos(x);
+    case Lib::TAN:
+      return mathTan(x);
+    case Lib::ATAN:
+      return mathAtan(x);
+    case Lib::ASIN:
+      return mathAsin(x);
+    case Lib::ACOS:
+      return mathAcos(x);
+    case Lib::EXP:
+      return mathExp(x);
+    case Lib::LOG:
+      return mathLog(x);
+    case Lib::FLOOR:
+      return mathFloor(x);
+    case Lib::CEIL:
+      return mathCeil(x);
+    case Lib::ATAN2:
+      return mathAtan2(x, y);
+    case Lib::POW:
+      return mathPow(x, y);
+    default:
+      return mathFmod(x, y);
+  }
+}
+
+}  // namespace
 
 std::string Vm::State::formatPrintf(uint32_t instructionPc) {
   std::string out;
@@ -199,6 +239,23 @@ void Vm::State::libBegin() {
     }
     case Lib::FABS:
       eval[sp++] = a[0] & 0x7FFFFFFFu;
+      return;
+    case Lib::SQRT:
+    case Lib::SIN:
+    case Lib::COS:
+    case Lib::TAN:
+    case Lib::ATAN:
+    case Lib::ASIN:
+    case Lib::ACOS:
+    case Lib::EXP:
+    case Lib::LOG:
+    case Lib::FLOOR:
+    case Lib::CEIL:
+    case Lib::ATAN2:
+    case Lib::POW:
+    case Lib::FMOD:
+      eval[sp++] = std::bit_cast<uint32_t>(
+          mathLib(id, std::bit_cast<float>(a[0]), std::bit_cast<float>(a[1])));
       return;
     case Lib::DELAYMS:
     case Lib::DELAYSEC:
