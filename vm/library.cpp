@@ -64,10 +64,10 @@ float mathLib(Lib id, float x, float y) {
 
 }  // namespace
 
-std::string Vm::State::formatPrintf(uint32_t instructionPc) {
+std::string Vm::State::formatPrintf(uint32_t instructionPc, int formatArg) {
   std::string out;
-  uint32_t f = lib.args[0];
-  int next = 1;
+  uint32_t f = lib.args[formatArg];
+  int next = formatArg + 1;
   auto arg = [&]() -> uint32_t { return next < lib.argc ? lib.args[next++] : 0; };
   auto readString = [&](uint32_t a, size_t limit) {
     std::string s;
@@ -306,10 +306,26 @@ void Vm::State::libBegin() {
       return;
     case Lib::STRLEN:
     case Lib::STRCMP:
+    case Lib::STRNCMP:
+    case Lib::MEMCMP:
+    case Lib::STRCHR:
+    case Lib::ATOI:
+      lib.active = true;
+      return;
+    case Lib::STRCAT:
+    case Lib::STRNCPY:
+      lib.result = a[0] & 0xFFFF;
+      lib.mark = kNoMark;
+      lib.active = true;
+      return;
+    case Lib::SPRINTF:
+      lib.text = formatPrintf(instructionPc, 1);
+      if (fault) return;
+      lib.result = w(static_cast<int32_t>(lib.text.size()));
       lib.active = true;
       return;
     case Lib::PRINTF:
-      lib.text = formatPrintf(instructionPc);
+      lib.text = formatPrintf(instructionPc, 0);
       if (fault) return;
       lib.result = w(static_cast<int32_t>(lib.text.size()));
       // Per character: the routine's own loop (builtins.def's step sequence)
@@ -389,6 +405,100 @@ void Vm::State::libStep() {
           lib.result = w(x - y);
           finished = true;
         }
+        break;
+      }
+      case Lib::STRCAT: {
+        // First the end of dst (mark: where it is), then src copied there.
+        if (lib.mark == kNoMark) {
+          if (!checkAccess(a[0] + i, 1, lib.pc)) return;
+          if (rd8(a[0] + i) == 0) lib.mark = i;
+          break;
+        }
+        const uint32_t k = i - lib.mark - 1;
+        if (!checkAccess(a[1] + k, 1, lib.pc) || !checkAccess(a[0] + lib.mark + k, 1, lib.pc))
+          return;
+        const uint8_t c = rd8(a[1] + k);
+        wr8(a[0] + lib.mark + k, c);
+        finished = c == 0;
+        break;
+      }
+      case Lib::STRNCPY: {
+        // mark: where src ended (NUL from there on).
+        const uint32_t n = a[2] & 0xFFFF;
+        if (i >= n) {
+          finished = true;
+          continue;
+        }
+        uint8_t c = 0;
+        if (lib.mark == kNoMark) {
+          if (!checkAccess(a[1] + i, 1, lib.pc)) return;
+          c = rd8(a[1] + i);
+          if (c == 0) lib.mark = i;
+        }
+        if (!checkAccess(a[0] + i, 1, lib.pc)) return;
+        wr8(a[0] + i, c);
+        finished = i + 1 >= n;
+        break;
+      }
+      case Lib::STRNCMP:
+      case Lib::MEMCMP: {
+        const uint32_t n = a[2] & 0xFFFF;
+        if (i >= n) {
+          lib.result = 0;
+          finished = true;
+          continue;
+        }
+        if (!checkAccess(a[0] + i, 1, lib.pc) || !checkAccess(a[1] + i, 1, lib.pc)) return;
+        const int x = rd8(a[0] + i), y = rd8(a[1] + i);
+        if (x != y || (x == 0 && lib.id == Lib::STRNCMP)) {
+          lib.result = w(x - y);
+          finished = true;
+        } else if (i + 1 >= n) {
+          lib.result = 0;
+          finished = true;
+        }
+        break;
+      }
+      case Lib::STRCHR: {
+        if (!checkAccess(a[0] + i, 1, lib.pc)) return;
+        const uint8_t c = rd8(a[0] + i);
+        if (c == static_cast<uint8_t>(a[1])) {
+          lib.result = (a[0] + i) & 0xFFFF;
+          finished = true;
+        } else if (c == 0) {
+          lib.result = 0;
+          finished = true;
+        }
+        break;
+      }
+      case Lib::ATOI: {
+        // mark: 0 in the leading white space, 1 after a '-', 2 after '+'
+        // or a first digit; result: the value so far, 16-bit.
+        if (!checkAccess(a[0] + i, 1, lib.pc)) return;
+        const uint8_t c = rd8(a[0] + i);
+        if (lib.index == 0) lib.mark = 0;
+        if (lib.mark == 0 && (c == ' ' || (c >= '\t' && c <= '\r'))) break;
+        if (lib.mark == 0 && (c == '-' || c == '+')) {
+          lib.mark = c == '-' ? 1 : 2;
+          break;
+        }
+        if (c >= '0' && c <= '9') {
+          if (lib.mark == 0) lib.mark = 2;
+          const int32_t digit = c - '0';
+          const int32_t sofar = asInt16(lib.result);
+          lib.result = w(sofar * 10 + (lib.mark == 1 ? -digit : digit));
+          break;
+        }
+        finished = true;
+        break;
+      }
+      case Lib::SPRINTF: {
+        // The formatted text, then its NUL, one character a step.
+        const uint32_t dst = a[0] + i;
+        if (!checkAccess(dst, 1, lib.pc)) return;
+        finished = i >= lib.text.size();
+        wr8(dst, finished ? 0 : static_cast<uint8_t>(lib.text[i]));
+        if (finished) lib.text.clear();
         break;
       }
       case Lib::MEMSET:

@@ -42,6 +42,9 @@ inline constexpr long kMaxPrintfField = 127;
 inline constexpr uint32_t kCallFrameBytes = 4;
 inline constexpr uint32_t kInterruptFrameBytes = 14;
 
+// LibCall::mark before a routine's second phase has begun.
+inline constexpr uint32_t kNoMark = 0xFFFFFFFFu;
+
 struct LibCall {
   bool active = false;
   Lib id{};
@@ -55,6 +58,7 @@ struct LibCall {
   bool awaitingBegin = false;
   uint32_t index = 0;      // bytes processed
   uint32_t remaining = 0;  // T-states still to burn (A/D, printf)
+  uint32_t mark = 0;       // a routine's second phase: where it began
   uint32_t result = 0;
   std::string text;  // printf's formatted output
   bool operator==(const LibCall&) const = default;
@@ -441,7 +445,7 @@ struct Vm::State {
   void libBegin();
   void libStep();
   void libFinish(bool pushResult);
-  std::string formatPrintf(uint32_t instructionPc);
+  std::string formatPrintf(uint32_t instructionPc, int formatArg);
 
   template <bool kProfile>
   Stop run(Tick until);
