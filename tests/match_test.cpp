@@ -16,6 +16,7 @@
 #include "plant/plant.h"
 #include "support/records.h"
 #include "support/traced.h"
+#include "vm/bytecode.h"
 
 using namespace simbot;
 
@@ -431,6 +432,37 @@ TEST(Match, CostateHunterPlaysIcemanAndLatchesFrames) {
   EXPECT_EQ(a.framesRejected, 0);
   EXPECT_GT(a.shots, 0);
   EXPECT_GT(a.hits, 0);
+}
+
+// Issue 24's student program: the bearing to a remembered point with atan2
+// and sqrt, steered through a table of function pointers. It compiles with
+// no warning, its code calls through pointers and reaches the math
+// routines, and it plays a whole match against fig92 without a fault,
+// every frame latched (it waits for cc before each send).
+TEST(Match, BearingStudentProgramPlaysFig92) {
+  const std::string bearing = SIMBOT_SOURCE_DIR "/programs/bearing.dc";
+  const auto compiled = compiler::compileFile(bearing);
+  ASSERT_TRUE(compiled.image.has_value());
+  EXPECT_TRUE(compiled.warnings.empty())
+      << (compiled.warnings.empty() ? "" : compiled.warnings[0].format());
+  std::set<std::string> reached;
+  const auto& code = compiled.image->code;
+  for (uint32_t at = 0; at < code.size();) {
+    const auto op = static_cast<vm::Op>(code[at]);
+    if (op == vm::Op::CALLI) reached.insert("CALLI");
+    if (op == vm::Op::LIB) reached.insert(std::string(vm::kLibInfo[code[at + 1]].name));
+    at += static_cast<uint32_t>(vm::instructionSize(op));
+  }
+  EXPECT_TRUE(reached.count("CALLI") && reached.count("atan2") && reached.count("sqrt"));
+  const auto r = testkit::runTraced(
+      matchConfig({{"A", bearing, *compiled.image}, {"B", kFig92, compileFile(kFig92)}}, 180));
+  ASSERT_EQ(r.robots.size(), 2u);
+  const auto& a = r.robots[0];
+  EXPECT_FALSE(a.fault.has_value());
+  EXPECT_GT(a.framesLatched, 1000);
+  EXPECT_EQ(a.framesOverwritten, 0);
+  EXPECT_EQ(a.framesRejected, 0);
+  EXPECT_GT(a.shots, 0);
 }
 
 // Keeps only the trace records of the kinds listed (a 180-s match writes
