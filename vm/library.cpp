@@ -309,6 +309,7 @@ void Vm::State::libBegin() {
     case Lib::STRNCMP:
     case Lib::MEMCMP:
     case Lib::STRCHR:
+    case Lib::STRRCHR:
     case Lib::ATOI:
       lib.active = true;
       return;
@@ -469,6 +470,13 @@ void Vm::State::libStep() {
           lib.result = 0;
           finished = true;
         }
+        break;
+      }
+      case Lib::STRRCHR: {
+        if (!checkAccess(a[0] + i, 1, lib.pc)) return;
+        const uint8_t c = rd8(a[0] + i);
+        if (c == static_cast<uint8_t>(a[1])) lib.result = (a[0] + i) & 0xFFFF;
+        finished = c == 0;
         break;
       }
       case Lib::ATOI: {
