@@ -207,6 +207,48 @@ main()
   EXPECT_EQ(v.now() - before, 84);
 }
 
+// A paused named costatement (CoPause: STOPPED) goes no further than its
+// JP Z to the end: LD HL,nn 9 + BIT 0,(HL) 9 + JP Z taken 9 = 27 T-states
+// (vm/z180.def), + (27 x 2 + 10) / 20 = 3 of refresh: 30, from COSTATE to
+// the instruction after the costatement. The listing gives the three paths
+// as stopped / fresh / resumed, "30/84/85" (it gave "87/88/84/85", as if a
+// taken JP Z ran on through the sequence; issue 24).
+TEST(Costate, APausedEntryTakesItsStoppedSequence) {
+  const auto img = testkit::compileOrDie(R"(int n;
+main()
+{
+    costate walk {
+        n = 1;
+    }
+    CoPause(&walk);
+    costate walk {
+        n = 2;
+    }
+}
+)");
+  std::vector<uint32_t> entries;
+  for (uint32_t at = 0; at < img.code.size();
+       at += static_cast<uint32_t>(vm::instructionSize(static_cast<vm::Op>(img.code[at]))))
+    if (img.code[at] == static_cast<uint8_t>(vm::Op::COSTATE)) entries.push_back(at);
+  ASSERT_EQ(entries.size(), 2u);
+  const uint32_t second = entries[1];
+  const int16_t rel = static_cast<int16_t>(img.code[second + 3] | (img.code[second + 4] << 8));
+  const uint32_t end = second + static_cast<uint32_t>(vm::instructionSize(vm::Op::COSTATE)) +
+                       static_cast<uint32_t>(rel);
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  v.setBreakpoint(second);
+  v.setBreakpoint(end);
+  ASSERT_EQ(v.run(vm::kTicksPerSecond), vm::Stop::Breakpoint);
+  ASSERT_EQ(v.pc(), second);
+  const Tick before = v.now();
+  ASSERT_EQ(v.run(vm::kTicksPerSecond), vm::Stop::Breakpoint);
+  ASSERT_EQ(v.pc(), end);
+  EXPECT_EQ(v.now() - before, 30);
+  const std::string text = vm::disassemble(img);
+  EXPECT_NE(text.find("     30/84/85  COSTATE"), std::string::npos) << text;
+}
+
 // A CoData whose resume address is overwritten faults that robot, never the
 // host: the checksum no longer matches.
 TEST(Costate, CorruptedResumeAddressFaults) {

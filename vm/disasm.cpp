@@ -93,7 +93,11 @@ std::string annotate(const Image& img, Op op, uint32_t at) {
 //   "58/59/59/61"  two branches (the signed comparisons): both taken /
 //                  first only / second only / neither;
 //   "31/30+18n"    a loop of n passes (the 16-bit shifts): count 0, its
-//                  JR Z taken over the loop / n >= 1 passes.
+//                  JR Z taken over the loop / n >= 1 passes;
+//   "41+26n"       a library routine with an inner loop, n its units
+//                  (bytes, characters; ad_rd8: "+N" its conversion);
+//   "30/84/85"     COSTATE: stopped (paused or done) / entered fresh /
+//                  resumed.
 std::string costText(const CostTable& costs, Op op, const Image& img, uint32_t operandAt) {
   const int i = static_cast<int>(op);
   const auto path = [&](unsigned p) {
@@ -103,8 +107,22 @@ std::string costText(const CostTable& costs, Op op, const Image& img, uint32_t o
     const int id = img.code[operandAt];
     if (id >= kLibCount) return fmt::format("{}", costs.op[i]);
     const int64_t call = int64_t{costs.op[i]} + costs.libCall[id];
-    if (!libPathFromArguments(static_cast<Lib>(id))) return fmt::format("{}", call);
-    return fmt::format("{}/{}", call + costs.libTakenDelta[id], call);
+    std::string text = libPathFromArguments(static_cast<Lib>(id))
+                           ? fmt::format("{}/{}", call + costs.libTakenDelta[id], call)
+                           : fmt::format("{}", call);
+    // What the VM adds after the call sequence: the A/D conversion, or the
+    // inner loop once per unit (a printf character also the debug port's).
+    if (static_cast<Lib>(id) == Lib::AD_RD8) return text + fmt::format("+{}", costs.adConversion);
+    if (kLibInfo[id].unit.empty()) return text;
+    const uint32_t unit =
+        costs.libStep[id] + (static_cast<Lib>(id) == Lib::PRINTF ? costs.printfChar : 0);
+    return text + fmt::format("+{}n", unit);
+  }
+  if (op == Op::COSTATE) {
+    // Its JP Z leaves the sequence when taken: a STOPPED costatement costs
+    // kCostateStoppedSeq; the others go on to the JR Z, taken when fresh.
+    return fmt::format("{}/{}/{}", int64_t{costs.op[i]} + costs.costateStoppedDelta, path(2),
+                       path(0));
   }
   const SeqCost& seq = kOpSeqCost[i];
   if (seq.loops > 0) {
