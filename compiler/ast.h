@@ -135,6 +135,8 @@ struct Function {
   Pos defPos;
   bool called = false;
   Pos firstCall;
+  bool addressTaken = false;  // named as a value (a function pointer's)
+  Pos addressPos;
   std::vector<Node*> uncheckedCalls;  // calls made before the parameters were known
   // code generation
   int address = -1;

@@ -41,6 +41,9 @@ void CodeGen::store(const Loc& l, const Type* t, bool keep, int line) {
   static constexpr Op k[] = {Op::STIBK, Op::STIWK, Op::STILK};
   if (l.kind == Loc::Stack) {
     emit(keep ? k[w] : s[w], line);
+    // STIBK keeps the stored byte zero-extended; a signed char's value is
+    // its sign extension.
+    if (keep && r == Rep::ByteS) emit(Op::SXB, line);
     return;
   }
   if (keep) emit(Op::DUP, line);

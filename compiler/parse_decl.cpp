@@ -549,7 +549,7 @@ std::string letterName(char c) {
 // routine is variadic). Otherwise an error naming both. False if `d` names
 // no library routine.
 bool Parser::libraryDeclaration(const Declarator& d) {
-  const int lib = vm::libraryIndex(d.name);
+  const int lib = library(d.name);
   if (lib < 0) return false;
   const vm::LibInfo* info = &vm::kLibInfo[lib];
   const Type* fn = d.type;
@@ -592,7 +592,12 @@ Function* Parser::declareFunction(Declarator& d, const VarAttr& attr) {
     } else if (d.type->hasProto && !f->type->hasProto) {
       f->type = d.type;
     }
-    if (attr.isInterrupt) f->isHandler = true;
+    if (attr.isInterrupt) {
+      f->isHandler = true;
+      if (f->addressTaken)
+        fail(f->addressPos, "cannot take the address of interrupt function '" + f->name +
+                                "' (it returns with RETI; bind it to a vector with #INT_VEC)");
+    }
     return f;
   }
   Obj* o = newObj(d.name, d.type, d.pos, Storage::Function);

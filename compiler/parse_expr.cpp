@@ -431,7 +431,7 @@ Node* Parser::primary() {
       n->lib = nameTok.text == "EI" ? 0 : 1;
       return n;
     }
-    if (const int lib = vm::libraryIndex(nameTok.text); lib >= 0) return libcall(nameTok, lib);
+    if (const int lib = library(nameTok.text); lib >= 0) return libcall(nameTok, lib);
     // K&R: an undeclared function is "int f()".
     Declarator d;
     d.name = nameTok.text;
@@ -447,7 +447,7 @@ Node* Parser::primary() {
                       nameTok.text + "()'; declare it before this call)");
     return funcall(nameTok, f);
   }
-  if (vm::libraryIndex(nameTok.text) >= 0)
+  if (library(nameTok.text) >= 0)
     fail(pos, "library routine '" + nameTok.text +
                   "' has no address in simbot (it is built into the VM); call it from a "
                   "function of your own and take that one's address");
@@ -504,6 +504,10 @@ Node* Parser::funcRef(Function* f, Pos pos) {
                   "' (it returns with RETI; bind it to a vector with #INT_VEC)");
   Node* n = newNode(NodeKind::FuncRef, pos, pointerTo(f->type, pos));
   n->callee = f;
+  if (!f->addressTaken) {  // an interrupt function defined later is refused there
+    f->addressTaken = true;
+    f->addressPos = pos;
+  }
   if (!f->called) {  // it must be defined, as a called one must
     f->called = true;
     f->firstCall = pos;

@@ -204,6 +204,12 @@ class Parser {
   void callArguments(Node* n);
   void convertArguments(Node* n, Type* ft, const std::string& to);
   Node* libcall(const Token& nameTok, int lib);
+  // The library routine `name` names here, or -1: MATH.LIB's only after
+  // #use MATH.LIB.
+  int library(const std::string& name) const {
+    const int id = vm::libraryIndex(name);
+    return id >= 0 && vm::inMathLib(id) && !pp_.uses("math.lib") ? -1 : id;
+  }
   int64_t constExpr(Type** type = nullptr);
 
   // ---- typing helpers ----

@@ -401,6 +401,7 @@ void Preprocessor::directive(const Token& hash) {
     for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (std::find(kLibraries.begin(), kLibraries.end(), lower) == kLibraries.end())
       fail(line[0].pos, "unknown library '" + lib + "'");
+    if (!uses(lower)) used_.push_back(lower);
   } else if (name == "if" || name == "ifdef" || name == "ifndef") {
     if (conds_.size() >= kMaxCondDepth) fail(hash.pos, "nesting too deep");
     std::vector<Token> line = readLine();

@@ -7,6 +7,7 @@
 // bindings are collected for the end of compilation, when their handler
 // names can be resolved.
 #pragma once
+#include <algorithm>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -31,6 +32,11 @@ class Preprocessor {
   // The next token after preprocessing; Eof (repeatedly) at the end.
   Token next();
   const std::vector<IntVecDirective>& intVecs() const { return intVecs_; }
+  // Whether a #use or #include has named `library` (lower case, as
+  // "math.lib") so far.
+  bool uses(std::string_view library) const {
+    return std::find(used_.begin(), used_.end(), library) != used_.end();
+  }
 
  private:
   struct Macro {
@@ -69,6 +75,7 @@ class Preprocessor {
   std::unordered_map<std::string, Macro> macros_;
   std::vector<Cond> conds_;
   std::vector<IntVecDirective> intVecs_;
+  std::vector<std::string> used_;  // libraries named by #use / #include
   int expandDepth_ = 0;
   long expandedTokens_ = 0;
 };

@@ -140,6 +140,7 @@ std::string typeName(const Type* t) {
     case TypeKind::Float:
       return "float";
     case TypeKind::Ptr: {
+      if (t->base->kind == TypeKind::Func) return typeName(t->base->base) + " (*)()";
       std::string b = typeName(t->base);
       return b + (b.back() == '*' ? "*" : " *");
     }

@@ -139,6 +139,12 @@ TEST(FloatMath, SpecialValues) {
   EXPECT_TRUE(std::signbit(mathAtan2(-0.0f, 1.0f)));
   EXPECT_EQ(mathAtan(inf), static_cast<float>(M_PI / 2));
   EXPECT_EQ(mathSqrt(0.25f), 0.5f);
+  // Past exact reduction (|x| > 1e6) the result stays a sine's: bounded.
+  for (const float big : {2e6f, 1e16f, 1e20f, 3e38f, -3e38f}) {
+    EXPECT_LE(std::fabs(mathSin(big)), 1.0f) << big;
+    EXPECT_LE(std::fabs(mathCos(big)), 1.0f) << big;
+    EXPECT_TRUE(std::isfinite(mathTan(big))) << big;
+  }
   EXPECT_EQ(mathPow(2.0f, 10.0f), 1024.0f);
 }
 

@@ -31,7 +31,7 @@ TEST(FunctionPointers, MisusesAreErrorsAtTheirColumn) {
   EXPECT_PRED2(startsWith, firstError(f + "main() { int (*p)(int); p = f; p++; }\n"),
                "f.dc:2:33: error: arithmetic on a pointer to a function");
   EXPECT_PRED2(startsWith, firstError(f + "main() { int (*p)(int); p = f; p(1, 2); }\n"),
-               "f.dc:2:33: error: too many arguments in a call through 'int () *' (expected 1, "
+               "f.dc:2:33: error: too many arguments in a call through 'int (*)()' (expected 1, "
                "got 2)");
   EXPECT_PRED2(startsWith, firstError(f + "main() { int n; n(1); }\n"),
                "f.dc:2:18: error: called object 'n' is not a function");
@@ -41,6 +41,10 @@ TEST(FunctionPointers, MisusesAreErrorsAtTheirColumn) {
                firstError("#INT_VEC PIOA_VEC edge\ninterrupt reti edge() { }\n"
                           "main() { int (*p)(); p = edge; }\n"),
                "f.dc:3:26: error: cannot take the address of interrupt function 'edge'");
+  EXPECT_PRED2(startsWith,
+               firstError("#INT_VEC PIOA_VEC edge\nvoid edge();\n"
+                          "main() { void (*p)(); p = edge; }\ninterrupt reti edge() { }\n"),
+               "f.dc:3:27: error: cannot take the address of interrupt function 'edge'");
   EXPECT_PRED2(startsWith, firstError("int g();\nmain() { int (*p)(); p = g; }\n"),
                "f.dc:2:26: error: undefined function 'g'");
   EXPECT_PRED2(startsWith, firstError("main() { int (*p)(); p = strlen; }\n"),
@@ -69,8 +73,10 @@ main()
     at += static_cast<uint32_t>(vm::instructionSize(static_cast<vm::Op>(img.code[at])));
   ASSERT_LT(at, img.code.size());
   ASSERT_EQ(img.entries.size(), 2u);  // main and set
-  const uint32_t target =
-      img.entries[0].address == img.entry + 0u ? img.entries[1].address : img.entries[0].address;
+  uint32_t target = 0;
+  for (const auto& sym : img.symbols)
+    if (sym.name == "set") target = sym.address;
+  ASSERT_TRUE(img.entryAt(target) != nullptr);
   TestHost host;
   vm::Vm v(img, host, testkit::calibratedCosts());
   v.setBreakpoint(at);

@@ -106,6 +106,13 @@ inline constexpr LibInfo kLibInfo[] = {
 
 constexpr const LibInfo& info(Lib lib) { return kLibInfo[static_cast<int>(lib)]; }
 
+// MATH.LIB's routines (SQRT through FMOD, kept together in builtins.def):
+// known to a program only after its #use MATH.LIB, as in Dynamic C, so that
+// a program's own pow() or floor() keeps working without it.
+constexpr bool inMathLib(int id) {
+  return id >= static_cast<int>(Lib::SQRT) && id <= static_cast<int>(Lib::FMOD);
+}
+
 // The library routine a program names, by its C name: its id, or -1.
 constexpr int libraryIndex(std::string_view name) {
   for (int i = 0; i < kLibCount; ++i)

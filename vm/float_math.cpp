@@ -11,9 +11,12 @@
 //     scaled by 2^k exactly;
 //   log: x = m 2^e with m in [sqrt(1/2), sqrt(2)), log m = 2 atanh(s),
 //     s = (m - 1) / (m + 1), |s| < 0.172, series to s^33.
-// Cody-Waite reduction is exact while k pi/2's leading parts multiply
-// exactly: for |x| below about 2^30. Beyond that sin and cos lose accuracy
-// (the same bits everywhere still); a robot's angles are far smaller.
+// Cody-Waite reduction is exact while k times pi/2's 33-bit leading part is
+// exact: k below 2^20, |x| below about 1.6e6 (kExactReduction: 1e6). A
+// larger argument is first reduced exactly (fmod) modulo the double nearest
+// 2 pi: the result is bounded, the same bits everywhere, but no longer the
+// true sine of so large an argument (that would need Payne and Hanek's
+// reduction); a robot's angles are far smaller.
 #include "vm/float_math.h"
 
 #include <bit>
@@ -52,8 +55,11 @@ double cosSeries(double r) {
   return 1.0 + s;
 }
 
+constexpr double kExactReduction = 1.0e6;
+
 // x = k pi/2 + r: the quadrant k mod 4 and r.
 int reduce(double x, double& r) {
+  if (std::fabs(x) > kExactReduction) x = std::fmod(x, 2.0 * kPi);
   const double k = std::nearbyint(x / kPiOver2);
   r = ((x - k * kPiOver2Hi) - k * kPiOver2Mid) - k * kPiOver2Lo;
   return static_cast<int>(std::fmod(k, 4.0) + 4.0) % 4;
