@@ -535,25 +535,22 @@ template <bool kIfZero>
 }
 SIMBOT_INSTRUCTION(JZ) { return branchIf<true>(r); }
 SIMBOT_INSTRUCTION(JNZ) { return branchIf<false>(r); }
-SIMBOT_INSTRUCTION(CALL) {
-  if (msp < stackLimit + kCallFrameBytes) return fail(r, "stack overflow");
-  if (r.esp > kEvalSlots - kEvalHeadroom) return fail(r, "stack overflow (expression stack)");
-  calls.push_back(CallFrame{static_cast<uint32_t>(r.ip), msp, mfp, false});
-  msp -= kCallFrameBytes;
-  r.ip = r.u16();
-  return true;
-}
-SIMBOT_INSTRUCTION(CALLI) {
-  const uint32_t target = r.pop() & 0xFFFF;
-  const uint32_t argc = r.code[r.opPc + 1];
-  const Image::Entry* entry = image->entryAt(target);
-  if (!entry || entry->params != argc) return badCallThrough(r, target, argc);
+// CALL and CALLI: the return address and frame saved, then the jump.
+[[gnu::always_inline]] inline bool Vm::State::callTo(Regs& r, uint32_t target) {
   if (msp < stackLimit + kCallFrameBytes) return fail(r, "stack overflow");
   if (r.esp > kEvalSlots - kEvalHeadroom) return fail(r, "stack overflow (expression stack)");
   calls.push_back(CallFrame{static_cast<uint32_t>(r.ip), msp, mfp, false});
   msp -= kCallFrameBytes;
   r.ip = target;
   return true;
+}
+SIMBOT_INSTRUCTION(CALL) { return callTo(r, r.u16()); }
+SIMBOT_INSTRUCTION(CALLI) {
+  const uint32_t target = r.pop() & 0xFFFF;
+  const uint32_t argc = r.code[r.opPc + 1];
+  const Image::Entry* entry = image->entryAt(target);
+  if (!entry || entry->params != argc) return badCallThrough(r, target, argc);
+  return callTo(r, target);
 }
 SIMBOT_INSTRUCTION(ENTER) {
   const uint32_t size = r.u16();

@@ -466,6 +466,7 @@ struct Vm::State {
   void burnTail(Regs& r);
   bool fail(const Regs& r, const char* message);
   bool badCallThrough(const Regs& r, uint32_t target, uint32_t argc);
+  bool callTo(Regs& r, uint32_t target);
   bool access(const Regs& r, uint32_t address, uint32_t bytes);
   template <Op O>
   void branch(Regs& r, unsigned path);
