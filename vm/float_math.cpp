@@ -65,9 +65,9 @@ int reduce(double x, double& r) {
   return static_cast<int>(std::fmod(k, 4.0) + 4.0) % 4;
 }
 
-double sinD(double x) {
-  double r;
-  switch (reduce(x, r)) {
+// sin(k pi/2 + r) by the quadrant k mod 4; cos x is sin of the next one.
+double sinQuadrant(int q, double r) {
+  switch (q % 4) {
     case 0:
       return sinSeries(r);
     case 1:
@@ -79,18 +79,16 @@ double sinD(double x) {
   }
 }
 
+double sinD(double x) {
+  double r;
+  const int q = reduce(x, r);
+  return sinQuadrant(q, r);
+}
+
 double cosD(double x) {
   double r;
-  switch (reduce(x, r)) {
-    case 0:
-      return cosSeries(r);
-    case 1:
-      return -sinSeries(r);
-    case 2:
-      return -cosSeries(r);
-    default:
-      return sinSeries(r);
-  }
+  const int q = reduce(x, r);
+  return sinQuadrant(q + 1, r);
 }
 
 // atan t for |t| <= 0.2: t - t^3/3 + t^5/5 - ...
