@@ -399,15 +399,6 @@ void Vm::State::libStep() {
         }
         break;
       }
-      case Lib::STRCMP: {
-        if (!checkAccess(a[0] + i, 1, lib.pc) || !checkAccess(a[1] + i, 1, lib.pc)) return;
-        const int x = rd8(a[0] + i), y = rd8(a[1] + i);
-        if (x != y || x == 0) {
-          lib.result = w(x - y);
-          finished = true;
-        }
-        break;
-      }
       case Lib::STRCAT: {
         // First the end of dst (mark: where it is), then src copied there.
         if (lib.mark == kNoMark) {
@@ -441,9 +432,11 @@ void Vm::State::libStep() {
         finished = i + 1 >= n;
         break;
       }
+      case Lib::STRCMP:
       case Lib::STRNCMP:
       case Lib::MEMCMP: {
-        const uint32_t n = a[2] & 0xFFFF;
+        // strcmp is strncmp with no bound; memcmp goes on past a NUL.
+        const uint32_t n = lib.id == Lib::STRCMP ? UINT32_MAX : a[2] & 0xFFFF;
         if (i >= n) {
           lib.result = 0;
           finished = true;
@@ -451,7 +444,7 @@ void Vm::State::libStep() {
         }
         if (!checkAccess(a[0] + i, 1, lib.pc) || !checkAccess(a[1] + i, 1, lib.pc)) return;
         const int x = rd8(a[0] + i), y = rd8(a[1] + i);
-        if (x != y || (x == 0 && lib.id == Lib::STRNCMP)) {
+        if (x != y || (x == 0 && lib.id != Lib::MEMCMP)) {
           lib.result = w(x - y);
           finished = true;
         } else if (i + 1 >= n) {
@@ -460,23 +453,15 @@ void Vm::State::libStep() {
         }
         break;
       }
-      case Lib::STRCHR: {
-        if (!checkAccess(a[0] + i, 1, lib.pc)) return;
-        const uint8_t c = rd8(a[0] + i);
-        if (c == static_cast<uint8_t>(a[1])) {
-          lib.result = (a[0] + i) & 0xFFFF;
-          finished = true;
-        } else if (c == 0) {
-          lib.result = 0;
-          finished = true;
-        }
-        break;
-      }
+      case Lib::STRCHR:
       case Lib::STRRCHR: {
+        // result (0 from the call: a null pointer) is the latest c seen;
+        // strchr stops at the first, strrchr reads on to the NUL.
         if (!checkAccess(a[0] + i, 1, lib.pc)) return;
         const uint8_t c = rd8(a[0] + i);
-        if (c == static_cast<uint8_t>(a[1])) lib.result = (a[0] + i) & 0xFFFF;
-        finished = c == 0;
+        const bool match = c == static_cast<uint8_t>(a[1]);
+        if (match) lib.result = (a[0] + i) & 0xFFFF;
+        finished = c == 0 || (match && lib.id == Lib::STRCHR);
         break;
       }
       case Lib::ATOI: {
