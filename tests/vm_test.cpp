@@ -270,6 +270,107 @@ TEST(Vm, RetPopsIxOnlyAfterEnter) {
   }
 }
 
+// The memory map (docs/cycle-model.md): the stack grows down from 0x10000;
+// CALL pushes the address after itself, ENTER the caller's IX, as the chip
+// does, so the words are in the robot's memory where a program can see them.
+TEST(Vm, ReturnAddressesAndSavedIxAreOnTheRobotStack) {
+  Assembler a;
+  // 0: CALL f (3 bytes); 3: HALT; f at 4: ENTER 2 (3); CALL g at 7 (3);
+  // 10: RET; g at 11: ENTER 4; DBG (the stop); RET.
+  a.op(Op::CALL, 4).op(Op::HALT);
+  a.bind("f").op(Op::ENTER, 2).op(Op::CALL, 11).op(Op::RET);
+  a.bind("g").op(Op::ENTER, 4).bind("in").op(Op::DBG).op(Op::RET);
+  ASSERT_EQ(a.label("g"), 11u);
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  v.setBreakpoint(a.label("in"));
+  ASSERT_EQ(v.run(1'000'000), Stop::Breakpoint);
+  EXPECT_EQ(v.read16(0xFFFE), 3u);       // f returns after CALL f
+  EXPECT_EQ(v.read16(0xFFFC), 0x0000u);  // the reset IX, 0x10000, in 16 bits
+  // f's 2-byte frame is 0xFFFA-0xFFFB (IX = 0xFFFA); CALL g pushes 10 at
+  // 0xFFF8 and g's ENTER pushes f's IX at 0xFFF6.
+  EXPECT_EQ(v.read16(0xFFF8), 10u);
+  EXPECT_EQ(v.read16(0xFFF6), 0xFFFAu);
+  v.setBreakpoint(a.label("in"), false);
+  EXPECT_EQ(v.run(1'000'000), Stop::Halted);
+  EXPECT_EQ(v.fault(), nullptr);
+}
+
+// A static function that stores over its own return address (at SP,
+// 0xFFFE under the start-up CALL) returns where the new word leads.
+TEST(Vm, RetGoesWhereItsSavedAddressLeads) {
+  Assembler a;
+  const uint16_t marker = a.data(2);
+  // 0: CALL f; 3: HALT; f at 4: PUSHW there (3); STGW 0xFFFE (3); PUSHW 0
+  // (3); RET at 13; there at 14: POP; INCGW marker; HALT.
+  a.op(Op::CALL, 4).op(Op::HALT);
+  a.bind("f").op(Op::PUSHW, 14).op(Op::STGW, 0xFFFE).op(Op::PUSHW, 0).op(Op::RET);
+  a.bind("there").op(Op::POP).op(Op::INCGW, marker).op(Op::HALT);
+  ASSERT_EQ(a.label("there"), 14u);
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  EXPECT_EQ(v.run(1'000'000), Stop::Halted);
+  EXPECT_EQ(v.fault(), nullptr);
+  EXPECT_EQ(v.read16(marker), 1u);
+  EXPECT_EQ(v.pc(), a.label("there") + 4);  // on the second HALT, not at 3
+}
+
+// Acceptance pushes PC, AF, BC, DE, HL, IX, IY: the interrupted PC at
+// SP - 2 and IX at SP - 12 (the VM has no AF..HL, IY to store).
+TEST(Vm, InterruptFrameHoldsTheInterruptedPcAndIx) {
+  Assembler a;
+  // 0: CALL f; 3: HALT; f at 4: ENTER 6; loop at 7: DBG; JMP loop.
+  a.op(Op::CALL, 4).op(Op::HALT);
+  a.bind("f").op(Op::ENTER, 6).bind("loop").op(Op::DBG).jump(Op::JMP, "loop");
+  countingHandler(a, a.data(2));
+  ASSERT_EQ(a.label("loop"), 7u);
+  const auto img = a.finish();
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  v.run(1000);
+  const uint32_t interrupted = v.pc();
+  v.setBreakpoint(a.label("handler"));
+  v.request(Irq::Pio, vm::kVecPIOA);
+  ASSERT_EQ(v.run(2000), Stop::Breakpoint);
+  // SP before acceptance: 0xFFFE (CALL f) - 2 (IX) - 6 = 0xFFF6; IX = 0xFFF6.
+  EXPECT_EQ(v.read16(0xFFF6 - 2), interrupted);
+  EXPECT_EQ(v.read16(0xFFF6 - 12), 0xFFF6u);
+}
+
+// RETI returns where the frame's PC slot leads: a handler that writes over
+// it sends the robot elsewhere, and an address outside the code faults.
+TEST(Vm, RetiGoesWhereTheSavedPcLeads) {
+  for (const uint32_t to : {13u, 0x7000u}) {
+    Assembler a;
+    const uint16_t marker = a.data(2);
+    // 0: loop: DBG; JMP loop (3); there at 4: INCGW marker (3); HALT at 7;
+    // handler at 8: PUSHW to (3); STGW 0xFFFE (3); RETI at 14. 13 is the
+    // last byte of STGW: no instruction's start.
+    a.bind("loop").op(Op::DBG).jump(Op::JMP, "loop");
+    a.bind("there").op(Op::INCGW, marker).op(Op::HALT);
+    a.bind("handler").op(Op::PUSHW, to == 13u ? 4u : to).op(Op::STGW, 0xFFFE).op(Op::RETI);
+    a.image.vectors.push_back({vm::kVecPIOA, static_cast<uint16_t>(a.label("handler")), "h"});
+    const auto img = a.finish();
+    TestHost host;
+    vm::Vm v(img, host, costs());
+    v.request(Irq::Pio, vm::kVecPIOA);
+    if (to == 13u) {
+      EXPECT_EQ(v.run(100'000), Stop::Halted);
+      EXPECT_EQ(v.fault(), nullptr);
+      EXPECT_EQ(v.read16(marker), 1u);
+      EXPECT_EQ(v.pc(), 7u);
+    } else {
+      EXPECT_EQ(v.run(100'000), Stop::Fault);
+      ASSERT_NE(v.fault(), nullptr);
+      EXPECT_EQ(v.fault()->message,
+                "pio_a handler returned to 0x7000, outside the code: the interrupted address saved "
+                "at 0xFFFE (0x0000) was overwritten");
+    }
+  }
+}
+
 TEST(Vm, LibraryCallIsChargedOneCall) {
   // PUSHW 20 x 2, then outport's sequence alone: POP 9; POP 9; CALL 16;
   // LD C,L 4; OUT (C),A 10 + 1 I/O wait; RET 9 = 58. The write happens at
@@ -554,6 +655,30 @@ TEST(VmFault, UnboundedRecursionOverflowsTheStack) {
   a.line = 7;
   a.bind("f").op(Op::CALL, 0);
   expectFault(a, "stack overflow");
+}
+
+// The expression stack is the VM's own, so code reached by a diverted
+// return can pop what its own call never pushed: that robot faults.
+TEST(VmFault, DivertedReturnThatUnderflowsTheExpressionStack) {
+  Assembler a;
+  // As above, but `there` is ADDW; ADDW: the RET leaves one value, the
+  // first ADDW takes two (the second from below the bottom), the second
+  // ADDW underflows.
+  a.op(Op::CALL, 4).op(Op::HALT);
+  a.bind("f").op(Op::PUSHW, 14).op(Op::STGW, 0xFFFE).op(Op::PUSHW, 0).op(Op::RET);
+  a.line = 7;
+  a.bind("there").op(Op::ADDW).op(Op::ADDW).op(Op::HALT);
+  ASSERT_EQ(a.label("there"), 14u);
+  expectFault(a, "expression stack underflow after a diverted return");
+}
+
+TEST(VmFault, ReturnIntoTheMiddleOfAnInstruction) {
+  Assembler a;
+  // f stores 5 over its return address: byte 5 is PUSHW's operand.
+  a.op(Op::CALL, 4).op(Op::HALT);
+  a.line = 7;
+  a.bind("f").op(Op::PUSHW, 5).op(Op::STGW, 0xFFFE).op(Op::PUSHW, 0).op(Op::RET);
+  expectFault(a, "returned to 0x0005, inside an instruction: its return address at 0xFFFE (0x0003");
 }
 
 TEST(VmFault, InterruptThroughUnboundVector) {

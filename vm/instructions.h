@@ -535,12 +535,14 @@ template <bool kIfZero>
 }
 SIMBOT_INSTRUCTION(JZ) { return branchIf<true>(r); }
 SIMBOT_INSTRUCTION(JNZ) { return branchIf<false>(r); }
-// CALL and CALLI: the return address and frame saved, then the jump.
+// CALL and CALLI: the return address pushed on the robot's stack, then the
+// jump.
 [[gnu::always_inline]] inline bool Vm::State::callTo(Regs& r, uint32_t target) {
-  if (msp < stackLimit + kCallFrameBytes) return fail(r, "stack overflow");
+  if (msp < stackLimit + kReturnAddressBytes) return fail(r, "stack overflow");
   if (r.esp > kEvalSlots - kEvalHeadroom) return fail(r, "stack overflow (expression stack)");
-  calls.push_back(CallFrame{static_cast<uint32_t>(r.ip), msp, mfp, false});
-  msp -= kCallFrameBytes;
+  msp -= kReturnAddressBytes;
+  r.wr16(msp, static_cast<uint32_t>(r.ip));
+  calls.push_back(CallFrame{static_cast<uint32_t>(r.ip), msp});
   r.ip = target;
   return true;
 }
@@ -554,25 +556,40 @@ SIMBOT_INSTRUCTION(CALLI) {
 }
 SIMBOT_INSTRUCTION(ENTER) {
   const uint32_t size = r.u16();
-  if (msp < stackLimit + size) return fail(r, "stack overflow");
+  if (msp < stackLimit + kSavedFpBytes + size) return fail(r, "stack overflow");
+  msp -= kSavedFpBytes;
+  r.wr16(msp, mfp);  // PUSH IX
   msp -= size;
   mfp = msp;
-  // The frame now holds the caller's IX (ENTER's PUSH IX): its RET pops it.
-  // (ENTER in main or in a handler has no CallFrame of its own; a
-  // handler's RETI restores IX anyway.)
-  if (static_cast<int>(calls.size()) > (ints.empty() ? 0 : ints.back().callDepth))
+  // Its RET pops IX. (A handler's ENTER has no CallFrame of its own: its
+  // RETI restores IX from the acceptance frame.)
+  if (static_cast<int>(calls.size()) > (ints.empty() ? 0 : ints.back().callDepth)) {
     calls.back().autoFrame = true;
+    calls.back().frameSize = size;
+  }
   return true;
 }
+// RET takes the return address (and an auto frame's saved IX, found from
+// IX as the epilogue finds it) from the robot's memory. Where it leads
+// anywhere but back to the call, divertedReturn decides.
 SIMBOT_INSTRUCTION(RET) {
   if (calls.empty() || (!ints.empty() && static_cast<int>(calls.size()) <= ints.back().callDepth))
     return fail(r, "return with no caller");
   const CallFrame f = calls.back();
   calls.pop_back();
-  if (f.autoFrame) r.charge(static_cast<int32_t>(costs.autoFrameRet));  // POP IX
-  r.ip = f.retPc;
-  msp = f.msp;
-  mfp = f.mfp;
+  uint32_t slot = msp;
+  if (f.autoFrame) {
+    r.charge(static_cast<int32_t>(costs.autoFrameRet));  // LD SP,IX; POP IX
+    const uint32_t savedFp = (mfp + f.frameSize) & 0xFFFF;
+    mfp = r.rd16(savedFp);
+    slot = (savedFp + kSavedFpBytes) & 0xFFFF;
+  }
+  const uint32_t target = r.rd16(slot);
+  // SP wraps at 16 bits; kMemorySize is the empty stack.
+  msp = (slot + kReturnAddressBytes - 1) % kMemorySize + 1;
+  if (__builtin_expect(target != f.retPc || slot != f.slot, 0))
+    return divertedReturn(r, f, target, slot);
+  r.ip = target;
   return true;
 }
 SIMBOT_INSTRUCTION(DBG) {
@@ -589,22 +606,44 @@ SIMBOT_INSTRUCTION(RETI) {
     return false;
   }
   InterruptFrame& f = ints.back();
-  if (f.evalSp != sp) {
+  if (f.evalSp != sp && !diverted) {
     raiseFault("internal error: stack imbalance at RETI", r.pc());
     return false;
   }
+  // The interrupted PC and IX come back from the acceptance frame in the
+  // robot's memory (msp is restored by the epilogue's balanced pops).
+  const uint32_t top = f.msp - kReturnAddressBytes;
+  const uint32_t target = rd16(top);
   pc = f.retPc;
   msp = f.msp;
-  mfp = f.mfp;
+  mfp = rd16(f.msp - kInterruptFpOffset);
   halted = f.halted;
   burn = f.burn;
   lib = std::move(f.lib);
   const Irq irq = f.irq;
+  const uint32_t expected = f.retPc;
   ints.pop_back();
   bus->interruptReturned(now, irq);
   // The epilogue's EI: IFF1 is set when the RETI after it ends.
   if (costs.knobs.epilogueEi && !iff1) bus->iffChanged(now, true);
   if (costs.knobs.epilogueEi) iff1 = iff2 = true;
+  if (target != expected) {
+    // A smashed frame: the robot goes where it leads, and what it was
+    // doing at the interrupted point (a library call, a HALT) is dropped.
+    const std::string problem = returnTargetProblem(target);
+    if (!problem.empty()) {
+      raiseFault(fmt::format("{} handler returned to 0x{:04X}, {}: the interrupted address "
+                             "saved at 0x{:04X} (0x{:04X}) was overwritten",
+                             irqName(irq), target, problem, top, expected),
+                 r.pc());
+      return false;
+    }
+    pc = target;
+    halted = false;
+    burn = 0;
+    lib = LibCall{};
+    diverted = true;
+  }
   return false;
 }
 SIMBOT_INSTRUCTION(HALT) {

@@ -37,10 +37,20 @@ inline constexpr uint32_t kMaxStepTstates = 100;  // long library calls: boundar
 // printf's largest field width and precision (assumption: Dynamic C's
 // printf formatted each field into a buffer of this size).
 inline constexpr long kMaxPrintfField = 127;
-// Robot stack bytes: CALL pushes the return address and IX; acceptance
-// pushes PC, AF, BC, DE, HL, IX, IY.
-inline constexpr uint32_t kCallFrameBytes = 4;
+// Robot stack bytes: CALL pushes the return address, ENTER the caller's IX
+// (the frame pointer) below it; acceptance pushes PC, AF, BC, DE, HL, IX,
+// IY, so the interrupted PC is at the top and IX 12 bytes below the SP it
+// interrupted.
+inline constexpr uint32_t kReturnAddressBytes = 2;
+inline constexpr uint32_t kSavedFpBytes = 2;
 inline constexpr uint32_t kInterruptFrameBytes = 14;
+inline constexpr uint32_t kInterruptFpOffset = 12;
+// Slots below the expression stack's bottom: after a return that a
+// smashed return address diverted, the stack can be popped past its
+// bottom; the slow boundary, which every instruction then takes, faults
+// there, and no instruction pops more than two (a library call checks its
+// arguments first).
+inline constexpr int kEvalFloor = 4;
 
 // LibCall::mark before a routine's second phase has begun.
 inline constexpr uint32_t kNoMark = 0xFFFFFFFFu;
@@ -64,10 +74,13 @@ struct LibCall {
   bool operator==(const LibCall&) const = default;
 };
 
+// What the host remembers of a call, for checks and messages: the return
+// address and saved IX themselves are in the robot's memory, and RET reads
+// them there (a program that overwrites them returns where they lead).
 struct CallFrame {
-  uint32_t retPc;
-  uint32_t msp;
-  uint32_t mfp;
+  uint32_t retPc;          // where the CALL's return address pointed
+  uint32_t slot;           // the address it was saved at
+  uint32_t frameSize = 0;  // ENTER's auto frame, below the saved IX
   bool autoFrame = false;  // ENTER ran: RET also pops IX
   bool operator==(const CallFrame&) const = default;
 };
@@ -75,8 +88,7 @@ struct CallFrame {
 struct InterruptFrame {
   uint32_t retPc;
   Irq irq;
-  uint32_t msp;
-  uint32_t mfp;
+  uint32_t msp;  // SP before acceptance pushed the frame
   int evalSp;
   int callDepth;
   bool halted;
@@ -229,7 +241,10 @@ struct Vm::State {
   Bus* bus;
   CostTable costs;
   std::vector<uint8_t> mem = std::vector<uint8_t>(kMemorySize, 0);
-  std::vector<uint32_t> eval = std::vector<uint32_t>(kEvalSlots, 0);
+  // The expression stack, kEvalFloor slots above the vector's start.
+  std::vector<uint32_t> eval = std::vector<uint32_t>(kEvalFloor + kEvalSlots, 0);
+  uint32_t* evalBase() { return eval.data() + kEvalFloor; }
+  uint32_t& slot(int i) { return eval[static_cast<size_t>(kEvalFloor + i)]; }
   int sp = 0;  // eval stack: next free slot
   std::vector<CallFrame> calls;
   std::vector<InterruptFrame> ints;
@@ -243,6 +258,10 @@ struct Vm::State {
   bool eiShadow = false;
   bool halted = false;
   bool hostStop = false;  // Vm::stopAtNextBoundary, during a run
+  // A RET or RETI went where a smashed return address led, not back to its
+  // call: the expression stack no longer matches the code, so every
+  // boundary is slow and checks it from then on.
+  bool diverted = false;
   std::array<bool, kIrqCount> pend{};
   std::array<uint8_t, kIrqCount> vec{};
   bool anyPending = false;
@@ -466,6 +485,10 @@ struct Vm::State {
   void burnTail(Regs& r);
   bool fail(const Regs& r, const char* message);
   bool badCallThrough(const Regs& r, uint32_t target, uint32_t argc);
+  bool divertedReturn(Regs& r, const CallFrame& frame, uint32_t target, uint32_t slot);
+  // Where a smashed return address may lead: instruction starts.
+  std::vector<uint8_t> instructionStart;
+  std::string returnTargetProblem(uint32_t target) const;
   bool callTo(Regs& r, uint32_t target);
   bool access(const Regs& r, uint32_t address, uint32_t bytes);
   template <Op O>

@@ -85,8 +85,12 @@ void Vm::State::accept() {
     raiseFault("stack overflow (interrupt frame)", interruptedPc);
     return;
   }
-  ints.push_back(InterruptFrame{pc, irq, msp, mfp, sp, static_cast<int>(calls.size()), halted, burn,
+  ints.push_back(InterruptFrame{pc, irq, msp, sp, static_cast<int>(calls.size()), halted, burn,
                                 std::move(lib)});
+  // The frame's PC and IX, as the handler's prologue pushed them (the other
+  // registers' slots keep what they held: the VM has no AF, BC, DE, HL, IY).
+  wr16(msp - kReturnAddressBytes, pc);
+  wr16(msp - kInterruptFpOffset, mfp);
   lib = LibCall{};
   burn = 0;
   resumeAtBreakpoint = false;
@@ -182,6 +186,51 @@ bool Vm::State::badCallThrough(const Regs& r, uint32_t target, uint32_t argc) {
   return false;
 }
 
+// Why a return cannot go to `target`, or "" when it can (an instruction's
+// first byte, where the chip would simply run on).
+std::string Vm::State::returnTargetProblem(uint32_t target) const {
+  if (target >= instructionStart.size()) return "outside the code";
+  if (!instructionStart[target]) {
+    const Symbol* f = image->functionAt(target);
+    return f ? fmt::format("inside an instruction of '{}'", f->name)
+             : std::string("inside an instruction");
+  }
+  return "";
+}
+
+// A RET whose return address, or the IX that finds it, is not what its
+// call left: a local array overrun (or a wild pointer) wrote over the
+// frame. The robot goes where the address leads, as the chip would, if
+// that is an instruction; otherwise it faults naming the smashed frame.
+bool Vm::State::divertedReturn(Regs& r, const CallFrame& frame, uint32_t target, uint32_t slot) {
+  const Symbol* callee = image->functionAt(r.pc());
+  const Symbol* caller = image->functionAt(frame.retPc);
+  const std::string name = callee ? fmt::format("'{}'", callee->name) : std::string("a function");
+  const std::string problem = returnTargetProblem(target);
+  if (problem.empty()) {
+    diverted = true;
+    r.ip = target;
+    r.limit = 0;
+    return true;
+  }
+  std::string message;
+  if (slot != frame.slot) {
+    message = fmt::format(
+        "{} returned to 0x{:04X}, {}: it read its return address at 0x{:04X}, not at 0x{:04X} "
+        "where its call saved it, because its frame pointer IX was overwritten (a saved IX on "
+        "the stack)",
+        name, target, problem, slot, frame.slot);
+  } else {
+    message = fmt::format(
+        "{} returned to 0x{:04X}, {}: its return address at 0x{:04X} (0x{:04X}, in '{}') was "
+        "overwritten",
+        name, target, problem, slot, frame.retPc, caller ? caller->name : "?");
+  }
+  save(r);
+  raiseFault(std::move(message), r.pc());
+  return false;
+}
+
 int64_t Vm::State::relTargetAt(uint32_t address) const {
   return int64_t{address} + 3 + static_cast<int16_t>(le16(&padded[address + 1]));
 }
@@ -191,6 +240,12 @@ void Vm::State::decode() {
   const auto size = static_cast<uint32_t>(code.size());
   padded = code;
   padded.resize(size + kCodePad, 0);
+  // The code is instructions end to end (the compiler puts no data in it).
+  instructionStart.assign(size, 0);
+  for (uint32_t a = 0; a < size;) {
+    instructionStart[a] = 1;
+    a += code[a] < kOpCount ? static_cast<uint32_t>(instructionSize(static_cast<Op>(code[a]))) : 1;
+  }
   baseDispatch.assign(size + kCodePad, kTrap);
   for (uint32_t a = 0; a < size; ++a) {
     const uint8_t b = code[a];
@@ -405,8 +460,8 @@ Stop Vm::State::run(Tick until) {
   const auto codeSize = static_cast<uint32_t>(image->code.size());
   const int16_t* const loopTop =
       costs.knobs.fastForward && !loopAtTop.empty() ? loopAtTop.data() : nullptr;
-  Regs r{now, 0,           stats.instructions, pc,   pc,
-         sp,  eval.data(), mem.data(),         code, kProfile ? profile.data() : nullptr};
+  Regs r{now, 0,          stats.instructions, pc,   pc,
+         sp,  evalBase(), mem.data(),         code, kProfile ? profile.data() : nullptr};
   Tick longLimit = -1;  // L_Long_: the limit its instruction's tail runs to
   uint8_t op = 0;
   hostStop = false;
@@ -432,6 +487,10 @@ boundary:
   if (fault) return Stop::Fault;
   if (sp > kEvalSlots - kEvalGuard) {
     raiseFault("expression stack overflow (too many arguments or values pending)", pc);
+    goto boundary;
+  }
+  if (sp < 0) {  // only after a diverted return, whose boundaries are all slow
+    raiseFault("expression stack underflow after a diverted return", pc);
     goto boundary;
   }
   if (hostStop) {
@@ -499,12 +558,14 @@ boundary:
   // The boundary after this instruction is slow too when anything rare is
   // due there (see "Fast path").
   r = Regs{now,
-           dispatch[pc] == kTrap || burn || (anyPending && iff1) ? 0 : std::min(until, nextTimer),
+           dispatch[pc] == kTrap || burn || (anyPending && iff1) || diverted
+               ? 0
+               : std::min(until, nextTimer),
            stats.instructions,
            pc,
            pc,
            sp,
-           eval.data(),
+           evalBase(),
            mem.data(),
            code,
            kProfile ? profile.data() : nullptr};
@@ -596,7 +657,7 @@ void Vm::State::attach(Vm* vm, Bus& to) {
 
 // Room for the deepest nesting, so that no push on the hot path allocates.
 void Vm::State::reserveStacks() {
-  calls.reserve(kMemorySize / kCallFrameBytes);
+  calls.reserve(kMemorySize / kReturnAddressBytes);
   ints.reserve(kMaxInterruptNesting);
 }
 
