@@ -340,23 +340,35 @@ TEST(Vm, InterruptFrameHoldsTheInterruptedPcAndIx) {
 }
 
 // RETI returns where the frame's PC slot leads: a handler that writes over
-// it sends the robot elsewhere, and an address outside the code faults.
+// it sends the robot elsewhere, and an address outside the code or inside
+// an instruction faults.
 TEST(Vm, RetiGoesWhereTheSavedPcLeads) {
-  for (const uint32_t to : {13u, 0x7000u}) {
+  struct Case {
+    uint32_t to;
+    const char* fault;  // null: runs on
+  };
+  // 0: loop: DBG; JMP loop (3); there at 4: INCGW marker (3); HALT at 7;
+  // handler at 8: PUSHW to (3); STGW 0xFFFE (3); RETI at 14. 6 is INCGW's
+  // last byte: no instruction's start.
+  for (const Case c : {Case{4, nullptr},
+                       Case{6,
+                            "pio_a handler returned to 0x0006, inside an instruction: the "
+                            "interrupted address saved at 0xFFFE (0x0000) was overwritten"},
+                       Case{0x7000,
+                            "pio_a handler returned to 0x7000, outside the code: the "
+                            "interrupted address saved at 0xFFFE (0x0000) was overwritten"}}) {
     Assembler a;
     const uint16_t marker = a.data(2);
-    // 0: loop: DBG; JMP loop (3); there at 4: INCGW marker (3); HALT at 7;
-    // handler at 8: PUSHW to (3); STGW 0xFFFE (3); RETI at 14. 13 is the
-    // last byte of STGW: no instruction's start.
     a.bind("loop").op(Op::DBG).jump(Op::JMP, "loop");
     a.bind("there").op(Op::INCGW, marker).op(Op::HALT);
-    a.bind("handler").op(Op::PUSHW, to == 13u ? 4u : to).op(Op::STGW, 0xFFFE).op(Op::RETI);
+    a.bind("handler").op(Op::PUSHW, c.to).op(Op::STGW, 0xFFFE).op(Op::RETI);
+    ASSERT_EQ(a.label("handler"), 8u);
     a.image.vectors.push_back({vm::kVecPIOA, static_cast<uint16_t>(a.label("handler")), "h"});
     const auto img = a.finish();
     TestHost host;
     vm::Vm v(img, host, costs());
     v.request(Irq::Pio, vm::kVecPIOA);
-    if (to == 13u) {
+    if (!c.fault) {
       EXPECT_EQ(v.run(100'000), Stop::Halted);
       EXPECT_EQ(v.fault(), nullptr);
       EXPECT_EQ(v.read16(marker), 1u);
@@ -364,9 +376,7 @@ TEST(Vm, RetiGoesWhereTheSavedPcLeads) {
     } else {
       EXPECT_EQ(v.run(100'000), Stop::Fault);
       ASSERT_NE(v.fault(), nullptr);
-      EXPECT_EQ(v.fault()->message,
-                "pio_a handler returned to 0x7000, outside the code: the interrupted address saved "
-                "at 0xFFFE (0x0000) was overwritten");
+      EXPECT_EQ(v.fault()->message, c.fault);
     }
   }
 }
@@ -661,15 +671,16 @@ TEST(VmFault, UnboundedRecursionOverflowsTheStack) {
 // return can pop what its own call never pushed: that robot faults.
 TEST(VmFault, DivertedReturnThatUnderflowsTheExpressionStack) {
   Assembler a;
-  // As above, but `there` is ADDW; ADDW: the RET leaves one value, the
-  // first ADDW takes two (the second from below the bottom), the second
-  // ADDW underflows.
+  // As above, but `there` is ADDW: the RET leaves one value and ADDW takes
+  // two, so the robot faults before it runs, naming the return (RET at 13
+  // = 0x0D, to 14).
   a.op(Op::CALL, 4).op(Op::HALT);
   a.bind("f").op(Op::PUSHW, 14).op(Op::STGW, 0xFFFE).op(Op::PUSHW, 0).op(Op::RET);
   a.line = 7;
   a.bind("there").op(Op::ADDW).op(Op::ADDW).op(Op::HALT);
   ASSERT_EQ(a.label("there"), 14u);
-  expectFault(a, "expression stack underflow after a diverted return");
+  expectFault(
+      a, "expression stack underflow (after the return at 0x000D went to 0x000E, off its call)");
 }
 
 TEST(VmFault, ReturnIntoTheMiddleOfAnInstruction) {

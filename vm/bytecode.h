@@ -75,6 +75,17 @@ inline constexpr OpInfo kOpInfo[] = {
 constexpr const OpInfo& info(Op op) { return kOpInfo[static_cast<int>(op)]; }
 constexpr int instructionSize(Op op) { return 1 + operandBytes(info(op).shape); }
 
+// The slots an instruction takes from the expression stack: opcodes.def's
+// count, or where that depends on the operands, CALL none (its callee's
+// prologue takes the arguments), CALLI the function's address, LIB its
+// arguments (the byte after its routine's id).
+constexpr int slotsTaken(Op op, const uint8_t* instruction) {
+  if (op == Op::CALL) return 0;
+  if (op == Op::CALLI) return 1;
+  if (op == Op::LIB) return instruction[2];
+  return info(op).pop;
+}
+
 // Builtin library routines (builtins.def).
 enum class Lib : uint8_t {
 #define BUILTIN(id, name, ret, args, call, step, unit) id,

@@ -150,14 +150,11 @@ std::string disassemble(const Image& img) {
   out += fmt::format("; {:<4}  {:>11}  {:<8} {}\n", "addr", "T-st", "op", "operands");
   int lastLine = -1;
   uint32_t at = 0;
-  // The function being listed began with ENTER (a #class auto frame): its
-  // RETs also pop IX, as the VM charges them.
-  bool autoFrame = false;
+  // A RET in a function that began with ENTER (a #class auto frame) also
+  // pops IX, as the VM charges it: the same table the VM decodes.
+  const std::vector<int32_t> returnFrames = img.returnFrames();
   while (at < img.code.size()) {
-    if (auto it = labels.find(at); it != labels.end()) {
-      out += fmt::format("\n{}:\n", it->second);
-      autoFrame = img.code[at] == static_cast<uint8_t>(Op::ENTER);
-    }
+    if (auto it = labels.find(at); it != labels.end()) out += fmt::format("\n{}:\n", it->second);
     const int line = img.lineAt(at);
     if (line != lastLine && line > 0) {
       const std::string text = line <= static_cast<int>(img.sourceLines.size())
@@ -182,7 +179,7 @@ std::string disassemble(const Image& img) {
     const std::string note = annotate(img, op, at + 1);
     if (!note.empty()) operands += fmt::format("  ({})", note);
     const std::string cost =
-        op == Op::RET && autoFrame
+        op == Op::RET && returnFrames[at] >= 0
             ? fmt::format("{}", costs.op[static_cast<int>(op)] + costs.autoFrameRet)
             : costText(costs, op, img, at + 1);
     out += fmt::format("  {:04x}  {:>11}  {:<8} {}\n", at, cost, info(op).name, operands);

@@ -22,6 +22,45 @@ const Image::Entry* Image::entryAt(uint32_t codeAddress) const {
   return it != entries.end() && it->address == codeAddress ? &*it : nullptr;
 }
 
+std::vector<int32_t> Image::returnFrames() const {
+  const auto size = static_cast<uint32_t>(code.size());
+  std::vector<uint8_t> starts(size, 0);
+  auto mark = [&](uint32_t a) {
+    if (a < size) starts[a] = 1;
+  };
+  for (const auto& s : symbols)
+    if (s.kind == Symbol::Kind::Function || s.kind == Symbol::Kind::Handler) mark(s.address);
+  for (const auto& v : vectors) mark(v.handler);
+  std::vector<int32_t> frames(size, -1);
+  // Two walks: CALL targets first (a CALL may target a function later in
+  // the code), then the frames.
+  for (uint32_t at = 0; at < size;) {
+    if (code[at] >= kOpCount) {
+      ++at;
+      continue;
+    }
+    const auto op = static_cast<Op>(code[at]);
+    if (op == Op::CALL && at + 3 <= size)
+      mark(static_cast<uint32_t>(code[at + 1] | (code[at + 2] << 8)));
+    at += static_cast<uint32_t>(instructionSize(op));
+  }
+  int32_t frame = -1;
+  for (uint32_t at = 0; at < size;) {
+    if (starts[at])
+      frame = code[at] == static_cast<uint8_t>(Op::ENTER) && at + 3 <= size
+                  ? static_cast<int32_t>(code[at + 1] | (code[at + 2] << 8))
+                  : -1;
+    if (code[at] >= kOpCount) {
+      ++at;
+      continue;
+    }
+    const auto op = static_cast<Op>(code[at]);
+    if (op == Op::RET) frames[at] = frame;
+    at += static_cast<uint32_t>(instructionSize(op));
+  }
+  return frames;
+}
+
 std::optional<uint32_t> Image::loopHead(int line) const {
   std::optional<uint32_t> head;
   for (uint32_t at = 0; at < code.size();) {

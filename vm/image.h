@@ -139,6 +139,12 @@ struct Image {
   int lineAt(uint32_t codeAddress) const {
     return codeAddress < lines.size() ? lines[codeAddress] : 0;
   }
+  // Per code address, for a RET: the size of the #class auto frame that
+  // its function's ENTER made (the epilogue pops IX from just above it, and
+  // the return address from above that), or -1: a static function's RET,
+  // or no RET. A function starts at a function symbol, a CALL's target or
+  // an interrupt handler; its frame is its first instruction's, if ENTER.
+  std::vector<int32_t> returnFrames() const;
   // The head of the loop written on source line N: the target of a
   // backward jump whose jump and target both belong to line N (the
   // outermost such loop when there are several: the lowest target). It

@@ -561,34 +561,31 @@ SIMBOT_INSTRUCTION(ENTER) {
   r.wr16(msp, mfp);  // PUSH IX
   msp -= size;
   mfp = msp;
-  // Its RET pops IX. (A handler's ENTER has no CallFrame of its own: its
-  // RETI restores IX from the acceptance frame.)
-  if (static_cast<int>(calls.size()) > (ints.empty() ? 0 : ints.back().callDepth)) {
-    calls.back().autoFrame = true;
-    calls.back().frameSize = size;
-  }
   return true;
 }
-// RET takes the return address (and an auto frame's saved IX, found from
-// IX as the epilogue finds it) from the robot's memory. Where it leads
-// anywhere but back to the call, divertedReturn decides.
+// RET takes the return address from the robot's memory: at SP, or in a
+// function whose ENTER made an auto frame (returnFrame), above the saved IX
+// that the epilogue pops from just above the frame that IX points at.
+// Where it leads anywhere but back to the call, divertedReturn decides.
 SIMBOT_INSTRUCTION(RET) {
   if (calls.empty() || (!ints.empty() && static_cast<int>(calls.size()) <= ints.back().callDepth))
     return fail(r, "return with no caller");
-  const CallFrame f = calls.back();
+  const CallFrame call = calls.back();
   calls.pop_back();
-  uint32_t slot = msp;
-  if (f.autoFrame) {
+  const int32_t frame = returnFrame[r.opPc];
+  const uint32_t fp = mfp;
+  uint32_t readAt = msp;
+  if (frame >= 0) {
     r.charge(static_cast<int32_t>(costs.autoFrameRet));  // LD SP,IX; POP IX
-    const uint32_t savedFp = (mfp + f.frameSize) & 0xFFFF;
+    const uint32_t savedFp = (fp + static_cast<uint32_t>(frame)) & 0xFFFF;
     mfp = r.rd16(savedFp);
-    slot = (savedFp + kSavedFpBytes) & 0xFFFF;
+    readAt = (savedFp + kSavedFpBytes) & 0xFFFF;
   }
-  const uint32_t target = r.rd16(slot);
+  const uint32_t target = r.rd16(readAt);
   // SP wraps at 16 bits; kMemorySize is the empty stack.
-  msp = (slot + kReturnAddressBytes - 1) % kMemorySize + 1;
-  if (__builtin_expect(target != f.retPc || slot != f.slot, 0))
-    return divertedReturn(r, f, target, slot);
+  msp = (readAt + kReturnAddressBytes - 1) % kMemorySize + 1;
+  if (__builtin_expect(target != call.retPc || readAt != call.saved, 0))
+    return divertedReturn(r, call, target, readAt, frame, fp);
   r.ip = target;
   return true;
 }
@@ -611,7 +608,10 @@ SIMBOT_INSTRUCTION(RETI) {
     return false;
   }
   // The interrupted PC and IX come back from the acceptance frame in the
-  // robot's memory (msp is restored by the epilogue's balanced pops).
+  // robot's memory, found where acceptance pushed it, as the epilogue's
+  // balanced pops find it (after a diversion inside the handler the chip's
+  // pops would start wherever SP was; simbot still uses the acceptance's
+  // SP: docs/cycle-model.md).
   const uint32_t top = f.msp - kReturnAddressBytes;
   const uint32_t target = rd16(top);
   pc = f.retPc;
@@ -642,7 +642,7 @@ SIMBOT_INSTRUCTION(RETI) {
     halted = false;
     burn = 0;
     lib = LibCall{};
-    diverted = true;
+    divert(r.pc(), target);
   }
   return false;
 }

@@ -169,14 +169,10 @@ std::string Vm::State::formatPrintf(uint32_t instructionPc, int formatArg) {
 // LIB: the call sequence runs first (in steps when it is longer than
 // kMaxStepTstates); the routine's effect happens at the end of it.
 void Vm::State::libCall(Lib id, int argc, uint32_t instructionPc) {
-  if (sp < argc) {  // only after a diverted return (kEvalFloor)
-    raiseFault("expression stack underflow after a diverted return", instructionPc);
-    return;
-  }
   lib.id = id;
   lib.pc = instructionPc;
   lib.argc = argc;
-  for (int k = argc - 1; k >= 0; --k) lib.args[k] = slot(--sp);
+  for (int k = argc - 1; k >= 0; --k) lib.args[k] = eval[--sp];
   lib.index = 0;
   lib.remaining = 0;
   lib.result = 0;
@@ -210,13 +206,13 @@ void Vm::State::libBegin() {
       lib.result = w(bus->adSample(now, static_cast<int>(asInt16(a[0]))));
       lib.remaining = costs.adConversion;
       lib.active = lib.remaining > 0;
-      if (!lib.active) slot(sp++) = lib.result;
+      if (!lib.active) eval[sp++] = lib.result;
       return;
     case Lib::OUTPORT:
       bus->out(now, static_cast<uint16_t>(a[0]), static_cast<uint8_t>(a[1]));
       return;
     case Lib::INPORT:
-      slot(sp++) = bus->in(now, static_cast<uint16_t>(a[0]));
+      eval[sp++] = bus->in(now, static_cast<uint16_t>(a[0]));
       return;
     case Lib::SER_INIT_Z1:
       // The routine restores the caller's interrupt state (JP PO; EI): IFF1
@@ -238,11 +234,11 @@ void Vm::State::libBegin() {
       return;
     case Lib::ABS: {
       int16_t v = asInt16(a[0]);
-      slot(sp++) = w(v < 0 ? -v : v);
+      eval[sp++] = w(v < 0 ? -v : v);
       return;
     }
     case Lib::FABS:
-      slot(sp++) = a[0] & 0x7FFFFFFFu;
+      eval[sp++] = a[0] & 0x7FFFFFFFu;
       return;
     case Lib::SQRT:
     case Lib::SIN:
@@ -258,7 +254,7 @@ void Vm::State::libBegin() {
     case Lib::ATAN2:
     case Lib::POW:
     case Lib::FMOD:
-      slot(sp++) = std::bit_cast<uint32_t>(
+      eval[sp++] = std::bit_cast<uint32_t>(
           mathLib(id, std::bit_cast<float>(a[0]), std::bit_cast<float>(a[1])));
       return;
     case Lib::DELAYMS:
@@ -269,7 +265,7 @@ void Vm::State::libBegin() {
                              : id == Lib::DELAYSEC ? image->timer.sec
                                                    : image->timer.tick;
       const auto interval = static_cast<int32_t>(id == Lib::DELAYTICKS ? a[1] & 0xFFFF : a[1]);
-      slot(sp++) = delayDone(a[0] & 0xFFFF, interval, timer, instructionPc) ? 1u : 0u;
+      eval[sp++] = delayDone(a[0] & 0xFFFF, interval, timer, instructionPc) ? 1u : 0u;
       return;
     }
     case Lib::COBEGIN:
@@ -295,10 +291,10 @@ void Vm::State::libBegin() {
           wr8(cd + kCoState, state & ~kCoStopped);
           return;
         case Lib::ISCODONE:
-          slot(sp++) = (state & (kCoStopped | kCoInit)) == (kCoStopped | kCoInit) ? 1u : 0u;
+          eval[sp++] = (state & (kCoStopped | kCoInit)) == (kCoStopped | kCoInit) ? 1u : 0u;
           return;
         default:
-          slot(sp++) = (state & kCoStopped) ? 0u : 1u;
+          eval[sp++] = (state & kCoStopped) ? 0u : 1u;
           return;
       }
     }
@@ -346,7 +342,7 @@ void Vm::State::libBegin() {
 
 void Vm::State::libFinish(bool pushResult) {
   lib.active = false;
-  if (pushResult) slot(sp++) = lib.result;
+  if (pushResult) eval[sp++] = lib.result;
 }
 
 // One step of a long library call: at most kMaxStepTstates T-states.

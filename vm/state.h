@@ -45,12 +45,6 @@ inline constexpr uint32_t kReturnAddressBytes = 2;
 inline constexpr uint32_t kSavedFpBytes = 2;
 inline constexpr uint32_t kInterruptFrameBytes = 14;
 inline constexpr uint32_t kInterruptFpOffset = 12;
-// Slots below the expression stack's bottom: after a return that a
-// smashed return address diverted, the stack can be popped past its
-// bottom; the slow boundary, which every instruction then takes, faults
-// there, and no instruction pops more than two (a library call checks its
-// arguments first).
-inline constexpr int kEvalFloor = 4;
 
 // LibCall::mark before a routine's second phase has begun.
 inline constexpr uint32_t kNoMark = 0xFFFFFFFFu;
@@ -74,15 +68,23 @@ struct LibCall {
   bool operator==(const LibCall&) const = default;
 };
 
-// What the host remembers of a call, for checks and messages: the return
-// address and saved IX themselves are in the robot's memory, and RET reads
-// them there (a program that overwrites them returns where they lead).
+// What the host remembers of a call, to check the return against and to
+// name it in messages: the return address itself is in the robot's memory,
+// and RET reads it there (a program that overwrites it returns where it
+// leads).
 struct CallFrame {
-  uint32_t retPc;          // where the CALL's return address pointed
-  uint32_t slot;           // the address it was saved at
-  uint32_t frameSize = 0;  // ENTER's auto frame, below the saved IX
-  bool autoFrame = false;  // ENTER ran: RET also pops IX
+  uint32_t retPc;  // the address after the CALL
+  uint32_t saved;  // where the CALL pushed it
   bool operator==(const CallFrame&) const = default;
+};
+
+// The first return that went where a smashed frame led, not back to its
+// call: every later fault names it, since the host's record of the calls
+// no longer matches what the robot runs.
+struct Diversion {
+  uint32_t at;      // the RET or RETI
+  uint32_t target;  // where it went
+  bool operator==(const Diversion&) const = default;
 };
 
 struct InterruptFrame {
@@ -241,10 +243,7 @@ struct Vm::State {
   Bus* bus;
   CostTable costs;
   std::vector<uint8_t> mem = std::vector<uint8_t>(kMemorySize, 0);
-  // The expression stack, kEvalFloor slots above the vector's start.
-  std::vector<uint32_t> eval = std::vector<uint32_t>(kEvalFloor + kEvalSlots, 0);
-  uint32_t* evalBase() { return eval.data() + kEvalFloor; }
-  uint32_t& slot(int i) { return eval[static_cast<size_t>(kEvalFloor + i)]; }
+  std::vector<uint32_t> eval = std::vector<uint32_t>(kEvalSlots, 0);
   int sp = 0;  // eval stack: next free slot
   std::vector<CallFrame> calls;
   std::vector<InterruptFrame> ints;
@@ -258,10 +257,10 @@ struct Vm::State {
   bool eiShadow = false;
   bool halted = false;
   bool hostStop = false;  // Vm::stopAtNextBoundary, during a run
-  // A RET or RETI went where a smashed return address led, not back to its
-  // call: the expression stack no longer matches the code, so every
-  // boundary is slow and checks it from then on.
-  bool diverted = false;
+  // Set at the first diverted return: from then on the expression stack
+  // need not match the code, so every boundary is slow and checks that the
+  // next instruction has the slots it takes.
+  std::optional<Diversion> diverted;
   std::array<bool, kIrqCount> pend{};
   std::array<uint8_t, kIrqCount> vec{};
   bool anyPending = false;
@@ -384,6 +383,12 @@ struct Vm::State {
   // ---- faults and memory ----
   void raiseFault(std::string message, uint32_t atPc) {
     if (fault) return;
+    if (diverted) {
+      const Symbol* f = image->functionAt(diverted->at);
+      message += fmt::format(" (after the return at 0x{:04X}{} went to 0x{:04X}, off its call)",
+                             diverted->at, f ? fmt::format(" in '{}'", f->name) : std::string(),
+                             diverted->target);
+    }
     fault = Fault{std::move(message), now, image->lineAt(atPc)};
   }
   // Checks a pointer access of `size` bytes; false (and a fault) if invalid.
@@ -485,10 +490,15 @@ struct Vm::State {
   void burnTail(Regs& r);
   bool fail(const Regs& r, const char* message);
   bool badCallThrough(const Regs& r, uint32_t target, uint32_t argc);
-  bool divertedReturn(Regs& r, const CallFrame& frame, uint32_t target, uint32_t slot);
-  // Where a smashed return address may lead: instruction starts.
+  bool divertedReturn(Regs& r, const CallFrame& call, uint32_t target, uint32_t readAt,
+                      int32_t frame, uint32_t fp);
+  void divert(uint32_t at, uint32_t target);
+  // Where a smashed return address may lead: instruction starts, but not
+  // the reset address.
   std::vector<uint8_t> instructionStart;
   std::string returnTargetProblem(uint32_t target) const;
+  // Per RET, the auto frame it releases, or -1 (Image::returnFrames).
+  std::vector<int32_t> returnFrame;
   bool callTo(Regs& r, uint32_t target);
   bool access(const Regs& r, uint32_t address, uint32_t bytes);
   template <Op O>

@@ -146,7 +146,8 @@ void Vm::State::timerService(uint32_t interruptedPc) {
 //  - a pending request with IFF1 set (only the slow path changes IFF1, the
 //    pending flags or the EI shadow while run() runs: the host raises
 //    requests between calls), the time of a long instruction still to burn,
-//    the eval stack past its guard: limit = 0, so the next boundary is slow;
+//    the eval stack past its guard, and every boundary after a diverted
+//    return (divertedReturn): limit = 0, so the next boundary is slow;
 //  - an address whose `dispatch` byte is kTrap (decode(): invalid opcodes,
 //    instructions past the end of the code or jumping outside it,
 //    fast-forward loop tops, breakpoints): the kTrap handler sends it to
@@ -186,10 +187,12 @@ bool Vm::State::badCallThrough(const Regs& r, uint32_t target, uint32_t argc) {
   return false;
 }
 
-// Why a return cannot go to `target`, or "" when it can (an instruction's
-// first byte, where the chip would simply run on).
+// Why a return cannot go to `target`, or "" when it can: an instruction's
+// first byte, where the chip would simply run on, except the reset address
+// (the chip would start its BIOS again, which simbot does not model).
 std::string Vm::State::returnTargetProblem(uint32_t target) const {
   if (target >= instructionStart.size()) return "outside the code";
+  if (target == image->entry) return "the reset address";
   if (!instructionStart[target]) {
     const Symbol* f = image->functionAt(target);
     return f ? fmt::format("inside an instruction of '{}'", f->name)
@@ -198,33 +201,58 @@ std::string Vm::State::returnTargetProblem(uint32_t target) const {
   return "";
 }
 
-// A RET whose return address, or the IX that finds it, is not what its
-// call left: a local array overrun (or a wild pointer) wrote over the
-// frame. The robot goes where the address leads, as the chip would, if
-// that is an instruction; otherwise it faults naming the smashed frame.
-bool Vm::State::divertedReturn(Regs& r, const CallFrame& frame, uint32_t target, uint32_t slot) {
+// The robot leaves its call path at `at` for `target`: every boundary is
+// slow from here on (see "Fast path").
+void Vm::State::divert(uint32_t at, uint32_t target) {
+  if (!diverted) diverted = Diversion{at, target};
+}
+
+// A RET that read a return address other than its call's, or read it
+// elsewhere (its IX was not its frame's): a local array overrun or a wild
+// pointer wrote over the frame. The robot goes where the address leads, as
+// the chip would, if that is an instruction; otherwise it faults, naming
+// the function, where the word was read and what the call had saved.
+bool Vm::State::divertedReturn(Regs& r, const CallFrame& call, uint32_t target, uint32_t readAt,
+                               int32_t frame, uint32_t fp) {
   const Symbol* callee = image->functionAt(r.pc());
-  const Symbol* caller = image->functionAt(frame.retPc);
+  const Symbol* caller = image->functionAt(call.retPc);
   const std::string name = callee ? fmt::format("'{}'", callee->name) : std::string("a function");
-  const std::string problem = returnTargetProblem(target);
-  if (problem.empty()) {
-    diverted = true;
+  // IX was not the frame's (a saved IX that a callee restored had been
+  // overwritten): the saved IX and return address were read elsewhere.
+  const std::string wrongFp =
+      frame >= 0 && readAt != call.saved
+          ? fmt::format(
+                " (its frame pointer IX was 0x{:04X}, not its frame's 0x{:04X}: a saved "
+                "IX on the stack was overwritten)",
+                fp, (call.saved - kSavedFpBytes - static_cast<uint32_t>(frame)) & 0xFFFF)
+          : std::string();
+  const uint32_t savedFp = (readAt - kSavedFpBytes) & 0xFFFF;
+  std::string message;
+  if (frame >= 0 && savedFp < kNullPageEnd) {
+    message =
+        fmt::format("{} read its saved IX at 0x{:04X}, in the null page{}", name, savedFp, wrongFp);
+  } else if (readAt < kNullPageEnd) {
+    message = fmt::format("{} read its return address at 0x{:04X}, in the null page{}", name,
+                          readAt, wrongFp);
+  } else if (const std::string problem = returnTargetProblem(target); !problem.empty()) {
+    message = readAt != call.saved
+                  ? fmt::format(
+                        "{} returned to 0x{:04X}, {}: it read its return address at "
+                        "0x{:04X}, not at 0x{:04X} where its call saved it{}",
+                        name, target, problem, readAt, call.saved, wrongFp)
+                  : fmt::format(
+                        "{} returned to 0x{:04X}, {}: its return address at 0x{:04X} "
+                        "(0x{:04X}, in '{}') was overwritten",
+                        name, target, problem, readAt, call.retPc, caller ? caller->name : "?");
+  } else {
+    // It runs on. The calls whose return addresses SP has now passed will
+    // never return: drop them, so that the host's record stays bounded.
+    const size_t floor = ints.empty() ? 0 : static_cast<size_t>(ints.back().callDepth);
+    while (calls.size() > floor && calls.back().saved < msp) calls.pop_back();
+    divert(r.pc(), target);
     r.ip = target;
     r.limit = 0;
     return true;
-  }
-  std::string message;
-  if (slot != frame.slot) {
-    message = fmt::format(
-        "{} returned to 0x{:04X}, {}: it read its return address at 0x{:04X}, not at 0x{:04X} "
-        "where its call saved it, because its frame pointer IX was overwritten (a saved IX on "
-        "the stack)",
-        name, target, problem, slot, frame.slot);
-  } else {
-    message = fmt::format(
-        "{} returned to 0x{:04X}, {}: its return address at 0x{:04X} (0x{:04X}, in '{}') was "
-        "overwritten",
-        name, target, problem, slot, frame.retPc, caller ? caller->name : "?");
   }
   save(r);
   raiseFault(std::move(message), r.pc());
@@ -240,6 +268,7 @@ void Vm::State::decode() {
   const auto size = static_cast<uint32_t>(code.size());
   padded = code;
   padded.resize(size + kCodePad, 0);
+  returnFrame = image->returnFrames();
   // The code is instructions end to end (the compiler puts no data in it).
   instructionStart.assign(size, 0);
   for (uint32_t a = 0; a < size;) {
@@ -460,8 +489,8 @@ Stop Vm::State::run(Tick until) {
   const auto codeSize = static_cast<uint32_t>(image->code.size());
   const int16_t* const loopTop =
       costs.knobs.fastForward && !loopAtTop.empty() ? loopAtTop.data() : nullptr;
-  Regs r{now, 0,          stats.instructions, pc,   pc,
-         sp,  evalBase(), mem.data(),         code, kProfile ? profile.data() : nullptr};
+  Regs r{now, 0,           stats.instructions, pc,   pc,
+         sp,  eval.data(), mem.data(),         code, kProfile ? profile.data() : nullptr};
   Tick longLimit = -1;  // L_Long_: the limit its instruction's tail runs to
   uint8_t op = 0;
   hostStop = false;
@@ -487,10 +516,6 @@ boundary:
   if (fault) return Stop::Fault;
   if (sp > kEvalSlots - kEvalGuard) {
     raiseFault("expression stack overflow (too many arguments or values pending)", pc);
-    goto boundary;
-  }
-  if (sp < 0) {  // only after a diverted return, whose boundaries are all slow
-    raiseFault("expression stack underflow after a diverted return", pc);
     goto boundary;
   }
   if (hostStop) {
@@ -545,6 +570,10 @@ boundary:
     raiseFault(fmt::format("invalid opcode {}", op), pc);
     goto boundary;
   }
+  if (diverted && sp < slotsTaken(static_cast<Op>(op), code + pc)) {
+    raiseFault("expression stack underflow", pc);
+    goto boundary;
+  }
   if (costs.op[op] <= kMaxStepTstates) {
     now += costs.op[op];
   } else {
@@ -565,7 +594,7 @@ boundary:
            pc,
            pc,
            sp,
-           evalBase(),
+           eval.data(),
            mem.data(),
            code,
            kProfile ? profile.data() : nullptr};
@@ -764,6 +793,7 @@ bool Vm::interruptsEnabled() const { return s_->iff1; }
 uint32_t Vm::pc() const { return s_->lib.active ? s_->lib.pc : s_->burn ? s_->burnPc : s_->pc; }
 int Vm::line() const { return s_->image->lineAt(pc()); }
 int Vm::interruptDepth() const { return static_cast<int>(s_->ints.size()); }
+int Vm::callDepth() const { return static_cast<int>(s_->calls.size()); }
 uint8_t Vm::read8(uint16_t a) const { return s_->rd8(a); }
 void Vm::write8(uint16_t a, uint8_t v) { s_->wr8(a, v); }
 uint16_t Vm::read16(uint16_t a) const { return s_->rd16(a); }

@@ -166,6 +166,7 @@ class Vm {
   uint32_t pc() const;
   int line() const;            // source line of pc()
   int interruptDepth() const;  // handlers in service (nested ones count)
+  int callDepth() const;       // calls not yet returned from
 
   // Power-on RAM from a random stream (a profile option, DESIGN.md): every
   // byte from kDataBase up that the image does not initialise is replaced,
