@@ -257,6 +257,10 @@ struct Arena::Impl {
   struct Rec {
     double tlo, thi;
     std::size_t off;  // 6 Taylor coefficients about tlo for each of nx components
+    // The step ARKODE planned after this one (the segment's first record:
+    // the step it started with; 0: ARKODE's own estimate). A reset inside
+    // this step starts from it (reinit).
+    double next = 0;
   };
   std::vector<Rec> recs;
   std::vector<double> coef;

@@ -23,14 +23,15 @@ def run(simbot, args, trace):
         sys.exit(f"FAIL: {' '.join(args)} exited {out.returncode}: {out.stderr}")
     summary = json.loads(out.stdout)
     summary.pop("wall_seconds", None)
-    # The integrator's steps and right-hand sides count work, not results:
-    # steps past an input's tick are thrown away at its re-initialisation,
-    # and fast-forward lets the scheduler end rounds elsewhere
-    # (Vm::quietUntil; scheduler/match.h, step 1). Resets and roots must match.
+    # The integrator's steps, right-hand sides and roots count work, not
+    # results: steps past an input's tick (and the roots found in them) are
+    # thrown away at its re-initialisation, and fast-forward lets the
+    # scheduler end rounds elsewhere (Vm::quietUntil; scheduler/match.h,
+    # step 1). Resets must match, and so must every event in the trace.
     integrator = summary.get("integrator")
     if integrator:
-        integrator.pop("steps", None)
-        integrator.pop("rhs_evals", None)
+        for work in ("steps", "rhs_evals", "roots"):
+            integrator.pop(work, None)
     return summary
 
 
