@@ -73,8 +73,10 @@ CostTable makeCostTable(const CostKnobs& knobs) {
     t.libTakenDelta[i] = static_cast<int32_t>(resolve(kLibPathCost[i][1], knobs)) -
                          static_cast<int32_t>(t.libCall[i]);
     t.libStep[i] = resolve(kLibStepCost[i], knobs);
+    t.libStepLooping[i] = resolve(kLibStepLoopingCost[i], knobs);
   }
   t.autoFrameRet = resolve(kAutoRetSeq, knobs);
+  t.ldirRepeat = resolve(sequenceCost("LDIR", 1), knobs);
   t.interruptAccept = resolve(kAcceptSeq, knobs);
   t.serialIsr = resolve(kSerialIsrSeq, knobs) + static_cast<uint32_t>(knobs.serialIsrTstates);
   for (int p = 0; p < kTimerIsrPaths; ++p) t.timerIsr[p] = resolve(kTimerPathSeq[p], knobs);

@@ -251,6 +251,28 @@ inline constexpr auto kLibStepCost = [] {
   return a;
 }();
 
+// An inner loop closed by a conditional branch, its step sequence's last
+// item ("...; OR A; JR NZ,e"): the branch is taken back for every unit but
+// the last, which falls through (kLibStepCost); LDIR likewise repeats at
+// its taken figure and ends at its not-taken one. Other loops (atoi's,
+// closed by a plain JR) cost the same every pass.
+constexpr bool stepLoopIsClosedByItsBranch(std::string_view seq) {
+  const auto semicolon = seq.rfind(';');
+  auto last = semicolon == std::string_view::npos ? seq : seq.substr(semicolon + 1);
+  while (!last.empty() && last.front() == ' ') last.remove_prefix(1);
+  return last == "JR cc,e" || last == "JP cc,nn" || last == "LDIR";
+}
+inline constexpr auto kLibStepLoopingCost = [] {
+  std::array<SeqCost, kLibCount> a{};
+  for (int i = 0; i < kLibCount; ++i) {
+    const std::string_view seq = kLibInfo[i].stepSeq;
+    const int branches = sequenceCost(seq).branches;
+    a[i] = stepLoopIsClosedByItsBranch(seq) ? sequenceCost(seq, 1u << (branches - 1))
+                                            : sequenceCost(seq);
+  }
+  return a;
+}();
+
 // A library call whose sequence saves the interrupt state and disables
 // interrupts (the serial library's "LD A,I; PUSH AF; DI ... POP AF; JP PO;
 // EI") is atomic: no instruction boundary inside it (DESIGN.md,
@@ -339,7 +361,8 @@ struct CostKnobs {
 struct CostTable {
   std::array<uint32_t, kOpCount> op{};
   std::array<uint32_t, kLibCount> libCall{};
-  std::array<uint32_t, kLibCount> libStep{};
+  std::array<uint32_t, kLibCount> libStep{};         // the last unit of an inner loop
+  std::array<uint32_t, kLibCount> libStepLooping{};  // each unit before it
   // Added to op[] when the instruction's branches go the way `path` says
   // (bit k: k-th branch taken); path 0 is 0 (op[] is the not-taken path).
   std::array<std::array<int32_t, kOpPaths>, kOpCount> branchDelta{};
@@ -351,6 +374,7 @@ struct CostTable {
   // the routines whose path comes from their argument (abs).
   std::array<int32_t, kLibCount> libTakenDelta{};
   uint32_t autoFrameRet = 0;     // RET of a frame that ran ENTER: POP IX
+  uint32_t ldirRepeat = 0;       // an LDIR byte after which BC is not yet 0 (COPY)
   uint32_t interruptAccept = 0;  // IM2 acknowledge + handler register saves
   uint32_t serialIsr = 0;        // acceptance + library ISR body
   // The timer service along each path (bit 0: no millisecond due, bit 1:

@@ -114,9 +114,16 @@ std::string costText(const CostTable& costs, Op op, const Image& img, uint32_t o
     // inner loop once per unit (a printf character also the debug port's).
     if (static_cast<Lib>(id) == Lib::AD_RD8) return text + fmt::format("+{}", costs.adConversion);
     if (kLibInfo[id].unit.empty()) return text;
-    const uint32_t unit =
-        costs.libStep[id] + (static_cast<Lib>(id) == Lib::PRINTF ? costs.printfChar : 0);
-    return text + fmt::format("+{}n", unit);
+    if (static_cast<Lib>(id) == Lib::PRINTF)
+      return text + fmt::format("+{}n", costs.libStep[id] + costs.printfChar);
+    // n units: n - 1 looping back, the last falling through.
+    const int64_t lastSaves = int64_t{costs.libStepLooping[id]} - costs.libStep[id];
+    if (lastSaves == 0) return text + fmt::format("+{}n", costs.libStep[id]);
+    const int64_t callLess = call - lastSaves;
+    text = libPathFromArguments(static_cast<Lib>(id))
+               ? fmt::format("{}/{}", callLess + costs.libTakenDelta[id], callLess)
+               : fmt::format("{}", callLess);
+    return text + fmt::format("+{}n", costs.libStepLooping[id]);
   }
   if (op == Op::COSTATE) {
     // Its JP Z leaves the sequence when taken: a STOPPED costatement costs
@@ -178,10 +185,14 @@ std::string disassemble(const Image& img) {
     std::string operands = operandText(info(op).shape, img, at + 1);
     const std::string note = annotate(img, op, at + 1);
     if (!note.empty()) operands += fmt::format("  ({})", note);
-    const std::string cost =
-        op == Op::RET && returnFrames[at] >= 0
-            ? fmt::format("{}", costs.op[static_cast<int>(op)] + costs.autoFrameRet)
-            : costText(costs, op, img, at + 1);
+    std::string cost = costText(costs, op, img, at + 1);
+    if (op == Op::RET && returnFrames[at] >= 0)
+      cost = fmt::format("{}", costs.op[static_cast<int>(op)] + costs.autoFrameRet);
+    if (op == Op::COPY) {  // LDIR repeats for every byte but the last
+      const uint32_t n = img.code[at + 1] | (img.code[at + 2] << 8);
+      cost = fmt::format("{}",
+                         costs.op[static_cast<int>(op)] + (n > 1 ? n - 1 : 0) * costs.ldirRepeat);
+    }
     out += fmt::format("  {:04x}  {:>11}  {:<8} {}\n", at, cost, info(op).name, operands);
     at += static_cast<uint32_t>(size);
   }

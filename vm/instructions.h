@@ -251,6 +251,7 @@ SIMBOT_INSTRUCTION(COPY) {
   const uint32_t src = r.pop() & 0xFFFF, dst = r.pop() & 0xFFFF;
   if (!access(r, src, n) || !access(r, dst, n)) return false;
   std::memmove(r.m + dst, r.m + src, n);
+  if (n > 1) r.charge(static_cast<int32_t>((n - 1) * costs.ldirRepeat));
   return true;
 }
 

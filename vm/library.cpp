@@ -348,7 +348,7 @@ void Vm::State::libFinish(bool pushResult) {
 // One step of a long library call: at most kMaxStepTstates T-states.
 void Vm::State::libStep() {
   const int id = static_cast<int>(lib.id);
-  const uint32_t unit = std::max<uint32_t>(1, costs.libStep[id]);
+  const uint32_t unit = std::max<uint32_t>(1, costs.libStepLooping[id]);
   const uint32_t perStep = std::max<uint32_t>(1, kMaxStepTstates / unit);
   const uint32_t* a = lib.args;
   ++stats.instructions;
@@ -518,7 +518,9 @@ void Vm::State::libStep() {
     ++lib.index;
     ++done;
   }
-  const uint32_t cost = done * unit;
+  // Every unit loops back (its branch taken) but the routine's last.
+  const uint32_t last = costs.libStep[id];
+  const uint32_t cost = done * unit - (finished && done > 0 ? unit - last : 0);
   now += cost;
   if (profiling) profile[lib.pc] += cost;
   if (finished) libFinish(true);
