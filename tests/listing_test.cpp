@@ -1,11 +1,8 @@
 // `simbot compile --disasm` against the clock (issue 24): for every opcode
-// but HALT, RETI, LIB (each routine is checked instead) and the
-// costatements', and every library routine that is not a costatement's,
-// the T-states the listing prints for an instruction are what the VM
-// charges it, on every path the listing names, measured between
-// breakpoints on the instruction and the one it leads to. The costatement
-// opcodes and routines, and RETI, have tests of their own with figures
-// worked by hand (Costate.*, InterruptTiming.*, Timer.*).
+// and every library routine, the T-states the listing prints for an
+// instruction are what the VM charges it, on every path the listing names,
+// measured between a breakpoint on the instruction and the one it leads to
+// (or, where that varies, over one instruction: run() to the next tick).
 //
 // A listing field is one figure per path ("44/46"), a figure per unit
 // ("57+36n": the call and n bytes), or a call and its conversion ("163+276").
@@ -16,12 +13,14 @@
 
 #include <bit>
 #include <cstring>
+#include <map>
 #include <optional>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "compiler/compiler.h"
 #include "support/assembler.h"
 #include "support/test_host.h"
 #include "vm/bytecode.h"
@@ -282,6 +281,139 @@ TEST(ListingMatchesClock, EveryControlOpcode) {
   }
 }
 
+bool isCostateRoutine(std::string_view name) {
+  return name.starts_with("Delay") || name.starts_with("Co") || name.starts_with("isCo");
+}
+
+// One instruction from a breakpoint: run() to the next tick stops at the
+// boundary after it. None when an interrupt came first or in between.
+std::optional<vm::Tick> stepOne(vm::Vm& v) {
+  const vm::Tick before = v.now();
+  const auto interrupts = v.stats().interrupts;
+  const uint64_t count = v.stats().instructions;
+  v.run(before + 1);
+  if (v.stats().interrupts != interrupts || v.stats().instructions != count + 1) return {};
+  return v.now() - before;
+}
+
+TEST(ListingMatchesClock, HaltAndReti) {
+  {
+    Assembler a;
+    a.bind("it").op(Op::HALT);
+    const auto img = a.finish();
+    TestHost host;
+    vm::Vm v(img, host, costs());
+    checkAll("HALT", {Measured{stepOne(v), listedCost(img, 0)}});
+  }
+  {
+    // 0: loop: DBG; JMP loop (3); handler at 4: RETI.
+    Assembler a;
+    a.bind("loop").op(Op::DBG).jump(Op::JMP, "loop");
+    a.bind("it").op(Op::RETI);
+    a.image.vectors.push_back({vm::kVecPIOA, static_cast<uint16_t>(a.label("it")), "h"});
+    const auto img = a.finish();
+    TestHost host;
+    vm::Vm v(img, host, costs());
+    v.setBreakpoint(a.label("it"));
+    v.request(vm::Irq::Pio, vm::kVecPIOA);
+    ASSERT_EQ(v.run(100'000), Stop::Breakpoint);
+    checkAll("RETI", {Measured{stepOne(v), listedCost(img, a.label("it"))}});
+  }
+}
+
+// The costatement opcodes and routines, in a program that takes each of
+// their paths over 6 s: every COSTATE, COYIELD, COEND and CODONE is
+// stepped from a breakpoint each time the robot reaches it, and every call
+// of a costatement routine measured to the instruction after its LIB.
+TEST(ListingMatchesClock, EveryCostatementOpcodeAndRoutine) {
+  const std::string source = R"(int n, i, r;
+main() {
+  for (n = 0; n < 4000; n++) {
+    costate every always_on {
+      waitfor(DelayMs(20L));
+      waitfor(DelaySec(1L));
+      waitfor(DelayTicks(3));
+      yield;
+      if (n > 3500) abort;
+    }
+    costate later {
+      yield;
+      i++;
+    }
+    costate once init_on {
+      i++;
+    }
+    if (n == 5) CoBegin(&later);
+    if (n == 9) CoPause(&every);
+    if (n == 12) CoResume(&every);
+    if (n == 15) CoReset(&later);
+    r = isCoDone(&once) + isCoRunning(&later);
+    for (i = 0; i < 50; i++) ;
+  }
+}
+)";
+  const auto compiled = compiler::compile(source, "co.dc");
+  ASSERT_TRUE(compiled.image) << compiled.errors[0].format();
+  const vm::Image& img = *compiled.image;
+  TestHost host;
+  vm::Vm v(img, host, costs());
+  std::map<uint32_t, std::vector<Measured>> runs;  // by code address
+  std::map<uint32_t, std::string> names;
+  std::map<uint32_t, std::vector<Alternative>> listed;
+  for (uint32_t at = 0; at < img.code.size();) {
+    const auto op = static_cast<Op>(img.code[at]);
+    const bool co = op == Op::COSTATE || op == Op::COYIELD || op == Op::COEND || op == Op::CODONE;
+    const bool coLib =
+        op == Op::LIB && isCostateRoutine(vm::info(static_cast<vm::Lib>(img.code[at + 1])).name);
+    if (co || coLib) {
+      v.setBreakpoint(at);
+      names[at] = coLib ? std::string(vm::info(static_cast<vm::Lib>(img.code[at + 1])).name)
+                        : std::string(vm::info(op).name);
+      listed[at] = listedCost(img, at);
+    }
+    at += static_cast<uint32_t>(vm::instructionSize(op));
+  }
+  const vm::Tick end = 6 * vm::kTicksPerSecond;
+  while (v.now() < end && v.run(end) == Stop::Breakpoint) {
+    const uint32_t at = v.pc();
+    const auto op = static_cast<Op>(img.code[at]);
+    if (op != Op::LIB) {
+      runs[at].push_back(Measured{stepOne(v), listed[at]});
+      continue;
+    }
+    // A routine: to the instruction after its LIB (a breakpoint of its own
+    // when it is one of ours).
+    const uint32_t next = at + 3;
+    const bool ours = names.count(next) > 0;
+    const vm::Tick before = v.now();
+    const auto interrupts = v.stats().interrupts;
+    if (!ours) v.setBreakpoint(next);
+    EXPECT_EQ(v.run(end + vm::kTicksPerSecond), Stop::Breakpoint);
+    if (!ours) v.setBreakpoint(next, false);
+    ASSERT_EQ(v.pc(), next);
+    const bool quiet = v.stats().interrupts == interrupts;
+    runs[at].push_back(
+        Measured{quiet ? std::optional<vm::Tick>(v.now() - before) : std::nullopt, listed[at]});
+  }
+  ASSERT_EQ(v.fault(), nullptr) << v.fault()->message;
+  // Each site's charges are among its listed figures; each figure of a
+  // kind (COSTATE's stopped, fresh and resumed) is reached at some site.
+  std::map<std::string, std::vector<Measured>> byKind;
+  for (auto& [at, list] : runs) {
+    for (const Measured& m : list) {
+      if (!m.ticks) continue;
+      EXPECT_GE(matching(m.listed, *m.ticks), 0)
+          << names[at] << " at " << at << " charged " << *m.ticks;
+      byKind[names[at]].push_back(m);
+    }
+  }
+  for (const auto& [kind, list] : byKind) checkAll(kind, list);
+  for (const char* kind :
+       {"COSTATE", "COYIELD", "COEND", "CODONE", "DelayMs", "DelaySec", "DelayTicks", "CoBegin",
+        "CoReset", "CoPause", "CoResume", "isCoDone", "isCoRunning"})
+    EXPECT_TRUE(byKind.count(kind)) << kind << " never measured";
+}
+
 // A library routine called with `args` (pushed as words, or as floats
 // where the routine's letter is 'f').
 Measured measureLib(vm::Lib lib, const std::vector<uint32_t>& args, Assembler& a) {
@@ -292,10 +424,6 @@ Measured measureLib(vm::Lib lib, const std::vector<uint32_t>& args, Assembler& a
   return measure(a);
 }
 
-bool isCostateRoutine(std::string_view name) {
-  return name.starts_with("Delay") || name.starts_with("Co") || name.starts_with("isCo");
-}
-
 // Library routines: each with arguments that reach its paths; one with an
 // inner loop twice, n and n + 3 units, whose charges differ by 3 units.
 TEST(ListingMatchesClock, EveryLibraryRoutine) {
@@ -303,7 +431,7 @@ TEST(ListingMatchesClock, EveryLibraryRoutine) {
   for (int id = 0; id < vm::kLibCount; ++id) {
     const auto lib = static_cast<vm::Lib>(id);
     const vm::LibInfo& info = vm::info(lib);
-    if (isCostateRoutine(info.name)) continue;
+    if (isCostateRoutine(info.name)) continue;  // EveryCostatementOpcodeAndRoutine
     SCOPED_TRACE(std::string(info.name));
     // Two runs: for a routine with units, strings of 4 and 7 characters
     // (memory routines: counts 4 and 7); otherwise arguments of each sign.
