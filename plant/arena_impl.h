@@ -257,9 +257,10 @@ struct Arena::Impl {
   struct Rec {
     double tlo, thi;
     std::size_t off;  // 6 Taylor coefficients about tlo for each of nx components
-    // The step ARKODE planned after this one (the segment's first record:
-    // the step it started with; 0: ARKODE's own estimate). A reset inside
-    // this step starts from it (reinit).
+    // The step ARKODE reported as its next after this one (its planned
+    // step; after a root or stop-time return, the step just taken), or for
+    // the segment's first record the step it started with (0: ARKODE's own
+    // estimate). A reset inside this step starts from it (reinit).
     double next = 0;
   };
   std::vector<Rec> recs;

@@ -378,8 +378,8 @@ void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, b
   fresh = true;
   segWheel = wheelTarget;
   segGun = gunTarget;
-  // The new segment starts with the step ARKODE planned after the step
-  // that holds t0 (a one-step method restarts for free), within half the
+  // The new segment starts with the step ARKODE reported as its next after
+  // the step that holds t0 (Rec::next; a one-step method restarts for free), within half the
   // distance to the nearest feature, and with its step controller afresh:
   // ERKStepSetInitStep clears the error history that ERKStepReset keeps.
   // Both then depend on the steps up to t0 alone, never on steps taken past

@@ -486,6 +486,19 @@ TEST(ListingMatchesClock, EveryLibraryRoutine) {
       const int64_t perUnit = runs[0].listed.back().perUnit;
       ASSERT_GT(perUnit, 0);
       EXPECT_EQ(*runs[1].ticks - *runs[0].ticks, (units[1] - units[0]) * perUnit);
+      // And exactly the units the routine processes for a length-L text or
+      // count: the string and its NUL (strcat: also the NUL it starts at;
+      // sprintf writes its NUL; atoi reads it), or the count (printf: the
+      // characters it prints).
+      const std::string_view name = info.name;
+      const int64_t extra = name == "strcat" ? 2
+                            : name == "memset" || name == "memcpy" || name == "strncpy" ||
+                                    name == "strncmp" || name == "memcmp" || name == "printf"
+                                ? 0
+                                : 1;
+      for (size_t k = 0; k < 2; ++k)
+        EXPECT_EQ(*runs[k].ticks, runs[k].listed.back().base + (units[k] + extra) * perUnit)
+            << "length " << units[k];
     }
     ++checked;
   }

@@ -251,7 +251,16 @@ SIMBOT_INSTRUCTION(COPY) {
   const uint32_t src = r.pop() & 0xFFFF, dst = r.pop() & 0xFFFF;
   if (!access(r, src, n) || !access(r, dst, n)) return false;
   std::memmove(r.m + dst, r.m + src, n);
-  if (n > 1) r.charge(static_cast<int32_t>((n - 1) * costs.ldirRepeat));
+  // LDIR's bytes before the last: time that passes in steps with a
+  // boundary between them, as a long instruction's tail (an interrupt can
+  // come between two bytes on the chip).
+  if (n > 1) {
+    const uint32_t repeats = (n - 1) * costs.ldirRepeat;
+    if (r.profile) r.profile[r.opPc] += repeats;
+    burn += repeats;
+    burnPc = r.pc();
+    r.limit = 0;
+  }
   return true;
 }
 

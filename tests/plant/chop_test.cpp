@@ -37,6 +37,7 @@ struct ChopRun {
   std::vector<Logged> events;
   IntegratorStats stats;
   int advances = 0;
+  int overshoots = 0;  // advances past an input that were retreated from
 };
 
 constexpr std::int64_t kEnd = 30 * kTicksPerSecond + 4321;
@@ -127,7 +128,7 @@ ChopRun drive(const std::function<std::int64_t(std::int64_t, std::int64_t)>& nex
     Arena& a = *owned;
     advanceTo(in.tick);
     if (overshoot > 0 && in.tick > 0) {
-      a.advance(in.tick + overshoot);
+      if (a.advance(in.tick + overshoot).tick > in.tick) ++run.overshoots;
       a.retreat(in.tick);
     }
     if (in.wheels) {
@@ -212,6 +213,7 @@ TEST(Chopping, StepsPastAnInputTheArenaRetreatedFromLeaveNoTrace) {
   const ChopRun direct = drive(atInputs);
   for (const std::int64_t overshoot : {4'321, 96'000, 700'001}) {
     ChopRun probed = drive(atInputs, -1, false, overshoot);
+    EXPECT_GT(probed.overshoots, 10);  // most inputs: the advance went past them
     // The integrator's work includes the steps past each input and the
     // roots found there.
     probed.stats.steps = direct.stats.steps;
@@ -220,6 +222,18 @@ TEST(Chopping, StepsPastAnInputTheArenaRetreatedFromLeaveNoTrace) {
     expectSame(direct, probed,
                ("advanced past each input by " + std::to_string(overshoot)).c_str());
   }
+  // And with irregular stops between the inputs.
+  SplitMix64 rng(777);
+  ChopRun both = drive(
+      [&rng](std::int64_t now, std::int64_t target) {
+        return std::min(target, now + 1 + static_cast<std::int64_t>(rng.next() % 300'000));
+      },
+      -1, false, 96'000);
+  EXPECT_GT(both.overshoots, 10);
+  both.stats.steps = direct.stats.steps;
+  both.stats.rhs_evals = direct.stats.rhs_evals;
+  both.stats.roots = direct.stats.roots;
+  expectSame(direct, both, "irregular stops, and past each input by 96,000");
 }
 
 // A copy of an arena (made by replaying its journal) goes on exactly as
