@@ -33,6 +33,7 @@ struct StreamSeeds {
   uint64_t eyeNoise;    // the A/D's reading of the eyes
   uint64_t gunLuck;     // jams and misfires
   uint64_t muzzle;      // muzzle-speed spread, one draw per launching stroke
+  uint64_t dispersion;  // the ball's azimuth and elevation, two draws per launching stroke
 };
 
 // Everything on the board but the Z180: a plain value.
@@ -42,6 +43,7 @@ struct Devices {
         eyeNoise(seeds.eyeNoise),
         gunLuck(seeds.gunLuck),
         muzzle(seeds.muzzle),
+        dispersion(seeds.dispersion),
         randomMemory(randomMemoryFill) {}
   bool operator==(const Devices&) const = default;
 
@@ -52,7 +54,7 @@ struct Devices {
   uint8_t plantLow = 0, injectedLow = 0;
   uint8_t edgeLines = 0xFF;
   int enb485 = -1;  // never written
-  plant::SplitMix64 memoryFill, eyeNoise, gunLuck, muzzle;
+  plant::SplitMix64 memoryFill, eyeNoise, gunLuck, muzzle, dispersion;
   bool randomMemory;
   // Over the whole run: ad_rd8 calls per eye and the last value each
   // returned, interrupts accepted per source (vm::Irq).

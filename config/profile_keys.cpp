@@ -109,6 +109,10 @@ const std::vector<KeyDef>& keyTable() {
       {"gun", "muzzle_speed", Kind::Speed, {1, 1000}, true, D(p.robot.muzzle_speed_fps)},
       // Below 1, so every drawn speed is positive.
       {"gun", "muzzle_speed_spread", Kind::Ratio, {0, 0.5}, true, D(p.robot.muzzle_speed_spread)},
+      // Standard deviations. At 5 deg the widest draw (8.6 sigmas, variation.cpp)
+      // stays below 45 deg: still a gun that shoots forward.
+      {"gun", "azimuth_sigma", Kind::Angle, {0, 5}, true, D(p.robot.azimuth_sigma_deg)},
+      {"gun", "elevation_sigma", Kind::Angle, {0, 5}, true, D(p.robot.elevation_sigma_deg)},
       {"gun", "launch_height", Kind::Length, {0.05, 10}, true, D(p.robot.launch_height_ft)},
       {"gun", "balls_per_gun", Kind::Count, {0, kMaxBallsPerGun}, true, I(p.robot.balls_per_gun)},
       {"gun", "jam_probability", Kind::Probability, {0, 1}, true, D(p.robot.jam_probability)},

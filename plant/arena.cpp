@@ -158,18 +158,21 @@ bool Arena::setDrive(int robot, double leftFps, double rightFps, std::int64_t ti
 }
 
 EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, RandomBits* gunLuck,
-                          RandomBits* muzzle) {
+                          RandomBits* muzzle, RandomBits* dispersion) {
   Impl& m = *impl_;
   const Journal::Entry entry(m.journal.get(), {.kind = Journal::Kind::SetPortB,
                                                .robot = robot,
                                                .tick = tick,
                                                .value = value,
                                                .gunLuck = gunLuck != nullptr,
-                                               .muzzle = muzzle != nullptr});
+                                               .muzzle = muzzle != nullptr,
+                                               .dispersion = dispersion != nullptr});
   Journal::Recorder gunLuckRecorder(m.journal.get(), gunLuck, 0);
   Journal::Recorder muzzleRecorder(m.journal.get(), muzzle, 1);
+  Journal::Recorder dispersionRecorder(m.journal.get(), dispersion, 2);
   gunLuck = gunLuckRecorder.use();
   muzzle = muzzleRecorder.use();
+  dispersion = dispersionRecorder.use();
   EventList ev;
   m.checkRobot(robot);
   m.checkInputTick(tick);
@@ -209,6 +212,7 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
         next.launchTick[static_cast<std::size_t>(g)] =
             tick + timebase::ticksFromSeconds(p.stroke_s);
         next.launchFactor[static_cast<std::size_t>(g)] = muzzleFactor(p, muzzle);
+        next.launchDispersion[static_cast<std::size_t>(g)] = drawDispersion(p, dispersion);
         scheduleChanges = true;
       }
       ev.push(e);

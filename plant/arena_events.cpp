@@ -62,10 +62,19 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
       r.ballsLeft[static_cast<std::size_t>(g)]--;
       r.shots++;
       const RobotParams& p = P(i);
-      const Vec2 dir = geom::headingDir(heading(ys, i));
+      const double h = heading(ys, i);
+      const Vec2 dir = geom::headingDir(h);
       const Vec2 muzzle = centre(ys, i) + radius(i) * dir;  // flush with the body edge (VIII.C)
       const double speed = p.muzzle_speed_fps * ys[i * kPerRobot + (g == 0 ? G1 : G2)] *
                            r.launchFactor[static_cast<std::size_t>(g)];
+      // The dispersion turns the ball's velocity, not the muzzle, which
+      // stays on the body: the speed splits into a horizontal part along
+      // heading + azimuth and a vertical one. No dispersion leaves the
+      // velocity bit for bit the ideal horizontal one (cos 0 = 1, h + 0 = h).
+      const Dispersion& disp = r.launchDispersion[static_cast<std::size_t>(g)];
+      const double elevation = geom::degToRad(disp.elevation_deg);
+      const Vec2 flight = geom::headingDir(h + geom::degToRad(disp.azimuth_deg));
+      const double across = speed * std::cos(elevation);
       Ball& b = d.balls[static_cast<std::size_t>(slot)];
       b = Ball{true,
                false,
@@ -75,8 +84,9 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
                muzzle.x(),
                muzzle.y(),
                p.launch_height_ft,
-               speed * dir.x(),
-               speed * dir.y()};
+               across * flight.x(),
+               across * flight.y(),
+               speed * std::sin(elevation)};
       Event e{EventKind::BallLaunch};
       e.robot = static_cast<std::int8_t>(i);
       e.gun = static_cast<std::int8_t>(g);
@@ -86,6 +96,8 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
       e.z = b.z0;
       e.vx = b.vx;
       e.vy = b.vy;
+      e.vz = b.vz;
+      e.heading_deg = geom::wrap360(geom::radToDeg(h));
       ev.push(e);
     }
   }
@@ -108,7 +120,12 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
       if (cfg.field.count_floor_skips) {
         // Appendix A counts skips: the ball goes on along the floor
         // (assumption) and can still hit.
-        const double dt = std::sqrt(2 * b.z0 / cfg.field.gravity_fps2);
+        // The root of z0 + vz s - g s^2 / 2 = 0, s > 0 (the stable form
+        // for a ball going down; vz = 0 gives sqrt(2 z0 / g) exactly).
+        const double gr = cfg.field.gravity_fps2;
+        const double dt = b.vz == 0  ? std::sqrt(2 * b.z0 / gr)
+                          : b.vz > 0 ? (b.vz + std::sqrt(b.vz * b.vz + 2 * gr * b.z0)) / gr
+                                     : 2 * b.z0 / (std::sqrt(b.vz * b.vz + 2 * gr * b.z0) - b.vz);
         b.x0 += b.vx * dt;
         b.y0 += b.vy * dt;
         b.t0 += dt;
@@ -143,7 +160,9 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
       const int tgt = 1 - b.shooter;
       const double R = radius(tgt);
       const bool crossed = reported(found, RootKind::BallHit, s) > 0 && p2 <= R * R;
-      if ((crossed || d2 <= R * R) && z <= P(tgt).target_height_ft) {
+      // Coming down through the body's height over it: a hit on the top.
+      const bool onTop = reported(found, RootKind::BallTop, s) < 0;
+      if ((crossed || d2 <= R * R) && (z <= P(tgt).target_height_ft || onTop)) {
         Event h = e;
         h.kind = EventKind::BallHit;
         h.other = static_cast<std::int8_t>(tgt);

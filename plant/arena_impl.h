@@ -38,7 +38,7 @@ constexpr int kXY = 2;
 // are never reloaded, so a launch always finds a free slot.
 constexpr int kMaxBalls = 64;
 static_assert(kMaxBalls >= 2 * 2 * kMaxBallsPerGun, "the ball table must hold every magazine");
-constexpr int kMaxRoots = 2 * 7 + 1 + kMaxBalls * 4;
+constexpr int kMaxRoots = 2 * 7 + 1 + kMaxBalls * 5;
 constexpr int kRing = 16;
 static_assert(kRing > kMaxRefereeLimit, "the referee must see one event more than its limit");
 // ERKStepEvolve's tout in ARK_ONE_STEP mode only bounds the first step's
@@ -66,6 +66,10 @@ enum class RootKind : std::uint8_t {
   BallHit,
   BallOut,
   BallDivider,
+  // A ball above the other robot's height: z - target height. Only for a
+  // ball that rises above it (elevation dispersion): its descent through
+  // that height over the body is a hit on the top of the cylinder.
+  BallTop,
 };
 
 struct RootDesc {
@@ -78,7 +82,7 @@ struct Ball {
   bool rolling = false;  // after the floor, only with count_floor_skips
   int shooter = 0, gun = 0;
   double t0 = 0;
-  double x0 = 0, y0 = 0, z0 = 0, vx = 0, vy = 0;
+  double x0 = 0, y0 = 0, z0 = 0, vx = 0, vy = 0, vz = 0;
   // Smallest distance to the other robot's body seen at an event tick or
   // at the closest-approach root of the hit function (for ball_miss).
   double closest = HUGE_VAL;
@@ -118,7 +122,8 @@ struct RobotDisc {
   std::array<bool, 2> gunOn{};
   std::array<bool, 2> gunJammed{};
   std::array<std::int64_t, 2> launchTick{-1, -1};
-  std::array<double, 2> launchFactor{1, 1};  // muzzleFactor drawn at the stroke
+  std::array<double, 2> launchFactor{1, 1};      // muzzleFactor drawn at the stroke
+  std::array<Dispersion, 2> launchDispersion{};  // drawDispersion, likewise
   std::array<int, 2> ballsLeft{};
   int shots = 0, hits = 0;
 };

@@ -51,7 +51,7 @@ class Replayed final : public RandomBits {
 
 void Journal::replay(Arena& arena) const {
   std::size_t cursor = 0;
-  Replayed gunLuck(draws, cursor, 0), muzzle(draws, cursor, 1);
+  Replayed gunLuck(draws, cursor, 0), muzzle(draws, cursor, 1), dispersion(draws, cursor, 2);
   for (const Call& c : calls) {
     switch (c.kind) {
       case Kind::SetWheels:
@@ -62,7 +62,7 @@ void Journal::replay(Arena& arena) const {
         break;
       case Kind::SetPortB:
         arena.setPortB(c.robot, c.value, c.tick, c.gunLuck ? &gunLuck : nullptr,
-                       c.muzzle ? &muzzle : nullptr);
+                       c.muzzle ? &muzzle : nullptr, c.dispersion ? &dispersion : nullptr);
         break;
       case Kind::TriggerReflex:
         arena.triggerReflex(c.robot, c.side, c.tick);

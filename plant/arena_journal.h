@@ -31,10 +31,10 @@ struct Journal {
     double left = 0, right = 0;
     std::uint8_t value = 0;
     Bumper side = Bumper::Front;
-    bool gunLuck = false, muzzle = false;  // setPortB was given the stream
+    bool gunLuck = false, muzzle = false, dispersion = false;  // setPortB was given the stream
   };
   // The random words setPortB's calls drew, in order, each with its stream
-  // (0: gunLuck, 1: muzzle).
+  // (0: gunLuck, 1: muzzle, 2: dispersion).
   struct Draw {
     std::uint8_t stream;
     std::uint64_t bits;

@@ -77,7 +77,7 @@ void Arena::Impl::ballAt(const Ball& b, double t, double& x, double& yy, double&
   const double dt = t - b.t0;
   x = b.x0 + b.vx * dt;
   yy = b.y0 + b.vy * dt;
-  z = b.rolling ? 0.0 : b.z0 - 0.5 * cfg.field.gravity_fps2 * dt * dt;
+  z = b.rolling ? 0.0 : b.z0 + b.vz * dt - 0.5 * cfg.field.gravity_fps2 * dt * dt;
 }
 
 // The non-grazing hit function: along-track offset plus half-chord.
@@ -160,6 +160,12 @@ double Arena::Impl::rootValue(const RootDesc& rd, double t, const double* y) con
       return ballOutG(D.balls[static_cast<std::size_t>(rd.robot)], t);
     case RootKind::BallDivider:
       return ballDividerG(D.balls[static_cast<std::size_t>(rd.robot)], t);
+    case RootKind::BallTop: {
+      const Ball& b = D.balls[static_cast<std::size_t>(rd.robot)];
+      double x, yy, z;
+      ballAt(b, t, x, yy, z);
+      return z - P(1 - b.shooter).target_height_ft;
+    }
   }
   return 1.0;
 }
@@ -264,6 +270,12 @@ void Arena::Impl::buildRoots() {
     if (nR == 2) add(RootKind::BallHit, b);
     add(RootKind::BallOut, b);
     add(RootKind::BallDivider, b);
+    // Only a ball whose apex, z0 + vz^2 / 2g, clears the other robot's
+    // height can come down on its top; no other ball pays for the root.
+    if (nR == 2 && !ball.rolling && ball.vz > 0 &&
+        ball.z0 + ball.vz * ball.vz / (2 * cfg.field.gravity_fps2) >
+            P(1 - ball.shooter).target_height_ft)
+      add(RootKind::BallTop, b);
   }
 }
 

@@ -29,10 +29,6 @@
 namespace simbot::plant {
 namespace {
 
-// [0, 1) from the top 53 bits.
-// (0, 1] from the top 53 bits (safe for log).
-double unit53Open0(std::uint64_t bits) { return static_cast<double>((bits >> 11) + 1) * 0x1.0p-53; }
-
 int quantise(double s, const RobotParams& p) {
   double q = 16.0 * std::floor(s / 16.0);
   q = std::clamp(q, 16.0, p.eye_max);

@@ -85,6 +85,11 @@ struct RobotParams {
   // Seeded, per launch (muzzleFactor): the muzzle speed times a factor
   // uniform in [1 - spread, 1 + spread]. 0 = every ball at muzzle_speed_fps.
   double muzzle_speed_spread = 0;
+  // Seeded, per launch (drawDispersion): the ball leaves turned from the
+  // heading by an azimuth (+ = clockwise, like the heading) and raised by an
+  // elevation, each normal with mean 0 and this standard deviation (deg),
+  // independently. 0 and 0 = every ball horizontal along the heading.
+  double azimuth_sigma_deg = 0, elevation_sigma_deg = 0;
   double launch_height_ft = 0;
   int balls_per_gun = 0;
   // Per stroke that would launch: the gun jams (launches nothing, now or
@@ -173,6 +178,10 @@ class RandomBits {
 };
 // A uniform double in [0, 1) from the top 53 bits of a draw.
 inline double unit53(std::uint64_t bits) { return static_cast<double>(bits >> 11) * 0x1.0p-53; }
+// A uniform double in (0, 1] from the top 53 bits (safe for log).
+inline double unit53Open0(std::uint64_t bits) {
+  return static_cast<double>((bits >> 11) + 1) * 0x1.0p-53;
+}
 
 // SplitMix64, a small reference generator for tests and callers.
 class SplitMix64 final : public RandomBits {
@@ -224,7 +233,7 @@ enum class EventKind : std::uint8_t {
   ContactEnd,      // robot, with
   ReflexStart,     // robot, bumper
   ReflexEnd,       // robot, bumper
-  BallLaunch,      // robot = shooter, gun, ball (slot); x, y, z, vx, vy: the flight
+  BallLaunch,      // robot = shooter, gun, ball (slot); x, y, z, vx, vy, vz: the flight
   BallHit,         // robot = shooter, gun, ball, other = target; x, y, z: where
   BallMiss,        // robot = shooter, gun, ball, miss; x, y, z: where; closest_ft
   BallSkip,        // robot = shooter, gun, ball; x, y: on the floor, rolling on
@@ -249,8 +258,11 @@ struct Event {
   std::int8_t gun = -1;
   std::int8_t ball = -1;
   // Balls: position (ft) at the event, and at a launch the velocity (ft/s):
-  // the flight is x + vx s, y + vy s, z - g s^2 / 2 after the launch tick.
-  double x = 0, y = 0, z = 0, vx = 0, vy = 0;
+  // the flight is x + vx s, y + vy s, z + vz s - g s^2 / 2 after the launch
+  // tick; and the shooter's heading (deg) then, from which the ball's
+  // azimuth dispersion turned it.
+  double x = 0, y = 0, z = 0, vx = 0, vy = 0, vz = 0;
+  double heading_deg = 0;
   // A miss: the ball's closest distance to the other robot's body (ft), the
   // smaller of that when it passed abreast of the body's centre and at the
   // end of its flight; negative when there is no other robot.
@@ -359,6 +371,15 @@ void drawWheelTrims(RobotParams& params, RandomBits& bits);
 // One launch's muzzle-speed factor, 1 + muzzle_speed_spread (2 u - 1) from
 // one word; exactly 1 with no draw if the spread is 0 or bits is null.
 double muzzleFactor(const RobotParams& params, RandomBits* bits);
+// One launch's angular dispersion (deg): azimuth and elevation from one
+// Box-Muller pair, two words (u1 in (0, 1], u2 in [0, 1)):
+// r = sqrt(-2 ln u1), azimuth = azimuth_sigma_deg r cos(2 pi u2),
+// elevation = elevation_sigma_deg r sin(2 pi u2): two independent normals.
+// Exactly {0, 0} with no draw if both sigmas are 0 or bits is null.
+struct Dispersion {
+  double azimuth_deg = 0, elevation_deg = 0;
+};
+Dispersion drawDispersion(const RobotParams& params, RandomBits* bits);
 
 // The arena integrates all robots and balls: closed forms and one ARKODE
 // ERKStep instance.
@@ -412,9 +433,11 @@ class Arena {
   // advance(). `gunLuck` draws a stroke's jam or misfire (one draw per
   // stroke that would launch, only if the robot's probabilities are not
   // both 0); null: guns never jam or misfire.
-  // `muzzle` draws each launching stroke's muzzleFactor (null: factor 1).
+  // `muzzle` draws each launching stroke's muzzleFactor (null: factor 1),
+  // `dispersion` its drawDispersion (null: along the heading, horizontal).
   EventList setPortB(int robot, std::uint8_t value, std::int64_t tick,
-                     RandomBits* gunLuck = nullptr, RandomBits* muzzle = nullptr);
+                     RandomBits* gunLuck = nullptr, RandomBits* muzzle = nullptr,
+                     RandomBits* dispersion = nullptr);
 
   // The motor controller's bumper reflex, as if that bumper switch closed
   // at `tick` (an injected bump). A reflex under way starts over. Returns

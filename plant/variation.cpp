@@ -3,15 +3,17 @@
 //
 // Three things differ between matches before anything moves: where a hand
 // put each robot down (placeByHand), and each wheel's trim (drawWheelTrims);
-// one differs per shot: the muzzle speed (muzzleFactor, drawn at the stroke
-// that schedules the launch, arena.cpp). Eye noise and bad readings are drawn
+// two differ per shot: the muzzle speed (muzzleFactor) and the ball's
+// angular dispersion (drawDispersion), both drawn at the stroke that
+// schedules the launch (arena.cpp). Eye noise and bad readings are drawn
 // per A/D read in optics.cpp. The amounts are profile values; this file only
 // turns a generator's raw words into them, with the plant's own arithmetic
 // (never std::*_distribution, whose output differs between library
-// versions). Every draw is uniform and bounded, so a pose, trim or speed can
-// never leave the range the profile checks allow. A zero amount draws
-// nothing, so a profile without variation (thesis-1997) is exactly the ideal
-// match, and a stream left undrawn cannot shift another.
+// versions). Every draw is bounded, so a pose, trim or speed can never leave
+// the range the profile checks allow (a dispersion angle is at most 8.6
+// sigmas: the largest Box-Muller radius from 53-bit words). A zero amount
+// draws nothing, so a profile without variation (thesis-1997) is exactly the
+// ideal match, and a stream left undrawn cannot shift another.
 #include <cmath>
 
 #include "plant/geometry.h"
@@ -77,6 +79,17 @@ void drawWheelTrims(RobotParams& params, RandomBits& bits) {
 double muzzleFactor(const RobotParams& params, RandomBits* bits) {
   if (params.muzzle_speed_spread == 0 || !bits) return 1.0;
   return spreadFactor(params.muzzle_speed_spread, *bits);
+}
+
+// A circular normal (for equal sigmas): the usual law of small independent
+// aiming errors. Box-Muller gives both axes from one pair of words, exactly
+// normal, with the arithmetic optics.cpp's eye noise uses.
+Dispersion drawDispersion(const RobotParams& params, RandomBits* bits) {
+  if ((params.azimuth_sigma_deg == 0 && params.elevation_sigma_deg == 0) || !bits) return {};
+  const double r = std::sqrt(-2.0 * std::log(unit53Open0(bits->next())));
+  const double theta = 2.0 * geom::kPi * unit53(bits->next());
+  return {params.azimuth_sigma_deg * r * std::cos(theta),
+          params.elevation_sigma_deg * r * std::sin(theta)};
 }
 
 }  // namespace simbot::plant

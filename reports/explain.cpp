@@ -348,7 +348,7 @@ struct Explainer::State {
     s.gun = static_cast<int>(x.gun);
     s.ball = static_cast<int>(x.ball);
     s.t = t;
-    s.muzzle_fps = std::hypot(x.vx_fps, x.vy_fps);
+    s.muzzle_fps = std::hypot(x.vx_fps, x.vy_fps, x.vz_fps);
     report.shots.push_back(s);
     const std::size_t index = report.shots.size() - 1;
     flying[x.ball] = index;
@@ -356,19 +356,14 @@ struct Explainer::State {
     eachOpenRun(x.robot, [](HandlerRun& h) { ++h.shots; });
     if (robots < 2) return;
     // The muzzle is the body's edge along the heading (plant/arena.cpp), so
-    // the velocity gives the heading and the muzzle less a radius the centre.
-    Robot& me = r[x.robot];
+    // the muzzle less a radius along it is the centre. The record's heading,
+    // not the velocity: dispersion turns the ball, not the gun.
+    const Robot& me = r[x.robot];
     PendingShot p{index, 1 - x.robot, 0, 0, 0};
-    if (s.muzzle_fps > 0) {
-      p.heading = degrees(std::atan2(x.vx_fps, x.vy_fps));
-      p.x = x.x_ft - me.radius * x.vx_fps / s.muzzle_fps;
-      p.y = x.y_ft - me.radius * x.vy_fps / s.muzzle_fps;
-    } else if (me.last) {  // a dead gun wheel: the latest sample's heading
-      p.heading = me.last->pose.heading;
-      const double h = p.heading * (kPi / 180.0);
-      p.x = x.x_ft - me.radius * std::sin(h);
-      p.y = x.y_ft - me.radius * std::cos(h);
-    }
+    p.heading = x.heading_deg;
+    const double h = p.heading * (kPi / 180.0);
+    p.x = x.x_ft - me.radius * std::sin(h);
+    p.y = x.y_ft - me.radius * std::cos(h);
     const auto& target = r[p.target].last;
     if (target && target->pose.t == t)
       aim(p, target->pose);

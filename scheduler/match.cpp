@@ -126,7 +126,8 @@ Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs, ui
       board(s.image, *this, robotCosts(costs, s.controller),
             board::StreamSeeds{
                 streamSeed(seed, "memory-fill-" + s.name), streamSeed(seed, "eye-noise-" + s.name),
-                streamSeed(seed, "gun-" + s.name), streamSeed(seed, "muzzle-" + s.name)},
+                streamSeed(seed, "gun-" + s.name), streamSeed(seed, "muzzle-" + s.name),
+                streamSeed(seed, "dispersion-" + s.name)},
             m.robotParams(i).random_memory),
       mainReturn(s.image.entry + static_cast<uint32_t>(vm::instructionSize(vm::Op::CALL))) {
   result.name = s.name;
@@ -430,9 +431,8 @@ void Match::applyInputs() {
     sampleUpTo(w.tick);
     const plant::EventList immediate = [&] {
       const PartScope plant(clock_, PartClock::Plant);
-      return arena_.setPortB(w.robot, w.value, w.tick,
-                             &robots_[static_cast<size_t>(w.robot)]->board.gunLuck,
-                             &robots_[static_cast<size_t>(w.robot)]->board.muzzle);
+      board::Board& b = robots_[static_cast<size_t>(w.robot)]->board;
+      return arena_.setPortB(w.robot, w.value, w.tick, &b.gunLuck, &b.muzzle, &b.dispersion);
     }();
     for (const auto& e : immediate) {
       if (config_.observer) config_.observer->onPlantEvent(w.tick, e);
@@ -471,7 +471,7 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
     case plant::EventKind::ReflexEnd:
       return rec::ReflexEnd{r, side(e.bumper)};
     case plant::EventKind::BallLaunch:
-      return rec::BallLaunch{r, e.gun, e.ball, e.x, e.y, e.z, e.vx, e.vy};
+      return rec::BallLaunch{r, e.gun, e.ball, e.x, e.y, e.z, e.vx, e.vy, e.vz, e.heading_deg};
     case plant::EventKind::BallSkip:
       return rec::BallSkip{r, e.gun, e.ball, e.x, e.y};
     case plant::EventKind::BallHit:

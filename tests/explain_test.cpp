@@ -104,7 +104,7 @@ TEST(Explain, IcemanShotsAgainstTheTraceRecords) {
     const ex::Shot& shot = r.report.shots[i];
     EXPECT_EQ(shot.t, t);
     EXPECT_EQ(shot.robot, 0);
-    EXPECT_DOUBLE_EQ(shot.muzzle_fps, std::hypot(launch.vx_fps, launch.vy_fps));
+    EXPECT_DOUBLE_EQ(shot.muzzle_fps, std::hypot(launch.vx_fps, launch.vy_fps, launch.vz_fps));
     auto ball = [&](const auto& e) { return e.first >= t && e.second.ball == launch.ball; };
     const auto hit = std::find_if(hits.begin(), hits.end(), ball);
     const auto miss = std::find_if(misses.begin(), misses.end(), ball);
@@ -125,9 +125,10 @@ TEST(Explain, IcemanShotsAgainstTheTraceRecords) {
 }
 
 // One shot's range and bearing error, from the records: the shooter's
-// heading is the ball's velocity direction, h = atan2(vx, vy) (the gun fires
-// along the heading), and its centre is the muzzle less a body radius along
-// it, C = M - (d / 2) v / |v| (the muzzle is flush with the body edge); the
+// heading h is the launch record's heading_deg (the ball's velocity is
+// turned from it by the gun's dispersion, so it is not the aim), and its
+// centre is the muzzle less a body radius along it, C = M - (d / 2)
+// (sin h, cos h) (the muzzle is flush with the body edge); the
 // target's centre at the launch tick t is interpolated linearly between its
 // samples at t0 <= t < t1: P = P0 + (t - t0) / (t1 - t0) (P1 - P0). Then
 // range = |P - C| and bearing error = atan2(Px - Cx, Py - Cy) - h, wrapped
@@ -142,10 +143,9 @@ TEST(Explain, OneShotsRangeAndBearingFromThePoses) {
   const double radius = setups[0].second.body_diameter_ft / 2;
   // The seventh launch (any would do).
   const auto& [t, launch] = launches[6];
-  const double speed = std::hypot(launch.vx_fps, launch.vy_fps);
-  const double heading = std::atan2(launch.vx_fps, launch.vy_fps) * 180 / kPi;
-  const double cx = launch.x_ft - radius * launch.vx_fps / speed;
-  const double cy = launch.y_ft - radius * launch.vy_fps / speed;
+  const double heading = launch.heading_deg;
+  const double cx = launch.x_ft - radius * std::sin(heading * kPi / 180);
+  const double cy = launch.y_ft - radius * std::cos(heading * kPi / 180);
   size_t k = 0;
   while (k + 1 < targetSamples.size() && targetSamples[k + 1].first <= t) ++k;
   ASSERT_LT(k + 1, targetSamples.size());

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -592,6 +593,8 @@ TEST(Match, IcemanAgainstFig92For180SecondsPinsItsKeyFigures) {
   // string routines charge their loop's branch taken on every byte but the
   // last (strcpy +2 T-states a byte), an interrupt acknowledge 18 T-states,
   // and the plant's resets no longer carry the step controller's history.
+  // Issue 25's gun dispersion moved none of them: it turns only the balls,
+  // and ICEMAN's two hits still hit.
   EXPECT_EQ(r.robots[0].framesLatched, 1029);
   EXPECT_EQ(r.robots[1].framesLatched, 8621);
   EXPECT_EQ(r.robots[0].shots, 30);
@@ -619,6 +622,27 @@ TEST(Match, IcemanAgainstFig92For180SecondsPinsItsKeyFigures) {
   EXPECT_EQ(strokes[0].first, 95'260'855);
   EXPECT_EQ(launches[0].first, 95'537'335);
   EXPECT_EQ(launches[0].first - strokes[0].first, 276'480);
+  // Issue 25: every ball carries its dispersion. The angles recovered from
+  // the ball_launch records (velocity against the record's heading) are
+  // standard normals once divided by the profile's sigmas, so over the 30
+  // launches the sum of their squares is chi-square with 60 degrees of
+  // freedom (Boost's quantiles: outside 0.05% .. 99.95% fails).
+  constexpr double kPi = 3.14159265358979323846;
+  const config::Profile prof = config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
+  double sumSquares = 0;
+  for (const auto& [tick, launch] : launches) {
+    const double across = std::hypot(launch.vx_fps, launch.vy_fps);
+    double az = std::atan2(launch.vx_fps, launch.vy_fps) * 180 / kPi - launch.heading_deg;
+    az = std::remainder(az, 360.0);
+    const double el = std::atan2(launch.vz_fps, across) * 180 / kPi;
+    EXPECT_NE(az, 0.0) << "a launch without azimuth dispersion at tick " << tick;
+    EXPECT_NE(el, 0.0) << "a launch without elevation dispersion at tick " << tick;
+    sumSquares += std::pow(az / prof.robot.azimuth_sigma_deg, 2) +
+                  std::pow(el / prof.robot.elevation_sigma_deg, 2);
+  }
+  const boost::math::chi_squared law(2.0 * static_cast<double>(launches.size()));
+  EXPECT_GT(sumSquares, boost::math::quantile(law, 0.0005));
+  EXPECT_LT(sumSquares, boost::math::quantile(law, 0.9995));
 }
 
 // Issue 22: bodies are rigid. In four seeded 180-s matches every 20-Hz

@@ -24,7 +24,7 @@ namespace {
 
 constexpr Tick kSecond = vm::kTicksPerSecond;
 
-const board::StreamSeeds kSeeds{1, 2, 3, 4};
+const board::StreamSeeds kSeeds{1, 2, 3, 4, 5};
 
 // Runs a board: its VM's bus, the receiver at the wire's far end.
 class Host : public vm::Bus {

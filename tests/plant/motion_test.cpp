@@ -216,6 +216,85 @@ TEST(Motion, ProjectileFlightTimeAndRange) {
   EXPECT_EQ(a.ballsLeft(0, 0), 14);
 }
 
+// Words chosen so that drawDispersion's Box-Muller pair gives a radius r
+// (u1 = exp(-r^2 / 2)) at angle pi/2 (u2 = 1/4): elevation sigma r, azimuth
+// ~0. The flight is then checked against the closed form of the velocity
+// the launch reports, not against the draw.
+class FixedWords final : public RandomBits {
+ public:
+  explicit FixedWords(double r)
+      : u1_((static_cast<std::uint64_t>(std::exp(-r * r / 2) * 0x1.0p53) - 1) << 11) {}
+  std::uint64_t next() override { return (n_++ % 2 == 0) ? u1_ : std::uint64_t{1} << 62; }
+
+ private:
+  std::uint64_t u1_;
+  int n_ = 0;
+};
+
+// A ball raised by the elevation dispersion flies z = h + vz s - g s^2 / 2
+// (muzzle 20 ft/s, elevation about 30 deg: vz = 10, across 17.3 ft/s, apex
+// 3.05 ft at 5.4 ft). Alone it lands where that parabola meets the floor.
+// A target whose body it passes entirely above 2.5 ft is not hit (it flies
+// over); a target centred where it comes down through 2.5 ft is hit on the
+// top, at that height, after it passed the body's side too high.
+TEST(Motion, AnElevatedBallFollowsItsParabolaOverAndOntoTheTarget) {
+  Profile p = thesis();
+  p.robot.muzzle_speed_fps = 20.0;
+  p.robot.elevation_sigma_deg = 5.0;
+  const double h = p.robot.launch_height_ft, g = p.field.gravity_fps2;
+  const double R = p.robot.body_diameter_ft / 2, top = p.robot.target_height_ft;
+  const double muzzleX = -6 + R;
+  struct Shot {
+    std::optional<Found> launch, end;
+  };
+  const auto shoot = [&](std::initializer_list<Pose> poses) {
+    Arena a(config(p, poses));
+    FixedWords words(6.0);
+    a.setPortB(0, 1u << 4, 0, nullptr, nullptr, &words);
+    Shot s;
+    s.launch = runUntil(a, EventKind::BallLaunch, ticks(2));
+    while (a.now() < ticks(2) && !s.end) {
+      const AdvanceResult r = a.advance(ticks(2));
+      for (const Event& e : r.events)
+        if (e.kind == EventKind::BallHit || e.kind == EventKind::BallMiss) s.end = Found{r.tick, e};
+    }
+    return s;
+  };
+  const Shot alone = shoot({Pose{-6, 0, 90}});
+  ASSERT_TRUE(alone.launch && alone.end);
+  const Event& l = alone.launch->event;
+  const double vz = l.vz, across = std::hypot(l.vx, l.vy);
+  ASSERT_NEAR(std::atan2(vz, across) * 180 / 3.14159265358979323846, 30, 1e-6);
+  EXPECT_NEAR(l.vy, 0, 1e-12);
+  // The floor: the positive root of h + vz s - g s^2 / 2.
+  const double floorS = (vz + std::sqrt(vz * vz + 2 * g * h)) / g;
+  EXPECT_EQ(alone.end->event.kind, EventKind::BallMiss);
+  EXPECT_EQ(alone.end->event.miss, MissReason::Floor);
+  EXPECT_NEAR(secondsFromTick(alone.end->tick), floorS, 2.0 / kTicksPerSecond);
+  EXPECT_NEAR(alone.end->event.x, muzzleX + across * floorS, 1e-4);
+  // Where it comes down through the target's height (the later root).
+  const double downS = (vz + std::sqrt(vz * vz - 2 * g * (top - h))) / g;
+  const double downX = muzzleX + across * downS;
+  // The apex, over a body whose near and far sides the ball passes above 2.5.
+  const double apexX = muzzleX + across * vz / g;
+  const auto zAt = [&](double x) {
+    const double s = (x - muzzleX) / across;
+    return h + vz * s - g * s * s / 2;
+  };
+  ASSERT_GT(zAt(apexX - R), top);
+  ASSERT_GT(zAt(apexX + R), top);
+  const Shot over = shoot({Pose{-6, 0, 90}, Pose{apexX, 0, 270}});
+  ASSERT_TRUE(over.end);
+  EXPECT_EQ(over.end->event.kind, EventKind::BallMiss) << "flew over the target";
+  ASSERT_GT(zAt(downX - R), top);  // too high at the body's side
+  const Shot onTop = shoot({Pose{-6, 0, 90}, Pose{downX, 0, 270}});
+  ASSERT_TRUE(onTop.end);
+  EXPECT_EQ(onTop.end->event.kind, EventKind::BallHit);
+  EXPECT_NEAR(onTop.end->event.z, top, 1e-3);
+  EXPECT_NEAR(onTop.end->event.x, downX, 1e-3);
+  EXPECT_NEAR(secondsFromTick(onTop.end->tick), downS, 2.0 / kTicksPerSecond);
+}
+
 // thesis-1997 follows Appendix E: gun motors on at all times. ICEMAN's
 // fire() strokes with 0x30, the motor bits already off again: the ball must
 // still leave at full muzzle speed there, and fall at the muzzle when the

@@ -6,6 +6,9 @@
 // computed from the same law (a wrong amount or law moves a mean by many
 // more; a correct one fails about once in 150,000 runs, and the seeds are
 // fixed, so the outcome is the same every run).
+#include <algorithm>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <boost/math/distributions/normal.hpp>
 #include <cmath>
 #include <vector>
 
@@ -151,6 +154,9 @@ TEST(Variation, ZeroAmountsDrawNothing) {
   RobotParams params = t.robot;
   drawWheelTrims(params, a);
   EXPECT_EQ(muzzleFactor(params, &a), 1.0);
+  const Dispersion none = drawDispersion(params, &a);
+  EXPECT_EQ(none.azimuth_deg, 0.0);
+  EXPECT_EQ(none.elevation_deg, 0.0);
   EXPECT_EQ(a.count + b.count, 0);
   EXPECT_EQ(params.left_trim, t.robot.left_trim);
   EXPECT_EQ(params.right_trim, t.robot.right_trim);
@@ -162,6 +168,72 @@ TEST(Variation, ZeroAmountsDrawNothing) {
   }
   // A default robot without a stream also launches at exactly the speed.
   EXPECT_EQ(muzzleFactor(defaults().robot, nullptr), 1.0);
+  EXPECT_EQ(drawDispersion(defaults().robot, nullptr).azimuth_deg, 0.0);
+  EXPECT_EQ(drawDispersion(defaults().robot, nullptr).elevation_deg, 0.0);
+}
+
+// Pearson's chi-square p-value of standardised draws z against a law whose
+// quantile function cuts the line into k bins of equal probability (the
+// oracle: Boost.Math's quantiles and chi-square tail, not simbot's code).
+template <class Quantile>
+double chiSquareP(const std::vector<double>& z, int k, Quantile quantile) {
+  std::vector<double> edges;
+  for (int j = 1; j < k; ++j) edges.push_back(quantile(static_cast<double>(j) / k));
+  std::vector<double> count(static_cast<std::size_t>(k), 0);
+  for (double x : z)
+    count[static_cast<std::size_t>(std::upper_bound(edges.begin(), edges.end(), x) -
+                                   edges.begin())] += 1;
+  const double expected = static_cast<double>(z.size()) / k;
+  double x2 = 0;
+  for (double c : count) x2 += (c - expected) * (c - expected) / expected;
+  return boost::math::cdf(boost::math::complement(boost::math::chi_squared(k - 1), x2));
+}
+
+double normalQuantile(double p) { return boost::math::quantile(boost::math::normal(), p); }
+
+// The stated law (profiles/default.toml [gun]): azimuth and elevation
+// independent normals, mean 0, standard deviations azimuth_sigma and
+// elevation_sigma. 40,000 draws (seed fixed): each axis / sigma against
+// N(0, 1) in 20 equiprobable bins, the pair on a 6 x 6 grid of the
+// marginals' equiprobable bins (independence: each cell 1/36), and the
+// squared radius against chi-square(2). Each must not be rejected at 0.1%;
+// the same draws read with a sigma 5% off must be (the test has teeth).
+TEST(Variation, DispersionDrawsPassChiSquareAgainstIndependentNormals) {
+  const RobotParams p = defaults().robot;
+  ASSERT_GT(p.azimuth_sigma_deg, 0);
+  ASSERT_GT(p.elevation_sigma_deg, 0);
+  const int n = 40000;
+  Counting bits(1997);
+  std::vector<double> az, el, r2, wrongAz;
+  for (int k = 0; k < n; ++k) {
+    const Dispersion d = drawDispersion(p, &bits);
+    az.push_back(d.azimuth_deg / p.azimuth_sigma_deg);
+    el.push_back(d.elevation_deg / p.elevation_sigma_deg);
+    r2.push_back(az.back() * az.back() + el.back() * el.back());
+    wrongAz.push_back(d.azimuth_deg / (1.05 * p.azimuth_sigma_deg));
+    // Bounded: 53-bit words give a Box-Muller radius of at most 8.58.
+    ASSERT_LT(std::sqrt(r2.back()), 8.58);
+  }
+  EXPECT_EQ(bits.count, 2 * n);
+  const double alpha = 1e-3;
+  EXPECT_GT(chiSquareP(az, 20, normalQuantile), alpha) << "azimuth";
+  EXPECT_GT(chiSquareP(el, 20, normalQuantile), alpha) << "elevation";
+  EXPECT_GT(
+      chiSquareP(r2, 20,
+                 [](double q) { return boost::math::quantile(boost::math::chi_squared(2), q); }),
+      alpha)
+      << "squared radius";
+  // The grid: cell index from both marginals' 6 equiprobable bins.
+  std::vector<double> edges;
+  for (int j = 1; j < 6; ++j) edges.push_back(normalQuantile(j / 6.0));
+  const auto bin = [&](double x) {
+    return static_cast<double>(std::upper_bound(edges.begin(), edges.end(), x) - edges.begin());
+  };
+  std::vector<double> cell;
+  for (int k = 0; k < n; ++k)
+    cell.push_back(6 * bin(az[static_cast<std::size_t>(k)]) + bin(el[static_cast<std::size_t>(k)]));
+  EXPECT_GT(chiSquareP(cell, 36, [](double q) { return 36 * q - 0.5; }), alpha) << "joint";
+  EXPECT_LT(chiSquareP(wrongAz, 20, normalQuantile), 1e-6) << "a 5% wrong sigma passed";
 }
 
 // Uniform in [1 - s, 1 + s]: mean 1, variance s^2/3, every factor inside.
@@ -292,6 +364,57 @@ TEST(Variation, ArenaLaunchesAtTheMuzzleSpeedTimesTheDrawnFactor) {
   ASSERT_EQ(plain.size(), 2u);
   EXPECT_NEAR(plain[0], 105, 1e-9);
   EXPECT_NEAR(plain[1], 105, 1e-9);
+}
+
+// Each launch carries its dispersion: the arena turns the ball's velocity
+// from the heading by the azimuth and raises it by the elevation, at the
+// full muzzle speed, and leaves the muzzle on the body's edge along the
+// heading. 10 single-robot arenas (thesis-1997's instant gun with default's
+// sigmas) fire all 30 balls each; the angles recovered from the launch
+// events' velocities (what ball_launch records) equal the draws of a copy
+// of the stream, and the 300 of them pass a chi-square test of each axis
+// against its normal law (10 equiprobable bins, Boost's quantiles).
+TEST(Variation, ArenaLaunchesCarryTheDrawnDispersion) {
+  Profile p = thesis();
+  const RobotParams d = defaults().robot;
+  p.robot.azimuth_sigma_deg = d.azimuth_sigma_deg;
+  p.robot.elevation_sigma_deg = d.elevation_sigma_deg;
+  std::vector<double> az, el;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    const double heading = 37.0 * static_cast<double>(seed);
+    Arena a(config(p, {Pose{0, 3, heading}}));
+    SplitMix64 stream(seed), copy(seed);
+    std::vector<Event> launches;
+    std::int64_t t = 0;
+    for (int shot = 0; shot < 2 * p.robot.balls_per_gun; ++shot) {
+      const std::uint8_t solenoid = shot % 2 == 0 ? 1u << 4 : 1u << 5;
+      for (const std::uint8_t v : {solenoid, std::uint8_t{0}}) {
+        a.setPortB(0, v, t, nullptr, nullptr, &stream);
+        t += 1000;
+        while (a.now() < t)
+          for (const Event& e : a.advance(t).events)
+            if (e.kind == EventKind::BallLaunch) launches.push_back(e);
+      }
+    }
+    ASSERT_EQ(launches.size(), 30u);
+    for (const Event& e : launches) {
+      const Dispersion want = drawDispersion(p.robot, &copy);
+      EXPECT_NEAR(e.heading_deg, std::fmod(heading, 360.0), 1e-9);
+      const double h = e.heading_deg * kPi / 180;
+      EXPECT_NEAR(e.x, 0.53125 * std::sin(h), 1e-9);  // the muzzle: along the heading
+      EXPECT_NEAR(e.y, 3 + 0.53125 * std::cos(h), 1e-9);
+      const double across = std::hypot(e.vx, e.vy);
+      EXPECT_NEAR(std::hypot(across, e.vz), 105, 1e-9);
+      const double gotAz = wrap180(std::atan2(e.vx, e.vy) * 180 / kPi - e.heading_deg);
+      const double gotEl = std::atan2(e.vz, across) * 180 / kPi;
+      EXPECT_NEAR(gotAz, want.azimuth_deg, 1e-9);
+      EXPECT_NEAR(gotEl, want.elevation_deg, 1e-9);
+      az.push_back(gotAz / p.robot.azimuth_sigma_deg);
+      el.push_back(gotEl / p.robot.elevation_sigma_deg);
+    }
+  }
+  EXPECT_GT(chiSquareP(az, 10, normalQuantile), 1e-3) << "azimuth";
+  EXPECT_GT(chiSquareP(el, 10, normalQuantile), 1e-3) << "elevation";
 }
 
 }  // namespace

@@ -222,7 +222,7 @@ function pairBalls(K) {
     if (kind === 0) {
       const c = K.ball_launch;
       const ball = { t0: t, robot: c.robot[i], gun: c.gun[i], number: c.ball[i], x0: c.x_ft[i],
-        y0: c.y_ft[i], z0: c.z_ft[i], vx: c.vx_fps[i], vy: c.vy_fps[i], end: null, skip: null, outcome: null };
+        y0: c.y_ft[i], z0: c.z_ft[i], vx: c.vx_fps[i], vy: c.vy_fps[i], vz: c.vz_fps[i], end: null, skip: null, outcome: null };
       open.set(ball.number, ball);
       balls.push(ball);
       continue;
@@ -243,7 +243,7 @@ function pairBalls(K) {
 // Where a ball is at tick t (exactly the plant's closed form).
 function ballPosition(ball, t, tps, g) {
   const s = (t - ball.t0) / tps;
-  let z = ball.z0 - 0.5 * g * s * s;
+  let z = ball.z0 + ball.vz * s - 0.5 * g * s * s;
   if (ball.skip !== null && t >= ball.skip) z = 0;
   return { x: ball.x0 + ball.vx * s, y: ball.y0 + ball.vy * s, z: Math.max(z, 0) };
 }
