@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <tuple>
 #include <type_traits>
+#include <utility>
 
 #include "plant/plant.h"
 #include "reports/stall.h"
@@ -97,6 +99,9 @@ struct Explainer::State {
     std::vector<std::size_t> handlers;                       // open handler runs
     std::map<std::string, std::size_t> touch;                // open contacts by what they touch
     std::map<std::size_t, std::optional<Pose>> handlerLast;  // a run's latest sample inside it
+    // The chains of the latest send and the one before it (serial_send),
+    // by tick: a frame_overwritten comes right after the send that made it.
+    std::pair<Tick, std::string> lastCalls{-1, ""}, callsBefore{-1, ""};
   };
   Robot r[2];
   struct PendingShot {
@@ -255,19 +260,22 @@ struct Explainer::State {
     o.previous_count = static_cast<int>(x.previous_count);
     o.previous_bytes_fetched = static_cast<int>(x.fetched);
     const Robot& me = r[x.robot];
-    if (!me.handlers.empty()) {
-      const HandlerRun& h = report.handler_runs[me.handlers.back()];
-      o.handler = h.handler;
-      o.line = h.line;
-      o.function = h.function;
-    } else if (me.last) {
-      o.line = me.last->line;
-      o.function = me.last->function;
-    }
+    if (!me.handlers.empty()) o.handler = report.handler_runs[me.handlers.back()].handler;
+    auto calls = [](const std::pair<Tick, std::string>& c, Tick at) {
+      return c.first == at ? c.second : std::string();
+    };
+    o.send = {static_cast<int>(x.line), x.function, static_cast<int>(x.caller_line),
+              x.caller_function, calls(me.lastCalls, t)};
+    o.previous = {static_cast<int>(x.previous_line), x.previous_function,
+                  static_cast<int>(x.previous_caller_line), x.previous_caller_function,
+                  calls(me.callsBefore, x.previous_t)};
     report.overwritten.push_back(std::move(o));
   }
-  void on(Tick, const rec::SerialSend& x) {
-    if (x.robot < robots) eachOpenRun(x.robot, [](HandlerRun& h) { ++h.sends; });
+  void on(Tick t, const rec::SerialSend& x) {
+    if (x.robot >= robots) return;
+    Robot& me = r[x.robot];
+    me.callsBefore = std::exchange(me.lastCalls, {t, x.calls});
+    eachOpenRun(x.robot, [](HandlerRun& h) { ++h.sends; });
   }
   void on(Tick t, const rec::SerialIsr& x) {
     if (x.robot >= robots) return;
@@ -414,6 +422,27 @@ struct Explainer::State {
   template <class R>
   void on(Tick, const R&) {}
 
+  // The overwritten sends by robot and the two sends' sites, most first.
+  void groupOverwrites() {
+    using Site = std::tuple<int, std::string, int, std::string>;
+    auto site = [](const SendSite& x) {
+      return Site{x.line, x.function, x.caller_line, x.caller_function};
+    };
+    std::map<std::tuple<int, Site, Site>, std::size_t> index;
+    auto& groups = report.overwrite_groups;
+    for (const OverwrittenSend& o : report.overwritten) {
+      const auto key = std::make_tuple(o.robot, site(o.send), site(o.previous));
+      const auto [it, fresh] = index.emplace(key, groups.size());
+      if (fresh) groups.push_back({o.robot, o.send, o.previous, 0, o.t, o.t});
+      OverwriteGroup& g = groups[it->second];
+      ++g.count;
+      g.last = o.t;
+    }
+    std::stable_sort(groups.begin(), groups.end(), [](const auto& a, const auto& b) {
+      return a.robot != b.robot ? a.robot < b.robot : a.count > b.count;
+    });
+  }
+
   // Ends every open period at the last tick.
   void finish() {
     const Tick end = report.end_t;
@@ -432,6 +461,7 @@ struct Explainer::State {
       total.longest = std::max(total.longest, length);
     }
     for (auto& [key, total] : totals) report.handler_totals.push_back(total);
+    groupOverwrites();
     std::stable_sort(report.stalls.begin(), report.stalls.end(),
                      [](const Stall& a, const Stall& b) { return a.from < b.from; });
   }
@@ -456,6 +486,7 @@ Report onlyRobot(const Report& in, int robot) {
   keep(out.shots);
   keep(out.stalls);
   keep(out.overwritten);
+  keep(out.overwrite_groups);
   keep(out.handler_runs);
   keep(out.handler_totals);
   keep(out.contacts);
@@ -497,6 +528,25 @@ struct Fmt {
   std::string where(int line, const std::string& function) const {
     if (line <= 0) return function.empty() ? "start-up code" : function + "()";
     return fmt::format("line {}{}", line, function.empty() ? "" : " in " + function + "()");
+  }
+  // "line 78 in platform() (called from line 71 in main())".
+  std::string send(const SendSite& x) const {
+    if (x.line <= 0) return "an unknown line";
+    std::string out = where(x.line, x.function);
+    if (x.caller_line > 0) out += " (called from " + where(x.caller_line, x.caller_function) + ")";
+    return out;
+  }
+  std::string overwrite(const OverwrittenSend& x) const {
+    return fmt::format(
+        "the send from {} restarted the send of {} s from {} when the port had taken {} of its "
+        "{} bytes{}",
+        send(x.send), s(x.previous_t), send(x.previous), x.previous_bytes_fetched, x.previous_count,
+        x.handler.empty() ? "" : fmt::format("; handler {} in service", x.handler));
+  }
+  std::string group(const OverwriteGroup& x) const {
+    return fmt::format("{} send{} from {} overwrote the send from {}; {} s .. {} s", x.count,
+                       x.count == 1 ? "" : "s", send(x.send), send(x.previous), s(x.first),
+                       s(x.last));
   }
   std::string frames(const std::vector<std::string>& f) const {
     if (f.empty()) return "no frame latched";
@@ -622,15 +672,12 @@ std::vector<TextLine> textLines(const Report& r) {
       fmt::format("Sends overwritten: a ser_send_z1 before the port had taken the previous send's "
                   "last byte ({})",
                   r.overwritten.size()));
+  if (!r.overwrite_groups.empty()) add("  by the two sends' lines, most first:");
+  for (const OverwriteGroup& x : r.overwrite_groups)
+    add(fmt::format("  {}: {}", f.name(x.robot), f.group(x)), x.first);
+  if (!r.overwritten.empty()) add("  each:");
   for (const OverwrittenSend& x : r.overwritten)
-    add(fmt::format(
-            "  {} {} s: restarted the send of {} s when the port had taken {} of its {} bytes, {}",
-            f.name(x.robot), f.s(x.t), f.s(x.previous_t), x.previous_bytes_fetched,
-            x.previous_count,
-            x.handler.empty() ? "from " + f.where(x.line, x.function)
-                              : fmt::format("from handler {} (it interrupted {})", x.handler,
-                                            f.where(x.line, x.function))),
-        x.t);
+    add(fmt::format("  {} {} s: {}", f.name(x.robot), f.s(x.t), f.overwrite(x)), x.t);
 
   add("");
   add("Handlers: time in service (acceptance to the end of RETI)");
@@ -729,14 +776,14 @@ std::string markdown(const Report& r) {
       "send's last byte: the library re-points at `buf[0]`, so that frame is never latched as "
       "sent.\n\n",
       r.overwritten.size());
+  if (!r.overwrite_groups.empty()) {
+    o += "By the two sends' lines, most first:\n\n";
+    for (const OverwriteGroup& x : r.overwrite_groups)
+      o += fmt::format("- **{}** {}\n", f.name(x.robot), f.group(x));
+    o += "\nEach:\n\n";
+  }
   for (const OverwrittenSend& x : r.overwritten)
-    o += fmt::format(
-        "- **{}** {} s: restarted the send of {} s when the port had taken {} of its {} bytes, "
-        "{}\n",
-        f.name(x.robot), f.s(x.t), f.s(x.previous_t), x.previous_bytes_fetched, x.previous_count,
-        x.handler.empty() ? "from " + f.where(x.line, x.function)
-                          : fmt::format("from handler `{}` (it interrupted {})", x.handler,
-                                        f.where(x.line, x.function)));
+    o += fmt::format("- **{}** {} s: {}\n", f.name(x.robot), f.s(x.t), f.overwrite(x));
 
   o += "\n## Handlers\n\n| robot | handler | runs | total (s) | longest (s) "
        "|\n|---|---|---:|---:|---:|\n";
@@ -838,17 +885,38 @@ nlohmann::json json(const Report& r) {
          {"one_eye", x.one_eye}});
   }
   j["stalls"] = stalls;
+  // A send's site as fields named with `prefix`.
+  auto site = [](json& o, const std::string& prefix, const SendSite& x) {
+    o[prefix + "line"] = x.line;
+    o[prefix + "function"] = sinks::jsonString(x.function, false);
+    o[prefix + "caller_line"] = x.caller_line;
+    o[prefix + "caller_function"] = sinks::jsonString(x.caller_function, false);
+    o[prefix + "calls"] = sinks::jsonString(x.calls, false);
+  };
   json sends = json::array();
-  for (const OverwrittenSend& x : r.overwritten)
-    sends.push_back({{"robot", kNames[x.robot & 1]},
-                     {"time_s", sec(x.t)},
-                     {"previous_s", sec(x.previous_t)},
-                     {"previous_count", x.previous_count},
-                     {"previous_bytes_fetched", x.previous_bytes_fetched},
-                     {"handler", sinks::jsonString(x.handler, false)},
-                     {"line", x.line},
-                     {"function", sinks::jsonString(x.function, false)}});
+  for (const OverwrittenSend& x : r.overwritten) {
+    json o = {{"robot", kNames[x.robot & 1]},
+              {"time_s", sec(x.t)},
+              {"previous_s", sec(x.previous_t)},
+              {"previous_count", x.previous_count},
+              {"previous_bytes_fetched", x.previous_bytes_fetched},
+              {"handler", sinks::jsonString(x.handler, false)}};
+    site(o, "", x.send);
+    site(o, "previous_", x.previous);
+    sends.push_back(std::move(o));
+  }
   j["overwritten_sends"] = sends;
+  json groups = json::array();
+  for (const OverwriteGroup& x : r.overwrite_groups) {
+    json o = {{"robot", kNames[x.robot & 1]},
+              {"count", x.count},
+              {"first_s", sec(x.first)},
+              {"last_s", sec(x.last)}};
+    site(o, "", x.send);
+    site(o, "previous_", x.previous);
+    groups.push_back(std::move(o));
+  }
+  j["overwrite_groups"] = groups;
   json totals = json::array();
   for (const HandlerTotal& x : r.handler_totals)
     totals.push_back({{"robot", kNames[x.robot & 1]},

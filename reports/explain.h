@@ -82,6 +82,17 @@ struct Stall {
   bool one_eye = false;
 };
 
+// Where a send came from (the serial_send and frame_overwritten records):
+// its ser_send_z1 call's line and function, and the call of that function
+// (caller_line 0: none, a send in main or in a handler's own code).
+struct SendSite {
+  int line = 0;  // 0: not known
+  std::string function;
+  int caller_line = 0;
+  std::string caller_function;
+  std::string calls;  // the whole chain, outermost first (serial_send's `calls`)
+};
+
 // A ser_send_z1 before the port had taken (fetched into its data register)
 // the previous send's last byte: the library re-points at buf[0], so the
 // rest of the previous frame is never sent and that frame never latches.
@@ -92,8 +103,17 @@ struct OverwrittenSend {
   int previous_count = 0;
   int previous_bytes_fetched = 0;
   std::string handler;  // the handler in service at the new send ("" if none)
-  int line = 0;         // where the handler interrupted, or the latest sample's line
-  std::string function;
+  SendSite send;        // the send that overwrote
+  SendSite previous;    // the send it overwrote
+};
+
+// The overwritten sends of one robot with the same two sends, the most
+// frequent pair first: which line overwrites which.
+struct OverwriteGroup {
+  int robot = 0;
+  SendSite send, previous;  // `calls` of the first of them
+  int count = 0;
+  Tick first = 0, last = 0;
 };
 
 // One handler run: acceptance to the end of its RETI.
@@ -151,6 +171,7 @@ struct Report {
   std::vector<Shot> shots;
   std::vector<Stall> stalls;
   std::vector<OverwrittenSend> overwritten;
+  std::vector<OverwriteGroup> overwrite_groups;
   std::vector<HandlerRun> handler_runs;
   std::vector<HandlerTotal> handler_totals;
   std::vector<Contact> contacts;

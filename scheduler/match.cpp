@@ -151,6 +151,8 @@ Robot::Robot(const Robot& other, Match& m)
       receiver(other.receiver),
       serialEventAt(other.serialEventAt),
       serialIsrAccepted(other.serialIsrAccepted),
+      lastSend(other.lastSend),
+      sendBefore(other.sendBefore),
       result(other.result),
       mainReturn(other.mainReturn) {}
 

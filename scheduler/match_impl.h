@@ -115,6 +115,20 @@ class Robot : public vm::Bus {
   trace::Watch watchedValues() const;
   void scheduleSerial(Tick t);
 
+  // Where a send came from (traced runs only, so an untraced run builds no
+  // text): its ser_send_z1 call and the call of the function it is in.
+  struct SendSite {
+    Tick t = -1;  // the send's T0
+    int line = 0;
+    std::string function;
+    int callerLine = 0;
+    std::string callerFunction;
+    std::string calls;  // the serial_send record's chain
+  };
+  SendSite sendSite(Tick t) const;
+  [[gnu::noinline]] void traceSend(Tick t, uint16_t cc);
+  [[gnu::noinline]] void traceOverwrite(Tick t, const board::OverwrittenSend& overwritten);
+
   // Where the program was at each sample tick (traced runs): taken at the
   // VM's first instruction boundary at or after the tick.
   struct Snapshot {
@@ -138,6 +152,8 @@ class Robot : public vm::Bus {
   plant::MotorReceiver receiver;
   Tick serialEventAt = -1;
   Tick serialIsrAccepted = 0;
+  // The latest send and the one before it: a frame_overwritten names both.
+  SendSite lastSend, sendBefore;
   RobotResult result;
   uint32_t mainReturn;
 };

@@ -10,6 +10,8 @@
 // applies the inputs is in match.cpp.
 #include <bit>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "scheduler/match_impl.h"
 
@@ -63,13 +65,58 @@ int Robot::adSample(Tick t, int channel) {
   return value;
 }
 
+// The call chain of the send under way: the VM's frames and then the
+// library call itself (pc() has moved past it by now). The start-up code's
+// call of main, in no function, is left out.
+Robot::SendSite Robot::sendSite(Tick t) const {
+  const vm::Image& image = spec.image;
+  std::vector<vm::Vm::Frame> frames = board.cpu.frames();
+  std::erase_if(frames, [&](const vm::Vm::Frame& f) {
+    return f.at + 1 == mainReturn || !image.functionAt(f.at) || image.lineAt(f.at) <= 0;
+  });
+  const vm::Vm::Frame send{board.cpu.libraryCallPc(), false};
+  auto name = [&](uint32_t at) {
+    const vm::Symbol* fn = image.functionAt(at);
+    return fn ? fn->name : std::string();
+  };
+  SendSite site{t, image.lineAt(send.at), name(send.at), 0, "", ""};
+  // A handler's own code has no caller: it was not called.
+  if (!frames.empty() && !frames.back().interrupted) {
+    site.callerLine = image.lineAt(frames.back().at);
+    site.callerFunction = name(frames.back().at);
+  }
+  frames.push_back(send);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (i) site.calls += frames[i - 1].interrupted ? " > interrupt > " : " > ";
+    site.calls += name(frames[i].at) + ':' + std::to_string(image.lineAt(frames[i].at));
+  }
+  return site;
+}
+
+// The records of a send, kept out of serialSend so that an untraced run's
+// path stays as short as it was.
+void Robot::traceSend(Tick t, uint16_t cc) {
+  SendSite site = sendSite(t);
+  match.emit(t, trace::rec::SerialSend{index, board.cpu.read8(cc), site.line, site.function,
+                                       site.callerLine, site.callerFunction, site.calls});
+  sendBefore = std::exchange(lastSend, std::move(site));
+}
+
+void Robot::traceOverwrite(Tick t, const board::OverwrittenSend& overwritten) {
+  // The overwritten send is the latest before this one; a snapshot or
+  // reload that lost it leaves its lines 0.
+  const SendSite before = sendBefore.t == overwritten.sentAt ? sendBefore : SendSite{};
+  match.emit(t, trace::rec::FrameOverwritten{
+                    index, overwritten.sentAt, overwritten.count, overwritten.fetched,
+                    lastSend.line, lastSend.function, lastSend.callerLine, lastSend.callerFunction,
+                    before.line, before.function, before.callerLine, before.callerFunction});
+}
+
 void Robot::serialSend(Tick t, uint16_t buf, uint16_t cc) {
-  if (match.tracing()) match.emit(t, trace::rec::SerialSend{index, board.cpu.read8(cc)});
+  if (match.tracing()) traceSend(t, cc);  // *cc as the program set it
   if (const auto overwritten = board.serialSend(t, buf, cc)) {
     ++result.framesOverwritten;
-    if (match.tracing())
-      match.emit(t, trace::rec::FrameOverwritten{index, overwritten->sentAt, overwritten->count,
-                                                 overwritten->fetched});
+    if (match.tracing()) traceOverwrite(t, *overwritten);
   }
   scheduleSerial(t);
 }

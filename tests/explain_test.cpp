@@ -326,7 +326,13 @@ TEST(Explain, OverwrittenSend) {
   // until buf[0] is out.
   ASSERT_LT(sends[1].first - sends[0].first, 9600);
   EXPECT_EQ(o.previous_bytes_fetched, 2);
-  EXPECT_EQ(o.function, "main");
+  // The sends' own lines (12 and 15 of the source above), not where a
+  // sample last found the program.
+  EXPECT_EQ(o.send.line, 15);
+  EXPECT_EQ(o.send.function, "main");
+  EXPECT_EQ(o.send.caller_line, 0);
+  EXPECT_EQ(o.previous.line, 12);
+  EXPECT_EQ(o.previous.function, "main");
   // The trace records it at the new send, as the report does.
   const auto records = r.all<rec::FrameOverwritten>(0);
   ASSERT_EQ(records.size(), 1u);
@@ -334,8 +340,127 @@ TEST(Explain, OverwrittenSend) {
   EXPECT_EQ(records[0].second.previous_t, sends[0].first);
   EXPECT_EQ(records[0].second.previous_count, 9);
   EXPECT_EQ(records[0].second.fetched, 2);
+  EXPECT_EQ(records[0].second.line, 15);
+  EXPECT_EQ(records[0].second.previous_line, 12);
   // Solo: no opponent, so no range, no stall.
   EXPECT_TRUE(r.report.stalls.empty());
+}
+
+// tests/programs/send_twice.dc sends three pairs back to back (its header
+// works the lines out): line 27 overwrites line 24 in main(); platform()'s
+// send on line 45 called from main line 33 overwrites it called from line
+// 31; and called from main line 37 overwrites it called from line 51 in
+// spin() (main line 36). explain names each send with its caller, in the
+// text, the JSON and from the JSONL file alike.
+TEST(Explain, NamesBothSendsAndTheirCallers) {
+  auto c = config({SIMBOT_SOURCE_DIR "/tests/programs/send_twice.dc"}, 0.5, "thesis-1997");
+  const Traced r = run(c);
+  ASSERT_EQ(r.all<rec::SerialSend>(0).size(), 6u);
+  // Each pair's second frame latches, its first never does.
+  const auto latched = r.all<rec::FrameLatched>(0);
+  ASSERT_EQ(latched.size(), 3u);
+  EXPECT_EQ(latched[0].second.bytes, "8fgr8rgr");
+  EXPECT_EQ(latched[1].second.bytes, "afgrargr");
+  EXPECT_EQ(latched[2].second.bytes, "4fgr4rgr");
+  struct Want {
+    int line;
+    const char* function;
+    int callerLine;
+    const char* callerFunction;
+    const char* calls;
+  };
+  const Want sends[3][2] = {// {the send that overwrote, the send overwritten}
+                            {{27, "main", 0, "", "main:27"}, {24, "main", 0, "", "main:24"}},
+                            {{45, "platform", 33, "main", "main:33 > platform:45"},
+                             {45, "platform", 31, "main", "main:31 > platform:45"}},
+                            {{45, "platform", 37, "main", "main:37 > platform:45"},
+                             {45, "platform", 51, "spin", "main:36 > spin:51 > platform:45"}}};
+  auto expectSite = [](const ex::SendSite& got, const Want& want, const std::string& what) {
+    EXPECT_EQ(got.line, want.line) << what;
+    EXPECT_EQ(got.function, want.function) << what;
+    EXPECT_EQ(got.caller_line, want.callerLine) << what;
+    EXPECT_EQ(got.caller_function, want.callerFunction) << what;
+    EXPECT_EQ(got.calls, want.calls) << what;
+  };
+  ASSERT_EQ(r.report.overwritten.size(), 3u);
+  ASSERT_EQ(r.report.overwrite_groups.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    const std::string pair = "pair " + std::to_string(k + 1);
+    expectSite(r.report.overwritten[k].send, sends[k][0], pair + ", the send");
+    expectSite(r.report.overwritten[k].previous, sends[k][1], pair + ", the send overwritten");
+    EXPECT_TRUE(r.report.overwritten[k].handler.empty());
+    // One of each pair: the groups keep the order they first happened in.
+    const ex::OverwriteGroup& g = r.report.overwrite_groups[k];
+    EXPECT_EQ(g.count, 1);
+    EXPECT_EQ(g.first, r.report.overwritten[k].t);
+    expectSite(g.send, sends[k][0], pair + ", its group");
+    expectSite(g.previous, sends[k][1], pair + ", its group");
+  }
+  const std::string text = ex::text(r.report);
+  for (const char* line :
+       {"  A: 1 send from line 27 in main() overwrote the send from line 24 in main(); ",
+        "  A: 1 send from line 45 in platform() (called from line 33 in main()) overwrote the "
+        "send from line 45 in platform() (called from line 31 in main()); ",
+        "  A: 1 send from line 45 in platform() (called from line 37 in main()) overwrote the "
+        "send from line 45 in platform() (called from line 51 in spin()); "})
+    EXPECT_NE(text.find(line), std::string::npos) << line << "\nin\n" << text;
+  const nlohmann::json j = ex::json(r.report);
+  EXPECT_EQ(j["overwritten_sends"][2]["caller_line"], 37);
+  EXPECT_EQ(j["overwritten_sends"][2]["previous_caller_function"], "spin");
+  EXPECT_EQ(j["overwritten_sends"][2]["previous_calls"], "main:36 > spin:51 > platform:45");
+  EXPECT_EQ(j["overwrite_groups"][1]["count"], 1);
+  // The JSONL trace reads back to the same report.
+  const std::string path = ::testing::TempDir() + "explain_send_twice.jsonl";
+  {
+    sinks::JsonlSink sink(path);
+    for (const auto& e : r.entries) sink.write(e);
+    sink.close();
+  }
+  EXPECT_EQ(ex::text(ex::explainFile(path)), text);
+  std::remove(path.c_str());
+}
+
+// Overwritten sends group by robot and the two sends' sites, the most
+// frequent first, whatever the order they came in: from hand-made records
+// (ticks apart, so each frame_overwritten follows its own serial_send).
+TEST(Explain, OverwrittenSendsGroupByTheirTwoLines) {
+  ex::Explainer e;
+  rec::Run run;
+  run.robots = 1;
+  run.ticks_per_second = scheduler::kTicksPerSecond;
+  e.write({0, run, {}});
+  auto overwrite = [&](trace::Tick t, int line, int callerLine) {
+    const std::string calls =
+        "main:" + std::to_string(callerLine) + " > platform:" + std::to_string(line);
+    e.write({t, rec::SerialSend{0, 9, line, "platform", callerLine, "main", calls}, {}});
+    e.write({t,
+             rec::FrameOverwritten{0, t - 100, 9, 2, line, "platform", callerLine, "main", line,
+                                   "platform", 66, "main"},
+             {}});
+  };
+  overwrite(1000, 78, 71);
+  overwrite(2000, 78, 93);
+  overwrite(3000, 78, 71);
+  overwrite(4000, 78, 71);
+  const ex::Report r = e.report();
+  ASSERT_EQ(r.overwritten.size(), 4u);
+  ASSERT_EQ(r.overwrite_groups.size(), 2u);
+  EXPECT_EQ(r.overwrite_groups[0].count, 3);
+  EXPECT_EQ(r.overwrite_groups[0].send.caller_line, 71);
+  EXPECT_EQ(r.overwrite_groups[0].previous.caller_line, 66);
+  EXPECT_EQ(r.overwrite_groups[0].first, 1000);
+  EXPECT_EQ(r.overwrite_groups[0].last, 4000);
+  EXPECT_EQ(r.overwrite_groups[0].send.calls, "main:71 > platform:78");
+  EXPECT_EQ(r.overwrite_groups[1].count, 1);
+  EXPECT_EQ(r.overwrite_groups[1].send.caller_line, 93);
+  // The overwritten send's chain is known only from its own serial_send
+  // record, which these hand-made ones leave out.
+  EXPECT_EQ(r.overwritten[0].previous.calls, "");
+  EXPECT_NE(ex::text(r).find("  A: 3 sends from line 78 in platform() (called from line 71 in "
+                             "main()) overwrote the send from line 78 in platform() (called from "
+                             "line 66 in main())"),
+            std::string::npos)
+      << ex::text(r);
 }
 
 // An injected edge runs ICEMAN's handler: its run is acceptance to RETI,

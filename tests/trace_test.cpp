@@ -167,6 +167,136 @@ TEST(Trace, SamplesSayWhenAHandlerIsInService) {
   EXPECT_EQ(portA[1].second.value, 0xFF);
 }
 
+// Each serial_send says where it came from. tests/programs/send_twice.dc
+// (its header works the lines out) sends from main lines 24 and 27, then
+// from platform()'s line 45 called from main lines 31 and 33, from spin()'s
+// line 51 (spin called from main line 36) and from main line 37.
+TEST(Trace, SendsSayWhereTheyCameFrom) {
+  std::ifstream in(SIMBOT_SOURCE_DIR "/tests/programs/send_twice.dc");
+  std::stringstream text;
+  text << in.rdbuf();
+  const Traced t = run(solo(text.str(), 0.5));
+  struct Want {
+    int line;
+    const char* function;
+    int callerLine;
+    const char* callerFunction;
+    const char* calls;
+  };
+  const Want want[] = {{24, "main", 0, "", "main:24"},
+                       {27, "main", 0, "", "main:27"},
+                       {45, "platform", 31, "main", "main:31 > platform:45"},
+                       {45, "platform", 33, "main", "main:33 > platform:45"},
+                       {45, "platform", 51, "spin", "main:36 > spin:51 > platform:45"},
+                       {45, "platform", 37, "main", "main:37 > platform:45"}};
+  const auto sends = t.all<rec::SerialSend>();
+  ASSERT_EQ(sends.size(), std::size(want));
+  for (size_t k = 0; k < sends.size(); ++k) {
+    const rec::SerialSend& s = sends[k].second;
+    EXPECT_EQ(s.count, 9) << k;
+    EXPECT_EQ(s.line, want[k].line) << k;
+    EXPECT_EQ(s.function, want[k].function) << k;
+    EXPECT_EQ(s.caller_line, want[k].callerLine) << k;
+    EXPECT_EQ(s.caller_function, want[k].callerFunction) << k;
+    EXPECT_EQ(s.calls, want[k].calls) << k;
+  }
+  // Every second send of a pair overwrites the first: the record names both,
+  // at the new send's tick.
+  const auto over = t.all<rec::FrameOverwritten>();
+  ASSERT_EQ(over.size(), 3u);
+  for (size_t k = 0; k < over.size(); ++k) {
+    const rec::FrameOverwritten& o = over[k].second;
+    const Want& send = want[2 * k + 1];
+    const Want& before = want[2 * k];
+    EXPECT_EQ(over[k].first, sends[2 * k + 1].first) << k;
+    EXPECT_EQ(o.previous_t, sends[2 * k].first) << k;
+    EXPECT_EQ(o.line, send.line) << k;
+    EXPECT_EQ(o.function, send.function) << k;
+    EXPECT_EQ(o.caller_line, send.callerLine) << k;
+    EXPECT_EQ(o.caller_function, send.callerFunction) << k;
+    EXPECT_EQ(o.previous_line, before.line) << k;
+    EXPECT_EQ(o.previous_function, before.function) << k;
+    EXPECT_EQ(o.previous_caller_line, before.callerLine) << k;
+    EXPECT_EQ(o.previous_caller_function, before.callerFunction) << k;
+  }
+  // They read back from JSONL field for field.
+  for (const auto& e : t.entries) {
+    const nlohmann::json j = sinks::traceJson(e);
+    EXPECT_EQ(sinks::traceJson(sinks::traceEntry(j)), j);
+  }
+  // A trace from before the fields were recorded is refused, naming the
+  // field (the reader requires every field of the definition).
+  nlohmann::json old = sinks::traceJson(trace::Entry{sends[0].first, sends[0].second, {}});
+  old.erase("line");
+  try {
+    sinks::traceEntry(old);
+    FAIL() << "a serial_send without its line must be refused";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("\"line\""), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("older simbot"), std::string::npos) << e.what();
+  }
+}
+
+// A send from a handler: the chain goes through the code the edge
+// interrupted (main line 29 called wait(), whose loop is line 17), then the
+// handler edge() on line 12 calls go(), which sends on line 8; the
+// handler's own send on line 13 has no caller (nothing called edge()) and
+// overwrites go()'s.
+const char* kHandlerSends =
+    "#INT_VEC PIOA_VEC edge\n"
+    "char buf[9];\n"
+    "char cc;\n"
+    "int z;\n"
+    "go()\n"
+    "{\n"
+    "    cc = sizeof(buf);\n"
+    "    ser_send_z1(buf, &cc);\n"
+    "}\n"
+    "interrupt reti edge()\n"
+    "{\n"
+    "    go();\n"
+    "    ser_send_z1(buf, &cc);\n"
+    "}\n"
+    "wait()\n"
+    "{\n"
+    "    for (z = 0; z < 30000; z++);\n"
+    "}\n"
+    "main()\n"
+    "{\n"
+    "    ser_init_z1(0, 9600/1200);\n"
+    "    outport(PIOCA, 0xff);\n"
+    "    outport(PIOCA, 0xff);\n"
+    "    outport(PIOCA, PIOA_VEC);\n"
+    "    outport(PIOCA, 0x97);\n"
+    "    outport(PIOCA, 0xfc);\n"
+    "    outport(PIOCA, 0x87);\n"
+    "    strcpy(buf, \"cfgrcfgr\");\n"
+    "    wait();\n"
+    "}\n";
+
+TEST(Trace, SendsFromAHandlerSayWhatItInterrupted) {
+  auto c = solo(kHandlerSends, 0.5);
+  c.injections.push_back(config::parseInjection("A:edge_fore@0.2s", 1));
+  const Traced t = run(c);
+  const auto sends = t.all<rec::SerialSend>();
+  ASSERT_EQ(sends.size(), 2u);
+  EXPECT_EQ(sends[0].second.line, 8);
+  EXPECT_EQ(sends[0].second.function, "go");
+  EXPECT_EQ(sends[0].second.caller_line, 12);
+  EXPECT_EQ(sends[0].second.caller_function, "edge");
+  EXPECT_EQ(sends[0].second.calls, "main:29 > wait:17 > interrupt > edge:12 > go:8");
+  EXPECT_EQ(sends[1].second.line, 13);
+  EXPECT_EQ(sends[1].second.function, "edge");
+  EXPECT_EQ(sends[1].second.caller_line, 0);
+  EXPECT_EQ(sends[1].second.caller_function, "");
+  EXPECT_EQ(sends[1].second.calls, "main:29 > wait:17 > interrupt > edge:13");
+  const auto over = t.all<rec::FrameOverwritten>();
+  ASSERT_EQ(over.size(), 1u);
+  EXPECT_EQ(over[0].second.line, 13);
+  EXPECT_EQ(over[0].second.previous_line, 8);
+  EXPECT_EQ(over[0].second.previous_caller_line, 12);
+}
+
 // Fires gun 1 once (thesis-1997: gun wheels always at full speed, no
 // stroke time, 105 ft/s, launched 1.5 ft up from the body's edge).
 const char* kShootOnce =

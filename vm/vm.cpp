@@ -794,6 +794,27 @@ uint32_t Vm::pc() const { return s_->lib.active ? s_->lib.pc : s_->burn ? s_->bu
 int Vm::line() const { return s_->image->lineAt(pc()); }
 int Vm::interruptDepth() const { return static_cast<int>(s_->ints.size()); }
 int Vm::callDepth() const { return static_cast<int>(s_->calls.size()); }
+uint32_t Vm::libraryCallPc() const { return s_->lib.pc; }
+
+std::vector<Vm::Frame> Vm::frames() const {
+  const auto& calls = s_->calls;
+  const auto& ints = s_->ints;
+  std::vector<Frame> out;
+  out.reserve(calls.size() + ints.size());
+  // A handler accepted with d calls under way comes after call d - 1: the
+  // calls it makes are calls[d..].
+  size_t k = 0;
+  auto handlersAt = [&](size_t depth) {
+    for (; k < ints.size() && static_cast<size_t>(ints[k].callDepth) <= depth; ++k)
+      out.push_back({ints[k].lib.active ? ints[k].lib.pc : ints[k].retPc, true});
+  };
+  for (size_t i = 0; i < calls.size(); ++i) {
+    handlersAt(i);
+    out.push_back({calls[i].retPc - 1, false});
+  }
+  handlersAt(SIZE_MAX);
+  return out;
+}
 uint8_t Vm::read8(uint16_t a) const { return s_->rd8(a); }
 void Vm::write8(uint16_t a, uint8_t v) { s_->wr8(a, v); }
 uint16_t Vm::read16(uint16_t a) const { return s_->rd16(a); }

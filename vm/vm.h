@@ -167,6 +167,21 @@ class Vm {
   int line() const;            // source line of pc()
   int interruptDepth() const;  // handlers in service (nested ones count)
   int callDepth() const;       // calls not yet returned from
+  // The calls and handlers the program is inside, outermost first, for
+  // trace records and messages (it allocates: not for the hot path). A
+  // call not yet returned from gives an address inside its CALL (its
+  // return address less one: the line table covers every byte); a handler
+  // in service, the instruction it interrupted (`interrupted`), where it
+  // nests among the calls. The current instruction is not among them.
+  struct Frame {
+    uint32_t at;
+    bool interrupted;
+  };
+  std::vector<Frame> frames() const;
+  // The LIB instruction of the latest library call: during a routine's
+  // bus access (Bus::serialSend, ...) the call that made it, which pc() is
+  // no longer once the routine's effect has begun.
+  uint32_t libraryCallPc() const;
 
   // Power-on RAM from a random stream (a profile option, DESIGN.md): every
   // byte from kDataBase up that the image does not initialise is replaced,

@@ -302,8 +302,13 @@ function describeEvent(kind, c, i) {
     case 'injection': return `${c.what[i]} (line ${c.line[i]})`;
     case 'fault': return `line ${c.line[i]}: ${c.message[i]}`;
     case 'reload': return `reload ${c.reloads[i]}: main starts again`;
-    case 'frame_overwritten':
-      return `the port had taken ${c.fetched[i]} of the previous send's ${c.previous_count[i]} bytes`;
+    case 'frame_overwritten': {
+      // Each send's line, and the line that called its function (0: none).
+      const site = (line, caller) => `line ${line}` + (caller > 0 ? ` (called from line ${caller})` : '');
+      return `the send from ${site(c.line[i], c.caller_line[i])} overwrote the send from ` +
+        `${site(c.previous_line[i], c.previous_caller_line[i])}: the port had taken ` +
+        `${c.fetched[i]} of its ${c.previous_count[i]} bytes`;
+    }
     case 'console': return c.text[i];
     default: return '';
   }
