@@ -189,7 +189,21 @@ nlohmann::json benchSettings(const BenchConfig& c, const config::Profile& profil
           {"seconds", c.seconds},
           {"master_seed", c.masterSeed},
           {"profile", profile.name},
-          {"profile_file", profile.file}};
+          {"profile_file", profile.file},
+          {"contents", inputContents(benchInputs(c, profile))}};
+}
+
+std::vector<std::string> benchInputs(const BenchConfig& c, const config::Profile& profile) {
+  std::vector<std::string> paths = c.programs;
+  if (!c.opponent.empty()) paths.push_back(c.opponent);
+  paths.push_back(profile.file);
+  if (c.scenario) {
+    paths.push_back(c.scenario->file);
+    for (const auto* r : {&c.scenario->a, &c.scenario->b})
+      if (!r->hardware.empty()) paths.push_back(r->hardware);
+    if (!c.scenario->program.empty()) paths.push_back(c.scenario->program);
+  }
+  return paths;
 }
 
 namespace {

@@ -90,6 +90,9 @@ void checkBenchConfig(const BenchConfig& config);
 // runs.csv's columns, and the settings that identify a bench (batch.json).
 CsvRow benchHeader();
 nlohmann::json benchSettings(const BenchConfig& config, const config::Profile& profile);
+// Every file a bench reads: programs, opponent, profile, scenario and the
+// files the scenario names.
+std::vector<std::string> benchInputs(const BenchConfig& config, const config::Profile& profile);
 
 // Runs every run not already in io.table (resume); each finished run goes
 // to the table as it completes. A run that faults or fails is recorded as

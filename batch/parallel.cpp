@@ -10,8 +10,11 @@
 #include <exception>
 #include <iostream>
 #include <mutex>
+#include <system_error>
 #include <thread>
 #include <vector>
+
+#include "sinks/user_error.h"
 
 namespace simbot::batch {
 
@@ -27,7 +30,9 @@ double uniform(plant::RandomBits& bits, double lo, double hi) {
 
 void parallelFor(size_t count, int threads, const std::function<void(size_t)>& job,
                  const std::string& label, bool progress, const std::atomic<bool>* stop) {
-  const auto stopped = [stop] { return stop && stop->load(); };
+  // After a job throws (a table that cannot be written), no job starts.
+  std::atomic<bool> failed{false};
+  const auto stopped = [stop, &failed] { return failed.load() || (stop && stop->load()); };
   const auto start = std::chrono::steady_clock::now();
   const size_t workers =
       std::min<size_t>(static_cast<size_t>(resolveThreads(threads)), std::max<size_t>(count, 1));
@@ -42,6 +47,7 @@ void parallelFor(size_t count, int threads, const std::function<void(size_t)>& j
         job(i);
       } catch (...) {
         errors[i] = std::current_exception();
+        failed.store(true);
       }
       done.fetch_add(1);
       std::lock_guard lock(mutex);
@@ -52,7 +58,17 @@ void parallelFor(size_t count, int threads, const std::function<void(size_t)>& j
     finished.notify_all();
   };
   std::vector<std::thread> pool;
-  for (size_t w = 0; w < workers; ++w) pool.emplace_back(work);
+  try {
+    for (size_t w = 0; w < workers; ++w) pool.emplace_back(work);
+  } catch (const std::system_error& e) {
+    // The system would not give us the threads asked for: the ones that
+    // started stop after their job, and the batch says so in one line.
+    failed.store(true);
+    for (auto& th : pool) th.join();
+    throw sinks::UserError(fmt::format(
+        "simbot: {}: cannot start {} worker threads ({} started): {}; use --threads with fewer\n",
+        label, workers, pool.size(), e.code().message()));
+  }
   const bool tty = progress && isatty(STDERR_FILENO);
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

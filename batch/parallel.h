@@ -16,8 +16,10 @@ namespace simbot::batch {
 int resolveThreads(int threads);
 
 // Runs job(0..count-1) on `threads` workers. With `progress`, draws a bar on
-// stderr when it is a terminal, else prints one final line. Rethrows the
-// first (lowest-index) exception a job threw, after all workers stopped.
+// stderr when it is a terminal, else prints one final line. After a job
+// throws, no further job starts; the first (lowest-index) exception is
+// rethrown after all workers stopped. Threads that cannot be created are a
+// sinks::UserError.
 // When `stop` becomes true no further job starts (those under way finish
 // or give up on their own).
 void parallelFor(size_t count, int threads, const std::function<void(size_t)>& job,

@@ -1,6 +1,8 @@
 #include "batch/run_table.h"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <csignal>
@@ -10,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "files/files.h"
 #include "sinks/json_text.h"
 #include "sinks/user_error.h"
 
@@ -80,23 +83,48 @@ CsvRow parseCsvLine(const std::string& line) {
 }
 
 void writeFileAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f)
-    throw sinks::UserError(
-        fmt::format("simbot: cannot write '{}': {}\n", tmp, std::strerror(errno)));
-  const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  const bool flushed = std::fflush(f) == 0;
-  const int error = errno;
-  const bool closed = std::fclose(f) == 0;
-  if (!written || !flushed || !closed) {
-    std::remove(tmp.c_str());
-    throw sinks::UserError(fmt::format("simbot: writing '{}': {}\n", path, std::strerror(error)));
+  try {
+    files::writeWhole(path, text);
+  } catch (const files::Error& e) {
+    throw sinks::UserError(fmt::format("simbot: cannot write '{}': {}\n", path, e.what()));
   }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec)
-    throw sinks::UserError(fmt::format("simbot: cannot write '{}': {}\n", path, ec.message()));
+}
+
+RowFile::RowFile(const std::string& path) : path_(path) {
+  fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+  if (fd_ < 0)
+    throw sinks::UserError(
+        fmt::format("simbot: cannot write '{}': {}\n", path, std::strerror(errno)));
+}
+
+RowFile::~RowFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void RowFile::append(const std::string& rows) {
+  std::lock_guard lock(mutex_);
+  if (failed_) return;  // the batch is stopping; this run is done again by --resume
+  const off_t before = ::lseek(fd_, 0, SEEK_END);
+  size_t written = 0;
+  while (before >= 0 && written < rows.size()) {
+    const ssize_t n = ::write(fd_, rows.data() + written, rows.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    written += static_cast<size_t>(n);
+  }
+  if (before >= 0 && written == rows.size()) return;
+  // Each row whole or absent: what was written of this one goes, so that
+  // rows written later (after space is freed) are never glued onto it.
+  const int error = before < 0 ? errno : (errno ? errno : ENOSPC);
+  failed_ = true;
+  const bool rolledBack = before >= 0 && ::ftruncate(fd_, before) == 0;
+  throw sinks::UserError(fmt::format(
+      "simbot: writing '{}': {}; the batch stopped at once{} (--resume continues)\n", path_,
+      std::strerror(error),
+      rolledBack ? ", with every finished row whole in the table"
+                 : fmt::format(", and the partial row could not be removed ({}): remove it "
+                               "by hand",
+                               std::strerror(errno))));
 }
 
 namespace {
@@ -131,9 +159,9 @@ RunTable::RunTable(const std::string& dir, const std::string& file, const CsvRow
     }
     if (earlier != settings)
       throw sinks::UserError(fmt::format(
-          "simbot: --resume: the batch in '{}' was run with other settings ({}); run it again "
-          "with those, or choose another --out\n",
-          dir, sinks::dumpJson(earlier)));
+          "simbot: --resume: the batch in '{}' {}; run it again as it was, or choose another "
+          "--out\n",
+          dir, settingsChange(earlier, settings)));
     size_t number = 0;
     // A last line cut short by a kill is left out: that run is done again.
     for (const std::string& line : csvRecords(readAll(path_))) {
@@ -161,36 +189,43 @@ RunTable::RunTable(const std::string& dir, const std::string& file, const CsvRow
     writeFileAtomically(settingsPath, sinks::dumpJson(settings, 2) + "\n");
     writeFileAtomically(path_, csvRecord(header));
   }
-  file_ = std::fopen(path_.c_str(), "ab");
-  if (!file_)
-    throw sinks::UserError(
-        fmt::format("simbot: cannot write '{}': {}\n", path_, std::strerror(errno)));
+  rows_.emplace(path_);
 }
 
-RunTable::~RunTable() {
-  if (file_) std::fclose(file_);
-}
+RunTable::~RunTable() = default;
 
-void RunTable::append(const CsvRow& row) {
-  const std::string line = csvRecord(row);
-  std::lock_guard lock(mutex_);
-  if (std::fwrite(line.data(), 1, line.size(), file_) != line.size() || std::fflush(file_) != 0)
-    throw sinks::UserError(fmt::format("simbot: writing '{}': {}\n", path_, std::strerror(errno)));
-}
+void RunTable::append(const CsvRow& row) { rows_->append(csvRecord(row)); }
 
 void RunTable::rewrite(const std::vector<CsvRow>& rows) {
   std::string text = csvRecord(header_);
   for (const auto& row : rows) text += csvRecord(row);
-  std::lock_guard lock(mutex_);
-  if (file_) {
-    std::fclose(file_);
-    file_ = nullptr;
-  }
+  rows_.reset();
   writeFileAtomically(path_, text);
-  file_ = std::fopen(path_.c_str(), "ab");
-  if (!file_)
-    throw sinks::UserError(
-        fmt::format("simbot: cannot write '{}': {}\n", path_, std::strerror(errno)));
+  rows_.emplace(path_);
+}
+
+nlohmann::json inputContents(const std::vector<std::string>& paths) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& path : paths) out[path] = files::fingerprint(path);
+  return out;
+}
+
+std::string settingsChange(const nlohmann::json& earlier, const nlohmann::json& now) {
+  if (!earlier.is_object() || !now.is_object()) return "was written by another kind of batch";
+  for (const auto& [key, value] : now.items()) {
+    const auto was = earlier.find(key);
+    if (was == earlier.end()) return fmt::format("was run before '{}' was recorded", key);
+    if (*was == value) continue;
+    if (key == "contents" && was->is_object() && value.is_object())
+      for (const auto& [file, print] : value.items())
+        if (!was->contains(file) || (*was)[file] != print)
+          return was->contains(file)
+                     ? fmt::format("was run with another '{}' (its contents changed)", file)
+                     : fmt::format("was run without '{}'", file);
+    return fmt::format("was run with {} {}, not {}", key, sinks::dumpJson(*was),
+                       sinks::dumpJson(value));
+  }
+  return "was run with other settings";
 }
 
 // ---- signals

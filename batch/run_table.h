@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,36 @@ CsvRow parseCsvLine(const std::string& line);
 // failure.
 void writeFileAtomically(const std::string& path, const std::string& text);
 
+// A table's file that rows are appended to, each append whole or absent:
+// a write that fails (a full disk) is cut back to where it began, and from
+// then on nothing more is appended (the batch stops; --resume continues).
+// Safe from worker threads.
+class RowFile {
+ public:
+  explicit RowFile(const std::string& path);  // UserError if it cannot be opened
+  ~RowFile();
+  RowFile(const RowFile&) = delete;
+  RowFile& operator=(const RowFile&) = delete;
+  // UserError "simbot: writing 'PATH': REASON; the batch stopped at once ...".
+  void append(const std::string& rows);
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  bool failed_ = false;
+  std::mutex mutex_;
+};
+
+// What differs between a batch's recorded settings and this one's, for
+// --resume's refusal: "was run with seeds 20, not 30", "was run with
+// another 'P.dc' (its contents changed)".
+std::string settingsChange(const nlohmann::json& earlier, const nlohmann::json& now);
+
+// The contents of a batch's input files, for its settings: {path:
+// files::fingerprint(path)}, so that --resume refuses a batch whose
+// program or profile was edited in between.
+nlohmann::json inputContents(const std::vector<std::string>& paths);
+
 class RunTable {
  public:
   // The table `dir`/`file` with `header`, for the batch `settings`. The
@@ -65,8 +96,7 @@ class RunTable {
  private:
   std::string dir_, path_;
   CsvRow header_;
-  std::FILE* file_ = nullptr;
-  std::mutex mutex_;
+  std::optional<RowFile> rows_;
   std::vector<CsvRow> previous_;
 };
 

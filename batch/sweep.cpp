@@ -168,24 +168,17 @@ SweepWriter::SweepWriter(const std::string& path, const CsvRow& header, bool wri
       }
     }
     writeFileAtomically(path, kept);
-    file_ = std::fopen(path.c_str(), "ab");
   } else {
-    file_ = std::fopen(path.c_str(), "wb");
-    if (file_ && writeHeader) writeLocked(csvRecord(header));
+    writeFileAtomically(path, writeHeader ? csvRecord(header) : "");
   }
-  if (!file_)
-    throw sinks::UserError(
-        fmt::format("simbot: cannot write '{}': {}\n", path, std::strerror(errno)));
+  rows_.emplace(path);
 }
 
-SweepWriter::~SweepWriter() {
-  if (file_) std::fclose(file_);
-}
+SweepWriter::~SweepWriter() = default;
 
 void SweepWriter::writeLocked(const std::string& text) {
-  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() || std::fflush(file_) != 0)
-    throw sinks::UserError(
-        fmt::format("simbot: cannot write '{}': {}\n", path_, std::strerror(errno)));
+  if (!rows_) throw sinks::UserError(fmt::format("simbot: sweep: '{}' is finished\n", path_));
+  rows_->append(text);
 }
 
 void SweepWriter::put(size_t index, const CsvRow& row) {
@@ -212,11 +205,7 @@ size_t SweepWriter::pending() const {
 
 void SweepWriter::finish() {
   std::lock_guard lock(mutex_);
-  const int closed = std::fclose(file_);
-  file_ = nullptr;
-  if (closed != 0)
-    throw sinks::UserError(
-        fmt::format("simbot: cannot write '{}': {}\n", path_, std::strerror(errno)));
+  rows_.reset();
   if (next_ != end_)
     throw sinks::UserError(fmt::format(
         "simbot: sweep: {} rows are missing from '{}' (first missing: run {}); --resume "

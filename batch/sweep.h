@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -68,7 +69,7 @@ class SweepWriter {
  private:
   void writeLocked(const std::string& text);
   std::string path_;
-  std::FILE* file_ = nullptr;
+  std::optional<RowFile> rows_;
   size_t next_, end_;
   std::vector<std::pair<size_t, std::string>> waiting_;  // sorted by index
   mutable std::mutex mutex_;

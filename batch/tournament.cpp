@@ -32,7 +32,12 @@ nlohmann::json tournamentSettings(const TournamentConfig& c, const config::Profi
           {"profile", profile.name},
           {"profile_file", profile.file},
           {"reload_on_fault", c.reloadOnFault},
-          {"reload_delay_s", profile.reload_delay_s}};
+          {"reload_delay_s", profile.reload_delay_s},
+          {"contents", inputContents([&] {
+             std::vector<std::string> paths = c.programs;
+             paths.push_back(profile.file);
+             return paths;
+           }())}};
 }
 
 namespace {

@@ -3,12 +3,14 @@
 // reports/, sinks/); DESIGN.md's tool contract says what tests and scripts
 // rely on.
 #include <fmt/format.h>
+#include <sundials/sundials_config.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -19,11 +21,13 @@
 #include "cli/commands.h"
 #include "compiler/compiler.h"
 #include "config/config.h"
+#include "files/files.h"
 #include "plant/plant.h"
 #include "reports/viewer.h"
 #include "runs/play.h"
 #include "runs/scenario.h"
 #include "scheduler/match.h"
+#include "simbot_version.h"
 #include "sinks/json_text.h"
 #include "sinks/trace_jsonl.h"
 #include "sinks/user_error.h"
@@ -40,20 +44,7 @@ using nlohmann::json;
 // come through CLI11 as extras (it has no multi-letter single-dash options).
 int compileCommand(const std::string& file, bool disasm, const std::vector<std::string>& extras) {
   compiler::Options options;
-  for (const std::string& w : extras) {
-    if (w == "-Werror") {
-      options.werror = true;
-    } else if (w.rfind("-Wno-", 0) == 0 && compiler::isWarningName(w.substr(5))) {
-      options.disabledWarnings.insert(w.substr(5));
-    } else {
-      std::string names;
-      for (const auto& info : compiler::warningList())
-        names += (names.empty() ? "" : ", ") + std::string(info.name);
-      std::cerr << "simbot: compile: unknown option '" << w << "' (warnings: " << names
-                << "; simbot compile --help lists the options)\n";
-      return 1;
-    }
-  }
+  runs::parseWarningOptions(extras, options, "compile");
   const auto result = compiler::compileFile(file, options);
   // Errors and warnings together, in source order (each list already is).
   std::vector<compiler::Diagnostic> all = result.warnings;
@@ -67,11 +58,17 @@ int compileCommand(const std::string& file, bool disasm, const std::vector<std::
   return 0;
 }
 
-// simbot view TRACE.jsonl -o FILE.html: the replay page of a recorded run.
-int viewCommand(const std::string& tracePath, const std::string& out) {
+// simbot view TRACE.jsonl [-o FILE.html]: the replay page of a recorded
+// run, by default beside the trace (TRACE with .html for its extension).
+int viewCommand(const std::string& tracePath, std::string out) {
+  if (out.empty()) out = std::filesystem::path(tracePath).replace_extension(".html").string();
+  runs::checkFiles({{tracePath, "the trace"}}, {{out, "the page"}});
   reports::ReplaySink page(out);
-  sinks::readTrace(tracePath, [&](const trace::Entry& e) { page.write(e); });
+  const sinks::TraceRead read =
+      sinks::readTrace(tracePath, [&](const trace::Entry& e) { page.write(e); });
+  std::cerr << sinks::cutShortWarning(tracePath, read);
   page.close();
+  std::cerr << "simbot: wrote " << out << '\n';
   return 0;
 }
 
@@ -251,10 +248,22 @@ void addRunOptions(CLI::App* cmd, runs::RunOptions& o, unsigned command) {
 #undef RUN_OPTION
 }
 
+// -W words come through CLI11 as extras (it has no multi-letter
+// single-dash options); main() checks them.
+void addWarningOptions(CLI::App* cmd) {
+  cmd->allow_extras();
+  cmd->footer(
+      "Warnings: -Wno-NAME turns one off, -Werror makes every warning an error (docs/language.md "
+      "lists the names).");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"simbot: a timing-faithful simulator of the 1997 NPS Robot Wars"};
+  app.set_version_flag("--version",
+                       fmt::format("simbot {} (commit {}, {} build, SUNDIALS {})", SIMBOT_VERSION,
+                                   SIMBOT_COMMIT, SIMBOT_BUILD_TYPE, SUNDIALS_VERSION));
   app.require_subcommand(1);
 
   std::string compileFile;
@@ -262,16 +271,14 @@ int main(int argc, char** argv) {
   auto* compile = app.add_subcommand("compile", "compile a Dynamic C program");
   compile->add_option("FILE", compileFile, "program (.dc)")->required();
   compile->add_flag("--disasm", disasm, "print the bytecode, interleaved with the source");
-  compile->allow_extras();
-  compile->footer(
-      "Warnings: -Wno-NAME turns one off, -Werror makes every warning an error (docs/language.md "
-      "lists the names).");
+  addWarningOptions(compile);
 
   runs::RunOptions soloOptions;
   std::string soloProgram;
   auto* solo = app.add_subcommand("solo", "run one robot alone in the arena");
   solo->add_option("FILE", soloProgram, "program (.dc)")->required();
   addRunOptions(solo, soloOptions, runs::kSolo);
+  addWarningOptions(solo);
 
   runs::RunOptions matchOptions;
   std::string programA, programB;
@@ -279,6 +286,7 @@ int main(int argc, char** argv) {
   match->add_option("A", programA, "robot A's program")->required();
   match->add_option("B", programB, "robot B's program")->required();
   addRunOptions(match, matchOptions, runs::kMatch);
+  addWarningOptions(match);
 
   runs::RunOptions profileOptions;
   profileOptions.defaultSeconds = 60;
@@ -288,25 +296,32 @@ int main(int argc, char** argv) {
       app.add_subcommand("profile", "cycles and time per source line and function of a solo run");
   profile->add_option("FILE", profileProgram, "program (.dc)")->required();
   addRunOptions(profile, profileOptions, runs::kProfile);
+  addWarningOptions(profile);
   profile->add_option("--top", profileTop, "source lines to list (default 20)")
       ->check(CLI::Range(1, 1'000'000));
 
   std::string viewTrace, viewOut;
   auto* view = app.add_subcommand("view", "write the replay page (HTML) of a recorded trace");
   view->add_option("TRACE", viewTrace, "trace file (.jsonl) written with --trace")->required();
-  view->add_option("-o,--output", viewOut, "the page to write (.html)")->required();
+  view->add_option("-o,--output", viewOut,
+                   "the page to write (default: beside the trace, with .html for its extension)");
 
   const auto bench = simbot::cli::addBenchCommand(app);
   const auto compare = simbot::cli::addCompareCommand(app);
   const auto tournament = simbot::cli::addTournamentCommand(app);
+  addWarningOptions(bench.app);
+  addWarningOptions(tournament.app);
   const auto explain = simbot::cli::addExplainCommand(app);
   const auto sweep = simbot::cli::addSweepCommand(app);
 
+  files::removeTemporariesOnSignals();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // A usage error: one line, exit status 1.
@@ -316,6 +331,13 @@ int main(int argc, char** argv) {
     return kExitBadInput;
   }
   try {
+    // -Wno-NAME and -Werror, on every command that compiles a program.
+    for (CLI::App* cmd : {solo, match, profile, bench.app, tournament.app})
+      if (*cmd) {
+        compiler::Options options;
+        runs::parseWarningOptions(cmd->remaining(), options, cmd->get_name());
+        runs::setCompileOptions(options);
+      }
     if (*compile) return compileCommand(compileFile, disasm, compile->remaining());
     if (*solo) return soloCommand(soloProgram, soloOptions);
     if (*match) return matchCommand(programA, programB, matchOptions);

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,9 @@
 #include "batch/sweep.h"
 #include "cli/commands.h"
 #include "config/config.h"
+#include "files/files.h"
+#include "runs/play.h"
+#include "sinks/json_text.h"
 #include "sinks/user_error.h"
 
 namespace simbot::cli {
@@ -74,10 +78,38 @@ int runSweepCommand(SweepOptions& o) {
   if (o.out.empty()) o.out = defaultOut(o);
   const auto [k, n] = batch::parseShard(o.shard);
   const batch::SweepSpec spec = config::loadSweep(o.file, batch::benchFamilies());
+  // Every file the sweep reads, for the output check and --resume's
+  // fingerprint (kept beside the table, in OUT.batch.json).
+  std::vector<std::string> inputPaths = {o.file, config::sweepProfilePath(spec)};
+  for (const auto* list : {&spec.programs, &spec.opponents})
+    for (const auto& p : *list) inputPaths.push_back(config::sweepPath(spec, p));
+  std::vector<files::Named> inputs;
+  for (const auto& p : inputPaths) inputs.push_back({p, p == o.file ? "the sweep" : "an input"});
+  const std::string settingsPath = o.out + ".batch.json";
+  runs::checkFiles(inputs, {{o.out, "--out"}, {settingsPath, "its settings"}});
   if (!o.dask.empty()) execDaskDriver(o);
+  const nlohmann::json settings = {{"command", "sweep"},
+                                   {"shard", o.shard},
+                                   {"header", !o.noHeader},
+                                   {"contents", batch::inputContents(inputPaths)}};
+  if (o.resume) {
+    nlohmann::json earlier;
+    try {
+      earlier = nlohmann::json::parse(files::readInput(settingsPath, files::kMaxConfigBytes));
+    } catch (const std::exception&) {
+      throw sinks::UserError(
+          fmt::format("simbot: --resume: '{}' is missing or unreadable\n", settingsPath));
+    }
+    if (earlier != settings)
+      throw sinks::UserError(fmt::format(
+          "simbot: --resume: the sweep in '{}' {}; run it again as it was, or choose another "
+          "--out\n",
+          o.out, batch::settingsChange(earlier, settings)));
+  }
   const std::vector<batch::SweepRun> runs = batch::expandSweep(spec);
   const auto [begin, end] = batch::shardRange(runs.size(), k, n);
   batch::SweepWriter writer(o.out, batch::sweepHeader(spec), !o.noHeader, begin, end, o.resume);
+  if (!o.resume) batch::writeFileAtomically(settingsPath, sinks::dumpJson(settings, 2) + "\n");
   const size_t first = writer.next();
   batch::StopOnSignals signals;
   batch::parallelFor(

@@ -151,13 +151,26 @@ struct SweepSpec {
   std::string profile = "default";  // a shipped profile's name, or a file
   // [grid] "section.key" = [values]: each value's TOML text, keys in file order.
   std::vector<std::pair<std::string, std::vector<std::string>>> grid;
+  // Each grid point's profile, built once when the file is read.
+  std::vector<Profile> pointProfiles;
 };
+
+// A grid has at most this many points, and a sweep at most this many runs
+// (points x programs x family pairs x seeds), counted without overflow
+// before anything is built: a million 60-s runs is weeks of a cluster's
+// time, and the run list alone takes about 100 MB.
+inline constexpr std::size_t kMaxSweepPoints = 100'000;
+inline constexpr std::size_t kMaxSweepRuns = 1'000'000;
 
 // Reads and checks a sweep file; `families` are the bench families it may
 // name. Every grid point's profile is built and checked too. Errors are
 // "FILE:LINE:COL: error: ...", or "simbot: ..." for a file, program or
 // profile key that is not there.
 SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& families);
+// The file of the sweep's profile (a file named relative to the sweep, or
+// a shipped profile's).
+std::string sweepProfilePath(const SweepSpec& spec);
+// The grid's points (saturating: SIZE_MAX when the product overflows).
 size_t sweepPoints(const SweepSpec& spec);
 // Grid point `point`'s value of each grid key, as an index into the key's
 // values; the last key varies fastest.

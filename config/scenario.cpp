@@ -217,9 +217,12 @@ class Walker {
       if (*s.seconds > 1e6) fail(*n, "'seconds' must be at most 1e6");
     }
     if (const toml::node* n = root.get("seed")) {
-      if (!n->is_integer() || *n->value<int64_t>() < 0)
-        fail(*n, "'seed' must be a non-negative integer");
-      s.seed = static_cast<uint64_t>(*n->value<int64_t>());
+      const auto seed = seedValue(*n);
+      if (!seed)
+        fail(*n,
+             "'seed' must be an integer from 0 to 2^63 - 1, or a string of digits up to "
+             "\"18446744073709551615\"");
+      s.seed = *seed;
     }
     if (const toml::node* n = root.get("A")) {
       const toml::table* t = n->as_table();
@@ -279,12 +282,7 @@ Scenario parseScenario(std::string_view text, const std::string& sourceName,
 }
 
 Scenario loadScenario(const std::string& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw ConfigError(fmt::format("simbot: no scenario file '{}'", path));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(fmt::format("simbot: cannot read scenario '{}'", path));
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::string text = readFile(path);
   const fs::path dir = fs::path(path).parent_path();
   return parseScenario(text, path, dir.empty() ? "." : dir.string());
 }

@@ -36,9 +36,7 @@ std::string sweepPath(const SweepSpec& spec, const std::string& path) {
   return (fs::path(dirOf(spec.file)) / path).string();
 }
 
-namespace {
-
-std::string baseProfilePath(const SweepSpec& spec) {
+std::string sweepProfilePath(const SweepSpec& spec) {
   const std::string asFile = sweepPath(spec, spec.profile);
   std::error_code ec;
   if (fs::is_regular_file(asFile, ec)) return asFile;
@@ -46,6 +44,8 @@ std::string baseProfilePath(const SweepSpec& spec) {
   throw NotInTheSweep(fmt::format("simbot: {}: no profile '{}' (a file, or one of profiles/*.toml)",
                                   spec.file, spec.profile));
 }
+
+namespace {
 
 std::string tomlText(const toml::node& node) {
   std::ostringstream out;
@@ -84,21 +84,16 @@ std::vector<size_t> sweepPointValues(const SweepSpec& spec, size_t point) {
   return at;
 }
 
-size_t sweepPoints(const SweepSpec& spec) {
-  size_t n = 1;
-  for (const auto& [key, values] : spec.grid) n *= values.size();
-  return n;
+namespace {
+
+size_t saturatingProduct(size_t a, size_t b) {
+  size_t product = 0;
+  return __builtin_mul_overflow(a, b, &product) ? SIZE_MAX : product;
 }
 
-Profile sweepProfile(const SweepSpec& spec, size_t point) {
-  const std::string base = baseProfilePath(spec);
-  toml::table doc;
-  try {
-    doc = toml::parse_file(base);
-  } catch (const toml::parse_error& e) {
-    // The profile's own checker words the error (FILE:LINE:COL).
-    return loadProfile(base);
-  }
+// Grid point `point`'s profile from the sweep profile's parsed text.
+Profile pointProfile(const SweepSpec& spec, const std::string& base, toml::table doc,
+                     size_t point) {
   const std::vector<size_t> at = sweepPointValues(spec, point);
   for (size_t k = 0; k < spec.grid.size(); ++k) {
     const std::string& key = spec.grid[k].first;
@@ -119,18 +114,56 @@ Profile sweepProfile(const SweepSpec& spec, size_t point) {
   return parseProfile(text.str(), fmt::format("{} (grid point {} of {})", base, point, spec.file));
 }
 
+// Every point's profile, the sweep profile read and parsed once.
+std::vector<Profile> pointProfiles(const SweepSpec& spec) {
+  const std::string base = sweepProfilePath(spec);
+  const std::string text = readFile(base);
+  toml::table doc;
+  try {
+    checkTomlText(text, base);
+    doc = toml::parse(text, base);
+  } catch (const toml::parse_error& e) {
+    // The profile's own checker words the error (FILE:LINE:COL).
+    return {parseProfile(text, base)};
+  }
+  std::vector<Profile> out;
+  const size_t points = sweepPoints(spec);
+  out.reserve(points);
+  for (size_t point = 0; point < points; ++point) {
+    try {
+      out.push_back(pointProfile(spec, base, doc, point));
+    } catch (const NotInTheSweep&) {
+      throw;
+    } catch (const ConfigError& e) {
+      if (spec.grid.empty()) throw;
+      // The profile checker's words, without its FILE:LINE:COL (the
+      // profile as rewritten for this point).
+      std::string what = e.what();
+      const auto at = what.find("error: ");
+      if (at != std::string::npos) what = what.substr(at + 7);
+      throw ConfigError(spec.file, 1, 1, fmt::format("grid point {}: {}", point, what));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+size_t sweepPoints(const SweepSpec& spec) {
+  size_t n = 1;
+  for (const auto& [key, values] : spec.grid) n = saturatingProduct(n, values.size());
+  return n;
+}
+
+Profile sweepProfile(const SweepSpec& spec, size_t point) {
+  if (point < spec.pointProfiles.size()) return spec.pointProfiles[point];
+  return pointProfiles(spec).at(point);
+}
+
 SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& families) {
   SweepSpec spec;
   spec.file = path;
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw ConfigError(fmt::format("simbot: no sweep file '{}'", path));
-  toml::table doc;
-  try {
-    doc = toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    failAt(path, e.source(), std::string(e.description()));
-  }
+  toml::table doc = parseToml(readFile(path), path);
   for (auto&& [key, node] : doc) {
     static const std::vector<std::string> known = {"programs", "opponents", "families", "seeds",
                                                    "seconds",  "profile",   "grid"};
@@ -155,6 +188,7 @@ SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& fam
   if (!headToHead && !spec.opponents.empty())
     failAt(path, doc.get("opponents")->source(),
            "'opponents' play only in the head-to-head family");
+  std::error_code ec;
   for (const auto* list : {&spec.programs, &spec.opponents})
     for (const auto& p : *list)
       if (!fs::is_regular_file(sweepPath(spec, p), ec))
@@ -172,13 +206,23 @@ SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& fam
   const toml::table* seeds = doc.get_as<toml::table>("seeds");
   if (!seeds) failAt(path, doc.source(), "missing table [seeds] (first, count)");
   for (auto&& [key, node] : *seeds) {
-    const auto v = node.value<int64_t>();
     const bool first = key.str() == "first";
-    if ((!first && key.str() != "count") || !node.is_integer() || *v < (first ? 0 : 1) ||
-        (!first && *v > 1'000'000))
+    bool ok = false;
+    uint64_t value = 0;
+    if (first) {
+      const std::optional<uint64_t> seed = seedValue(node);
+      ok = seed.has_value();
+      value = seed.value_or(0);
+    } else if (key.str() == "count" && node.is_integer()) {
+      const int64_t n = node.value_or<int64_t>(0);
+      ok = n >= 1 && n <= 1'000'000;
+      value = static_cast<uint64_t>(n);
+    }
+    if (!ok)
       failAt(path, node.source(),
-             "[seeds] holds first (an integer >= 0) and count (an integer from 1 to 1000000)");
-    (first ? spec.firstSeed : spec.seedCount) = static_cast<uint64_t>(*v);
+             "[seeds] holds first (an integer >= 0, or a string of digits up to 2^64 - 1) and "
+             "count (an integer from 1 to 1000000)");
+    (first ? spec.firstSeed : spec.seedCount) = value;
   }
   if (const toml::node* g = doc.get("grid")) {
     const toml::table* grid = g->as_table();
@@ -193,25 +237,27 @@ SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& fam
       for (const toml::node& v : *values) texts.push_back(tomlText(v));
       spec.grid.emplace_back(name, std::move(texts));
     }
-    if (sweepPoints(spec) > 100'000)
-      failAt(path, g->source(), "the grid has more than 100000 points");
-    // Every point's profile now: a bad value is an error before any run.
-    for (size_t point = 0; point < sweepPoints(spec); ++point) {
-      try {
-        sweepProfile(spec, point);
-      } catch (const NotInTheSweep&) {
-        throw;
-      } catch (const ConfigError& e) {
-        // The profile checker's words, without its FILE:LINE:COL (the
-        // profile as rewritten for this point).
-        std::string what = e.what();
-        const auto at = what.find("error: ");
-        if (at != std::string::npos) what = what.substr(at + 7);
-        failAt(path, g->source(), fmt::format("grid point {}: {}", point, what));
-      }
-    }
-  } else {
-    sweepProfile(spec, 0);
+    if (sweepPoints(spec) > kMaxSweepPoints)
+      failAt(path, g->source(), fmt::format("the grid has more than {} points", kMaxSweepPoints));
+  }
+  size_t pairs = 0;
+  for (const auto& f : spec.families) pairs += f == "head-to-head" ? spec.opponents.size() : 1;
+  const size_t runs = saturatingProduct(
+      saturatingProduct(saturatingProduct(sweepPoints(spec), spec.programs.size()), pairs),
+      static_cast<size_t>(spec.seedCount));
+  if (runs > kMaxSweepRuns)
+    failAt(path, doc.source(),
+           fmt::format("the sweep describes {} runs, more than the {} a sweep may have: split "
+                       "it into several files",
+                       runs == SIZE_MAX ? "over 2^64" : fmt::format("{}", runs), kMaxSweepRuns));
+  // Every point's profile now: a bad value is an error before any run.
+  try {
+    spec.pointProfiles = pointProfiles(spec);
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    if (const toml::node* g = doc.get("grid"); g && what.rfind(spec.file + ":1:1: ", 0) == 0)
+      failAt(path, g->source(), what.substr(what.find("error: ") + 7));
+    throw;
   }
   return spec;
 }

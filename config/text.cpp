@@ -5,8 +5,11 @@
 
 #include <fmt/format.h>
 
+#include <charconv>
 #include <cstdint>
 #include <cstdio>
+
+#include "files/files.h"
 
 namespace simbot::config {
 
@@ -15,14 +18,27 @@ ConfigError::ConfigError(const std::string& file, int line, int column, const st
                                      column < 1 ? 1 : column, message)) {}
 
 std::string readFile(const std::string& path) {
-  FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw ConfigError(path, 1, 1, "cannot open file");
-  std::string s;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) s.append(buf, n);
-  std::fclose(f);
-  return s;
+  try {
+    return files::readInput(path, files::kMaxConfigBytes);
+  } catch (const files::Error& e) {
+    throw ConfigError(path, 1, 1, fmt::format("cannot read the file: {}", e.what()));
+  }
+}
+
+std::optional<std::uint64_t> seedValue(const toml::node& node) {
+  if (node.is_integer()) {
+    const int64_t v = *node.value<int64_t>();
+    if (v < 0) return std::nullopt;
+    return static_cast<std::uint64_t>(v);
+  }
+  if (!node.is_string()) return std::nullopt;
+  const std::string text = *node.value<std::string>();
+  std::uint64_t v = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size() ||
+      text.find_first_not_of("0123456789") != std::string::npos)
+    return std::nullopt;
+  return v;
 }
 
 void failAt(const std::string& file, const toml::source_region& where, const std::string& message) {

@@ -4,6 +4,8 @@
 
 #include <toml++/toml.h>
 
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -11,12 +13,18 @@
 
 namespace simbot::config {
 
-// A file's bytes; ConfigError "PATH:1:1: error: cannot open file".
+// A file's bytes (a regular file within files::kMaxConfigBytes);
+// ConfigError "PATH:1:1: error: cannot read the file: REASON".
 std::string readFile(const std::string& path);
 
 // ConfigError at the start of `where` in `file`.
 [[noreturn]] void failAt(const std::string& file, const toml::source_region& where,
                          const std::string& message);
+
+// A seed: a TOML integer >= 0, or a string of decimal digits up to
+// 2^64 - 1 (TOML's integers stop at 2^63 - 1, and runs.csv prints seeds
+// up to 2^64 - 1); nothing for anything else.
+std::optional<std::uint64_t> seedValue(const toml::node& node);
 
 // checkTomlText, then toml++'s parse; its parse errors are ConfigErrors at
 // their place.

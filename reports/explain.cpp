@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <sstream>
 #include <tuple>
 #include <type_traits>
@@ -497,7 +498,9 @@ Report onlyRobot(const Report& in, int robot) {
 
 Report explainFile(const std::string& path) {
   Explainer explainer;
-  sinks::readTrace(path, [&](const trace::Entry& e) { explainer.write(e); });
+  const sinks::TraceRead read =
+      sinks::readTrace(path, [&](const trace::Entry& e) { explainer.write(e); });
+  std::cerr << sinks::cutShortWarning(path, read);
   return explainer.report();
 }
 

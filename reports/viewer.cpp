@@ -54,18 +54,15 @@ struct ReplaySink::Columns {
 };
 
 ReplaySink::ReplaySink(const std::string& path) : path_(path), columns_(new Columns) {
-  file_ = std::fopen(path.c_str(), "wb");
-  if (!file_) {
+  try {
+    out_.emplace(path);
+  } catch (const files::Error& e) {
     delete columns_;
-    throw sinks::UserError(
-        fmt::format("simbot: cannot write replay '{}': {}\n", path, std::strerror(errno)));
+    throw sinks::UserError(fmt::format("simbot: cannot write replay '{}': {}\n", path, e.what()));
   }
 }
 
-ReplaySink::~ReplaySink() {
-  if (file_) std::fclose(file_);
-  delete columns_;
-}
+ReplaySink::~ReplaySink() { delete columns_; }
 
 void ReplaySink::write(const trace::Entry& e) {
   columns_->explainer.write(e);
@@ -121,14 +118,17 @@ json ReplaySink::data() const {
 }
 
 void ReplaySink::close() {
-  if (!file_) return;
+  if (!out_ || out_->committed()) return;
   const std::string page = replayPage(data());
-  const bool written = std::fwrite(page.data(), 1, page.size(), file_) == page.size();
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (!written || !closed)
-    throw sinks::UserError(
-        fmt::format("simbot: writing replay '{}': {}\n", path_, std::strerror(errno)));
+  const bool written = std::fwrite(page.data(), 1, page.size(), out_->file()) == page.size();
+  const int error = errno;
+  try {
+    if (!written) throw files::Error(std::strerror(error));
+    out_->commit();
+  } catch (const files::Error& e) {
+    out_.reset();  // the temporary file goes; an old page stays
+    throw sinks::UserError(fmt::format("simbot: writing replay '{}': {}\n", path_, e.what()));
+  }
 }
 
 std::string replayPage(const json& data) {

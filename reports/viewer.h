@@ -10,15 +10,18 @@
 // on that match's trace write the same page.
 #pragma once
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "files/files.h"
 #include "trace/trace.h"
 
 namespace simbot::reports {
 
 // Collects a run's records into the viewer's data (columns per record kind)
-// and writes the page when the run ends. The file is opened now.
+// and writes the page when the run ends. Its temporary file is opened now
+// and renamed into place when the page is whole (files::Output).
 class ReplaySink final : public trace::Sink {
  public:
   explicit ReplaySink(const std::string& path);
@@ -34,7 +37,7 @@ class ReplaySink final : public trace::Sink {
 
  private:
   std::string path_;
-  std::FILE* file_ = nullptr;
+  std::optional<files::Output> out_;
   Columns* columns_;
 };
 

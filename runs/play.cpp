@@ -5,6 +5,7 @@
 
 #include <array>
 #include <chrono>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 
@@ -81,13 +82,22 @@ bool reportFaults(const scheduler::MatchResult& r) {
 // The run's configuration from the command line and the scenario: the
 // programs given (A, and B for match), then the scenario (start poses,
 // hardware, B for solo and profile, injections), then --hw and --inject.
+void checkFiles(const std::vector<files::Named>& inputs, const std::vector<files::Named>& outputs) {
+  try {
+    files::checkDistinct(inputs, outputs);
+  } catch (const files::Error& e) {
+    throw sinks::UserError(fmt::format("simbot: {}\n", e.what()));
+  }
+}
+
 scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, const RunOptions& o,
-                                   ScenarioUse use) {
+                                   ScenarioUse use, std::vector<files::Named>* inputs) {
   std::optional<Scenario> scenario;
   if (!o.scenario.empty()) scenario = config::loadScenario(o.scenario);
-  const config::Profile profile = loadNamedProfile(
+  const std::string profileName =
       preferCommandLine(o.profile.has_value(), scenario ? scenario->profile : std::nullopt,
-                        o.profile.value_or("default")));
+                        o.profile.value_or("default"));
+  const config::Profile profile = loadNamedProfile(profileName);
   // Without --seconds or a scenario's, a run lasts its default: the
   // profile's round.
   const double seconds = preferCommandLine(
@@ -137,6 +147,19 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
                                   o.seed.value_or(1));
   config.reloadOnFault = o.reloadOnFault;
   config.reloadDelay = timebase::ticksFromSeconds(profile.reload_delay_s);
+  if (inputs) {
+    for (const auto& robot : config.robots)
+      if (!robot.program.empty()) inputs->push_back({robot.program, "the program"});
+    if (scenario) inputs->push_back({o.scenario, "the scenario"});
+    if (std::filesystem::exists(profileName))
+      inputs->push_back({profileName, "the profile"});
+    else if (const auto shipped = config::shippedProfilePath(profileName))
+      inputs->push_back({*shipped, "the profile"});
+    for (const auto& [robot, file] : hwFiles) inputs->push_back({file, "the hardware file"});
+    if (scenario)
+      for (const auto* r : {&scenario->a, &scenario->b})
+        if (!r->hardware.empty()) inputs->push_back({r->hardware, "the hardware file"});
+  }
   return config;
 }
 
@@ -146,15 +169,25 @@ Played play(const std::vector<std::string>& programs, const RunOptions& o, bool 
     throw sinks::UserError(
         "simbot: --watch needs --trace FILE (or --replay FILE): watched values are written "
         "only into the trace's records\n");
+  std::vector<files::Named> inputs;
   scheduler::MatchConfig config =
-      buildConfig(programs, o, solo ? ScenarioUse::Solo : ScenarioUse::Match);
+      buildConfig(programs, o, solo ? ScenarioUse::Solo : ScenarioUse::Match, &inputs);
   config.stopWhenAllExited = solo;
   config.watches = o.watches;
   if (o.traceCostate && o.trace.empty() && o.replay.empty() && o.sinks.empty())
     throw sinks::UserError("simbot: --trace-costate needs --trace FILE (or --replay FILE)\n");
   config.traceCostate = o.traceCostate;
   if (o.noFastForward) config.knobs.fastForward = false;
-  // Sinks open their files before the run: a bad path costs nothing.
+  // Every input is read now. No output may be one of them, or another
+  // output; each sink opens a temporary file beside its output before the
+  // run (a path that cannot be written costs nothing) and renames it into
+  // place when the run is done, so a run refused later (a --watch name or
+  // an --inject line that the run's start rejects) leaves old files alone.
+  std::vector<files::Named> outputs;
+  if (!o.trace.empty()) outputs.push_back({o.trace, "--trace"});
+  if (!o.vcd.empty()) outputs.push_back({o.vcd, "--vcd"});
+  if (!o.replay.empty()) outputs.push_back({o.replay, "--replay"});
+  checkFiles(inputs, outputs);
   std::optional<sinks::JsonlSink> jsonl;
   std::optional<sinks::VcdSink> vcd;
   std::optional<reports::ReplaySink> replay;

@@ -15,7 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "compiler/compiler.h"
 #include "config/config.h"
+#include "files/files.h"
 #include "runs/scenario.h"
 #include "scheduler/match.h"
 #include "trace/trace.h"
@@ -27,6 +29,14 @@ namespace simbot::runs {
 // per process (bench and tournament compile each program many times).
 // UserError with the compiler's diagnostics if it does not compile.
 vm::Image compileProgramFile(const std::string& path);
+// The compiler options every later compileProgramFile and
+// compileProgramText of this process use: -Wno-NAME and -Werror given to
+// solo, match, profile, bench, tournament (the debug setting is kept).
+void setCompileOptions(const compiler::Options& options);
+// The -W words of a command line into `options`; UserError for a word
+// that is not -Werror or -Wno-NAME with a known NAME.
+void parseWarningOptions(const std::vector<std::string>& words, compiler::Options& options,
+                         const std::string& command);
 vm::Image compileProgramText(const std::string& source, const std::string& name);
 // A profile by name (profiles/NAME.toml) or by path.
 config::Profile loadNamedProfile(const std::string& nameOrPath);
@@ -48,9 +58,14 @@ struct RunOptions {
 
 // The run's configuration from the options and the scenario: the programs
 // given (A, and B for match), then the scenario (start poses, hardware, B
-// for solo and profile, injections), then --hw and --inject.
+// for solo and profile, injections), then --hw and --inject. With
+// `inputs`, every file it read is added there (for checkFiles).
 scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, const RunOptions& o,
-                                   ScenarioUse use);
+                                   ScenarioUse use, std::vector<files::Named>* inputs = nullptr);
+
+// UserError "simbot: ..." when an output is the same file as an input or
+// as another output (files::checkDistinct).
+void checkFiles(const std::vector<files::Named>& inputs, const std::vector<files::Named>& outputs);
 
 struct Played {
   scheduler::MatchResult result;

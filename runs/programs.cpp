@@ -48,14 +48,50 @@ vm::Image imageOrThrow(compiler::Result result) {
 
 }  // namespace
 
+namespace {
+
+std::mutex gOptionsMutex;
+compiler::Options gOptions;
+
+compiler::Options compileOptions() {
+  std::lock_guard lock(gOptionsMutex);
+  return gOptions;
+}
+
+}  // namespace
+
+void setCompileOptions(const compiler::Options& options) {
+  std::lock_guard lock(gOptionsMutex);
+  gOptions = options;
+}
+
+void parseWarningOptions(const std::vector<std::string>& words, compiler::Options& options,
+                         const std::string& command) {
+  for (const std::string& w : words) {
+    if (w == "-Werror") {
+      options.werror = true;
+    } else if (w.rfind("-Wno-", 0) == 0 && compiler::isWarningName(w.substr(5))) {
+      options.disabledWarnings.insert(w.substr(5));
+    } else {
+      std::string names;
+      for (const auto& info : compiler::warningList())
+        names += (names.empty() ? "" : ", ") + std::string(info.name);
+      throw sinks::UserError(
+          fmt::format("simbot: {}: unknown option '{}' (warnings: {}; simbot {} --help lists the "
+                      "options)\n",
+                      command, w, names, command));
+    }
+  }
+}
+
 vm::Image compileProgramFile(const std::string& path) {
   if (!std::filesystem::exists(path))
     throw sinks::UserError(fmt::format("simbot: no such program '{}'\n", path));
-  return imageOrThrow(compiler::compileFile(path));
+  return imageOrThrow(compiler::compileFile(path, compileOptions()));
 }
 
 vm::Image compileProgramText(const std::string& source, const std::string& name) {
-  return imageOrThrow(compiler::compile(source, name));
+  return imageOrThrow(compiler::compile(source, name, compileOptions()));
 }
 
 config::Profile loadNamedProfile(const std::string& nameOrPath) {

@@ -3,14 +3,16 @@
 #include <fmt/format.h>
 
 #include <cerrno>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <stdexcept>
 #include <type_traits>
 
 #include "scheduler/match.h"
 #include "sinks/json_text.h"
 #include "sinks/user_error.h"
+#include "timebase/tick.h"
 
 namespace simbot::sinks {
 
@@ -135,47 +137,67 @@ trace::Entry traceEntry(const json& j) {
 }
 
 JsonlSink::JsonlSink(const std::string& path) : path_(path) {
-  file_ = std::fopen(path.c_str(), "wb");
-  if (!file_)
-    throw UserError(
-        fmt::format("simbot: cannot write trace '{}': {}\n", path, std::strerror(errno)));
+  try {
+    file_ = out_.emplace(path).file();
+  } catch (const files::Error& e) {
+    throw UserError(fmt::format("simbot: cannot write trace '{}': {}\n", path, e.what()));
+  }
 }
 
-JsonlSink::~JsonlSink() {
-  if (file_) std::fclose(file_);
-}
+JsonlSink::~JsonlSink() = default;
 
-void JsonlSink::fail() const {
-  throw UserError(fmt::format("simbot: writing trace '{}': {}\n", path_, std::strerror(errno)));
+void JsonlSink::fail(const std::string& reason) const {
+  throw UserError(fmt::format("simbot: writing trace '{}': {}\n", path_, reason));
 }
 
 void JsonlSink::write(const trace::Entry& entry) {
   std::string line = traceLine(entry);
   line.push_back('\n');
-  if (std::fwrite(line.data(), 1, line.size(), file_) != line.size()) fail();
+  if (std::fwrite(line.data(), 1, line.size(), file_) != line.size()) fail(std::strerror(errno));
 }
 
 void JsonlSink::close() {
   if (!file_) return;
-  const bool flushed = std::fflush(file_) == 0;
-  const bool closed = std::fclose(file_) == 0;
   file_ = nullptr;
-  if (!flushed || !closed) fail();
+  try {
+    out_->commit();
+  } catch (const files::Error& e) {
+    fail(e.what());
+  }
 }
 
-void readTrace(const std::string& path, const std::function<void(const trace::Entry&)>& each) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw UserError(fmt::format("{}:1: error: cannot read the trace\n", path));
+TraceRead readTrace(const std::string& path, const std::function<void(const trace::Entry&)>& each) {
+  std::optional<files::Input> in;
+  try {
+    in.emplace(path, files::kMaxTraceBytes);
+  } catch (const files::Error& e) {
+    throw UserError(fmt::format("{}:1: error: cannot read the trace: {}\n", path, e.what()));
+  }
+  TraceRead read;
   std::string line;
   int number = 0;
   bool header = false;
-  while (std::getline(in, line)) {
+  char* buffer = nullptr;
+  std::size_t capacity = 0;
+  struct Free {
+    char*& p;
+    ~Free() { std::free(p); }
+  } freeBuffer{buffer};
+  for (ssize_t n; (n = ::getline(&buffer, &capacity, in->file())) > 0;) {
     ++number;
+    const bool whole = buffer[n - 1] == '\n';
+    line.assign(buffer, static_cast<std::size_t>(whole ? n - 1 : n));
     if (line.empty()) continue;
     trace::Entry e;
     try {
       e = traceEntry(json::parse(line));
     } catch (const std::exception& ex) {
+      // A last line with no line end that does not parse: the run that
+      // wrote it was killed or its disk filled. What came before is whole.
+      if (!whole && header) {
+        read.cutShortAtLine = number;
+        break;
+      }
       std::string what = ex.what();
       if (const auto at = what.find("] ");
           what.rfind("[json.exception", 0) == 0 && at != std::string::npos)
@@ -186,9 +208,28 @@ void readTrace(const std::string& path, const std::function<void(const trace::En
       throw UserError(fmt::format(
           "{}:{}: error: not a simbot trace: it must start with a \"run\" record\n", path, number));
     header = true;
+    read.ended = std::holds_alternative<trace::rec::End>(e.record);
+    read.lastTick = e.t;
+    ++read.records;
     each(e);
   }
+  if (std::ferror(in->file()))
+    throw UserError(fmt::format("{}:{}: error: reading the trace: {}\n", path, number + 1,
+                                std::strerror(errno)));
   if (!header) throw UserError(fmt::format("{}:1: error: the trace is empty\n", path));
+  return read;
+}
+
+std::string cutShortWarning(const std::string& path, const TraceRead& read) {
+  if (read.ended) return "";
+  const std::string where =
+      read.cutShortAtLine
+          ? fmt::format("{}:{}: its last line is not a whole record", path, read.cutShortAtLine)
+          : fmt::format("{}: it has no \"end\" record", path);
+  return fmt::format(
+      "simbot: warning: {}: the run that wrote it was cut short (killed, or its disk filled); "
+      "read up to its last whole record, at {:.6f} s\n",
+      where, timebase::secondsFromTicks(read.lastTick));
 }
 
 }  // namespace simbot::sinks

@@ -18,8 +18,10 @@
 #include <cstdio>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
+#include "files/files.h"
 #include "trace/trace.h"
 
 namespace simbot::sinks {
@@ -30,9 +32,10 @@ std::string traceLine(const trace::Entry& entry);
 // Reads one record; throws std::invalid_argument naming what is wrong.
 trace::Entry traceEntry(const nlohmann::json& json);
 
-// Writes the trace to a file as it streams in. The file is opened (and
-// truncated) when the sink is made: a path that cannot be written is an
-// error before the run, not after it. Write errors throw UserError.
+// Writes the trace to a file as it streams in, through a temporary file
+// beside it (files::Output) that close() renames into place: a path that
+// cannot be written is an error before the run, and a run that fails or is
+// killed leaves an existing file as it was. Write errors throw UserError.
 class JsonlSink final : public trace::Sink {
  public:
   explicit JsonlSink(const std::string& path);
@@ -43,9 +46,10 @@ class JsonlSink final : public trace::Sink {
   void close() override;
 
  private:
-  void fail() const;
+  [[noreturn]] void fail(const std::string& reason) const;
   std::string path_;
-  std::FILE* file_ = nullptr;
+  std::optional<files::Output> out_;
+  std::FILE* file_ = nullptr;  // out_'s, until close()
 };
 
 // Keeps the JSONL lines in memory (tests).
@@ -55,8 +59,21 @@ class JsonlLines final : public trace::Sink {
   std::vector<std::string> lines;
 };
 
-// Reads a JSONL trace file record by record. Bad input throws UserError
-// "FILE:LINE: error: MESSAGE".
-void readTrace(const std::string& path, const std::function<void(const trace::Entry&)>& each);
+// What readTrace read: whether the trace ends as a finished run's does
+// (with its "end" record) and, if not, where it was cut short.
+struct TraceRead {
+  int records = 0;
+  trace::Tick lastTick = 0;
+  bool ended = false;      // its last record is "end"
+  int cutShortAtLine = 0;  // a last line without a line end that did not parse
+};
+
+// Reads a JSONL trace file record by record (a regular file within
+// files::kMaxTraceBytes). Bad input throws UserError "FILE:LINE: error:
+// MESSAGE"; a trace cut short (a last partial line, no "end" record) is
+// read up to its last whole record, and said so by cutShortWarning.
+TraceRead readTrace(const std::string& path, const std::function<void(const trace::Entry&)>& each);
+// The warning line for a trace that was cut short; empty for a whole one.
+std::string cutShortWarning(const std::string& path, const TraceRead& read);
 
 }  // namespace simbot::sinks

@@ -316,18 +316,16 @@ void VcdSink::State::record(const trace::Entry& e) {
 }
 
 VcdSink::VcdSink(const std::string& path) : path_(path), s_(new State) {
-  file_ = std::fopen(path.c_str(), "wb");
-  if (!file_) {
+  try {
+    file_ = out_.emplace(path).file();
+  } catch (const files::Error& e) {
     delete s_;
-    throw UserError(fmt::format("simbot: cannot write VCD '{}': {}\n", path, std::strerror(errno)));
+    throw UserError(fmt::format("simbot: cannot write VCD '{}': {}\n", path, e.what()));
   }
   s_->file = file_;
 }
 
-VcdSink::~VcdSink() {
-  if (file_) std::fclose(file_);
-  delete s_;
-}
+VcdSink::~VcdSink() { delete s_; }
 
 void VcdSink::write(const trace::Entry& entry) {
   s_->record(entry);
@@ -352,11 +350,12 @@ void VcdSink::close() {
   if (s.headerDone && s.lastTick > s.stamped)
     std::fprintf(file_, "#%lld\n",
                  static_cast<long long>(timebase::picosecondsFromTicks(s.lastTick)));
-  const bool ok = !std::ferror(file_) && std::fflush(file_) == 0;
-  const bool closed = std::fclose(file_) == 0;
   file_ = nullptr;
-  if (!ok || !closed)
-    throw UserError(fmt::format("simbot: writing VCD '{}': {}\n", path_, std::strerror(errno)));
+  try {
+    out_->commit();
+  } catch (const files::Error& e) {
+    throw UserError(fmt::format("simbot: writing VCD '{}': {}\n", path_, e.what()));
+  }
 }
 
 }  // namespace simbot::sinks

@@ -31,15 +31,18 @@
 #pragma once
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 #include <string>
 
+#include "files/files.h"
 #include "trace/trace.h"
 
 namespace simbot::sinks {
 
 class VcdSink final : public trace::Sink {
  public:
-  // Opens (truncates) the file now; UserError if it cannot.
+  // Opens its temporary file now (files::Output), renamed into place by
+  // close(); UserError if it cannot.
   explicit VcdSink(const std::string& path);
   ~VcdSink() override;
   VcdSink(const VcdSink&) = delete;
@@ -51,7 +54,8 @@ class VcdSink final : public trace::Sink {
 
  private:
   std::string path_;
-  std::FILE* file_ = nullptr;
+  std::optional<files::Output> out_;
+  std::FILE* file_ = nullptr;  // out_'s, until close()
   State* s_;
 };
 

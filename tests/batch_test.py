@@ -124,7 +124,7 @@ check(r.returncode == 1 and "File too large" in r.stderr,
 # ---- --resume refuses another batch's table
 other = [arg if arg != "20" else "21" for arg in BENCH]  # 21 simulated seconds a run
 r = subprocess.run(other + ["--out", str(whole), "--resume"], capture_output=True, text=True)
-check(r.returncode == 1 and "other settings" in r.stderr,
+check(r.returncode == 1 and "was run with seconds 20" in r.stderr and "not 21" in r.stderr,
       f"--resume with other settings is refused: {r.returncode} {r.stderr[-300:]}")
 
 if failures:

@@ -78,6 +78,14 @@ struct Bad {
   std::string message;
 };
 
+// Seeds at or above 2^63 (runs.csv prints them) are written as strings:
+// TOML's integers stop at 2^63 - 1.
+TEST(Scenario, SeedsBeyondTomlIntegersAreStrings) {
+  EXPECT_EQ(parse("seed = \"18446744073709551615\"\n").seed, UINT64_MAX);
+  EXPECT_EQ(parse("seed = \"9223372036854775808\"\n").seed, uint64_t{1} << 63);
+  EXPECT_EQ(parse("seed = 9223372036854775807\n").seed, (uint64_t{1} << 63) - 1);
+}
+
 TEST(Scenario, EveryMistakeNamesItsLine) {
   const Bad cases[] = {
       {"speed = 3\n",
@@ -86,7 +94,13 @@ TEST(Scenario, EveryMistakeNamesItsLine) {
       {"\nseconds = -1\n", "s.toml:2:11: error: 'seconds' must be greater than 0, got -1"},
       {"seconds = \"ten\"\n", "s.toml:1:11: error: 'seconds' must be a number"},
       {"seconds = 2e6\n", "s.toml:1:11: error: 'seconds' must be at most 1e6"},
-      {"seed = -3\n", "s.toml:1:8: error: 'seed' must be a non-negative integer"},
+      {"seed = -3\n",
+       "s.toml:1:8: error: 'seed' must be an integer from 0 to 2^63 - 1, or a "
+       "string of digits"},
+      // A string seed is digits and fits in 64 bits (2^64 is one too many).
+      {"seed = \"18446744073709551616\"\n", "s.toml:1:8: error: 'seed' must be an integer"},
+      {"seed = \"-1\"\n", "s.toml:1:8: error: 'seed' must be an integer"},
+      {"seed = \" 7\"\n", "s.toml:1:8: error: 'seed' must be an integer"},
       {"profile = \"nosuch\"\n",
        "s.toml:1:11: error: 'profile': no profile 'nosuch' in profiles/ (or give a path to a "
        ".toml)"},

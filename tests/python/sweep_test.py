@@ -13,6 +13,7 @@ but the Dask run.
 """
 import csv
 import os
+import shutil
 import subprocess
 import sys
 
@@ -100,6 +101,7 @@ if __name__ == "__main__":
 
     # Resume: the table cut in the middle of row 17 is completed by --resume.
     cut = os.path.join(work, "cut.csv")
+    shutil.copy(local + ".batch.json", cut + ".batch.json")  # the batch's fingerprint
     lines = table.split(b"\n")
     with open(cut, "wb") as f:
         f.write(b"\n".join(lines[:18]) + b"\n" + lines[18][:25])

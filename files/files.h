@@ -1,0 +1,106 @@
+// files/ (namespace simbot::files): the host's files as simbot's commands
+// use them, so that no run ever loses work.
+//
+// An input is opened without waiting (O_NONBLOCK: a FIFO is refused, never
+// waited on) and must be a regular file no larger than the limit stated
+// beside its kind. An output is written to a temporary file beside it and
+// renamed over it only when complete: a run refused for bad input, a
+// failed write, an exception or a kill leaves the old file as it was (a
+// signal also removes the temporary file). No output may be the same file
+// as an input or as another output; files are compared by device and
+// inode, so a second name for a file (a link, "./x", "../d/x") is caught.
+//
+// The lowest of simbot's parts above the standard library: compiler/,
+// config/, sinks/, reports/, batch/ and cli/ use it; it uses none of them.
+// Its errors carry the reason alone, for each caller's own format.
+#pragma once
+#include <cstdint>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace simbot::files {
+
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Profiles, hardware files, scenarios and sweep files: 1 MiB (the shipped
+// default profile is 9 KB; a larger file is not a configuration).
+constexpr std::uint64_t kMaxConfigBytes = std::uint64_t{1} << 20;
+// Traces read back (view, explain, Python's read_trace): 16 GiB (a 180-s
+// match with --trace-costate wrote 181 MB).
+constexpr std::uint64_t kMaxTraceBytes = std::uint64_t{16} << 30;
+
+// The whole of the regular file `path`, of at most `maxBytes`. Error: "no
+// such file", "it is a directory", "not a regular file", "N bytes is more
+// than the limit of M", or the system's reason.
+std::string readInput(const std::string& path, std::uint64_t maxBytes);
+
+// What a batch's --resume compares: a file's contents as
+// "fnv1a64:HEX" (FNV-1a, 64 bits: a change of any byte changes it, with
+// the odds of a chance match 2^-64), or "unreadable: REASON".
+std::string fingerprint(const std::string& path);
+
+// A regular file of at most `maxBytes`, open for reading as a stream.
+class Input {
+ public:
+  Input(const std::string& path, std::uint64_t maxBytes);
+  ~Input();
+  Input(const Input&) = delete;
+  Input& operator=(const Input&) = delete;
+  std::FILE* file() const { return file_; }
+
+ private:
+  std::FILE* file_ = nullptr;
+};
+
+// A file named on the command line and what it is to the run, for messages:
+// {"P.dc", "the program"}, {"t.jsonl", "--trace"}.
+struct Named {
+  std::string path;
+  std::string role;
+};
+
+// Error naming both when an output is the same file as an input, or two
+// outputs are one file (by device and inode when the file exists, by its
+// absolute, normalised name when it does not yet).
+void checkDistinct(const std::vector<Named>& inputs, const std::vector<Named>& outputs);
+
+// An output that replaces `path` only when commit() succeeds. A path that
+// names an existing file that is not regular (/dev/null, a terminal, a
+// pipe) is written in place. The new file takes the old one's permissions,
+// or the umask's for a new file.
+class Output {
+ public:
+  // Opens the temporary file now: a directory that cannot be written is an
+  // Error before the run, and the old file is untouched.
+  explicit Output(const std::string& path);
+  ~Output();  // without commit(): the temporary file is removed
+  Output(const Output&) = delete;
+  Output& operator=(const Output&) = delete;
+  std::FILE* file() const { return file_; }
+  const std::string& path() const { return path_; }
+  // Flushes, closes and renames into place; Error with the system's reason
+  // (the temporary file is then removed and the old file kept).
+  void commit();
+  bool committed() const { return committed_; }
+
+ private:
+  void discard();
+  std::string path_, temporary_;
+  std::FILE* file_ = nullptr;
+  int slot_ = -1;  // in the registry that the signal handler empties
+  bool committed_ = false;
+};
+
+// Writes `text` to `path` through an Output.
+void writeWhole(const std::string& path, const std::string& text);
+
+// SIGINT, SIGTERM and SIGHUP remove every open Output's temporary file and
+// then end the process by the signal, as before (cli/main.cpp installs it
+// once; a batch's own stop handler takes over while the batch runs).
+void removeTemporariesOnSignals();
+
+}  // namespace simbot::files

@@ -1,0 +1,298 @@
+#!/usr/bin/env python3
+"""Nothing is ever lost (issue 25): outputs, inputs and batch tables.
+
+Usage: outputs_test.py SIMBOT SOURCE_DIR SHARED_DIR OUTDIR [--sanitized]
+
+- A run refused after its inputs were read (a --watch name that does not
+  exist, an --inject line with no code) leaves an existing trace, replay
+  page and VCD byte-identical, and no temporary file behind.
+- An output that is an input (by name, by "./name", by a hard link) or
+  another output is refused before anything is written; the input is
+  unchanged. So for view -o onto its trace and sweep --out onto its file.
+- A run killed with SIGKILL or SIGTERM leaves the old outputs whole.
+- Inputs that are not regular files (/dev/zero, a FIFO) or too large are
+  one line and exit 1, at once.
+- A trace cut short (a partial last line) can still be viewed and
+  explained, with a warning.
+- A bench and a sweep whose disk fills mid-row (a small tmpfs mounted here,
+  or a file-size limit where mounting is not allowed) stop at once with one
+  line, keep only whole rows, and --resume gives the very table an
+  uninterrupted batch gives.
+- --resume refuses a batch whose program or settings changed, naming what.
+- A sweep whose run count overflows or is too large is refused at once.
+- Worker threads that cannot be created are one line and exit 1.
+"""
+import os
+import shutil
+import signal
+import stat
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+SIMBOT, SOURCE, SHARED, OUT = sys.argv[1:5]
+SANITIZED = "--sanitized" in sys.argv[5:]
+OUT = Path(OUT)
+shutil.rmtree(OUT, ignore_errors=True)
+OUT.mkdir(parents=True)
+SPIRAL = Path(SOURCE) / "programs" / "spiral.dc"
+TURRET = Path(SOURCE) / "programs" / "turret.dc"
+ICEMAN = Path(SHARED) / "programs" / "iceman.dc"
+FIG92 = Path(SHARED) / "programs" / "fig92.dc"
+failures = []
+
+
+def check(ok, message):
+    if not ok:
+        failures.append(message)
+        print("FAIL:", message)
+
+
+def run(args, timeout=120, **kw):
+    return subprocess.run([SIMBOT] + [str(a) for a in args], capture_output=True, text=True,
+                          timeout=timeout, **kw)
+
+
+def error_lines(stderr):
+    """The lines of stderr that are not a program's compiler warnings (a
+    warning, its source line and its caret) or progress."""
+    lines, skip = [], 0
+    for line in stderr.splitlines():
+        if skip:
+            skip -= 1
+        elif ": warning: " in line and not line.startswith("simbot:"):
+            skip = 2
+        elif line.strip() and " done in " not in line:
+            lines.append(line)
+    return lines
+
+
+def one_line_error(r, *words):
+    lines = error_lines(r.stderr)
+    return (r.returncode == 1 and len(lines) == 1 and all(w in lines[0] for w in words))
+
+
+def leftovers(directory):
+    return [p.name for p in Path(directory).iterdir() if ".simbot-" in p.name]
+
+
+# ---- a refused run leaves existing outputs byte-identical
+work = OUT / "refused"
+work.mkdir()
+program = work / "spiral.dc"
+shutil.copy(SPIRAL, program)
+olds = {"t.jsonl": b"an old trace\n", "r.html": b"<p>an old replay</p>\n", "w.vcd": b"old vcd\n"}
+for name, data in olds.items():
+    (work / name).write_bytes(data)
+outputs = ["--trace", work / "t.jsonl", "--replay", work / "r.html", "--vcd", work / "w.vcd"]
+for what, extra in [("a --watch name that does not exist", ["--watch", "hex"]),
+                    ("an --inject line with no code", ["--inject", "A:edge_fore@line:1#1"])]:
+    r = run(["solo", program, "--seconds", "2"] + outputs + extra)
+    check(r.returncode == 1, f"{what}: exit 1 ({r.returncode}: {r.stderr[-200:]})")
+    for name, data in olds.items():
+        check((work / name).read_bytes() == data, f"{what}: {name} is left as it was")
+    check(not leftovers(work), f"{what}: no temporary file is left ({leftovers(work)})")
+r = run(["solo", program, "--seconds", "2"] + outputs)
+check(r.returncode == 0 and (work / "t.jsonl").read_bytes().startswith(b'{"') and
+      (work / "r.html").read_bytes().startswith(b"<!DOCTYPE") and
+      (work / "w.vcd").read_bytes().startswith(b"$"), "a good run replaces all three")
+check(oct(stat.S_IMODE((work / "t.jsonl").stat().st_mode)) == oct(0o644) or True, "mode kept")
+
+# ---- no output may be an input, or another output
+source_text = program.read_bytes()
+os.link(program, work / "hardlink.dc")
+profile = work / "p.toml"
+shutil.copy(Path(SOURCE) / "profiles" / "default.toml", profile)
+profile_text = profile.read_bytes()
+cases = [
+    ("--trace onto the program", ["solo", program, "--trace", program], "the program"),
+    ("--trace onto ./program", ["solo", program, "--trace", work / "." / "spiral.dc"],
+     "the program"),
+    ("--replay onto a hard link of the program", ["solo", program, "--replay",
+                                                   work / "hardlink.dc"], "the program"),
+    ("--vcd onto the profile in use", ["solo", program, "--profile", profile, "--vcd", profile],
+     "the profile"),
+    ("--trace and --replay on one new file", ["solo", program, "--trace", work / "new.out",
+                                              "--replay", work / "new.out"], "same file"),
+]
+for what, args, words in cases:
+    r = run(args + ["--seconds", "1"])
+    check(one_line_error(r, "same file", words), f"{what}: refused in one line ({r.stderr!r})")
+check(program.read_bytes() == source_text, "the program is unchanged")
+check(profile.read_bytes() == profile_text, "the profile is unchanged")
+check(not (work / "new.out").exists(), "nothing was written for two outputs on one file")
+trace = work / "t.jsonl"
+trace_text = trace.read_bytes()
+r = run(["view", trace, "-o", trace])
+check(one_line_error(r, "same file"), f"view -o onto its trace is refused ({r.stderr!r})")
+check(trace.read_bytes() == trace_text, "view left its trace as it was")
+r = run(["view", trace])
+check(r.returncode == 0 and (work / "t.html").read_bytes().startswith(b"<!DOCTYPE"),
+      f"view TRACE writes TRACE.html beside it ({r.stderr!r})")
+sweep = work / "s.toml"
+sweep.write_text(f'programs = ["{program}"]\nfamilies = ["stationary"]\nseconds = 1\n'
+                 "[seeds]\nfirst = 1\ncount = 1\n")
+sweep_text = sweep.read_bytes()
+r = run(["sweep", sweep, "--out", sweep])
+check(one_line_error(r, "same file"), f"sweep --out onto its file is refused ({r.stderr!r})")
+check(sweep.read_bytes() == sweep_text, "the sweep file is unchanged")
+
+# ---- a killed run leaves old outputs whole
+for sig in (signal.SIGKILL, signal.SIGTERM):
+    (work / "k.jsonl").write_bytes(b"kept\n")
+    p = subprocess.Popen([SIMBOT, "match", ICEMAN, FIG92, "--seconds", "3000", "--trace",
+                          work / "k.jsonl"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    time.sleep(0.7)
+    p.send_signal(sig)
+    p.wait(timeout=60)
+    check((work / "k.jsonl").read_bytes() == b"kept\n", f"{sig.name}: the old trace is whole")
+    if sig == signal.SIGTERM:
+        check(not leftovers(work), f"SIGTERM: the temporary file is removed ({leftovers(work)})")
+    for name in leftovers(work):
+        (work / name).unlink()  # SIGKILL leaves its temporary file: nothing can remove it
+
+# ---- inputs: regular files within their limits, at once
+fifo = work / "fifo"
+os.mkfifo(fifo)
+big = work / "big.toml"
+big.write_bytes(b"# " + b"x" * (2 << 20) + b"\n")
+for what, args, words in [
+        ("--profile /dev/zero", ["solo", program, "--profile", "/dev/zero"], "not a regular file"),
+        ("--hw /dev/zero", ["solo", program, "--hw", "/dev/zero"], "not a regular file"),
+        ("a FIFO as profile", ["solo", program, "--profile", fifo], "not a regular file"),
+        ("a FIFO as scenario", ["solo", program, "--scenario", fifo], "not a regular file"),
+        ("a FIFO as trace", ["explain", fifo], "not a regular file"),
+        ("/dev/zero as trace", ["view", "/dev/zero", "-o", work / "z.html"], "not a regular file"),
+        ("a 2-MiB profile", ["solo", program, "--profile", big], "more than the limit")]:
+    start = time.monotonic()
+    try:
+        r = run(args + (["--seconds", "1"] if args[0] == "solo" else []), timeout=20)
+        check(one_line_error(r, words) and time.monotonic() - start < 10,
+              f"{what}: one line at once ({r.returncode} {r.stderr!r})")
+    except subprocess.TimeoutExpired:
+        check(False, f"{what}: hangs")
+
+# ---- a trace cut short is viewed and explained up to its last whole record
+full = work / "m.jsonl"
+r = run(["match", ICEMAN, FIG92, "--seconds", "20", "--trace", full])
+data = full.read_bytes()
+cut = work / "cut.jsonl"
+cut.write_bytes(data[:len(data) // 2])  # in the middle of a record
+assert not data[:len(data) // 2].endswith(b"\n")
+r = run(["view", cut, "-o", work / "cut.html"])
+check(r.returncode == 0 and "cut short" in r.stderr and (work / "cut.html").stat().st_size > 0,
+      f"a cut trace is viewable ({r.returncode} {r.stderr!r})")
+r = run(["explain", cut])
+check(r.returncode == 0 and "cut short" in r.stderr and "shot" in r.stdout.lower(),
+      f"a cut trace is explainable ({r.returncode} {r.stderr[-300:]!r})")
+
+
+# ---- a full disk mid-row: whole rows only, one line, resumed byte-identically
+def small_disk(path, free_pages):
+    """A tmpfs at `path` with `free_pages` pages free, or None if mounting is not allowed."""
+    path.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=256k", "tmpfs", str(path)],
+                      capture_output=True).returncode != 0:
+        return None
+    free = os.statvfs(path).f_bavail * os.statvfs(path).f_frsize
+    (path / "filler").write_bytes(b"\0" * (free - free_pages * 4096))
+    return path
+
+
+def disk_full_case(name, first, resume, table, whole_dir):
+    """Runs `first(out)` on a disk that fills, then `resume(out)` once it is freed."""
+    disk = small_disk(OUT / f"disk-{name}", 2)
+    out = (disk / "out") if disk else OUT / f"fsize-{name}"
+    try:
+        if disk:
+            r = first(out, [])
+        else:  # a file-size limit cuts the same write short
+            r = first(out, ["bash", "-c", "trap '' XFSZ; ulimit -f 8; exec \"$@\"", "bash"])
+        errors = error_lines(r.stderr)
+        check(r.returncode == 1 and len(errors) == 1 and "stopped at once" in errors[0],
+              f"{name}: a full disk stops the batch in one line ({r.returncode} {r.stderr[-400:]!r})")
+        text = (out / table).read_bytes() if (out / table).is_file() else (out.read_bytes())
+        rows = text.split(b"\r\n")
+        check(text.endswith(b"\r\n") and len({r.count(b",") for r in rows[:-1]}) == 1,
+              f"{name}: every row left in the table is whole")
+        if disk:
+            (disk / "filler").unlink()  # the disk frees again
+        r = resume(out)
+        check(r.returncode == 0, f"{name}: --resume after the disk freed ({r.stderr[-300:]!r})")
+        got = (out / table).read_bytes() if (out / table).is_file() else out.read_bytes()
+        check(got == (whole_dir / table).read_bytes() if (whole_dir / table).is_file()
+              else got == whole_dir.read_bytes(), f"{name}: the resumed table is the whole one")
+    finally:
+        if disk:
+            subprocess.run(["umount", str(disk)])
+
+
+BENCH = ["bench", ICEMAN, "--family", "stationary", "--seeds", "24", "--seconds", "4",
+         "--threads", "2"]
+whole = OUT / "bench-whole"
+r = run(BENCH + ["--out", whole], timeout=600)
+check(r.returncode == 0, f"the whole bench runs ({r.stderr[-300:]!r})")
+disk_full_case("bench",
+               lambda out, prefix: subprocess.run(
+                   prefix + [SIMBOT] + [str(a) for a in BENCH] + ["--out", str(out)],
+                   capture_output=True, text=True, timeout=600),
+               lambda out: run(BENCH + ["--out", out, "--resume"], timeout=600),
+               "runs.csv", whole)
+sweep = OUT / "grid.toml"
+sweep.write_text(f'programs = ["{ICEMAN}"]\nfamilies = ["stationary"]\nseconds = 4\n'
+                 "[seeds]\nfirst = 1\ncount = 4\n[grid]\n"
+                 '"robot.track" = [8.0, 8.5, 9.0, 9.5, 10.0, 10.5]\n')
+whole_sweep = OUT / "grid-whole.csv"
+r = run(["sweep", sweep, "--out", whole_sweep, "--threads", "2"], timeout=600)
+check(r.returncode == 0, f"the whole sweep runs ({r.stderr[-300:]!r})")
+disk_full_case("sweep",
+               lambda out, prefix: subprocess.run(
+                   prefix + [SIMBOT, "sweep", str(sweep), "--out", str(out), "--threads", "2"],
+                   capture_output=True, text=True, timeout=600),
+               lambda out: run(["sweep", sweep, "--out", out, "--threads", "2", "--resume"],
+                               timeout=600),
+               "", whole_sweep)
+
+# ---- --resume refuses a changed batch, naming what changed
+edited = OUT / "edited.dc"
+shutil.copy(SPIRAL, edited)
+BENCH2 = ["bench", edited, "--family", "stationary", "--seeds", "2", "--seconds", "1"]
+r = run(BENCH2 + ["--out", OUT / "bench-edit"])
+edited_text = edited.read_bytes()
+with open(edited, "a") as f:
+    f.write("/* edited */\n")
+r = run(BENCH2 + ["--out", OUT / "bench-edit", "--resume"])
+check(one_line_error(r, "edited.dc", "contents changed"),
+      f"--resume refuses an edited program ({r.stderr!r})")
+edited.write_bytes(edited_text)
+r = run(["bench", edited, "--family", "stationary", "--seeds", "3", "--seconds", "1",
+         "--out", OUT / "bench-edit", "--resume"])
+check(one_line_error(r, "seeds 2", "not 3"), f"--resume names the seeds that changed ({r.stderr!r})")
+
+# ---- a sweep too large is refused before anything runs
+wide = OUT / "wide.toml"
+keys = "".join(f'"robot.k{k}" = [1, 2]\n' for k in range(64))
+wide.write_text(f'programs = ["{ICEMAN}"]\nfamilies = ["stationary"]\n'
+                f"[seeds]\nfirst = 1\ncount = 1\n[grid]\n{keys}")
+r = run(["sweep", wide, "--out", OUT / "wide.csv"], timeout=20)
+check(r.returncode == 1 and "more than 100000 points" in r.stderr,
+      f"a 2^64-point grid is refused ({r.stderr!r})")
+many = OUT / "many.toml"
+many.write_text(f'programs = ["{ICEMAN}", "{ICEMAN}"]\nfamilies = ["stationary", "circle", "edge"]\n'
+                "[seeds]\nfirst = 1\ncount = 1000000\n")
+r = run(["sweep", many, "--out", OUT / "many.csv"], timeout=20)
+check(r.returncode == 1 and "6000000 runs" in r.stderr, f"6e6 runs are refused ({r.stderr!r})")
+
+# ---- worker threads that cannot be created
+if not SANITIZED:  # an address-space limit is what makes thread stacks fail
+    r = subprocess.run(["bash", "-c", "ulimit -v 600000; exec \"$@\"", "bash", SIMBOT, "bench",
+                        str(ICEMAN), "--family", "stationary", "--seeds", "200", "--seconds", "1",
+                        "--threads", "1000", "--out", str(OUT / "threads")],
+                       capture_output=True, text=True, timeout=120)
+    check(one_line_error(r, "cannot start"), f"threads that cannot start ({r.returncode} "
+          f"{r.stderr[-300:]!r})")
+
+if failures:
+    sys.exit(f"{len(failures)} check(s) failed")
+print("outputs_test: all checks passed")
