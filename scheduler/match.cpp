@@ -617,6 +617,15 @@ void Match::rounds(Tick pause) {
       ++subRounds_;
       horizon = std::min(queue_.nextTick(), earliestAction() + kLookahead);
     }
+    if (config_.stopWhenAllExited && allExited()) {
+      // The run ends where the last robot stopped, not at the round's
+      // horizon: where that falls depends on how long the rounds were
+      // (fast-forward makes longer ones), and the run must not.
+      Tick stopped = roundStart_;
+      for (const auto& r : robots_)
+        stopped = std::max(stopped, r->vm().fault() ? r->vm().fault()->tick : r->result.exitTick);
+      horizon = std::min(horizon, stopped);
+    }
     if (horizon < step.tick) {
       // The round ends before the plant's stop: it goes back to the horizon
       // (a prediction is kept for later), as if it had stopped there.
