@@ -3,7 +3,11 @@
 // without console errors, draw the robots where the trace puts them at
 // three seek positions, advance time when playing, highlight the source
 // line the trace gives, render every camera preset, and show the report of
-// `simbot explain` in its Explain panel. It writes
+// `simbot explain` in its Explain panel, have a legend listing every symbol
+// the timeline draws, draw a trail per robot that its toggle hides and
+// shows, and place the miss labels so that no two overlap. It measures and
+// prints (never asserts) how long the page took to be ready: from
+// navigation start to the page's 'simbot-ready' performance mark. It writes
 // screenshots of the 2-D view, the 3-D view and the timeline.
 //
 // Usage: node viewer_test.mjs SIMBOT ICEMAN FIG92 OUTDIR
@@ -79,8 +83,14 @@ await page.goto(pathToFileURL(pagePath).href);
 await page.waitForFunction(() => window.simbotViewer && window.simbotViewer.ready === true, null,
   { timeout: 60000 });
 const openMs = Date.now() - started;
+const readyMark = await page.evaluate(() => {
+  const m = performance.getEntriesByName('simbot-ready');
+  return m.length ? m[0].startTime : null;
+});
+check(readyMark !== null, "the page sets its 'simbot-ready' mark");
 console.log(`viewer: the 180-s page (${(readFileSync(pagePath).length / 1e6).toFixed(1)} MB) ` +
-  `was ready ${openMs} ms after navigation`);
+  `was ready ${Math.round(readyMark)} ms after navigation start ('simbot-ready' mark; ` +
+  `${openMs} ms as the test saw it)`);
 
 // ---- robots where the trace puts them, at three seek positions (sample ticks)
 const TPS = 9216000;
@@ -141,6 +151,56 @@ await longest.click();
 const seekTo = await page.evaluate(() => window.simbotViewer.time());
 check(Math.abs(seekTo / TPS - stallStart) < 0.001,
   `clicking the longest stall seeks to ${stallStart} s (cursor at ${seekTo / TPS} s)`);
+
+// ---- the legend lists every symbol the timeline draws (whole match in view)
+await page.evaluate((end) => { window.simbotViewer.setWindow(0, end); window.simbotViewer.seek(95 * 9216000); },
+  180 * TPS);
+const drawnSymbols = await page.evaluate(() => window.simbotViewer.timelineSymbols());
+const legendSymbols = await page.evaluate(() =>
+  [...document.querySelectorAll('#legend .legend-item')].filter((e) => e.getBoundingClientRect().width > 0)
+    .map((e) => e.dataset.symbol));
+check(drawnSymbols.length >= 8, `the timeline drew ${drawnSymbols.join(', ')}`);
+for (const s of drawnSymbols) check(legendSymbols.includes(s), `the legend lists "${s}", which the timeline draws`);
+await page.evaluate(() => window.simbotViewer.setWindow(85 * 9216000, 100 * 9216000));
+const zoomed = await page.evaluate(() => window.simbotViewer.timelineSymbols());
+for (const s of zoomed) check(legendSymbols.includes(s), `the legend lists "${s}" (zoomed in)`);
+
+// ---- trails: a path per robot, hidden and shown again by the toggle
+const trailsOn = await page.evaluate(() => window.simbotViewer.trails());
+const fieldOn = await page.evaluate(() => document.getElementById('field2d').toDataURL());
+check(trailsOn.length === 2 && trailsOn.every((t) => t.points > 1000),
+  `a trail per robot at 95 s: ${JSON.stringify(trailsOn)}`);
+await page.locator('#trails').uncheck();
+const trailsOff = await page.evaluate(() => window.simbotViewer.trails());
+const fieldOff = await page.evaluate(() => document.getElementById('field2d').toDataURL());
+check(trailsOff.length === 0 && fieldOff !== fieldOn, 'the trails toggle hides the trails');
+await page.locator('#trails').check();
+check((await page.evaluate(() => window.simbotViewer.trails())).length === 2, 'the trails toggle shows them again');
+
+// ---- no two miss labels overlap, wherever misses are on the field
+const missTicks = [];
+for (const line of readFileSync(tracePath, 'utf8').split('\n'))
+  if (line.includes('"type":"ball_miss"')) missTicks.push(JSON.parse(line).t);
+check(missTicks.length > 1, `misses to label (${missTicks.length})`);
+let mostShown = 0;
+for (const t of missTicks) {
+  for (const at of [t, t + 1 * TPS, t + 3 * TPS]) {
+    await page.evaluate((x) => window.simbotViewer.seek(x), at);
+    const boxes = await page.evaluate(() => [...document.querySelectorAll('#field-labels .mark-label.miss')]
+      .filter((e) => e.style.display !== 'none').map((e) => {
+        const r = e.getBoundingClientRect();
+        return { l: r.left, r: r.right, t: r.top, b: r.bottom, text: e.textContent };
+      }));
+    mostShown = Math.max(mostShown, boxes.length);
+    for (let i = 0; i < boxes.length; ++i)
+      for (let j = i + 1; j < boxes.length; ++j) {
+        const a = boxes[i], b = boxes[j];
+        check(!(a.l < b.r && b.l < a.r && a.t < b.b && b.t < a.b),
+          `miss labels "${a.text}" and "${b.text}" overlap at ${at / TPS} s`);
+      }
+  }
+}
+check(mostShown >= 2, `at some time several miss labels are shown (at most ${mostShown})`);
 
 // ---- every camera preset renders something; screenshots
 await page.evaluate((t) => window.simbotViewer.seek(t), 95 * TPS);

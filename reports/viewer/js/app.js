@@ -21,7 +21,7 @@ function startViewer() {
   let startT = 0, endT = model.endTick;
 
   // ---- views
-  const field = createField2d($('field2d'), model);
+  const field = createField2d($('field2d'), model, $('field-labels'));
   const scene = createScene3d($('view3d'), model);
   const timeline = createTimeline($('timeline'), $('tooltip'), model, {
     seek: (t) => seek(t),
@@ -84,6 +84,31 @@ function startViewer() {
     div.addEventListener('click', () => seek(t));
     $('log').appendChild(div);
   }
+
+  // ---- the timeline's legend: every symbol its lanes can draw
+  for (const s of LANE_SYMBOLS.concat(Object.entries(EVENT_STYLE).map(([key, e]) =>
+    ({ key, shape: 'glyph', glyph: e.glyph, color: e.color, label: e.label })))) {
+    const item = document.createElement('span');
+    item.className = 'legend-item';
+    item.dataset.symbol = s.key;
+    const swatch = document.createElement('span');
+    swatch.className = 'swatch';
+    if (s.shape === 'glyph') {
+      swatch.textContent = s.glyph;
+      swatch.style.color = s.color;
+    } else if (s.shape === 'line' || s.shape === 'dash') {
+      swatch.style.borderTop = `2px ${s.shape === 'dash' ? 'dashed' : 'solid'} ${s.color}`;
+      swatch.style.height = '0';
+    } else {
+      swatch.style.background = s.color;
+      if (s.shape === 'tick') { swatch.style.minWidth = '3px'; swatch.style.width = '3px'; }
+      if (s.shape === 'bar') swatch.style.height = '4px';
+    }
+    item.appendChild(swatch);
+    item.appendChild(document.createTextNode(s.label));
+    $('legend').appendChild(item);
+  }
+  $('trails').addEventListener('change', () => { field.setTrails($('trails').checked); render(); });
 
   createExplainPanel($('explain-body'), data.explain || [], (t) => seek(t));
 
@@ -236,9 +261,14 @@ function startViewer() {
     setCamera: (name) => { scene.setPreset(name); render(); },
     view3dStats: () => scene.stats(),
     explainText: () => $('explain-body').textContent,
+    trails: () => field.trails(),
+    timelineSymbols: () => timeline.symbols(),
+    setWindow: (from, to) => timeline.setWindow(from, to),
   });
   render();
   hook.ready = true;
+  // The page is ready: the test reads this mark's time since navigation start.
+  performance.mark('simbot-ready');
 }
 
 startViewer();

@@ -2,13 +2,16 @@
 //
 // North (+y) is up, as in the thesis's figures. Everything is drawn in feet
 // through one transform; the canvas is redrawn whole at every frame (a few
-// hundred shapes).
+// hundred shapes), the robots' trails too (a few thousand points). The
+// marks' labels are elements over it (see placeLabels).
 
 const ROBOT_COLORS = ['#4aa3ff', '#ff8a3d'];
 const FOV_RADIUS_FT = 30;  // the eyes see to the end of the field and beyond
 
-function createField2d(canvas, model) {
+function createField2d(canvas, model, labelLayer) {
   const ctx = canvas.getContext('2d');
+  let trails = true;
+  let trailPoints = [];  // per robot, the points of the path the last draw drew
   const half = model.run.field_size_ft / 2;
   const margin = 0.6;  // ft around the field
   let scale = 1, cx = 0, cy = 0;
@@ -128,13 +131,70 @@ function createField2d(canvas, model) {
     }
   }
 
+  // Each robot's path from the start to its pose at t: its samples (20 Hz).
+  function drawTrails(t, poses) {
+    trailPoints = [];
+    if (!trails) return;
+    model.robots.forEach((robot, i) => {
+      const s = robot.samples;
+      const last = lastAtOrBefore(s.t, t);
+      ctx.strokeStyle = ROBOT_COLORS[robot.robot] + 'a0';
+      ctx.lineWidth = 1.5;
+      ctx.beginPath();
+      ctx.moveTo(px(last < 0 ? poses[i].x_ft : s.x[0]), py(last < 0 ? poses[i].y_ft : s.y[0]));
+      for (let k = 1; k <= last; ++k) ctx.lineTo(px(s.x[k]), py(s.y[k]));
+      ctx.lineTo(px(poses[i].x_ft), py(poses[i].y_ft));
+      ctx.stroke();
+      trailPoints.push({ robot: robot.name, points: Math.max(0, last) + 2 });
+    });
+  }
+
+  // The marks' labels are elements over the canvas, placed so that no two
+  // overlap: each goes to the right of its mark or, if that is taken, the
+  // nearest free place above or below it, inside the field's panel.
+  const labelPool = [];
+  function placeLabels(labels) {
+    const dpr = window.devicePixelRatio || 1;
+    const W = canvas.clientWidth, H = canvas.clientHeight;
+    const placed = [];
+    labels.forEach((l, i) => {
+      let div = labelPool[i];
+      if (!div) {
+        div = document.createElement('div');
+        labelPool.push(div);
+        labelLayer.appendChild(div);
+      }
+      div.className = `mark-label ${l.kind}`;
+      div.textContent = l.text;
+      div.style.display = 'block';
+      div.style.color = l.color;
+      div.style.opacity = String(l.alpha);
+      div.style.fontSize = `${l.fontPx}px`;
+      const box = div.getBoundingClientRect();
+      const w = box.width + 2, h = box.height + 2;  // a pixel apart
+      const x0 = Math.min(Math.max(0, l.x / dpr), Math.max(0, W - w));
+      const y0 = l.y / dpr - h;
+      let at = null;
+      for (let k = 0; k <= 40 && !at; ++k) {
+        const dy = (k % 2 ? 1 : -1) * Math.ceil(k / 2) * h;
+        const y = Math.min(Math.max(0, y0 + dy), Math.max(0, H - h));
+        if (!placed.some((p) => x0 < p.x + p.w && p.x < x0 + w && y < p.y + p.h && p.y < y + h)) at = { x: x0, y };
+      }
+      if (!at) at = { x: x0, y: Math.max(0, ...placed.map((p) => p.y + p.h)) };  // below all of them
+      placed.push({ x: at.x, y: at.y, w, h });
+      div.style.left = `${at.x}px`;
+      div.style.top = `${at.y}px`;
+    });
+    for (let i = labels.length; i < labelPool.length; ++i) labelPool[i].style.display = 'none';
+  }
+
   // Ball outcomes and referee actions: shown for a while after they happen.
   function drawMarks(t) {
+    const labels = [];
     const keep = 4 * model.tps;
     const from = firstAtOrAfter(model.markTicks, t - keep);
-    ctx.font = `${Math.max(11, Math.round(0.32 * scale))}px sans-serif`;
-    ctx.textAlign = 'left';
-    ctx.textBaseline = 'bottom';
+    const dpr = window.devicePixelRatio || 1;
+    const fontPx = Math.max(11, Math.round(0.32 * scale / dpr));
     for (let i = from; i < model.marks.length && model.marks[i].t <= t; ++i) {
       const m = model.marks[i];
       const alpha = 1 - (t - m.t) / keep;
@@ -152,10 +212,11 @@ function createField2d(canvas, model) {
         ctx.moveTo(px(x) - s, py(y) + s); ctx.lineTo(px(x) + s, py(y) - s);
       }
       ctx.stroke();
-      ctx.fillStyle = ctx.strokeStyle;
-      ctx.fillText(m.text, px(x) + s * 1.3, py(y) - s);
+      labels.push({ kind: m.kind, text: m.text, color: ctx.strokeStyle, alpha: ctx.globalAlpha, fontPx,
+        x: px(x) + s * 1.3, y: py(y) - s });
     }
     ctx.globalAlpha = 1;
+    if (labelLayer) placeLabels(labels);
   }
 
   function draw(t, poses, states) {
@@ -164,11 +225,17 @@ function createField2d(canvas, model) {
     ctx.fillRect(0, 0, canvas.width, canvas.height);
     drawField();
     model.robots.forEach((robot, i) => drawEyes(robot, poses[i]));
+    drawTrails(t, poses);
     drawBalls(t);
     model.robots.forEach((robot, i) => drawRobot(robot, poses[i], states[i]));
     drawMarks(t);
   }
 
   resize();
-  return { draw, resize };
+  return {
+    draw,
+    resize,
+    setTrails(on) { trails = Boolean(on); },
+    trails: () => trailPoints.slice(),
+  };
 }

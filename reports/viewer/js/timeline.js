@@ -10,6 +10,21 @@
 // falls inside the window is drawn, found by binary search, and items that
 // would share a pixel column are drawn once.
 
+// Everything the lanes draw besides the event glyphs (EVENT_STYLE), for
+// the legend: a box, a thin bar, a line or a dashed line of a colour.
+const LANE_SYMBOLS = [
+  { key: 'serial_byte', shape: 'box', color: '#3d6fa8', label: 'serial byte on TXD' },
+  { key: 'frame_latched', shape: 'tick', color: '#3fbf5f', label: 'frame latched' },
+  { key: 'frame_rejected', shape: 'tick', color: '#ff4040', label: 'frame rejected' },
+  { key: 'handler', shape: 'box', color: '#a05cd6', label: 'edge handler in service' },
+  { key: 'serial_isr', shape: 'bar', color: '#f0d060', label: 'serial transmit interrupt' },
+  { key: 'reflex', shape: 'box', color: 'rgba(224,112,48,0.35)', label: 'bumper reflex' },
+  { key: 'eye_left', shape: 'line', color: '#59d16b', label: 'left eye (ad_rd8)' },
+  { key: 'eye_right', shape: 'line', color: '#e85fa0', label: 'right eye (ad_rd8)' },
+  { key: 'threshold', shape: 'dash', color: '#d0d0d0', label: 'your threshold' },
+  { key: 'cursor', shape: 'tick', color: '#ffffff', label: 'cursor' },
+];
+
 function createTimeline(canvas, tooltip, model, callbacks) {
   const ctx = canvas.getContext('2d');
   const lanes = [];
@@ -22,6 +37,7 @@ function createTimeline(canvas, tooltip, model, callbacks) {
   let from = 0, to = model.endTick, cursor = 0, dpr = 1;
   let thresholds = model.robots.map(() => []);
   let hoverItems = [];  // {x0, x1, y0, y1, text} of what was drawn, for the tooltip
+  let drawn = new Set();  // the symbols (LANE_SYMBOLS keys, EVENT_STYLE kinds) the last draw drew
 
   function resize() {
     dpr = window.devicePixelRatio || 1;
@@ -71,6 +87,7 @@ function createTimeline(canvas, tooltip, model, callbacks) {
       if (x1 - lastX < 1 && x1 - x0 < 1) continue;
       lastX = x1;
       ctx.fillRect(x0, y, Math.max(1, x1 - x0 - (x1 - x0 > 4 ? 1 : 0)), h);
+      drawn.add('serial_byte');
       if (label) label(i, x0, x1);
     }
   }
@@ -91,7 +108,8 @@ function createTimeline(canvas, tooltip, model, callbacks) {
   }
 
   function drawFrames(robot, y, h) {
-    for (const [frames, color, what] of [[robot.latched, '#3fbf5f', 'latched'], [robot.rejected, '#ff4040', 'REJECTED']]) {
+    for (const [frames, color, what, key] of [[robot.latched, '#3fbf5f', 'latched', 'frame_latched'],
+      [robot.rejected, '#ff4040', 'REJECTED', 'frame_rejected']]) {
       const lo = firstAtOrAfter(frames.t, from), hi = firstAtOrAfter(frames.t, to);
       let lastX = -Infinity;
       ctx.fillStyle = color;
@@ -100,6 +118,7 @@ function createTimeline(canvas, tooltip, model, callbacks) {
         if (x - lastX < 1) continue;
         lastX = x;
         ctx.fillRect(x - 1, y + 1, 2, h - 2);
+        drawn.add(key);
         remember(x - 3, x + 3, y, y + h, `${robot.name} frame ${what} "${frames.bytes[i]}" at ${fmtT(frames.t[i])}`);
       }
     }
@@ -114,6 +133,7 @@ function createTimeline(canvas, tooltip, model, callbacks) {
       if (sp.end < from) continue;
       const x0 = xOf(sp.start), x1 = xOf(sp.end);
       ctx.fillRect(x0, y + 2 + 2 * sp.depth, Math.max(1, x1 - x0), h - 4 - 4 * sp.depth);
+      drawn.add('handler');
       remember(x0, x1, y, y + h, `${robot.name} ${sp.handler} (${sp.source}) in service ` +
         `${fmtT(sp.start)} to ${fmtT(sp.end)}, ${((sp.end - sp.start) / model.tps * 1000).toFixed(3)} ms; ` +
         `it interrupted line ${sp.line} in ${sp.function || 'start-up'}`);
@@ -128,6 +148,7 @@ function createTimeline(canvas, tooltip, model, callbacks) {
       if (x1 - lastX < 1 && x1 - x0 < 1) continue;
       lastX = x1;
       ctx.fillRect(x0, y + h / 2 - 2, Math.max(1, x1 - x0), 4);
+      drawn.add('serial_isr');
       if (x1 - x0 >= 2) remember(x0, x1, y, y + h, `${robot.name} serial transmit interrupt ` +
         `${fmtT(isr.t[i])} to ${fmtT(isr.end_t[i])} (${isr.end_t[i] - isr.t[i]} ticks)`);
     }
@@ -142,6 +163,7 @@ function createTimeline(canvas, tooltip, model, callbacks) {
       if (sp.end < from) continue;
       const x0 = xOf(sp.start), x1 = xOf(sp.end);
       ctx.fillRect(x0, y + 1, Math.max(1, x1 - x0), h - 2);
+      drawn.add('reflex');
       remember(x0, x1, y, y + h, `${robot.name} bumper reflex (${sp.bumper}) ${fmtT(sp.start)} to ${fmtT(sp.end)}`);
     }
     const ev = model.events[robot.robot];
@@ -159,6 +181,7 @@ function createTimeline(canvas, tooltip, model, callbacks) {
       const style = EVENT_STYLE[e.kind];
       ctx.fillStyle = style.color;
       ctx.fillText(style.glyph, x, y + h / 2);
+      drawn.add(e.kind);
       remember(x - 4, x + 4, y, y + h, `${robot.name} ${style.label} at ${fmtT(e.t)}${e.text ? ': ' + e.text : ''}`);
     }
   }
@@ -171,14 +194,16 @@ function createTimeline(canvas, tooltip, model, callbacks) {
     ctx.setLineDash([4, 3]);
     ctx.strokeStyle = '#d0d0d0';
     for (const v of thresholds[robot.robot]) {
+      drawn.add('threshold');
       ctx.beginPath();
       ctx.moveTo(LABEL_W, yOf(v));
       ctx.lineTo(LABEL_W + width(), yOf(v));
       ctx.stroke();
     }
     ctx.setLineDash([]);
-    for (const [steps, color] of [[robot.eyes[0], '#59d16b'], [robot.eyes[1], '#e85fa0']]) {
+    for (const [steps, color, key] of [[robot.eyes[0], '#59d16b', 'eye_left'], [robot.eyes[1], '#e85fa0', 'eye_right']]) {
       if (!steps.t.length) continue;
+      drawn.add(key);
       const first = Math.max(0, lastAtOrBefore(steps.t, from));
       const hi = firstAtOrAfter(steps.t, to);
       let value = steps.t[first] <= from ? steps.v[first] : 0;  // 0: not read yet
@@ -212,6 +237,7 @@ function createTimeline(canvas, tooltip, model, callbacks) {
     ctx.fillStyle = '#15191e';
     ctx.fillRect(0, 0, canvas.width / dpr, canvas.height / dpr);
     hoverItems = [];
+    drawn = new Set();
     drawAxis();
     let y = AXIS_H;
     const labels = { serial: 'TXD', frames: 'frames', handlers: 'handlers', events: 'events', eyes: 'eyes' };
@@ -237,6 +263,7 @@ function createTimeline(canvas, tooltip, model, callbacks) {
     }
     const cx = xOf(cursor);
     if (cx >= LABEL_W) {
+      drawn.add('cursor');
       ctx.strokeStyle = '#ffffff';
       ctx.lineWidth = 1;
       ctx.beginPath();
@@ -320,6 +347,7 @@ function createTimeline(canvas, tooltip, model, callbacks) {
     setCursor(t) { cursor = t; },
     setWindow(f, t) { from = f; to = Math.max(t, f + 100); draw(); },
     window: () => [from, to],
+    symbols: () => [...drawn],
     setThresholds(robotIndex, values) { thresholds[robotIndex] = values; draw(); },
   };
 }
