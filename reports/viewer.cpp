@@ -40,6 +40,19 @@ std::string_view script(std::string_view text, const char* what) {
 
 constexpr const char* kRobotNames[] = {"A", "B"};
 
+// Record kinds the page's script never reads (reports/viewer/js/): left out
+// of its data, so that they neither fill the page nor count toward its cap
+// (--trace-costate's records, PIO and RS-485 writes, IFF1...). The Explain
+// panel still sees them.
+bool pageShows(std::string_view kind) {
+  constexpr std::string_view kUnshown[] = {"costate",  "iff1",         "port_a",
+                                           "port_b",   "rs485_enable", "contact_end",
+                                           "path_leg", "disc_shooter"};
+  for (const auto k : kUnshown)
+    if (k == kind) return false;
+  return true;
+}
+
 }  // namespace
 
 // Columns per record kind: {"t": [...], field: [...], ...}; robot fields as
@@ -66,6 +79,8 @@ ReplaySink::~ReplaySink() { delete columns_; }
 
 void ReplaySink::write(const trace::Entry& e) {
   columns_->explainer.write(e);
+  const char* const kind = trace::kindOf(e.record).name;
+  if (!pageShows(kind)) return;
   // A page is for a person to look at: beyond this many records (a program
   // flooding port B) the rest of the run is left out, and the page says so,
   // so that its memory stays bounded. The end of the run is always kept.
@@ -77,7 +92,7 @@ void ReplaySink::write(const trace::Entry& e) {
     return;
   }
   ++columns_->records;
-  json& cols = columns_->kinds[trace::kindOf(e.record).name];
+  json& cols = columns_->kinds[kind];
   cols["t"].push_back(e.t);
   trace::forEachField(e.record, [&](const trace::FieldInfo& f, const auto& v) {
     using V = std::remove_cvref_t<decltype(v)>;

@@ -154,10 +154,12 @@ Robot::Robot(const Robot& other, Match& m)
       lastSend(other.lastSend),
       sendBefore(other.sendBefore),
       result(other.result),
-      mainReturn(other.mainReturn) {}
+      mainReturn(other.mainReturn),
+      costates(other.costates) {}
 
 void Robot::reload(Tick t) {
   reloadPending = false;
+  costates.clear();  // the reloaded program's costatements start afresh
   // The delay is long enough that no byte is left in the port. The VM
   // keeps its breakpoints (main's return, the injections) and counters.
   board.reset(t);

@@ -156,6 +156,14 @@ class Robot : public vm::Bus {
   SendSite lastSend, sendBefore;
   RobotResult result;
   uint32_t mainReturn;
+  // --trace-costate: where each costatement (by its CoData's address) rests,
+  // so that only its changes of state are recorded (Robot::costate).
+  enum class CoRest : uint8_t { Started, FromTop, Waiting, Resumed, Ended };
+  struct CoState {
+    CoRest rest = CoRest::Started;
+    int line = 0;  // Waiting, Resumed: the line it gave way at
+  };
+  std::map<uint16_t, CoState> costates;
 };
 
 class Match {

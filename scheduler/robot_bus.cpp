@@ -285,9 +285,45 @@ void Robot::iffChanged(Tick t, bool iff1) {
 
 bool Robot::wantCostateEvents() const { return match.tracingCostates(); }
 
+// Only a change of state is recorded (trace/records.def, docs/trace.md).
+// A costatement rests between passes either waiting at the line it gave way
+// at, or at its top (ended, or never run). The VM reports every entry,
+// give-way and end; of these the record keeps
+//   - the first entry ever (enter);
+//   - a give-way at a line the costatement was not already waiting at
+//     (yield): a waitfor re-checked and still false writes nothing, as does
+//     the entry that resumed it;
+//   - an end that follows a wait or the first entry (end): a costatement
+//     that runs from its top to its end without giving way, pass after pass,
+//     writes nothing after its first pass.
+// An entry after an end or a wait is not recorded when it happens (whether
+// the wait is over is known only at the next give-way or end).
 // The costatement is named by its CoData's symbol: the name a named one
 // was given, "costate@LINE" for an unnamed one (FUNCTION.costate@LINE).
 void Robot::costate(Tick t, uint16_t coData, CostateEvent e, int line) {
+  const auto [it, first] = costates.try_emplace(coData);
+  CoState& co = it->second;
+  bool record = false;
+  switch (e) {
+    case CostateEvent::Enter:
+      record = first;
+      if (first)
+        co.rest = CoRest::Started;
+      else if (co.rest == CoRest::Waiting)
+        co.rest = CoRest::Resumed;
+      else if (co.rest == CoRest::Ended)
+        co.rest = CoRest::FromTop;
+      break;
+    case CostateEvent::Yield:
+      record = !(co.rest == CoRest::Resumed && co.line == line);
+      co = {CoRest::Waiting, line};
+      break;
+    case CostateEvent::End:
+      record = co.rest != CoRest::FromTop;
+      co = {CoRest::Ended, 0};
+      break;
+  }
+  if (!record) return;
   std::string name = fmt::format("0x{:04x}", coData);
   for (const auto& s : spec.image.symbols)
     if (s.address == coData && s.size == vm::kCoDataSize &&

@@ -10,6 +10,7 @@
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "support/test_host.h"
+#include "trace/trace.h"
 
 using namespace simbot;
 using simbot::testkit::TestHost;
@@ -307,6 +308,63 @@ TEST(Timer, ProfileKnobDecidesWhetherTheServiceRuns) {
   const auto neverToggler = scheduler::runMatch(soloConfig(toggler, vm::TimerService::Never, 2));
   EXPECT_FALSE(neverToggler.robots[0].exited);
   EXPECT_EQ(neverToggler.robots[0].interrupts.at("timer"), 0u);
+}
+
+// --trace-costate records only changes of state (Robot::costate). By hand,
+// pass by pass of the loop below (k counts the passes that reach counter):
+//   pass 1: waiter's first entry (enter, line 7), its waitfor false with
+//           k = 0: it begins waiting at line 7 (yield 7); counter's first
+//           entry (enter, line 11) and its end (end 12);
+//   passes 2-4: waiter resumed at line 7, k = 1..3, gives way at line 7
+//           again: still waiting, nothing; counter runs from its top to its
+//           end again: nothing;
+//   pass 5: k = 4: waiter's wait is over, n = 1, it ends (end 9);
+//   passes 6-7: waiter runs from its top to its end without a wait (n = 2,
+//           3): nothing. The loop ends and main returns.
+// Five records, where the VM reports 2 + 7 x 2 (counter) + 4 + 4 x 2 + 2 x 2
+// (waiter) = 32 entries, give-ways and ends.
+// --trace-costate records changes of state only (trace/records.def). By
+// hand, with the program's lines (waiter 6-9, its waitfor on 7; counter
+// 10-12): pass 1 enters waiter (enter 7), whose waitfor is false (yield 7),
+// and enters counter (enter 11), which runs to its end (end 12). Passes 2-4
+// re-check the waitfor at the same line (nothing) and run counter top to
+// end again (nothing: its first pass said so). Pass 5 (k = 4) lets waiter
+// through to its end (end 9); from then on waiter too runs top to end
+// without giving way, and n reaches 3 on pass 7: five records in all.
+TEST(Costate, TraceRecordsOnlyChangesOfState) {
+  const std::string file = testing::TempDir() + "costate_changes.dc";
+  std::FILE* f = std::fopen(file.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fputs(R"(int n, k;
+main()
+{
+    n = 0; k = 0;
+    while (n < 3) {
+        costate waiter always_on {
+            waitfor(k >= 4);
+            n++;
+        }
+        costate counter always_on {
+            k++;
+        }
+    }
+}
+)",
+             f);
+  std::fclose(f);
+  auto config = soloConfig(file, vm::TimerService::Auto, 1);
+  trace::Collector collector;
+  config.sinks.push_back(&collector);
+  config.traceCostate = true;
+  const auto result = scheduler::runMatch(config);
+  EXPECT_TRUE(result.robots[0].exited);
+  std::vector<std::string> got;
+  for (const auto& e : collector.entries)
+    if (const auto* c = std::get_if<trace::rec::Costate>(&e.record))
+      got.push_back(c->name + ' ' + c->event + ' ' + std::to_string(c->line));
+  const std::vector<std::string> want = {"waiter enter 7", "waiter yield 7", "counter enter 11",
+                                         "counter end 12", "waiter end 9"};
+  EXPECT_EQ(got, want);
 }
 
 }  // namespace
