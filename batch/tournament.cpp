@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <stdexcept>
 
 #include "batch/parallel.h"
 #include "config/config.h"
@@ -18,9 +19,22 @@
 namespace simbot::batch {
 
 CsvRow tournamentHeader() {
-  return {"pair_i",  "pair_j",  "round",       "a",         "b",
-          "seed",    "hits_a",  "hits_b",      "winner",    "tie_broken_by_coin",
-          "fault_a", "fault_b", "plant_fault", "reloads_a", "reloads_b"};
+  return {"pair_i",
+          "pair_j",
+          "round",
+          "a",
+          "b",
+          "seed",
+          "hits_a",
+          "hits_b",
+          "winner",
+          "winner_side",
+          "tie_broken_by_coin",
+          "fault_a",
+          "fault_b",
+          "plant_fault",
+          "reloads_a",
+          "reloads_b"};
 }
 
 nlohmann::json tournamentSettings(const TournamentConfig& c, const config::Profile& profile) {
@@ -42,16 +56,20 @@ nlohmann::json tournamentSettings(const TournamentConfig& c, const config::Profi
 
 namespace {
 
-CsvRow gameRow(const TournamentGame& g) {
+// a, b and winner are the programs' names as given; pair_i and pair_j their
+// places in the list (from 0); winner_side says which robot won (A or B).
+CsvRow gameRow(const TournamentGame& g, const std::vector<std::string>& programs) {
+  const auto name = [&](int p) { return programs[static_cast<size_t>(p)]; };
   return {std::to_string(g.i),
           std::to_string(g.j),
           std::to_string(g.round),
-          std::to_string(g.a),
-          std::to_string(g.b),
+          name(g.a),
+          name(g.b),
           std::to_string(g.seed),
           std::to_string(g.hitsA),
           std::to_string(g.hitsB),
-          std::to_string(g.winner),
+          name(g.winner),
+          g.winner == g.a ? "A" : "B",
           g.coin ? "1" : "0",
           g.faultA,
           g.faultB,
@@ -60,23 +78,32 @@ CsvRow gameRow(const TournamentGame& g) {
           std::to_string(g.reloadsB)};
 }
 
-TournamentGame gameFromRow(const CsvRow& r) {
+// The game a row of games.csv records; sides and winner are checked against
+// the pair and round (the names must be the programs this tournament plays).
+TournamentGame gameFromRow(const CsvRow& r, const std::vector<std::string>& programs) {
   TournamentGame g;
-  g.i = std::stoi(r[0]);
-  g.j = std::stoi(r[1]);
-  g.round = std::stoi(r[2]);
-  g.a = std::stoi(r[3]);
-  g.b = std::stoi(r[4]);
-  g.seed = std::stoull(r[5]);
-  g.hitsA = std::stoi(r[6]);
-  g.hitsB = std::stoi(r[7]);
-  g.winner = std::stoi(r[8]);
-  g.coin = r[9] == "1";
-  g.faultA = r[10];
-  g.faultB = r[11];
-  g.plantFault = r[12];
-  g.reloadsA = std::stoi(r.at(13));
-  g.reloadsB = std::stoi(r.at(14));
+  g.i = std::stoi(r.at(0));
+  g.j = std::stoi(r.at(1));
+  g.round = std::stoi(r.at(2));
+  const int n = static_cast<int>(programs.size());
+  if (g.i < 0 || g.j <= g.i || g.j >= n || g.round < 0) throw std::out_of_range("pair");
+  g.a = g.round % 2 == 0 ? g.i : g.j;
+  g.b = g.round % 2 == 0 ? g.j : g.i;
+  if (r.at(3) != programs[static_cast<size_t>(g.a)] ||
+      r.at(4) != programs[static_cast<size_t>(g.b)])
+    throw std::out_of_range("sides");
+  g.seed = std::stoull(r.at(5));
+  g.hitsA = std::stoi(r.at(6));
+  g.hitsB = std::stoi(r.at(7));
+  if (r.at(9) != "A" && r.at(9) != "B") throw std::out_of_range("winner_side");
+  g.winner = r.at(9) == "A" ? g.a : g.b;
+  if (r.at(8) != programs[static_cast<size_t>(g.winner)]) throw std::out_of_range("winner");
+  g.coin = r.at(10) == "1";
+  g.faultA = r.at(11);
+  g.faultB = r.at(12);
+  g.plantFault = r.at(13);
+  g.reloadsA = std::stoi(r.at(14));
+  g.reloadsB = std::stoi(r.at(15));
   g.done = true;
   return g;
 }
@@ -137,7 +164,7 @@ TournamentResult runTournament(const TournamentConfig& config, const config::Pro
     for (const CsvRow& row : table->previous()) {
       TournamentGame g;
       try {
-        g = gameFromRow(row);
+        g = gameFromRow(row, config.programs);
       } catch (const std::exception&) {
         throw sinks::UserError(
             fmt::format("simbot: --resume: a malformed row in {}/games.csv\n", table->dir()));
@@ -187,7 +214,7 @@ TournamentResult runTournament(const TournamentConfig& config, const config::Pro
       g.plantFault = fmt::format("error: internal error: {}", e.what());
     }
     g.done = true;
-    if (table) table->append(gameRow(g));
+    if (table) table->append(gameRow(g, config.programs));
   };
   parallelFor(todo.size(), config.threads, job, "tournament", config.progress, stop);
   result.stopped = std::any_of(result.games.begin(), result.games.end(),
@@ -224,18 +251,45 @@ TournamentResult runTournament(const TournamentConfig& config, const config::Pro
   return result;
 }
 
+namespace {
+
+// A program name as a Markdown table cell: | and \ escaped, a line break
+// (possible in a file name) a space.
+std::string markdownCell(const std::string& text) {
+  std::string out;
+  for (const char ch : text) {
+    if (ch == '|' || ch == '\\') out += '\\';
+    out += ch == '\n' || ch == '\r' ? ' ' : ch;
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string standingsTable(const TournamentResult& result) {
   const auto& c = result.config;
+  std::vector<std::string> names;
   size_t width = 7;
-  for (const auto& p : c.programs) width = std::max(width, p.size());
-  std::string out = fmt::format("{:>4}  {:<{}}  {:>6} {:>4} {:>6} {:>8} {:>12} {:>6} {:>7}\n",
-                                "rank", "program", width, "played", "wins", "losses", "hits for",
-                                "hits against", "points", "faulted");
+  for (const auto& s : result.standings) {
+    names.push_back(markdownCell(c.programs[static_cast<size_t>(s.program)]));
+    width = std::max(width, names.back().size());
+  }
+  // A Markdown table (GitHub's pipe tables), its columns padded so that it
+  // reads as a table in a terminal too.
+  std::string out = fmt::format(
+      "| rank | {:<{}} | played | wins | losses | hits for | hits against | points | faulted |\n",
+      "program", width);
+  out += fmt::format(
+      "| ---: | :{:-<{}} | -----: | ---: | -----: | -------: | -----------: | -----: | ------: |\n",
+      "", width - 1);
   int rank = 0;
-  for (const auto& s : result.standings)
-    out += fmt::format("{:>4}  {:<{}}  {:>6} {:>4} {:>6} {:>8} {:>12} {:>6} {:>7}\n", ++rank,
-                       c.programs[static_cast<size_t>(s.program)], width, s.played, s.wins,
-                       s.losses, s.hitsFor, s.hitsAgainst, s.points, s.faulted);
+  for (const auto& s : result.standings) {
+    out +=
+        fmt::format("| {:>4} | {:<{}} | {:>6} | {:>4} | {:>6} | {:>8} | {:>12} | {:>6} | {:>7} |\n",
+                    rank + 1, names[static_cast<size_t>(rank)], width, s.played, s.wins, s.losses,
+                    s.hitsFor, s.hitsAgainst, s.points, s.faulted);
+    ++rank;
+  }
   return out;
 }
 
@@ -284,7 +338,7 @@ nlohmann::json tournamentJson(const TournamentResult& result) {
 void writeTournamentOutputs(const TournamentResult& result, RunTable& table) {
   std::vector<CsvRow> rows;
   for (const auto& g : result.games)
-    if (g.done) rows.push_back(gameRow(g));
+    if (g.done) rows.push_back(gameRow(g, result.config.programs));
   table.rewrite(rows);
   const std::filesystem::path dir = table.dir();
   writeFileAtomically((dir / "standings.json").string(),

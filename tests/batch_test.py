@@ -7,7 +7,8 @@ Usage: batch_test.py SIMBOT ICEMAN FIG92 SPIRAL TURRET OUTDIR
   very runs.csv and summaries an uninterrupted bench writes (cmp).
 - A bench stopped with SIGINT exits 130, keeps every finished run (each one
   identical to the uninterrupted bench's row) and summarises those.
-- The same kill and resume for a tournament's games.csv and standings.
+- The same kill and resume for a tournament's games.csv and standings;
+  games.csv names the programs and standings.md is a Markdown table.
 - The output location is checked before the first run; a write that fails
   (a file-size limit) ends the bench with an error, not a success.
 - --resume refuses a table another batch wrote.
@@ -100,6 +101,21 @@ whole_t = OUT / "tournament-whole"
 subprocess.run(TOURNAMENT + ["--out", str(whole_t)], check=True, capture_output=True)
 games = rows(whole_t / "games.csv")
 check(games == 12, f"4 programs, 2 rounds: 12 games, not {games}")
+# games.csv names the programs; standings.md is a Markdown table
+import csv  # noqa: E402
+with open(whole_t / "games.csv", newline="") as f:
+    table = list(csv.DictReader(f))
+programs = {ICEMAN, FIG92, SPIRAL, TURRET}
+check(all(g["a"] in programs and g["b"] in programs and g["winner"] in (g["a"], g["b"])
+          and g["winner_side"] == ("A" if g["winner"] == g["a"] else "B") for g in table),
+      f"games.csv names the programs: {table[:1]}")
+md = (whole_t / "standings.md").read_text().splitlines()
+check(len(md) == 6 and all(line.startswith("| ") and line.endswith(" |") for line in md)
+      and md[0].split("|")[1:3] == [" rank ", md[0].split("|")[2]] and "program" in md[0]
+      and set(md[1]) <= set("|-: ") and all(line.count("|") == 10 for line in md),
+      "standings.md is a Markdown table: " + " / ".join(md[:3]))
+check(sorted(line.split("|")[2].strip() for line in md[2:]) == sorted(programs),
+      "standings.md has a row per program")
 killed_t = OUT / "tournament-killed"
 proc = start_and_wait(TOURNAMENT + ["--out", str(killed_t)], killed_t / "games.csv", 3)
 proc.send_signal(signal.SIGKILL)

@@ -205,7 +205,9 @@ def check_csv_files(simbot, a, b, out):
     run([simbot, "tournament", str(odd), b, "--rounds", "2", "--seconds", "2",
          "--out", str(out / "tournament")])
     games = load_games(out / "tournament" / "games.csv")
-    if len(games) != 2 or not set(games["winner"]) <= {0, 1}:
+    if (len(games) != 2 or not set(games["winner"]) <= {str(odd), b}
+            or not set(games["winner_side"]) <= {"A", "B"}
+            or set(games["a"]) != {str(odd), b}):
         failures.append(f"games.csv: {games}")
 
 
