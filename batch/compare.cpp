@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <tuple>
+#include <utility>
 
 #include "stats/stats.h"
 
@@ -38,6 +40,19 @@ int64_t total(const std::vector<const BenchRun*>& runs, size_t m) {
   return sum;
 }
 
+// CompareRow's reached and total of metric m over the runs measured.
+std::pair<int64_t, int64_t> reached(const std::vector<const BenchRun*>& runs, size_t m) {
+  const std::string& name = metricNames()[m];
+  if (metricKind(name) == MetricKind::Ratio)
+    return {total(runs, indexOf("hits")), total(runs, indexOf("shots"))};
+  int64_t got = 0;
+  for (const BenchRun* run : runs) {
+    const auto& v = run->metrics.values[m];
+    got += metricKind(name) == MetricKind::Count ? v.value_or(0) > 0 : v.has_value();
+  }
+  return {got, static_cast<int64_t>(runs.size())};
+}
+
 }  // namespace
 
 std::vector<CompareRow> compareRuns(const BenchResult& a, const BenchResult& b) {
@@ -50,6 +65,8 @@ std::vector<CompareRow> compareRuns(const BenchResult& a, const BenchResult& b) 
     row.metric = names[m];
     row.a = sa[0].robots[0].metrics[m];
     row.b = sb[0].robots[0].metrics[m];
+    std::tie(row.reachedA, row.totalA) = reached(ra, m);
+    std::tie(row.reachedB, row.totalB) = reached(rb, m);
     switch (metricKind(names[m])) {
       case MetricKind::Time: {
         row.test = "log-rank";
@@ -119,6 +136,10 @@ std::vector<CompareRow> compareRuns(const BenchResult& a, const BenchResult& b) 
     };
     row.a = winEstimate(sa[0]);
     row.b = winEstimate(sb[0]);
+    row.reachedA = sa[0].winsA;
+    row.totalA = sa[0].games;
+    row.reachedB = sb[0].winsA;
+    row.totalB = sb[0].games;
     const auto t = stats::fisherExact(sa[0].winsA, sa[0].games - sa[0].winsA, sb[0].winsA,
                                       sb[0].games - sb[0].winsA);
     row.statistic = finite(t.statistic);
@@ -134,8 +155,10 @@ nlohmann::json optionalJson(const std::optional<double>& v) {
   return v && std::isfinite(*v) ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }
 
-nlohmann::json estimateJson(const MetricEstimate& e) {
+nlohmann::json estimateJson(const MetricEstimate& e, int64_t reached, int64_t total) {
   return {{"estimator", e.estimator},
+          {"reached", reached},
+          {"total", total},
           {"n", e.n},
           {"events", e.events},
           {"estimate", optionalJson(e.estimate)},
@@ -159,8 +182,8 @@ nlohmann::json compareJson(const CompareResult& r) {
   for (const auto& row : r.rows)
     rows.push_back({{"metric", row.metric},
                     {"test", row.test},
-                    {"a", estimateJson(row.a)},
-                    {"b", estimateJson(row.b)},
+                    {"a", estimateJson(row.a, row.reachedA, row.totalA)},
+                    {"b", estimateJson(row.b, row.reachedB, row.totalB)},
                     {"statistic", optionalJson(row.statistic)},
                     {"p", optionalJson(row.p)}});
   return {{"family", benchLabel(r.a.config)},
@@ -180,11 +203,17 @@ std::string compareMarkdown(const CompareResult& r) {
       r.a.config.programs[0], r.profileA, r.b.config.programs[0], r.profileB, benchLabel(c),
       c.opponent.empty() ? "" : " vs " + c.opponent, c.seeds, c.seconds);
   out +=
-      "| metric | estimator | A (95% CI) | B (95% CI) | test | statistic | p |\n"
-      "|---|---|---|---|---|---:|---:|\n";
+      "| metric | estimator | A reached / total | A (95% CI) | B reached / total | B (95% CI) | "
+      "test | statistic | p |\n"
+      "|---|---|---:|---|---:|---|---|---:|---:|\n";
   for (const auto& row : r.rows)
-    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", row.metric, row.a.estimator,
-                       side(row.a), side(row.b), row.test, number(row.statistic), number(row.p));
+    out += fmt::format("| {} | {} | {}/{} | {} | {}/{} | {} | {} | {} | {} |\n", row.metric,
+                       row.a.estimator, row.reachedA, row.totalA, side(row.a), row.reachedB,
+                       row.totalB, side(row.b), row.test, number(row.statistic), number(row.p));
+  out +=
+      "\nreached / total: times, the runs that got there of the runs measured (a median is blank "
+      "while fewer than half got there); hit_ratio, hits of shots; counts, the runs with at least "
+      "one; stall_s, the runs with a value; win_rate, games won of games.\n";
   return out + '\n';
 }
 

@@ -21,6 +21,12 @@ struct CompareRow {
   std::string test;  // "log-rank", "Fisher exact", "exact Poisson rates", "permutation"
   MetricEstimate a, b;
   std::optional<double> statistic, p;  // none: the test does not apply (no events)
+  // What each side's estimate stands on, so that a blank estimate (a median
+  // fewer than half the runs reached, a mean of no values) is explained:
+  // times: runs that got there of the runs measured; the hit ratio: hits of
+  // shots; counts: runs with at least one of the runs measured; stall_s:
+  // runs with a value of the runs measured; win_rate: games won of games.
+  int64_t reachedA = 0, totalA = 0, reachedB = 0, totalB = 0;
 };
 
 struct CompareResult {

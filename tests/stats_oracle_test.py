@@ -156,6 +156,11 @@ def check_compare(simbot, a, b, out, seeds):
         ta, sa = time_sample(da, metric, 20.0)
         tb, sb = time_sample(db, metric, 20.0)
         got = rows[metric]
+        for side, df in (("a", da), ("b", db)):
+            want = (int(df[metric].notna().sum()), len(df))
+            if (got[side]["reached"], got[side]["total"]) != want:
+                failures.append(f"compare {metric} {side} reached/total "
+                                f"{got[side]['reached']}/{got[side]['total']}, runs.csv {want}")
         if got["test"] != "log-rank":
             failures.append(f"compare {metric}: test {got['test']}")
         if sa.sum() + sb.sum() == 0 or len(ta) == 0 or len(tb) == 0:
