@@ -9,8 +9,15 @@
 //   positives: such a variable reads 0 only because of the power-on state
 //   (or garbage under #class auto, or with the memory-fill profile option).
 //   An assignment, an initialiser, ++/--, a compound assignment or taking
-//   the address counts as assigning. Arrays, structs, parameters and globals
-//   are not checked (a global may be meant as a zero constant).
+//   the address counts as assigning. Arrays, structs and parameters are not
+//   checked.
+//   A global scalar or pointer (file-level static too) is checked over the
+//   whole program: read somewhere, and never assigned in any function
+//   (interrupt handlers included) nor by an initialiser, and its address
+//   never taken anywhere (in code or in another global's initialiser: a
+//   write through a pointer, or by a library routine such as ser_send_z1's
+//   &cc or memset(&x, ...), then counts). The BIOS's timer variables are
+//   written by the BIOS and not checked.
 //
 // send-without-delay: a ser_send_z1 that can run after an earlier one with
 //   no delay between them. The Z180's serial port sends the motor command
@@ -28,6 +35,7 @@
 //   only through goto labels are not followed.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <map>
 #include <set>
 #include <vector>
@@ -101,6 +109,31 @@ void uninitialized(const Function& f, Diagnostics& diags) {
                    : fmt::format("'{}' is read but never assigned in '{}': it holds 0 only "
                                  "because memory is zero at power-on",
                                  o->name, f.name));
+  }
+}
+
+// Globals read somewhere in the program and assigned nowhere (above).
+void uninitializedGlobals(const Program& prog, Diagnostics& diags) {
+  std::set<const Obj*> written;
+  std::map<const Obj*, Pos> reads;
+  for (const Obj* o : prog.globals) collectInit(o->init, written, reads);
+  for (const Function* f : prog.functions) {
+    for (const Obj* o : f->locals) collectInit(o->init, written, reads);
+    collectUses(f->body, written, reads);
+  }
+  // Each is reported at the first read met (functions in definition order).
+  for (const Obj* o : prog.globals) {
+    if (o->init || o->isExtern || o->biosTimer || o->storage == Storage::Function) continue;
+    if (!o->type || !(isArith(o->type) || o->type->kind == TypeKind::Ptr)) continue;
+    if (std::find(prog.timer.begin(), prog.timer.end(), o) != prog.timer.end()) continue;
+    if (written.count(o)) continue;
+    const auto r = reads.find(o);
+    if (r == reads.end()) continue;
+    diags.warn(r->second, "uninitialized",
+               fmt::format("global '{}' is read but never assigned anywhere in the program: it "
+                           "holds 0 only because memory is zero at power-on (not with the "
+                           "profile's random_memory); initialise it, or assign it before use",
+                           o->name));
   }
 }
 
@@ -324,6 +357,7 @@ void sendWithoutDelay(const Program& prog, Diagnostics& diags) {
 
 void analyze(const Program& prog, Diagnostics& diags) {
   for (const Function* f : prog.functions) uninitialized(*f, diags);
+  uninitializedGlobals(prog, diags);
   sendWithoutDelay(prog, diags);
 }
 

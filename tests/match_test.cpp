@@ -435,6 +435,25 @@ TEST(Match, CostateHunterPlaysIcemanAndLatchesFrames) {
   EXPECT_GT(a.hits, 0);
 }
 
+// The same robot with power-on RAM randomised (the profile's random_memory):
+// it sets cc and every other flag it reads before the loop first reads them,
+// so it still latches frames from the start (issue 25: it used to wait for
+// a cc that the random fill had left non-zero, and sent nothing in 180 s).
+TEST(Match, CostateHunterLatchesFramesWithRandomPowerOnMemory) {
+  const std::string hunter = SIMBOT_SOURCE_DIR "/programs/costate_hunter.dc";
+  for (const uint64_t seed : {1u, 2u, 3u}) {
+    SCOPED_TRACE(seed);
+    auto c = matchConfig({{"A", hunter, compileFile(hunter)}}, 5);
+    c.arena.robots[0].params.random_memory = true;
+    c.seed = seed;
+    const auto r = scheduler::runMatch(c);
+    const auto& a = r.robots[0];
+    EXPECT_FALSE(a.fault.has_value());
+    EXPECT_GT(a.framesLatched, 50);
+    EXPECT_EQ(a.framesOverwritten, 0);
+  }
+}
+
 // Issue 24's student program: the bearing to a remembered point with atan2
 // and sqrt, steered through a table of function pointers. It compiles with
 // no warning, its code calls through pointers and reaches the math
