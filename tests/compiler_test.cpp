@@ -950,4 +950,20 @@ TEST(CompilerWarnings, ReferenceProgramsWarnOnlyOfImplicitDeclarations) {
     for (const auto& d : r.warnings) EXPECT_EQ(d.warning, "implicit-function-declaration");
   }
 }
+
+// The shipped programs (programs/*.dc, what the quickstart and the README
+// use) compile with no warning at all: prototypes before their calls, every
+// global read assigned somewhere (issue 25).
+TEST(CompilerWarnings, ShippedProgramsCompileWithoutWarnings) {
+  int seen = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(SIMBOT_SOURCE_DIR) / "programs")) {
+    if (entry.path().extension() != ".dc") continue;
+    ++seen;
+    const std::string name = entry.path().filename().string();
+    Result r = simbot::compiler::compileFile(entry.path().string());
+    ASSERT_TRUE(r.image.has_value()) << name;
+    for (const auto& d : r.warnings) ADD_FAILURE() << name << ": " << d.format();
+  }
+  EXPECT_GE(seen, 4);
+}
 }  // namespace
