@@ -183,6 +183,8 @@ void SweepWriter::writeLocked(const std::string& text) {
 
 void SweepWriter::put(size_t index, const CsvRow& row) {
   std::lock_guard lock(mutex_);
+  // Finished: nothing changes (a row taken now would count as written).
+  if (!rows_) throw sinks::UserError(fmt::format("simbot: sweep: '{}' is finished\n", path_));
   if (index < next_ || index >= end_)
     throw std::logic_error(fmt::format("simbot: sweep: run {} is not awaited", index));
   const auto at = std::lower_bound(waiting_.begin(), waiting_.end(), index,

@@ -8,6 +8,8 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -137,12 +139,53 @@ struct Sweep {
   std::vector<batch::SweepRun> runs;
   explicit Sweep(const std::string& path)
       : spec(config::loadSweep(path, batch::benchFamilies())), runs(batch::expandSweep(spec)) {}
+  // Every program the sweep plays (its programs, then its opponents), as
+  // the paths a run opens, each once.
+  std::vector<std::string> programs() const {
+    std::vector<std::string> out;
+    for (const auto* list : {&spec.programs, &spec.opponents})
+      for (const auto& p : *list)
+        if (const std::string path = config::sweepPath(spec, p);
+            std::find(out.begin(), out.end(), path) == out.end())
+          out.push_back(path);
+    return out;
+  }
   batch::CsvRow row(size_t index) const {
     if (index >= runs.size()) throw py::index_error("no run " + std::to_string(index));
     py::gil_scoped_release release;
     return batch::runSweepRow(spec, runs[index]);
   }
 };
+
+// batch::shardRange with its K/N checked (the CLI's come from parseShard):
+// 1 <= k <= n, and runs * n within size_t.
+std::pair<size_t, size_t> checkedShardRange(size_t runs, size_t k, size_t n) {
+  if (k < 1 || n < 1 || k > n)
+    throw py::value_error("shard_range: needs 1 <= k <= n, got k " + std::to_string(k) + ", n " +
+                          std::to_string(n));
+  if (runs > std::numeric_limits<size_t>::max() / n)
+    throw py::value_error("shard_range: " + std::to_string(runs) + " runs is too many");
+  return batch::shardRange(runs, k, n);
+}
+
+std::unique_ptr<batch::SweepWriter> makeSweepWriter(const std::string& path,
+                                                    const batch::CsvRow& header, bool writeHeader,
+                                                    size_t begin, size_t end, bool resume) {
+  if (begin > end)
+    throw py::value_error("SweepWriter: begin " + std::to_string(begin) + " is after end " +
+                          std::to_string(end));
+  if (header.empty()) throw py::value_error("SweepWriter: the header is empty");
+  return std::make_unique<batch::SweepWriter>(path, header, writeHeader, begin, end, resume);
+}
+
+// A Dask worker's compilations keep their warnings to themselves: the driver
+// prints each program's once (python/simbot/sweep.py), as a local sweep does.
+void silenceCompileWarnings() {
+  compiler::Options options;
+  for (const auto& info : compiler::warningList())
+    options.disabledWarnings.insert(std::string(info.name));
+  runs::setCompileOptions(options);
+}
 
 }  // namespace
 
@@ -168,13 +211,14 @@ PYBIND11_MODULE(_simbot, m) {
       .def(py::init<const std::string&>(), py::arg("path"))
       .def("__len__", [](const Sweep& s) { return s.runs.size(); })
       .def("header", [](const Sweep& s) { return batch::sweepHeader(s.spec); })
+      .def("programs", &Sweep::programs)
       .def("row", &Sweep::row, py::arg("index"));
   m.def("parse_shard", &batch::parseShard, py::arg("text"));
-  m.def("shard_range", &batch::shardRange, py::arg("runs"), py::arg("k"), py::arg("n"));
+  m.def("shard_range", &checkedShardRange, py::arg("runs"), py::arg("k"), py::arg("n"));
+  m.def("silence_compile_warnings", &silenceCompileWarnings);
   py::class_<batch::SweepWriter>(m, "SweepWriter")
-      .def(py::init<const std::string&, const batch::CsvRow&, bool, size_t, size_t, bool>(),
-           py::arg("path"), py::arg("header"), py::arg("write_header"), py::arg("begin"),
-           py::arg("end"), py::arg("resume"))
+      .def(py::init(&makeSweepWriter), py::arg("path"), py::arg("header"), py::arg("write_header"),
+           py::arg("begin"), py::arg("end"), py::arg("resume"))
       .def("next", &batch::SweepWriter::next)
       .def("put", &batch::SweepWriter::put, py::arg("index"), py::arg("row"))
       .def("pending", &batch::SweepWriter::pending)

@@ -10,12 +10,14 @@ import inspect
 import io
 import json
 import os
+import stat
 import warnings
 
 from . import _simbot
 from ._simbot import Error
 
-__all__ = ["Error", "compile", "solo", "match", "bench", "read_trace", "trace_frame"]
+__all__ = ["Error", "compile", "solo", "match", "bench", "read_trace", "trace_frame",
+           "MAX_TRACE_BYTES"]
 
 
 def compile(path, disasm=False):
@@ -29,10 +31,49 @@ def trace_frame(lines):
     return pandas.DataFrame.from_records([json.loads(line) for line in lines])
 
 
+# The largest trace read_trace reads, as the CLI's view and explain
+# (files/files.h, kMaxTraceBytes): 16 GiB.
+MAX_TRACE_BYTES = 16 << 30
+
+
 def read_trace(path):
-    """A trace file written with --trace (or trace=...) as a DataFrame."""
-    with open(path, encoding="utf-8") as f:
-        return trace_frame([line for line in f if line.strip()])
+    """A trace file written with --trace (or trace=...) as a DataFrame.
+
+    The file must be a regular file of at most MAX_TRACE_BYTES (16 GiB);
+    anything else (a directory, /dev/zero, a FIFO, which is not waited on)
+    raises simbot.Error at once, as the CLI refuses it."""
+    name = os.fspath(path)
+
+    def refuse(problem):
+        return Error(f"simbot: read_trace: '{name}': {problem}")
+
+    try:
+        # Opened without waiting (a FIFO with no writer), then checked.
+        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as e:
+        raise refuse(e.strerror or str(e)) from None
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise refuse("it is a directory")
+        if not stat.S_ISREG(st.st_mode):
+            raise refuse("not a regular file")
+        if st.st_size > MAX_TRACE_BYTES:
+            raise refuse(f"{st.st_size} bytes is more than the limit of {MAX_TRACE_BYTES}")
+        os.set_blocking(fd, True)
+        f = os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+    lines, size = [], 0
+    with f:
+        for line in f:
+            size += len(line)  # a file that grows while it is read
+            if size > MAX_TRACE_BYTES:
+                raise refuse(f"more than the limit of {MAX_TRACE_BYTES} bytes")
+            if line.strip():
+                lines.append(line.decode("utf-8"))
+    return trace_frame(lines)
 
 
 # The run options, as runs/run_options.def defines them for the command

@@ -10,10 +10,22 @@ and the simbot package installed on every worker.
 """
 import argparse
 import functools
+import logging
 import os
+import socket
 import sys
+import time
+import urllib.parse
 
 from . import _simbot
+
+# How long connecting to a Dask scheduler may take before --dask gives up
+# (docs/tools.md states it): a refused connection is reported at once.
+CONNECT_TIMEOUT_S = 10
+
+
+class DaskError(Exception):
+    """A failure of the cluster, reported in one line."""
 
 
 @functools.lru_cache(maxsize=4)
@@ -21,33 +33,86 @@ def _sweep(path):
     return _simbot.Sweep(path)
 
 
+@functools.lru_cache(maxsize=1)
+def _quiet_worker():
+    # The driver prints each program's compiler warnings once; a worker's
+    # compilations would print them again, once per worker process.
+    _simbot.silence_compile_warnings()
+
+
 def _row(path, index):
+    _quiet_worker()
     return index, _sweep(path).row(index)
+
+
+def _probe(address):
+    """A tcp:// scheduler that refuses or cannot be resolved fails now, not
+    after Dask's retries."""
+    parsed = urllib.parse.urlsplit(address if "://" in address else "tcp://" + address)
+    if parsed.scheme != "tcp":
+        return
+    try:
+        host, port = parsed.hostname, parsed.port
+    except ValueError as e:
+        raise DaskError(f"'{address}' is not an address ({e})") from None
+    if not host or port is None:
+        raise DaskError(f"'{address}' is not an address (tcp://HOST:PORT or local:N)")
+    try:
+        socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
+    except OSError as e:
+        reason = e.strerror or str(e) or type(e).__name__
+        raise DaskError(f"cannot connect to {address}: {reason}") from None
 
 
 def _client(address):
     from dask.distributed import Client, LocalCluster
     if address.startswith("local:"):
-        workers = int(address[len("local:"):])
+        try:
+            workers = int(address[len("local:"):])
+        except ValueError:
+            workers = 0
         if workers < 1:
-            raise ValueError("--dask local:N needs N >= 1")
+            raise DaskError("local:N needs a whole number N >= 1")
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                dashboard_address=None)
-        return Client(cluster), cluster
-    return Client(address), None
+        return Client(cluster, timeout=CONNECT_TIMEOUT_S), cluster
+    _probe(address)
+    try:
+        return Client(address, timeout=CONNECT_TIMEOUT_S), None
+    except (OSError, TimeoutError) as e:
+        raise DaskError(f"cannot connect to {address} within {CONNECT_TIMEOUT_S} s: "
+                        f"{_one_line(e)}") from None
 
 
-def run(path, out, dask, shard="1/1", header=True, resume=False):
-    """Runs the sweep (or its shard) on the Dask cluster at `dask` into `out`."""
+def _one_line(e):
+    text = " ".join(str(e).split())
+    return text or type(e).__name__
+
+
+def _print_warnings(sweep):
+    """Each program's compiler warnings, once (as a local sweep prints them)."""
+    for program in sweep.programs():
+        for line in _simbot.compile(program)["diagnostics"]:
+            print(line, file=sys.stderr)
+
+
+def run(path, out, dask, shard="1/1", header=True, resume=False, progress=True):
+    """Runs the sweep (or its shard) on the Dask cluster at `dask` into `out`.
+    With progress, a line on stderr each time another tenth of the runs is
+    done."""
     from dask.distributed import as_completed
     path = os.path.abspath(path)
     sweep = _sweep(path)
     k, n = _simbot.parse_shard(shard)
     begin, end = _simbot.shard_range(len(sweep), k, n)
-    writer = _simbot.SweepWriter(out, sweep.header(), header, begin, end, resume)
-    todo = list(range(writer.next(), end))
+    # Connected first: a cluster that cannot be reached leaves `out` as it was.
     client, cluster = _client(dask)
     try:
+        writer = _simbot.SweepWriter(out, sweep.header(), header, begin, end, resume)
+        todo = list(range(writer.next(), end))
+        if progress:
+            _print_warnings(sweep)
+        start, done, shown = time.monotonic(), 0, 0
         # By reference to simbot.sweep._row (run as __main__, _row would be
         # pickled by value with this module's globals).
         from simbot.sweep import _row as row_of
@@ -56,12 +121,17 @@ def run(path, out, dask, shard="1/1", header=True, resume=False):
             index, row = future.result()
             writer.put(index, row)
             future.release()
+            done += 1
+            if progress and (done * 10 // len(todo) > shown or done == len(todo)):
+                shown = done * 10 // len(todo)
+                print(f"sweep: {done}/{len(todo)} done in {time.monotonic() - start:.1f} s "
+                      f"on Dask", file=sys.stderr, flush=True)
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
     writer.finish()
-    return end - begin
+    return begin, end, len(sweep)
 
 
 def main(argv=None):
@@ -74,12 +144,26 @@ def main(argv=None):
     p.add_argument("--no-header", action="store_true")
     p.add_argument("--resume", action="store_true")
     a = p.parse_args(argv)
+    # Dask's own log lines (reconnection attempts, a worker's traceback) are
+    # not the user's: a failure is the one line below.
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
     try:
-        runs = run(a.sweep, a.out, a.dask, a.shard, not a.no_header, a.resume)
-    except _simbot.Error as e:
-        print(e, file=sys.stderr)
+        begin, end, total = run(a.sweep, a.out, a.dask, a.shard, not a.no_header, a.resume)
+    except _simbot.Error as e:  # simbot's own message, as the CLI prints it
+        print(str(e), file=sys.stderr)
         return 1
-    print(f"simbot: {runs} runs on Dask ({a.dask}); wrote {a.out}", file=sys.stderr)
+    except DaskError as e:
+        print(f"simbot: --dask: {e}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"simbot: --dask: interrupted; {a.out} holds the runs finished in order; "
+              "--resume continues", file=sys.stderr)
+        return 130
+    except Exception as e:  # the cluster's failures, a worker's exception
+        print(f"simbot: --dask: {type(e).__name__}: {_one_line(e)}", file=sys.stderr)
+        return 1
+    print(f"simbot: {end - begin} runs (runs {begin} to {end} of {total}) on Dask ({a.dask}); "
+          f"wrote {a.out}", file=sys.stderr)
     return 0
 
 

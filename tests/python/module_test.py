@@ -4,6 +4,10 @@ time), a solo run's trace DataFrame is the CLI's --trace file record by
 record, and a bench's summary and runs are the CLI's summary.json and
 runs.csv.
 
+It cannot be crashed through its private API (_simbot): a bad shard, the
+sweep writer finished twice or written after it finished, a trace that is
+no regular file, threads that cannot be created are exceptions.
+
 usage: module_test.py SIMBOT ICEMAN FIG92 WORKDIR (PYTHONPATH: build/python)
 """
 import csv
@@ -98,6 +102,78 @@ try:
     check(False, "match: --seconds -1 accepted")
 except simbot.Error as e:
     check("--seconds must be in" in str(e), f"match: error message {e}")
+
+# The module checks its arguments and cannot be crashed (issue 25): each
+# case below answers with an exception, never a signal.
+from simbot import _simbot  # noqa: E402
+
+
+def raises(kind, what, call):
+    try:
+        call()
+        check(False, f"{what}: no exception")
+    except kind as e:
+        return str(e)
+    except Exception as e:  # noqa: BLE001
+        check(False, f"{what}: {type(e).__name__} {e}, not {kind.__name__}")
+    return ""
+
+
+# shard_range: K/N checked (a division by N = 0 was SIGFPE).
+raises(ValueError, "shard_range(10, 1, 0)", lambda: _simbot.shard_range(10, 1, 0))
+raises(ValueError, "shard_range(10, 0, 3)", lambda: _simbot.shard_range(10, 0, 3))
+raises(ValueError, "shard_range(10, 4, 3)", lambda: _simbot.shard_range(10, 4, 3))
+check(_simbot.shard_range(10, 2, 3) == (3, 6), "shard_range(10, 2, 3)")
+# The sweep writer: finish twice, put after finish, a run not awaited, a
+# begin after its end.
+table = os.path.join(work, "writer.csv")
+w = _simbot.SweepWriter(table, ["run", "x"], True, 0, 1, False)
+w.put(0, ["0", "a"])
+w.finish()
+w.finish()  # twice: nothing more (it used to segfault)
+raises(RuntimeError, "put of a run already written", lambda: w.put(0, ["0", "b"]))
+with open(table, encoding="utf-8") as f:
+    check(f.read() == "run,x\n0,a\n", "writer: the table after finish")
+w = _simbot.SweepWriter(os.path.join(work, "writer2.csv"), ["run"], True, 0, 2, False)
+raises(RuntimeError, "put of a run not awaited", lambda: w.put(5, ["5"]))
+w.put(1, ["1"])
+raises(simbot.Error, "finish with a row missing", w.finish)
+message = raises(simbot.Error, "put after finish", lambda: w.put(0, ["0"]))
+check("is finished" in message, f"put after finish: {message}")
+raises(simbot.Error, "finish again", w.finish)
+raises(ValueError, "a writer whose begin is after its end",
+       lambda: _simbot.SweepWriter(os.path.join(work, "w3.csv"), ["run"], True, 3, 1, False))
+# read_trace: a regular file of at most 16 GiB, checked before reading.
+message = raises(simbot.Error, "read_trace('/dev/zero')", lambda: simbot.read_trace("/dev/zero"))
+check("not a regular file" in message, f"read_trace('/dev/zero'): {message}")
+fifo = os.path.join(work, "fifo")
+if not os.path.exists(fifo):
+    os.mkfifo(fifo)
+message = raises(simbot.Error, "read_trace(FIFO)", lambda: simbot.read_trace(fifo))
+check("not a regular file" in message, f"read_trace(FIFO): {message}")
+raises(simbot.Error, "read_trace(directory)", lambda: simbot.read_trace(work))
+raises(simbot.Error, "read_trace(missing)", lambda: simbot.read_trace(os.path.join(work, "no")))
+check(simbot.MAX_TRACE_BYTES == 16 << 30, "read_trace's stated limit is 16 GiB")
+# A bench whose threads cannot all be created is simbot.Error, not an
+# abort of Python: a child process with its address space limited so that
+# 400 thread stacks cannot fit.
+child = subprocess.run([sys.executable, "-c", f"""
+import resource, sys
+import simbot
+with open("/proc/self/status") as f:
+    size = next(int(l.split()[1]) for l in f if l.startswith("VmSize:")) * 1024
+limit = size + (256 << 20)
+resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+try:
+    simbot.bench({iceman!r}, "stationary", 400, seconds=0.05, threads=400)
+except simbot.Error as e:
+    print("Error:", e)
+    sys.exit(0)
+print("no error")
+"""], capture_output=True, text=True, env={**os.environ, "MALLOC_ARENA_MAX": "1"}, timeout=120)
+check(child.returncode == 0 and "cannot start" in child.stdout and "worker threads" in child.stdout,
+      f"bench with threads it cannot create: status {child.returncode}, "
+      f"{child.stdout.strip()[-200:]} {child.stderr.strip()[-300:]}")
 
 print("module_test:", "FAILED" if failures else "ok")
 sys.exit(1 if failures else 0)

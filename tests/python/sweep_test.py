@@ -8,6 +8,11 @@ seed S is the bench's run 0 with --seeds 1 --seed S under the same profile.
 
 usage: sweep_test.py SIMBOT ICEMAN TURRET WORKDIR [--no-dask] (PYTHONPATH: build/python)
 
+Through --dask, a program's compiler warning is printed once, with
+progress lines and a last line; a refused address (tcp://127.0.0.1:9) is
+one line, `simbot: --dask: ...`, in well under the 10-s connect timeout,
+and leaves --out as it was.
+
 --no-dask (the sanitizer builds, which have no Python module): everything
 but the Dask run.
 """
@@ -88,8 +93,50 @@ if __name__ == "__main__":
             dask = os.path.join(work, "dask.csv")
             sweep(cli, sweep_file, "--out", dask, "--dask", cluster.scheduler_address)
             check(read(dask) == table, "dask: table differs from the local one")
+            # A program with a compiler warning: printed once (not once per
+            # worker), with progress lines and a last line.
+            warned = os.path.join(work, "warned.dc")
+            with open(iceman, encoding="utf-8") as f:
+                source = f.read()
+            with open(warned, "w", encoding="utf-8") as f:
+                f.write(source + "\nunused() { return 1; return 2; }\n")
+            small = os.path.join(work, "small.toml")
+            with open(small, "w", encoding="utf-8") as f:
+                f.write(f'programs = ["{warned}"]\nfamilies = ["stationary"]\nseconds = 1.0\n'
+                        '[seeds]\ncount = 4\n')
+            r = subprocess.run([cli, "sweep", small, "--out", os.path.join(work, "small.csv"),
+                                "--dask", cluster.scheduler_address],
+                               capture_output=True, text=True, timeout=120)
+            lines = r.stderr.splitlines()
+            check(r.returncode == 0, f"dask, warned program: status {r.returncode}: {r.stderr}")
+            check(sum("warning: " in line and "unreachable" in line for line in lines) == 1,
+                  f"dask: the warning is printed once: {lines}")
+            check(any(line.startswith("sweep: 4/4 done in ") for line in lines)
+                  and lines[-1].startswith("simbot: 4 runs (runs 0 to 4 of 4) on Dask"),
+                  f"dask: progress and a last line: {lines}")
         finally:
             cluster.close()
+        # A refused address: one line, at once (Dask alone retries for 30 s).
+        import time
+        refused = os.path.join(work, "refused.csv")
+        with open(refused, "w", encoding="utf-8") as f:
+            f.write("an earlier table\n")
+        started = time.monotonic()
+        r = subprocess.run([cli, "sweep", sweep_file, "--out", refused,
+                            "--dask", "tcp://127.0.0.1:9"], capture_output=True, text=True,
+                           timeout=60)
+        took = time.monotonic() - started
+        lines = r.stderr.splitlines()
+        check(r.returncode == 1 and len(lines) == 1 and lines[0].startswith("simbot: --dask: ")
+              and "127.0.0.1:9" in lines[0],
+              f"dask, refused address: status {r.returncode}, {r.stderr.strip()[-500:]}")
+        check(took < 10, f"dask, refused address: {took:.1f} s")
+        check(read(refused) == b"an earlier table\n", "dask, refused address: --out was touched")
+        r = subprocess.run([cli, "sweep", sweep_file, "--out", os.path.join(work, "bad-addr.csv"),
+                            "--dask", "local:x"], capture_output=True, text=True, timeout=60)
+        check(r.returncode == 1 and r.stderr.count("\n") == 1
+              and r.stderr.startswith("simbot: --dask: "),
+              f"dask, local:x: status {r.returncode}, {r.stderr.strip()[-500:]}")
 
     # Three shards, the later two without the header, concatenated.
     parts = b""
