@@ -12,7 +12,10 @@ using scheduler::kTicksPerSecond;
 
 void MetricsObserver::onEyeRead(int robot, Tick t, int channel, int value) {
   if (robot != robot_ || (channel != 0 && channel != 1)) return;
-  stall_.eyeRead(t, channel, value);
+  if (value != lastEye_[channel]) {
+    lastEye_[channel] = value;
+    stallInputs_.push_back({StallInput::Kind::Eye, t, channel, value});
+  }
   if (channel == 0) {
     pairOpen_ = true;
     pairLeft_ = value;
@@ -38,8 +41,22 @@ void MetricsObserver::onFrame(int robot, Tick t, bool latched) {
     ++framesRejected;
     return;
   }
-  stall_.frameLatched(t);
+  stallInputs_.push_back({StallInput::Kind::Latch, t});
   latches_.push_back(t);
+}
+
+void MetricsObserver::onPose(int robot, Tick t, double x_ft, double y_ft) {
+  if (robot == robot_) stallInputs_.push_back({StallInput::Kind::Pose, t, 0, 0, x_ft, y_ft});
+}
+
+void MetricsObserver::onHalt(int robot, Tick t) {
+  if (robot == robot_) stallInputs_.push_back({StallInput::Kind::Halt, t});
+}
+
+void MetricsObserver::onReload(int robot, Tick t) {
+  if (robot != robot_) return;
+  lastEye_[0] = lastEye_[1] = -1;
+  stallInputs_.push_back({StallInput::Kind::Reload, t});
 }
 
 void MetricsObserver::onPlantEvent(Tick t, const plant::Event& e) {
@@ -67,8 +84,31 @@ void MetricsObserver::onPlantEvent(Tick t, const plant::Event& e) {
 }
 
 void MetricsObserver::finish(Tick endTick) {
-  stall_.finish(endTick);
-  stallTicks = stall_.total();
+  // Stable: within a tick, the order of the calls, which is the trace's.
+  std::stable_sort(stallInputs_.begin(), stallInputs_.end(),
+                   [](const StallInput& a, const StallInput& b) { return a.t < b.t; });
+  reports::StallWatch stall = stall_;
+  for (const StallInput& in : stallInputs_) {
+    switch (in.kind) {
+      case StallInput::Kind::Eye:
+        stall.eyeRead(in.t, in.channel, in.value);
+        break;
+      case StallInput::Kind::Latch:
+        stall.frameLatched(in.t);
+        break;
+      case StallInput::Kind::Pose:
+        stall.pose(in.t, in.x, in.y);
+        break;
+      case StallInput::Kind::Halt:
+        stall.halted(in.t);
+        break;
+      case StallInput::Kind::Reload:
+        stall.reloaded(in.t);
+        break;
+    }
+  }
+  stall.finish(endTick);
+  stallTicks = stall.total();
   std::sort(pioAccepts_.begin(), pioAccepts_.end());
   std::sort(latches_.begin(), latches_.end());
   std::sort(leaves_.begin(), leaves_.end());

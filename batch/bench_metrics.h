@@ -38,6 +38,9 @@ class MetricsObserver final : public scheduler::MatchObserver {
   void onInterruptAccepted(int robot, Tick t, vm::Irq irq) override;
   void onFrame(int robot, Tick t, bool latched) override;
   void onPlantEvent(Tick t, const plant::Event& e) override;
+  void onPose(int robot, Tick t, double x_ft, double y_ft) override;
+  void onHalt(int robot, Tick t) override;
+  void onReload(int robot, Tick t) override;
 
   // Closes the run at `endTick` (a stall still open runs to it).
   void finish(Tick endTick);
@@ -55,6 +58,17 @@ class MetricsObserver final : public scheduler::MatchObserver {
   bool pairOpen_ = false;
   int pairLeft_ = 0;
   reports::StallWatch stall_;
+  // What the StallWatch is fed, kept until finish() feeds it in tick order
+  // (the observer's calls are not: a pose sample comes after the VM ran
+  // past it). Eye readings only where they change, as the trace's ad_read.
+  struct StallInput {
+    enum class Kind : uint8_t { Eye, Latch, Pose, Halt, Reload } kind;
+    Tick t;
+    int channel = 0, value = 0;
+    double x = 0, y = 0;
+  };
+  std::vector<StallInput> stallInputs_;
+  int lastEye_[2] = {-1, -1};
   // edge legs, kept raw and resolved in finish()
   std::optional<plant::Detector> edgeDetector_;
   std::vector<Tick> pioAccepts_, latches_, leaves_;

@@ -103,6 +103,7 @@ struct Explainer::State {
     // The chains of the latest send and the one before it (serial_send),
     // by tick: a frame_overwritten comes right after the send that made it.
     std::pair<Tick, std::string> lastCalls{-1, ""}, callsBefore{-1, ""};
+    std::optional<std::pair<Tick, std::string>> lastFault;  // for its reload
   };
   Robot r[2];
   struct PendingShot {
@@ -209,6 +210,7 @@ struct Explainer::State {
     me.previous = me.last;
     me.last = s;
     resolveShots(x.robot, s);
+    stallFed(x.robot, me.stall.pose(t, x.x_ft, x.y_ft), t, false);
     for (const std::size_t run : me.handlers) {
       auto& last = me.handlerLast[run];
       if (last) report.handler_runs[run].moved_ft += std::hypot(x.x_ft - last->x, x.y_ft - last->y);
@@ -318,15 +320,34 @@ struct Explainer::State {
     }
   }
   void on(Tick t, const rec::Exit& x) {
+    if (x.robot >= robots) return;
     r[x.robot].halted = "exited";
-    report.faults.push_back({x.robot, t, "main returned", 0});
+    stallFed(x.robot, r[x.robot].stall.halted(t), t, false);
+    report.faults.push_back({x.robot, t, "main returned", 0, "", 0});
   }
   void on(Tick t, const rec::Fault& x) {
+    if (x.robot >= robots) return;
     r[x.robot].halted = "faulted";
-    report.faults.push_back({x.robot, t, x.message, static_cast<int>(x.line)});
+    r[x.robot].lastFault = {t, x.message};
+    stallFed(x.robot, r[x.robot].stall.halted(t), t, false);
+    report.faults.push_back(
+        {x.robot, t, x.message, static_cast<int>(x.line), x.calls, static_cast<int>(x.depth)});
+  }
+  void on(Tick t, const rec::Reload& x) {
+    if (x.robot >= robots) return;
+    Robot& me = r[x.robot];
+    me.halted.clear();
+    stallFed(x.robot, me.stall.reloaded(t), t, false);
+    std::string what =
+        fmt::format("reloaded (--reload-on-fault, reload {}): main started again", x.reloads);
+    if (me.lastFault)
+      what += fmt::format(" {:.3f} s after the fault at {:.3f} s ({})",
+                          static_cast<double>(t - me.lastFault->first) / tps(),
+                          static_cast<double>(me.lastFault->first) / tps(), me.lastFault->second);
+    report.faults.push_back({x.robot, t, std::move(what), 0, "", 0});
   }
   void on(Tick t, const rec::PlantFault& x) {
-    report.faults.push_back({-1, t, "plant fault: " + x.message, 0});
+    report.faults.push_back({-1, t, "plant fault: " + x.message, 0, "", 0});
   }
   void on(Tick, const rec::EdgeEnter& x) {
     eachOpenRun(x.robot, [](HandlerRun& h) { ++h.edges; });
@@ -399,11 +420,11 @@ struct Explainer::State {
   }
   void on(Tick t, const rec::RefereePutBack& x) {
     report.referee.push_back(
-        {x.robot, t, "put back inside the wire (its centre left the field)", 0});
+        {x.robot, t, "put back inside the wire (its centre left the field)", 0, "", 0});
   }
   void on(Tick t, const rec::RefereeTurn& x) {
     report.referee.push_back(
-        {x.robot, t, "turned 45 deg (too many bumper reflexes or edge events)", 0});
+        {x.robot, t, "turned 45 deg (too many bumper reflexes or edge events)", 0, "", 0});
   }
   void on(Tick, const rec::RobotResult& x) {
     if (x.robot >= robots) return;
@@ -609,6 +630,21 @@ struct Fmt {
       if (!best || x.to - x.from > best->to - best->from) best = &x;
     return best;
   }
+  // A handler run's time in service; one that never returned, to the end.
+  std::string inService(const HandlerRun& h) const {
+    if (h.to) return dur(*h.to - h.from);
+    return fmt::format("{} (still in service at the end, {} s: it never returned)",
+                       dur(r.end_t - h.from), s(r.end_t));
+  }
+  // A fault's line and call chain: " (line 7; call depth 251: main:12 > deep:7 x 251)".
+  static std::string faultWhere(const Event& x) {
+    if (x.line <= 0 && x.calls.empty()) return "";
+    std::string out = " (";
+    if (x.line > 0) out += fmt::format("line {}", x.line);
+    if (!x.calls.empty())
+      out += fmt::format("{}call depth {}: {}", x.line > 0 ? "; " : "", x.depth, x.calls);
+    return out + ")";
+  }
   std::string contactEnd(const Contact& c) const {
     return c.end_t ? fmt::format("for {}", dur(*c.end_t - c.t)) : "until the end";
   }
@@ -650,8 +686,8 @@ std::vector<TextLine> textLines(const Report& r) {
 
   add("");
   add(
-      fmt::format("Stalls: the program seeing the opponent and no motor frame latched for more "
-                  "than 1 s ({})",
+      fmt::format("Stalls: the program running and seeing the opponent, no motor frame latched "
+                  "and the robot standing still, for more than 1 s ({})",
                   r.stalls.size()));
   add(fmt::format("  ({})", kSeeing));
   if (const Stall* x = Fmt::longest(r))
@@ -693,8 +729,7 @@ std::vector<TextLine> textLines(const Report& r) {
                       r.robots[i].serial_isr_runs, f.dur(r.robots[i].serial_isr_total)));
   for (const HandlerRun& x : r.handler_runs) {
     add(fmt::format("  {} {} s {} for {}, interrupting {}", f.name(x.robot), f.s(x.from), x.handler,
-                    x.to ? f.dur(*x.to - x.from) : "(still in service at the end)",
-                    f.where(x.line, x.function)),
+                    f.inService(x), f.where(x.line, x.function)),
         x.from);
     add("      meanwhile " + f.meanwhile(x));
   }
@@ -712,11 +747,9 @@ std::vector<TextLine> textLines(const Report& r) {
     add(fmt::format("  {} {} s {}", f.name(x.robot), f.s(x.t), x.what), x.t);
 
   add("");
-  add(fmt::format("Faults and exits ({})", r.faults.size()));
+  add(fmt::format("Faults, exits and reloads ({})", r.faults.size()));
   for (const Event& x : r.faults)
-    add(fmt::format("  {} {} s {}{}", f.name(x.robot), f.s(x.t), x.what,
-                    x.line > 0 ? fmt::format(" (line {})", x.line) : ""),
-        x.t);
+    add(fmt::format("  {} {} s {}{}", f.name(x.robot), f.s(x.t), x.what, Fmt::faultWhere(x)), x.t);
   return out;
 }
 
@@ -760,8 +793,8 @@ std::string markdown(const Report& r) {
   }
 
   o += fmt::format(
-      "\n## Stalls ({})\n\nThe program seeing the opponent and no motor frame latched for more "
-      "than 1 s; {}.\n\n",
+      "\n## Stalls ({})\n\nThe program running and seeing the opponent, no motor frame latched "
+      "and the robot standing still, for more than 1 s; {}.\n\n",
       r.stalls.size(), kSeeing);
   if (const Stall* x = Fmt::longest(r))
     o += fmt::format("Longest: **{}** {} s .. {} ({}), {}.\n\n", f.name(x->robot), f.s(x->from),
@@ -800,9 +833,8 @@ std::string markdown(const Report& r) {
   if (!r.handler_runs.empty()) o += "\n";
   for (const HandlerRun& x : r.handler_runs)
     o += fmt::format("- **{}** {} s `{}` for {}, interrupting {}; meanwhile {}\n", f.name(x.robot),
-                     f.s(x.from), x.handler,
-                     x.to ? f.dur(*x.to - x.from) : "(still in service at the end)",
-                     f.where(x.line, x.function), f.meanwhile(x));
+                     f.s(x.from), x.handler, f.inService(x), f.where(x.line, x.function),
+                     f.meanwhile(x));
 
   o += fmt::format("\n## Contacts ({})\n\n", r.contacts.size());
   if (!r.contacts.empty()) {
@@ -814,10 +846,10 @@ std::string markdown(const Report& r) {
   o += fmt::format("\n## Referee ({})\n\n", r.referee.size());
   for (const Event& x : r.referee)
     o += fmt::format("- **{}** {} s {}\n", f.name(x.robot), f.s(x.t), x.what);
-  o += fmt::format("\n## Faults and exits ({})\n\n", r.faults.size());
+  o += fmt::format("\n## Faults, exits and reloads ({})\n\n", r.faults.size());
   for (const Event& x : r.faults)
     o += fmt::format("- **{}** {} s {}{}\n", f.name(x.robot), f.s(x.t), cell(x.what),
-                     x.line > 0 ? fmt::format(" (line {})", x.line) : "");
+                     cell(Fmt::faultWhere(x)));
   return o;
 }
 
@@ -962,7 +994,9 @@ nlohmann::json json(const Report& r) {
       a.push_back({{"robot", x.robot < 0 ? json(nullptr) : json(kNames[x.robot & 1])},
                    {"time_s", sec(x.t)},
                    {"what", sinks::jsonString(x.what, false)},
-                   {"line", x.line}});
+                   {"line", x.line},
+                   {"depth", x.depth},
+                   {"calls", sinks::jsonString(x.calls, false)}});
     return a;
   };
   j["referee"] = events(r.referee);

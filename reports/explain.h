@@ -149,6 +149,10 @@ struct Event {
   Tick t = 0;
   std::string what;
   int line = 0;
+  // A fault's call chain (the fault record's calls: main:12 > deep:7 x 251)
+  // and depth, the calls and handlers under way; "" and 0 for the others.
+  std::string calls;
+  int depth = 0;
 };
 
 struct RobotInfo {
@@ -176,7 +180,7 @@ struct Report {
   std::vector<HandlerTotal> handler_totals;
   std::vector<Contact> contacts;
   std::vector<Event> referee;
-  std::vector<Event> faults;
+  std::vector<Event> faults;  // faults, exits, reloads and plant faults, in tick order
 };
 
 class Explainer final : public trace::Sink {

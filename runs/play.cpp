@@ -45,7 +45,11 @@ json faultsJson(const std::vector<scheduler::FaultInfo>& faults) {
 
 json faultJson(const std::optional<scheduler::FaultInfo>& f) {
   if (!f) return nullptr;
-  return {{"message", f->message}, {"time_s", f->timeS}, {"line", f->line}};
+  return {{"message", f->message},
+          {"time_s", f->timeS},
+          {"line", f->line},
+          {"depth", f->depth},
+          {"calls", f->calls}};
 }
 
 // Findings that did not stop the run (injections that never fired, ...).
@@ -53,10 +57,12 @@ void reportWarnings(const scheduler::MatchResult& r) {
   for (const auto& w : r.warnings) std::cerr << "simbot: warning: " << w << '\n';
 }
 
-// A robot's fault in one line: robot, time, source line, message.
+// A robot's fault in one line: robot, time, source line, message, and the
+// calls under way (call depth 251: main:12 > deep:7 x 251).
 std::string faultText(const scheduler::RobotResult& rr, const scheduler::FaultInfo& f) {
-  return fmt::format("{}:{}: fault: robot {} at {:.6f} s: {}", rr.program, f.line, rr.name, f.timeS,
-                     f.message);
+  return fmt::format(
+      "{}:{}: fault: robot {} at {:.6f} s: {}{}", rr.program, f.line, rr.name, f.timeS, f.message,
+      f.calls.empty() ? std::string() : fmt::format(" (call depth {}: {})", f.depth, f.calls));
 }
 
 // One loud line per fault, on stderr; true if any robot faulted.

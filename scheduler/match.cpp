@@ -171,12 +171,16 @@ void Robot::reload(Tick t) {
   // reloaded program's frames).
   receiver.clear();
   serialEventAt = -1;
+  // The reloaded program has read nothing: its first reading of each eye is
+  // an ad_read record even if the faulted program's last was the same.
+  board.lastAdValue = {-1, -1};
   // Samples up to t were taken from the faulted program: the reloaded one's start at
   // the next sample tick.
   snapshots.clear();
   const Tick interval = match.sampleInterval();
   nextSnapshot = (t / interval + 1) * interval;
   if (match.tracing()) match.emit(t, trace::rec::Reload{index, result.reloads});
+  if (match.observer()) match.observer()->onReload(index, t);
 }
 
 void Robot::runTo(Tick horizon) {
@@ -190,10 +194,13 @@ void Robot::runTo(Tick horizon) {
       const Tick at = f->tick;
       if (!faultSeen) {
         faultSeen = true;
-        FaultInfo info{f->message, timebase::secondsFromTicks(at), f->line};
+        auto [calls, depth] = faultChain();
+        FaultInfo info{f->message, timebase::secondsFromTicks(at), f->line, depth, calls};
         if (!result.fault) result.fault = info;
         result.faults.push_back(info);
-        if (tracing) match.emit(at, trace::rec::Fault{index, f->message, f->line});
+        if (tracing)
+          match.emit(at, trace::rec::Fault{index, f->message, f->line, depth, std::move(calls)});
+        if (match.observer()) match.observer()->onHalt(index, at);
         match.faulted(index, at);
       }
       return;
@@ -203,6 +210,7 @@ void Robot::runTo(Tick horizon) {
       result.exited = true;
       result.exitTick = now();
       if (tracing) match.emit(now(), trace::rec::Exit{index});
+      if (match.observer()) match.observer()->onHalt(index, now());
     }
     if (auto it = lineInjections.find(board.cpu.pc()); it != lineInjections.end()) {
       const int hit = ++lineHits[board.cpu.pc()];
@@ -526,13 +534,17 @@ void Match::handlePlantEvents(Tick t, const plant::EventList& events) {
 
 // Trace samples at fixed ticks, read from dense output once the plant has
 // passed them and before any input discards that part of the trajectory.
+// An observer gets the same poses (MatchObserver::onPose).
 void Match::sampleUpTo(Tick t) {
-  if (!trace_.on()) return;
+  const bool tracing = trace_.on();
+  if (!tracing && !config_.observer) return;
   const Tick limit = std::min(t, arena_.now());
   while (nextSample_ <= limit) {
     if (nextSample_ >= arena_.lastReinitTick()) {
       for (int i = 0; i < arena_.robotCount(); ++i) {
         const plant::RobotState s = arena_.state(i, nextSample_);
+        if (config_.observer) config_.observer->onPose(i, nextSample_, s.pose.x_ft, s.pose.y_ft);
+        if (!tracing) continue;
         const plant::EyeReadings eyes = arena_.eyeReadings(i, nextSample_);
         Robot::Snapshot at = robots_[static_cast<size_t>(i)]->snapshotFor(nextSample_);
         emit(nextSample_,
@@ -563,7 +575,7 @@ bool Match::runUntil(Tick pause) {
   } catch (const plant::SolverError& e) {
     // The plant cannot go on: the run ends where the failing round began,
     // with everything before it kept.
-    result_.plantFault = FaultInfo{e.what(), timebase::secondsFromTicks(roundStart_), 0};
+    result_.plantFault = FaultInfo{e.what(), timebase::secondsFromTicks(roundStart_), 0, 0, {}};
     result_.endTick = roundStart_;
     over_ = true;
     if (trace_.on()) emit(roundStart_, trace::rec::PlantFault{e.what()}, {});

@@ -126,6 +126,15 @@ struct MatchObserver {
   virtual void onInterruptAccepted(int /*robot*/, Tick, vm::Irq) {}
   virtual void onFrame(int /*robot*/, Tick, bool /*latched*/) {}
   virtual void onPlantEvent(Tick, const plant::Event&) {}
+  // The robots' poses at the trace's sample ticks (every sample interval,
+  // the same ticks and values as the trace's sample records), and the
+  // program's faults, exits (main returned) and reloads, at their records'
+  // ticks. Called in the order the simulation learns of them, which is not
+  // always tick order: an observer that needs tick order sorts them (stably:
+  // within a tick this is the trace's order).
+  virtual void onPose(int /*robot*/, Tick, double /*x_ft*/, double /*y_ft*/) {}
+  virtual void onHalt(int /*robot*/, Tick) {}
+  virtual void onReload(int /*robot*/, Tick) {}
 };
 
 struct MatchConfig {
@@ -178,6 +187,8 @@ struct FaultInfo {
   std::string message;
   double timeS = 0;
   int line = 0;
+  int depth = 0;      // calls and handlers under way (the trace's fault record)
+  std::string calls;  // their chain, ending at the fault: main:12 > deep:7 x 251
 };
 
 struct RobotResult {

@@ -126,6 +126,14 @@ class Robot : public vm::Bus {
     std::string calls;  // the serial_send record's chain
   };
   SendSite sendSite(Tick t) const;
+  // "FUNCTION:LINE > ..." of frames, outermost first, " > interrupt > "
+  // after a handler's interrupted code, a run of n equal entries written
+  // once as "FUNCTION:LINE x n" (a recursion that overflowed the stack).
+  std::string chainText(const std::vector<vm::Vm::Frame>& frames) const;
+  // The chain and depth of the fault under way (every fault, traced or not:
+  // faults are rare): the calls and handlers not yet returned from, then the
+  // faulting instruction; depth counts the calls and handlers.
+  std::pair<std::string, int> faultChain() const;
   [[gnu::noinline]] void traceSend(Tick t, uint16_t cc);
   [[gnu::noinline]] void traceOverwrite(Tick t, const board::OverwrittenSend& overwritten);
 

@@ -86,11 +86,41 @@ Robot::SendSite Robot::sendSite(Tick t) const {
     site.callerFunction = name(frames.back().at);
   }
   frames.push_back(send);
-  for (size_t i = 0; i < frames.size(); ++i) {
-    if (i) site.calls += frames[i - 1].interrupted ? " > interrupt > " : " > ";
-    site.calls += name(frames[i].at) + ':' + std::to_string(image.lineAt(frames[i].at));
-  }
+  site.calls = chainText(frames);
   return site;
+}
+
+std::string Robot::chainText(const std::vector<vm::Vm::Frame>& frames) const {
+  const vm::Image& image = spec.image;
+  auto entry = [&](const vm::Vm::Frame& f) {
+    const vm::Symbol* fn = image.functionAt(f.at);
+    return (fn ? fn->name : std::string()) + ':' + std::to_string(image.lineAt(f.at));
+  };
+  std::string out;
+  for (size_t i = 0; i < frames.size();) {
+    const std::string here = entry(frames[i]);
+    size_t j = i + 1;
+    while (j < frames.size() && frames[j - 1].interrupted == frames[i].interrupted &&
+           entry(frames[j]) == here)
+      ++j;
+    if (i) out += frames[i - 1].interrupted ? " > interrupt > " : " > ";
+    out += here;
+    if (j - i > 1) out += " x " + std::to_string(j - i);
+    i = j;
+  }
+  return out;
+}
+
+std::pair<std::string, int> Robot::faultChain() const {
+  const vm::Image& image = spec.image;
+  std::vector<vm::Vm::Frame> frames = board.cpu.frames();
+  std::erase_if(frames, [&](const vm::Vm::Frame& f) { return f.at + 1 == mainReturn; });
+  const int depth = static_cast<int>(frames.size());
+  frames.push_back({board.cpu.fault() ? board.cpu.fault()->pc : board.cpu.pc(), false});
+  std::erase_if(frames, [&](const vm::Vm::Frame& f) {
+    return !image.functionAt(f.at) || image.lineAt(f.at) <= 0;
+  });
+  return {chainText(frames), depth};
 }
 
 // The records of a send, kept out of serialSend so that an untraced run's

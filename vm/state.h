@@ -389,7 +389,7 @@ struct Vm::State {
                              diverted->at, f ? fmt::format(" in '{}'", f->name) : std::string(),
                              diverted->target);
     }
-    fault = Fault{std::move(message), now, image->lineAt(atPc)};
+    fault = Fault{std::move(message), now, image->lineAt(atPc), atPc};
   }
   // Checks a pointer access of `size` bytes; false (and a fault) if invalid.
   bool checkAccess(uint32_t address, uint32_t size, uint32_t atPc) {

@@ -88,6 +88,7 @@ struct Fault {
   std::string message;
   Tick tick = 0;
   int line = 0;
+  uint32_t pc = 0;  // the faulting instruction's address
   bool operator==(const Fault&) const = default;
 };
 
