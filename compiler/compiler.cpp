@@ -76,7 +76,11 @@ Result compile(const std::string& rawSource, const std::string& fileName, const 
                                    rawSource.size(), kMaxSourceBytes)));
     return result;
   }
-  const std::string source = normalizeNewlines(rawSource);
+  // A UTF-8 byte order mark (editors on Windows write one) is not part of
+  // the program: dropped, so line 1's columns are what the editor shows.
+  constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
+  const std::string source = normalizeNewlines(
+      std::string_view(rawSource).substr(0, 3) == kByteOrderMark ? rawSource.substr(3) : rawSource);
   std::vector<std::string> lines = splitLines(source);
   Diagnostics diags;
   std::optional<vm::Image> image;

@@ -75,9 +75,20 @@ bool reportFaults(const scheduler::MatchResult& r) {
         "run ended there\n",
         r.plantFault->timeS, r.plantFault->message);
   }
+  // A reload storm (--reload-on-fault on a program that faults at once)
+  // can fault thousands of times: the first and the last few are shown, the
+  // rest counted; the JSON has them all.
+  constexpr size_t kShownFirst = 10, kShownLast = 3;
   for (const auto& rr : r.robots) {
-    for (size_t k = 0; k < rr.faults.size(); ++k) {
+    const size_t n = rr.faults.size();
+    for (size_t k = 0; k < n; ++k) {
       any = true;
+      if (k == kShownFirst && n > kShownFirst + kShownLast) {
+        std::cerr << fmt::format("{}: robot {}: ... {} more faults (the JSON lists them all)\n",
+                                 rr.program, rr.name, n - kShownFirst - kShownLast);
+        k = n - kShownLast - 1;
+        continue;
+      }
       std::cerr << faultText(rr, rr.faults[k])
                 << (k < static_cast<size_t>(rr.reloads) ? " (reloaded)" : "") << '\n';
     }
@@ -149,6 +160,10 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
     }
   }
   config.endTick = timebase::ticksFromSeconds(seconds);
+  if (config.endTick < 1)
+    throw sinks::UserError(fmt::format(
+        "simbot: --seconds {} is less than one tick of the 9.216 MHz clock (1.085e-07 s)\n",
+        seconds));
   config.seed = preferCommandLine(o.seed.has_value(), scenario ? scenario->seed : std::nullopt,
                                   o.seed.value_or(1));
   config.reloadOnFault = o.reloadOnFault;

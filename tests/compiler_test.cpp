@@ -550,6 +550,17 @@ TEST(CompilerErrors, DiagnosticFormatKeepsTabs) {
   EXPECT_EQ(r.errors[0].format(), "tab.dc:4:7: error: invalid character\n\tx = \t@;\n\t    \t^\n");
 }
 
+// A byte order mark before the program is dropped, and line 1's columns are
+// counted from the character after it: in `int x = @;` the `@` is the 9th.
+TEST(CompilerErrors, AByteOrderMarkIsNoPartOfTheProgram) {
+  Result ok = compile("\xEF\xBB\xBFmain() { }\n", "bom.dc");
+  EXPECT_TRUE(ok.errors.empty());
+  EXPECT_TRUE(ok.image.has_value());
+  Result r = compile("\xEF\xBB\xBFint x = @;\n", "bom.dc");
+  ASSERT_FALSE(r.errors.empty());
+  EXPECT_EQ(r.errors[0].format().substr(0, 36), "bom.dc:1:9: error: invalid character");
+}
+
 // ---------------------------------------------------------------------------
 // Hostile inputs: each is one clean error, no crash, no hang.
 

@@ -284,6 +284,22 @@ many.write_text(f'programs = ["{ICEMAN}", "{ICEMAN}"]\nfamilies = ["stationary",
 r = run(["sweep", many, "--out", OUT / "many.csv"], timeout=20)
 check(r.returncode == 1 and "6000000 runs" in r.stderr, f"6e6 runs are refused ({r.stderr!r})")
 
+# ---- runs that would say nothing, or too much
+r = run(["solo", SPIRAL, "--seconds", "1e-12"])
+check(one_line_error(r, "less than one tick"), f"--seconds 1e-12 is refused ({r.stderr!r})")
+storm = OUT / "storm.dc"
+storm.write_text("f() { f(); }\nmain() { f(); }\n")
+quick = OUT / "quick-reload.toml"  # a reload 0.01 s after each fault
+quick.write_text((Path(SOURCE) / "profiles" / "default.toml").read_text().replace(
+    "reload_delay = { value = 20.0,", "reload_delay = { value = 0.01,"))
+r = run(["solo", storm, "--reload-on-fault", "--seconds", "30", "--json", "--profile", quick])
+faults = [l for l in r.stderr.splitlines() if ": fault: " in l]
+import json as _json
+listed = len(_json.loads(r.stdout)["faults"])
+check(r.returncode == 3 and listed > 20 and len(faults) == 13 and
+      f"... {listed - 13} more faults" in r.stderr,
+      f"a reload storm prints 13 fault lines and counts the rest ({len(faults)} of {listed})")
+
 # ---- worker threads that cannot be created
 if not SANITIZED:  # an address-space limit is what makes thread stacks fail
     r = subprocess.run(["bash", "-c", "ulimit -v 600000; exec \"$@\"", "bash", SIMBOT, "bench",
