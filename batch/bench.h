@@ -37,6 +37,9 @@ struct BenchConfig {
   std::string opponent;  // head-to-head: B's program
   bool progress = true;
   MetricThresholds thresholds;  // what counts as acquired and aimed
+  // The Kaplan-Meier median on an exact 0.5 plateau (stats.h): its upper
+  // end (statsmodels), or its midpoint (SAS, R's survival): --median.
+  stats::QuantileRule median = stats::QuantileRule::FirstBelow;
   // The seeds' key in place of each program's file name (simbot compare:
   // both sides play the very same seeded runs).
   std::string seedKey;

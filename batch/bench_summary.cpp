@@ -88,7 +88,7 @@ MetricEstimate estimate(const BenchConfig& config, const std::vector<const Bench
       e.reachedByS = reachedByHorizon(config);
       if (obs.empty()) break;
       const stats::KaplanMeier km = stats::kaplanMeier(obs);
-      e.estimate = stats::quantile(km, 0.5);
+      e.estimate = stats::quantile(km, 0.5, config.median);
       if (const auto ci = stats::quantileCi(km, 0.5)) {
         e.low = ci->low;
         e.high = ci->high;

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include "batch/bench.h"
@@ -87,6 +88,12 @@ Subcommand addBenchCommand(CLI::App& app) {
   cmd->add_option("--out", o->out, "output directory (default out/bench-FAMILY)");
   cmd->add_flag("--resume", o->resume,
                 "continue an interrupted bench from the runs.csv in its output directory");
+  cmd->add_option("--median", o->config.median,
+                  "a Kaplan-Meier median on an exact 0.5 plateau: upper (its upper end, as "
+                  "statsmodels; the default) or midpoint (as SAS and R's survival)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, stats::QuantileRule>{{"upper", stats::QuantileRule::FirstBelow},
+                                                     {"midpoint", stats::QuantileRule::Midpoint}}));
   o->profileOption =
       cmd->add_option("--profile", o->profile, "profile name or file (default: default)");
   cmd->add_option("--opponent", o->config.opponent, "robot B's program (head-to-head)");

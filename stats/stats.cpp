@@ -90,9 +90,14 @@ double survivalAt(const KaplanMeier& km, double t) {
 }
 
 // SurvfuncRight.quantile.
-std::optional<double> quantile(const KaplanMeier& km, double p) {
-  for (size_t i = 0; i < km.times.size(); ++i)
-    if (km.survival[i] < 1 - p) return km.times[i];
+std::optional<double> quantile(const KaplanMeier& km, double p, QuantileRule rule) {
+  // S is a product of (1 - d/n) factors: "exactly 1 - p" within rounding.
+  constexpr double kSame = 1e-12;
+  for (size_t i = 0; i < km.times.size(); ++i) {
+    if (rule == QuantileRule::Midpoint && std::abs(km.survival[i] - (1 - p)) <= kSame)
+      return i + 1 < km.times.size() ? (km.times[i] + km.times[i + 1]) / 2 : km.times[i];
+    if (km.survival[i] < 1 - p - (rule == QuantileRule::Midpoint ? kSame : 0)) return km.times[i];
+  }
   return std::nullopt;
 }
 

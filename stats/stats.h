@@ -41,9 +41,18 @@ struct KaplanMeier {
 KaplanMeier kaplanMeier(const std::vector<Observation>& sample);
 // S(t) of the step function (1 before the first event).
 double survivalAt(const KaplanMeier& km, double t);
-// The p-quantile of the event time: the first event time with S < 1 - p
-// (strictly, as SAS and statsmodels); none if S never falls that low.
-std::optional<double> quantile(const KaplanMeier& km, double p);
+// Where S equals 1 - p exactly over an interval (with 200 runs, S is often
+// exactly 0.5 between two event times), conventions differ:
+//   FirstBelow  the first event time with S < 1 - p, i.e. the interval's
+//               upper end (statsmodels' SurvfuncRight.quantile);
+//   Midpoint    the midpoint of that interval (SAS's PROC LIFETEST and R's
+//               survival), the plateau's start if no event ends it.
+// Elsewhere both give the first event time with S < 1 - p.
+enum class QuantileRule : std::uint8_t { FirstBelow, Midpoint };
+// The p-quantile of the event time by `rule`; none if S never falls to
+// 1 - p (or, FirstBelow, below it).
+std::optional<double> quantile(const KaplanMeier& km, double p,
+                               QuantileRule rule = QuantileRule::FirstBelow);
 // Its 1 - alpha confidence interval by inverting z-tests on the cloglog
 // scale (the limits are event times; high is +infinity when the upper
 // limit lies past the last event); none if no event time qualifies.

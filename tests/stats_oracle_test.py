@@ -225,11 +225,43 @@ def load_games(path):
     return df
 
 
+def check_midpoint(simbot, program, out, seeds):
+    """bench --median midpoint: on an exact 0.5 plateau of statsmodels' own
+    Kaplan-Meier curve, the midpoint of the plateau (SAS's and R's rule);
+    elsewhere statsmodels' median. Returns how many medians sat on a plateau."""
+    summary = json.loads(run([simbot, "bench", program, "--family", "stationary",
+                              "--seeds", str(seeds), "--threads", "2", "--out", out,
+                              "--json", "--median", "midpoint"]))
+    df = load(pathlib.Path(out) / "runs.csv")
+    rows = {m["metric"]: m for m in summary["programs"][0]["metrics"]}
+    plateaus = 0
+    for metric in TIMES:
+        t, s = time_sample(df, metric, summary["seconds"])
+        if len(t) == 0 or s.sum() == 0:
+            continue
+        sf = SurvfuncRight(t, s)
+        times, surv = list(sf.surv_times), list(sf.surv_prob)
+        want = None
+        for i, p in enumerate(surv):
+            if abs(p - 0.5) <= 1e-12:
+                plateaus += 1
+                want = (times[i] + times[i + 1]) / 2 if i + 1 < len(times) else times[i]
+                break
+            if p < 0.5:
+                want = times[i]
+                break
+        close(f"{metric} midpoint median", rows[metric]["estimate"], want)
+    return plateaus
+
+
 def main():
     simbot, a, b, out, seeds = sys.argv[1:6]
     out = pathlib.Path(out)
     check_csv_files(simbot, a, b, out / "csv")
     summary = check_bench(simbot, a, str(out / "bench"), int(seeds))
+    plateaus = check_midpoint(simbot, a, str(out / "bench-midpoint"), int(seeds))
+    if plateaus == 0:
+        failures.append("no median sat on an exact 0.5 plateau: the midpoint rule went untested")
     check_compare(simbot, a, b, str(out / "compare"), max(8, int(seeds) // 2))
     if failures:
         print("\n".join(failures))
