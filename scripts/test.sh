@@ -3,7 +3,7 @@
 # (clang-format), the normal build with warnings as errors, the same suite
 # built with AddressSanitizer and UndefinedBehaviorSanitizer, the threaded
 # bench and tournament built with ThreadSanitizer, and a short campaign
-# (30 s) of each libFuzzer target.
+# (20 s) of each libFuzzer target.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
@@ -66,7 +66,7 @@ cmake --build build-tsan --parallel "$jobs" --target bench_test
 TSAN_OPTIONS=halt_on_error=1 \
   ctest --test-dir build-tsan -R '^(Bench|Tournament)\.' --output-on-failure --parallel "$jobs"
 phase "ThreadSanitizer build and tests"
-./scripts/fuzz.sh 30
+./scripts/fuzz.sh 20
 phase "fuzzing build and campaigns"
 echo "test.sh: time per stage"
 printf '  %s\n' "${stages[@]}"
