@@ -228,6 +228,14 @@ void crossChecks(const Profile& p, const Checker& c, const toml::table& doc) {
     if (std::abs(start.x_ft) + p.robot.body_diameter_ft / 2 > half ||
         std::abs(start.y_ft) + p.robot.body_diameter_ft / 2 > half)
       c.fail(where("start"), "a start pose puts the body outside the field");
+  // Two bodies on one mark (a scenario refuses the same; a match always
+  // places both robots). The placement spread may move them a few inches.
+  if (p.field.start.size() >= 2 && std::hypot(p.field.start[0].x_ft - p.field.start[1].x_ft,
+                                              p.field.start[0].y_ft - p.field.start[1].y_ft) <=
+                                       p.robot.body_diameter_ft + 2 * p.field.placement_radius_ft)
+    c.fail(where("start"),
+           "the two start poses overlap (their centres must be more than the body's diameter "
+           "plus twice placement_radius apart)");
   if (p.robot.eye_background >= p.robot.eye_max)
     c.fail(where("eyes"), "background must be below max");
   if (p.field.divider_north_ft < p.field.divider_south_ft)

@@ -206,6 +206,18 @@ TEST(Profiles, UnitsAreConverted) {
   EXPECT_NEAR(parseProfile(text, "x.toml").referee.turn_deg, 45.0, 1e-12);
 }
 
+// Both robots on one mark: refused, as a scenario refuses it. thesis-1997's
+// body is 12.75 in (1.0625 ft) across and its placement radius 0, so
+// centres 1.0 ft apart overlap and 1.5 ft apart do not.
+TEST(Profiles, StartPosesThatOverlapAreRefused) {
+  const char* b = "b_x       = { value = 6.5,";
+  for (const char* x : {"-6.5", "-5.5"}) {
+    const std::string text = edit(b, std::string("b_x       = { value = ") + x + ",");
+    EXPECT_NE(errorOf(text).find("the two start poses overlap"), std::string::npos) << x;
+  }
+  EXPECT_EQ(errorOf(edit(b, "b_x       = { value = -5.0,")), "");
+}
+
 TEST(Profiles, MissingFileIsAnError) {
   EXPECT_THROW(loadProfile("/nonexistent/profile.toml"), ConfigError);
 }
