@@ -41,7 +41,14 @@ void parallelFor(size_t count, int threads, const std::function<void(size_t)>& j
   std::vector<std::exception_ptr> errors(count);
   std::mutex mutex;
   std::condition_variable finished;
+  // Workers wait until every one of them exists: a thread that cannot be
+  // created then fails the batch before any job ran.
+  bool gateOpen = false;
   auto work = [&] {
+    {
+      std::unique_lock lock(mutex);
+      finished.wait(lock, [&] { return gateOpen; });
+    }
     for (size_t i; !stopped() && (i = next.fetch_add(1)) < count;) {
       try {
         job(i);
@@ -62,13 +69,23 @@ void parallelFor(size_t count, int threads, const std::function<void(size_t)>& j
     for (size_t w = 0; w < workers; ++w) pool.emplace_back(work);
   } catch (const std::system_error& e) {
     // The system would not give us the threads asked for: the ones that
-    // started stop after their job, and the batch says so in one line.
+    // exist leave at once, and the batch says so in one line.
     failed.store(true);
+    {
+      std::lock_guard lock(mutex);
+      gateOpen = true;
+    }
+    finished.notify_all();
     for (auto& th : pool) th.join();
     throw sinks::UserError(fmt::format(
         "simbot: {}: cannot start {} worker threads ({} started): {}; use --threads with fewer\n",
         label, workers, pool.size(), e.code().message()));
   }
+  {
+    std::lock_guard lock(mutex);
+    gateOpen = true;
+  }
+  finished.notify_all();
   const bool tty = progress && isatty(STDERR_FILENO);
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
