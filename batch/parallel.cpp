@@ -65,9 +65,10 @@ void parallelFor(size_t count, int threads, const std::function<void(size_t)>& j
     finished.notify_all();
   };
   std::vector<std::thread> pool;
+  pool.reserve(workers);
   try {
     for (size_t w = 0; w < workers; ++w) pool.emplace_back(work);
-  } catch (const std::system_error& e) {
+  } catch (const std::exception& e) {
     // The system would not give us the threads asked for: the ones that
     // exist leave at once, and the batch says so in one line.
     failed.store(true);
@@ -79,7 +80,10 @@ void parallelFor(size_t count, int threads, const std::function<void(size_t)>& j
     for (auto& th : pool) th.join();
     throw sinks::UserError(fmt::format(
         "simbot: {}: cannot start {} worker threads ({} started): {}; use --threads with fewer\n",
-        label, workers, pool.size(), e.code().message()));
+        label, workers, pool.size(),
+        dynamic_cast<const std::system_error*>(&e)
+            ? dynamic_cast<const std::system_error&>(e).code().message()
+            : std::string(e.what())));
   }
   {
     std::lock_guard lock(mutex);

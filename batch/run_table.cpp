@@ -101,9 +101,9 @@ RowFile::~RowFile() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-void RowFile::append(const std::string& rows) {
+bool RowFile::append(const std::string& rows) {
   std::lock_guard lock(mutex_);
-  if (failed_) return;  // the batch is stopping; this run is done again by --resume
+  if (failed_) return false;  // the batch is stopping; this run is done again by --resume
   const off_t before = ::lseek(fd_, 0, SEEK_END);
   size_t written = 0;
   while (before >= 0 && written < rows.size()) {
@@ -112,7 +112,7 @@ void RowFile::append(const std::string& rows) {
     if (n <= 0) break;
     written += static_cast<size_t>(n);
   }
-  if (before >= 0 && written == rows.size()) return;
+  if (before >= 0 && written == rows.size()) return true;
   // Each row whole or absent: what was written of this one goes, so that
   // rows written later (after space is freed) are never glued onto it.
   const int error = before < 0 ? errno : (errno ? errno : ENOSPC);

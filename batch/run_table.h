@@ -51,8 +51,9 @@ class RowFile {
   ~RowFile();
   RowFile(const RowFile&) = delete;
   RowFile& operator=(const RowFile&) = delete;
-  // UserError "simbot: writing 'PATH': REASON; the batch stopped at once ...".
-  void append(const std::string& rows);
+  // UserError "simbot: writing 'PATH': REASON; the batch stopped at once
+  // ..."; false, writing nothing, once an earlier append failed.
+  bool append(const std::string& rows);
 
  private:
   std::string path_;

@@ -178,7 +178,9 @@ SweepWriter::~SweepWriter() = default;
 
 void SweepWriter::writeLocked(const std::string& text) {
   if (!rows_) throw sinks::UserError(fmt::format("simbot: sweep: '{}' is finished\n", path_));
-  rows_->append(text);
+  if (!rows_->append(text))
+    throw sinks::UserError(
+        fmt::format("simbot: sweep: '{}' stopped after a failed write\n", path_));
 }
 
 void SweepWriter::put(size_t index, const CsvRow& row) {
@@ -192,12 +194,12 @@ void SweepWriter::put(size_t index, const CsvRow& row) {
   waiting_.insert(at, {index, csvRecord(row)});
   std::string ready;
   size_t n = 0;
-  while (n < waiting_.size() && waiting_[n].first == next_) {
-    ready += waiting_[n++].second;
-    ++next_;
-  }
+  while (n < waiting_.size() && waiting_[n].first == next_ + n) ready += waiting_[n++].second;
+  if (ready.empty()) return;
+  // Counted as written only once they are in the file.
+  writeLocked(ready);
+  next_ += n;
   waiting_.erase(waiting_.begin(), waiting_.begin() + static_cast<std::ptrdiff_t>(n));
-  if (!ready.empty()) writeLocked(ready);
 }
 
 size_t SweepWriter::pending() const {

@@ -111,7 +111,17 @@ int matchCommand(const std::string& a, const std::string& b, const runs::RunOpti
           "overwritten){}\n",
           rr.name, rr.program, rr.hits, rr.shots, rr.framesLatched, rr.framesRejected,
           rr.framesOverwritten, rr.reloads ? fmt::format("  reloads {}", rr.reloads) : "");
-      for (const auto& f : rr.faults) std::cout << "  " << runs::faultText(rr, f) << '\n';
+      // As many as stderr's report shows (runs::reportFaults), no more.
+      const size_t n = rr.faults.size();
+      for (size_t k = 0; k < n; ++k) {
+        if (k == runs::kFaultsShownFirst && n > runs::kFaultsShownFirst + runs::kFaultsShownLast) {
+          std::cout << fmt::format("  ... {} more faults\n",
+                                   n - runs::kFaultsShownFirst - runs::kFaultsShownLast);
+          k = n - runs::kFaultsShownLast - 1;
+          continue;
+        }
+        std::cout << "  " << runs::faultText(rr, rr.faults[k]) << '\n';
+      }
     }
     std::cout << fmt::format("winner: {}{}  ({:.1f} s simulated in {:.2f} s)\n", r.winner,
                              r.tieBrokenByCoin ? " (coin flip)" : "",
@@ -311,6 +321,7 @@ int main(int argc, char** argv) {
   const auto tournament = simbot::cli::addTournamentCommand(app);
   addWarningOptions(bench.app);
   addWarningOptions(tournament.app);
+  addWarningOptions(compare.app);
   const auto explain = simbot::cli::addExplainCommand(app);
   const auto sweep = simbot::cli::addSweepCommand(app);
 
@@ -332,7 +343,7 @@ int main(int argc, char** argv) {
   }
   try {
     // -Wno-NAME and -Werror, on every command that compiles a program.
-    for (CLI::App* cmd : {solo, match, profile, bench.app, tournament.app})
+    for (CLI::App* cmd : {solo, match, profile, bench.app, tournament.app, compare.app})
       if (*cmd) {
         compiler::Options options;
         runs::parseWarningOptions(cmd->remaining(), options, cmd->get_name());

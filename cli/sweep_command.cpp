@@ -87,7 +87,6 @@ int runSweepCommand(SweepOptions& o) {
   for (const auto& p : inputPaths) inputs.push_back({p, p == o.file ? "the sweep" : "an input"});
   const std::string settingsPath = o.out + ".batch.json";
   runs::checkFiles(inputs, {{o.out, "--out"}, {settingsPath, "its settings"}});
-  if (!o.dask.empty()) execDaskDriver(o);
   const nlohmann::json settings = {{"command", "sweep"},
                                    {"shard", o.shard},
                                    {"header", !o.noHeader},
@@ -106,10 +105,18 @@ int runSweepCommand(SweepOptions& o) {
           "--out\n",
           o.out, batch::settingsChange(earlier, settings)));
   }
+  if (!o.dask.empty()) {
+    // The Dask driver writes the table and keeps no fingerprints: an
+    // earlier run's are removed, so that a later --resume refuses the
+    // table rather than mix its rows with another version's.
+    std::error_code ignored;
+    std::filesystem::remove(settingsPath, ignored);
+    execDaskDriver(o);
+  }
+  if (!o.resume) batch::writeFileAtomically(settingsPath, sinks::dumpJson(settings, 2) + "\n");
   const std::vector<batch::SweepRun> runs = batch::expandSweep(spec);
   const auto [begin, end] = batch::shardRange(runs.size(), k, n);
   batch::SweepWriter writer(o.out, batch::sweepHeader(spec), !o.noHeader, begin, end, o.resume);
-  if (!o.resume) batch::writeFileAtomically(settingsPath, sinks::dumpJson(settings, 2) + "\n");
   const size_t first = writer.next();
   batch::StopOnSignals signals;
   batch::parallelFor(

@@ -224,6 +224,8 @@ SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& fam
              "count (an integer from 1 to 1000000)");
     (first ? spec.firstSeed : spec.seedCount) = value;
   }
+  if (spec.seedCount - 1 > UINT64_MAX - spec.firstSeed)
+    failAt(path, seeds->source(), "[seeds] first + count - 1 is past 2^64 - 1, the last seed");
   if (const toml::node* g = doc.get("grid")) {
     const toml::table* grid = g->as_table();
     if (!grid) failAt(path, g->source(), "'grid' is a table");

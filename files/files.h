@@ -82,8 +82,9 @@ class Output {
   Output& operator=(const Output&) = delete;
   std::FILE* file() const { return file_; }
   const std::string& path() const { return path_; }
-  // Flushes, closes and renames into place; Error with the system's reason
-  // (the temporary file is then removed and the old file kept).
+  // Flushes, syncs, closes and renames into place; Error with the system's
+  // reason (the old file is kept; the temporary file is removed, or, when
+  // only the rename failed, kept and named in the message).
   void commit();
   bool committed() const { return committed_; }
 
@@ -98,7 +99,8 @@ class Output {
 // Writes `text` to `path` through an Output.
 void writeWhole(const std::string& path, const std::string& text);
 
-// SIGINT, SIGTERM and SIGHUP remove every open Output's temporary file and
+// SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE and SIGXFSZ (when not ignored)
+// remove every open Output's temporary file and
 // then end the process by the signal, as before (cli/main.cpp installs it
 // once; a batch's own stop handler takes over while the batch runs).
 void removeTemporariesOnSignals();

@@ -56,12 +56,17 @@ extern "C" void onFatalSignal(int sig) {
 }
 
 mode_t processUmask() {
-  // Read once (umask can only be read by setting it), before any worker
-  // thread makes files.
+  // Read from /proc (Linux 4.7 and later), not by setting it: setting it,
+  // even for an instant, would make another thread's files (the Python
+  // module's caller's) with the wrong mode.
   static const mode_t mask = [] {
-    const mode_t m = ::umask(0);
-    ::umask(m);
-    return m;
+    std::FILE* status = std::fopen("/proc/self/status", "r");
+    unsigned value = 022;
+    char line[256];
+    while (status && std::fgets(line, sizeof line, status))
+      if (std::sscanf(line, "Umask: %o", &value) == 1) break;
+    if (status) std::fclose(status);
+    return static_cast<mode_t>(value);
   }();
   return mask;
 }
@@ -126,6 +131,8 @@ Output::Output(const std::string& path) : path_(path) {
     if (!file_) throw Error(std::strerror(errno));
     return;
   }
+  // A file we could not have opened for writing is not replaced either.
+  if (exists && ::access(path.c_str(), W_OK) != 0) throw Error(std::strerror(errno));
   // Through a link, the file it names is replaced, not the link.
   std::error_code ec;
   fs::path target = exists ? fs::canonical(path, ec) : fs::path(path);
@@ -164,19 +171,29 @@ void Output::discard() {
 
 void Output::commit() {
   if (committed_) return;
-  const bool written = !std::ferror(file_) && std::fflush(file_) == 0;
+  if (!file_) throw Error("the output was already given up");
+  errno = 0;
+  const bool flushed = !std::ferror(file_) && std::fflush(file_) == 0;
+  // On the disk before the rename: after a power loss, the old file or the
+  // whole new one, never an empty one.
+  const bool synced = flushed && (temporary_.empty() || ::fsync(::fileno(file_)) == 0);
   int error = errno;
   const bool closed = std::fclose(file_) == 0;
-  if (written && !closed) error = errno;
+  if (flushed && synced && !closed) error = errno;
   file_ = nullptr;
-  if (!written || !closed) {
+  if (!flushed || !synced || !closed) {
     discard();
     throw Error(std::strerror(error ? error : EIO));
   }
   if (!temporary_.empty() && ::rename(temporary_.c_str(), path_.c_str()) != 0) {
+    // The finished output is kept where it is, and said so.
     error = errno;
-    discard();
-    throw Error(std::strerror(error));
+    const std::string kept = temporary_;
+    unregisterTemporary(slot_);
+    slot_ = -1;
+    temporary_.clear();
+    throw Error(
+        fmt::format("{} (the finished output is kept as '{}')", std::strerror(error), kept));
   }
   unregisterTemporary(slot_);
   slot_ = -1;
@@ -193,7 +210,7 @@ void writeWhole(const std::string& path, const std::string& text) {
 
 void removeTemporariesOnSignals() {
   processUmask();
-  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXFSZ}) {
     struct sigaction previous {};
     ::sigaction(sig, nullptr, &previous);
     if (previous.sa_handler != SIG_DFL) continue;  // ignored (nohup) or taken: left so

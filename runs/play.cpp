@@ -78,7 +78,7 @@ bool reportFaults(const scheduler::MatchResult& r) {
   // A reload storm (--reload-on-fault on a program that faults at once)
   // can fault thousands of times: the first and the last few are shown, the
   // rest counted; the JSON has them all.
-  constexpr size_t kShownFirst = 10, kShownLast = 3;
+  constexpr size_t kShownFirst = kFaultsShownFirst, kShownLast = kFaultsShownLast;
   for (const auto& rr : r.robots) {
     const size_t n = rr.faults.size();
     for (size_t k = 0; k < n; ++k) {

@@ -56,6 +56,11 @@ struct RunOptions {
   std::vector<trace::Sink*> sinks;
 };
 
+// A run's fault lines shown (reportFaults, match's table): the first ten
+// and the last three, the others counted (a reload storm faults thousands
+// of times; the JSON lists them all).
+inline constexpr size_t kFaultsShownFirst = 10, kFaultsShownLast = 3;
+
 // The run's configuration from the options and the scenario: the programs
 // given (A, and B for match), then the scenario (start poses, hardware, B
 // for solo and profile, injections), then --hw and --inject. With
