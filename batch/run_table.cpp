@@ -150,18 +150,7 @@ RunTable::RunTable(const std::string& dir, const std::string& file, const CsvRow
   if (resume) {
     if (!fs::exists(path_))
       throw sinks::UserError(fmt::format("simbot: --resume: no table '{}' to resume\n", path_));
-    nlohmann::json earlier;
-    try {
-      earlier = nlohmann::json::parse(readAll(settingsPath));
-    } catch (const std::exception&) {
-      throw sinks::UserError(
-          fmt::format("simbot: --resume: '{}' is missing or unreadable\n", settingsPath));
-    }
-    if (earlier != settings)
-      throw sinks::UserError(fmt::format(
-          "simbot: --resume: the batch in '{}' {}; run it again as it was, or choose another "
-          "--out\n",
-          dir, settingsChange(earlier, settings)));
+    checkResumeSettings(settingsPath, settings, fmt::format("the batch in '{}'", dir));
     size_t number = 0;
     // A last line cut short by a kill is left out: that run is done again.
     for (const std::string& line : csvRecords(readAll(path_))) {
@@ -202,6 +191,21 @@ void RunTable::rewrite(const std::vector<CsvRow>& rows) {
   rows_.reset();
   writeFileAtomically(path_, text);
   rows_.emplace(path_);
+}
+
+void checkResumeSettings(const std::string& settingsPath, const nlohmann::json& settings,
+                         const std::string& what) {
+  nlohmann::json earlier;
+  try {
+    earlier = nlohmann::json::parse(files::readInput(settingsPath, files::kMaxConfigBytes));
+  } catch (const std::exception&) {
+    throw sinks::UserError(
+        fmt::format("simbot: --resume: '{}' is missing or unreadable\n", settingsPath));
+  }
+  if (earlier != settings)
+    throw sinks::UserError(
+        fmt::format("simbot: --resume: {} {}; run it again as it was, or choose another --out\n",
+                    what, settingsChange(earlier, settings)));
 }
 
 nlohmann::json inputContents(const std::vector<std::string>& paths) {

@@ -72,6 +72,11 @@ std::string settingsChange(const nlohmann::json& earlier, const nlohmann::json& 
 // program or profile was edited in between.
 nlohmann::json inputContents(const std::vector<std::string>& paths);
 
+// --resume's check: UserError unless `settingsPath` holds `settings`,
+// naming what changed ("simbot: --resume: WHAT was run with ...").
+void checkResumeSettings(const std::string& settingsPath, const nlohmann::json& settings,
+                         const std::string& what);
+
 class RunTable {
  public:
   // The table `dir`/`file` with `header`, for the batch `settings`. The

@@ -114,13 +114,11 @@ int matchCommand(const std::string& a, const std::string& b, const runs::RunOpti
       // As many as stderr's report shows (runs::reportFaults), no more.
       const size_t n = rr.faults.size();
       for (size_t k = 0; k < n; ++k) {
-        if (k == runs::kFaultsShownFirst && n > runs::kFaultsShownFirst + runs::kFaultsShownLast) {
+        if (runs::faultShown(k, n))
+          std::cout << "  " << runs::faultText(rr, rr.faults[k]) << '\n';
+        else if (k == runs::kFaultsShownFirst)
           std::cout << fmt::format("  ... {} more faults\n",
                                    n - runs::kFaultsShownFirst - runs::kFaultsShownLast);
-          k = n - runs::kFaultsShownLast - 1;
-          continue;
-        }
-        std::cout << "  " << runs::faultText(rr, rr.faults[k]) << '\n';
       }
     }
     std::cout << fmt::format("winner: {}{}  ({:.1f} s simulated in {:.2f} s)\n", r.winner,

@@ -91,20 +91,8 @@ int runSweepCommand(SweepOptions& o) {
                                    {"shard", o.shard},
                                    {"header", !o.noHeader},
                                    {"contents", batch::inputContents(inputPaths)}};
-  if (o.resume) {
-    nlohmann::json earlier;
-    try {
-      earlier = nlohmann::json::parse(files::readInput(settingsPath, files::kMaxConfigBytes));
-    } catch (const std::exception&) {
-      throw sinks::UserError(
-          fmt::format("simbot: --resume: '{}' is missing or unreadable\n", settingsPath));
-    }
-    if (earlier != settings)
-      throw sinks::UserError(fmt::format(
-          "simbot: --resume: the sweep in '{}' {}; run it again as it was, or choose another "
-          "--out\n",
-          o.out, batch::settingsChange(earlier, settings)));
-  }
+  if (o.resume)
+    batch::checkResumeSettings(settingsPath, settings, fmt::format("the sweep in '{}'", o.out));
   if (!o.dask.empty()) {
     // The Dask driver writes the table and keeps no fingerprints: an
     // earlier run's are removed, so that a later --resume refuses the

@@ -75,18 +75,14 @@ bool reportFaults(const scheduler::MatchResult& r) {
         "run ended there\n",
         r.plantFault->timeS, r.plantFault->message);
   }
-  // A reload storm (--reload-on-fault on a program that faults at once)
-  // can fault thousands of times: the first and the last few are shown, the
-  // rest counted; the JSON has them all.
-  constexpr size_t kShownFirst = kFaultsShownFirst, kShownLast = kFaultsShownLast;
   for (const auto& rr : r.robots) {
     const size_t n = rr.faults.size();
     for (size_t k = 0; k < n; ++k) {
       any = true;
-      if (k == kShownFirst && n > kShownFirst + kShownLast) {
-        std::cerr << fmt::format("{}: robot {}: ... {} more faults (the JSON lists them all)\n",
-                                 rr.program, rr.name, n - kShownFirst - kShownLast);
-        k = n - kShownLast - 1;
+      if (!faultShown(k, n)) {
+        if (k == kFaultsShownFirst)
+          std::cerr << fmt::format("{}: robot {}: ... {} more faults (the JSON lists them all)\n",
+                                   rr.program, rr.name, n - kFaultsShownFirst - kFaultsShownLast);
         continue;
       }
       std::cerr << faultText(rr, rr.faults[k])
@@ -111,10 +107,9 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
                                    ScenarioUse use, std::vector<files::Named>* inputs) {
   std::optional<Scenario> scenario;
   if (!o.scenario.empty()) scenario = config::loadScenario(o.scenario);
-  const std::string profileName =
+  const config::Profile profile = loadNamedProfile(
       preferCommandLine(o.profile.has_value(), scenario ? scenario->profile : std::nullopt,
-                        o.profile.value_or("default"));
-  const config::Profile profile = loadNamedProfile(profileName);
+                        o.profile.value_or("default")));
   // Without --seconds or a scenario's, a run lasts its default: the
   // profile's round.
   const double seconds = preferCommandLine(
@@ -172,10 +167,7 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
     for (const auto& robot : config.robots)
       if (!robot.program.empty()) inputs->push_back({robot.program, "the program"});
     if (scenario) inputs->push_back({o.scenario, "the scenario"});
-    if (std::filesystem::exists(profileName))
-      inputs->push_back({profileName, "the profile"});
-    else if (const auto shipped = config::shippedProfilePath(profileName))
-      inputs->push_back({*shipped, "the profile"});
+    inputs->push_back({profile.file, "the profile"});
     for (const auto& [robot, file] : hwFiles) inputs->push_back({file, "the hardware file"});
     if (scenario)
       for (const auto* r : {&scenario->a, &scenario->b})

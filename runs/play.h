@@ -60,6 +60,11 @@ struct RunOptions {
 // and the last three, the others counted (a reload storm faults thousands
 // of times; the JSON lists them all).
 inline constexpr size_t kFaultsShownFirst = 10, kFaultsShownLast = 3;
+// Whether the k-th of n faults is one of those shown.
+inline bool faultShown(size_t k, size_t n) {
+  return n <= kFaultsShownFirst + kFaultsShownLast || k < kFaultsShownFirst ||
+         k >= n - kFaultsShownLast;
+}
 
 // The run's configuration from the options and the scenario: the programs
 // given (A, and B for match), then the scenario (start poses, hardware, B
