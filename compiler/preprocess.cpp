@@ -5,7 +5,13 @@
 // is never re-expanded inside its own expansion and expansion always ends.
 // Expanded tokens are pushed back onto a pending stack and rescanned. The
 // cost is bounded: argument pre-expansion recursion is capped, and so is the
-// total number of tokens that expansions may produce.
+// total number of tokens that expansions may produce, counted as they are
+// produced. Hide sets are made once per operation and operands and shared
+// (40 doubling macros would otherwise make a set of 40 names for each of
+// their 2^40 tokens), and the names they hold are bounded too. A macro
+// invocation in the file is expanded in full before its first token goes to
+// the parser, so an expansion too large is the one error it gives (the
+// parser would first report what its leading tokens do not parse as).
 //
 // #include and #use name only built-in libraries (their functions are always
 // known to the compiler, so they add nothing); anything else is an error.
@@ -23,6 +29,9 @@ namespace {
 constexpr int kMaxExpandDepth = 32;
 constexpr size_t kMaxMacroNesting = 200;
 constexpr long kMaxExpandedTokens = 500'000;  // produced or collected as arguments
+// Names held by all the hide sets made (each set is also charged 4 names for
+// its own keeping): about 32 bytes a name, so at most some 64 MB.
+constexpr long kMaxHideNames = 2'000'000;
 constexpr size_t kMaxCondDepth = 200;
 
 constexpr std::array<std::string_view, 12> kLibraries = {
@@ -31,25 +40,6 @@ constexpr std::array<std::string_view, 12> kLibraries = {
 
 bool hides(const HideSet& hs, const std::string& name) {
   return hs && std::binary_search(hs->begin(), hs->end(), name);
-}
-
-HideSet hideUnion(const HideSet& a, const HideSet& b) {
-  if (!a || a->empty()) return b;
-  if (!b || b->empty()) return a;
-  auto out = std::make_shared<std::vector<std::string>>();
-  std::set_union(a->begin(), a->end(), b->begin(), b->end(), std::back_inserter(*out));
-  return out;
-}
-
-HideSet hideIntersection(const HideSet& a, const HideSet& b) {
-  if (!a || !b) return nullptr;
-  auto out = std::make_shared<std::vector<std::string>>();
-  std::set_intersection(a->begin(), a->end(), b->begin(), b->end(), std::back_inserter(*out));
-  return out;
-}
-
-HideSet hideAdd(const HideSet& a, const std::string& name) {
-  return hideUnion(a, std::make_shared<std::vector<std::string>>(1, name));
 }
 
 std::string quote(const std::string& s) {
@@ -340,6 +330,14 @@ std::vector<Token> Preprocessor::readLine(bool lenient) {
 }
 
 Token Preprocessor::next() {
+  if (readyAt_ < ready_.size()) {
+    Token t = std::move(ready_[readyAt_++]);
+    if (readyAt_ == ready_.size()) {
+      ready_.clear();
+      readyAt_ = 0;
+    }
+    return t;
+  }
   for (;;) {
     Token t = raw();
     if (t.fromFile && t.bol && t.kind == TokKind::Punct && t.text == "#") {
@@ -351,7 +349,20 @@ Token Preprocessor::next() {
       unget(t);
       return t;
     }
-    if (t.kind == TokKind::Ident && expand(t)) continue;
+    if (t.kind == TokKind::Ident && expand(t)) {
+      // The whole expansion: every token it made and rescanned, up to the
+      // next token of the file (which may be a directive) or its end.
+      while (!pending_.empty() && !pending_.back().fromFile &&
+             pending_.back().kind != TokKind::Eof) {
+        Token u = raw();
+        if (u.kind == TokKind::Ident && expand(u)) continue;
+        u.hide = nullptr;  // the parser has no use for it
+        ready_.push_back(std::move(u));
+      }
+      if (ready_.empty()) continue;
+      return next();
+    }
+    t.hide = nullptr;
     return t;
   }
 }
@@ -670,7 +681,7 @@ bool Preprocessor::expand(const Token& t) {
                     " deep (a chain of #defines)");
 
   if (!m.funcLike) {
-    pushExpansion(substitute(m, {}, t), hideAdd(t.hide, t.text), t);
+    pushExpansion(substitute(m, {}, t), hideAdd(t.hide, t.text, t.pos), t);
     return true;
   }
 
@@ -720,7 +731,7 @@ bool Preprocessor::expand(const Token& t) {
                     (want == 1 ? " argument" : " arguments") + ", but " +
                     std::to_string(args.size()) + " given");
   }
-  HideSet hs = hideAdd(hideIntersection(t.hide, rparen.hide), t.text);
+  HideSet hs = hideAdd(hideIntersection(t.hide, rparen.hide, t.pos), t.text, t.pos);
   pushExpansion(substitute(m, args, t), hs, t);
   return true;
 }
@@ -729,11 +740,50 @@ void Preprocessor::pushExpansion(std::vector<Token> toks, const HideSet& hs, con
   expandedTokens_ += static_cast<long>(toks.size());
   if (expandedTokens_ > kMaxExpandedTokens) fail(at.pos, "macro expansion too large");
   for (auto it = toks.rbegin(); it != toks.rend(); ++it) {
-    it->hide = hideUnion(it->hide, hs);
+    it->hide = hideUnion(it->hide, hs, at.pos);
     it->fromFile = false;
     it->bol = false;
     pending_.push_back(std::move(*it));
   }
+}
+
+HideSet Preprocessor::hideUnion(const HideSet& a, const HideSet& b, Pos at) {
+  if (!a || a->empty() || a == b) return b;
+  if (!b || b->empty()) return a;
+  auto found = hideMemo_.find({'|', a.get(), b.get()});
+  if (found != hideMemo_.end()) return found->second.made;
+  std::vector<std::string> names;
+  names.reserve(a->size() + b->size());
+  std::set_union(a->begin(), a->end(), b->begin(), b->end(), std::back_inserter(names));
+  return hideMade('|', a, b, std::move(names), at);
+}
+
+HideSet Preprocessor::hideIntersection(const HideSet& a, const HideSet& b, Pos at) {
+  if (!a || !b) return nullptr;
+  if (a == b) return a;
+  auto found = hideMemo_.find({'&', a.get(), b.get()});
+  if (found != hideMemo_.end()) return found->second.made;
+  std::vector<std::string> names;
+  std::set_intersection(a->begin(), a->end(), b->begin(), b->end(), std::back_inserter(names));
+  return hideMade('&', a, b, std::move(names), at);
+}
+
+HideSet Preprocessor::hideAdd(const HideSet& a, const std::string& name, Pos at) {
+  HideSet& single = hideSingles_[name];
+  if (!single) {
+    single = std::make_shared<const std::vector<std::string>>(1, name);
+    hideNames_ += 5;
+  }
+  return hideUnion(a, single, at);
+}
+
+HideSet Preprocessor::hideMade(char op, const HideSet& a, const HideSet& b,
+                               std::vector<std::string> names, Pos at) {
+  hideNames_ += static_cast<long>(names.size()) + 4;
+  if (hideNames_ > kMaxHideNames) fail(at, "macro expansion too large");
+  HideSet made = std::make_shared<const std::vector<std::string>>(std::move(names));
+  hideMemo_.emplace(std::make_tuple(op, a.get(), b.get()), HideMemo{a, b, made});
+  return made;
 }
 
 // The body of `m` with its parameters replaced (# stringizes, ## pastes,

@@ -8,8 +8,10 @@
 // names can be resolved.
 #pragma once
 #include <algorithm>
+#include <map>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -66,6 +68,11 @@ class Preprocessor {
   std::vector<Token> substitute(const Macro& m, const std::vector<std::vector<Token>>& args,
                                 const Token& at);
   void pushExpansion(std::vector<Token> toks, const HideSet& hs, const Token& at);
+  HideSet hideUnion(const HideSet& a, const HideSet& b, Pos at);
+  HideSet hideIntersection(const HideSet& a, const HideSet& b, Pos at);
+  HideSet hideAdd(const HideSet& a, const std::string& name, Pos at);
+  HideSet hideMade(char op, const HideSet& a, const HideSet& b, std::vector<std::string> names,
+                   Pos at);
 
   Lexer lex_;
   std::string fileName_;
@@ -78,6 +85,19 @@ class Preprocessor {
   std::vector<std::string> used_;  // libraries named by #use / #include
   int expandDepth_ = 0;
   long expandedTokens_ = 0;
+  // The tokens of a macro invocation in the file, expanded in full before
+  // the first is handed on; next() returns them from ready_[readyAt_].
+  std::vector<Token> ready_;
+  size_t readyAt_ = 0;
+  // Every hide set made, by the operation ('|', '&') and the sets it was
+  // made of, so that the same operation gives the same shared set; the
+  // entries hold their operands, so an address is never reused as a key.
+  struct HideMemo {
+    HideSet a, b, made;
+  };
+  std::map<std::tuple<char, const void*, const void*>, HideMemo> hideMemo_;
+  std::unordered_map<std::string, HideSet> hideSingles_;  // {name}, one per macro name
+  long hideNames_ = 0;  // names held by the sets made (and a charge per set)
 };
 
 }  // namespace simbot::compiler

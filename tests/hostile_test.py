@@ -31,15 +31,17 @@ def check(ok, message):
         print("FAIL:", message)
 
 
-def limits():
-    if not SANITIZED:
-        resource.setrlimit(resource.RLIMIT_AS, (500 << 20, 500 << 20))
+def limits(mb=500):
+    def set_limit():
+        if not SANITIZED:
+            resource.setrlimit(resource.RLIMIT_AS, (mb << 20, mb << 20))
+    return set_limit
 
 
-def simbot(*args):
+def simbot(*args, mb=500):
     try:
         return subprocess.run([SIMBOT, *map(str, args)], capture_output=True, timeout=TIMEOUT,
-                              preexec_fn=limits)
+                              preexec_fn=limits(mb))
     except subprocess.TimeoutExpired:
         check(False, f"simbot {' '.join(map(str, args))} ran past {TIMEOUT} s")
         return None
@@ -135,6 +137,13 @@ expect_error("a seed beyond 2^63 in a scenario", simbot("solo", SOURCE / "progra
 p = write("chain.dc", "".join(f"#define A{i} A{i + 1}\n" for i in range(20000)) +
           "#define A20000 1\nmain()\n{\n    int x;\n    x = A0;\n}\n")
 expect_error("a 20,000-deep #define chain", simbot("compile", p), 1, "macros nested more than 200 deep")
+# 40 doubling macros (tests/errors/74-macro-doubling.dc): A40 would be 2^40
+# tokens. The expansion stops at its token bound with one error, under a
+# 200-MB address-space limit (it took 370 MB before the bound was counted
+# as tokens were made and hide sets were shared).
+r = simbot("compile", SOURCE / "tests" / "errors" / "74-macro-doubling.dc", mb=200)
+expect_error("40 doubling macros", r, 1, "74-macro-doubling.dc:48:5: error: macro expansion too large")
+check(r is not None and r.stderr.count(b"error:") == 1, f"40 doubling macros: one error: {r and r.stderr!r}")
 p = write("params200k.dc", "f(" + ",".join(f"int p{i}" for i in range(200000)) + ") { return 0; }\nmain() { }\n")
 expect_error("200,000 parameters", simbot("compile", p), 1, "more than a program may have")
 p = write("params80k.dc", "f(" + ",".join(f"int p{i}" for i in range(80000)) + ") { return 0; }\nmain() { }\n")
