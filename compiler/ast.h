@@ -119,6 +119,7 @@ struct Obj {
   Function* fn = nullptr;  // Storage::Function
   int address = -1;        // data address, or frame offset for autos
   bool biosTimer = false;  // TICK_TIMER, MS_TIMER, SEC_TIMER (the BIOS's)
+  int scopeEnd = 0;        // autos and parameters: their block's last line
 };
 
 struct Function {

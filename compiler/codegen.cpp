@@ -279,6 +279,7 @@ vm::Image CodeGen::run() {
 
   // Symbols.
   using K = vm::Symbol::Kind;
+  DebugTypes types;
   for (Function* f : prog_.functions)
     img_.symbols.push_back(vm::Symbol{f->name, f->isHandler ? K::Handler : K::Function,
                                       static_cast<uint32_t>(f->address),
@@ -287,17 +288,19 @@ vm::Image CodeGen::run() {
   for (Obj* g : prog_.globals)
     img_.symbols.push_back(vm::Symbol{g->name, K::Global, static_cast<uint32_t>(g->address),
                                       static_cast<uint32_t>(g->type->size), typeName(g->type),
-                                      symbolValue(g->type), g->pos.line});
+                                      symbolValue(g->type), g->pos.line, types.id(g->type)});
   for (Function* f : prog_.functions) {
     auto add = [&](Obj* o) {
       K kind = o->storage == Storage::Auto ? K::Auto : o->isParam ? K::Param : K::Static;
       img_.symbols.push_back(vm::Symbol{o->symName, kind, static_cast<uint32_t>(o->address),
                                         static_cast<uint32_t>(o->type->size), typeName(o->type),
-                                        symbolValue(o->type), o->pos.line});
+                                        symbolValue(o->type), o->pos.line, types.id(o->type),
+                                        o->storage == Storage::Auto ? o->scopeEnd : 0, o->isParam});
     };
     for (Obj* p : f->params) add(p);
     for (Obj* l : f->locals) add(l);
   }
+  img_.types = types.take();
   return std::move(img_);
 }
 

@@ -93,6 +93,17 @@ inline int widthIndex(Rep r) {
 
 inline bool isAggregate(const Type* t) { return t->kind == TypeKind::Array || isStructLike(t); }
 
+// The image's type table, one entry per distinct type (debug_info.cpp).
+class DebugTypes {
+ public:
+  int32_t id(const Type* t);  // -1 for none
+  std::vector<vm::TypeInfo> take() { return std::move(types_); }
+
+ private:
+  std::unordered_map<const Type*, int32_t> ids_;
+  std::vector<vm::TypeInfo> types_;
+};
+
 class CodeGen {
  public:
   explicit CodeGen(Program& prog) : prog_(prog) {}

@@ -123,7 +123,13 @@ class Parser {
 
   // ---- scopes ----
   void enterScope() { scopes_.emplace_back(); }
-  void leaveScope() { scopes_.pop_back(); }
+  // A local's scope ends with the last token read (the block's brace).
+  void leaveScope() {
+    const int end = i_ > 0 ? at(i_ - 1).pos.line : 0;
+    for (auto& [name, entry] : scopes_.back().vars)
+      if (entry.var && entry.var->scopeEnd == 0) entry.var->scopeEnd = end;
+    scopes_.pop_back();
+  }
   ScopeEntry* findVar(const std::string& name);
   Type* findTag(const std::string& name);
   Type* typedefOf(const Token& t);

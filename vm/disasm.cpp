@@ -141,7 +141,41 @@ std::string costText(const CostTable& costs, Op op, const Image& img, uint32_t o
   return fmt::format("{}", costs.op[i]);
 }
 
+// One instruction's name, operands (with the symbol they name) and
+// T-states, as the listing and the debugger's stepi show it.
+struct Parts {
+  std::string name, operands, cost;
+};
+Parts instructionParts(const Image& img, const CostTable& costs,
+                       const std::vector<int32_t>& returnFrames, uint32_t at) {
+  const Op op = static_cast<Op>(img.code[at]);
+  std::string operands = operandText(info(op).shape, img, at + 1);
+  const std::string note = annotate(img, op, at + 1);
+  if (!note.empty()) operands += fmt::format("  ({})", note);
+  std::string cost = costText(costs, op, img, at + 1);
+  if (op == Op::RET && returnFrames[at] >= 0)
+    cost = fmt::format("{}", costs.op[static_cast<int>(op)] + costs.autoFrameRet);
+  if (op == Op::COPY) {  // LDIR repeats for every byte but the last
+    const uint32_t n = img.code[at + 1] | (img.code[at + 2] << 8);
+    cost =
+        fmt::format("{}", costs.op[static_cast<int>(op)] + (n > 1 ? n - 1 : 0) * costs.ldirRepeat);
+  }
+  return {std::string(info(op).name), operands, cost};
+}
+
 }  // namespace
+
+std::string disassembleAt(const Image& img, uint32_t at) {
+  if (at >= img.code.size()) return fmt::format("{:04x}  (outside the code)", at);
+  const uint8_t byte = img.code[at];
+  if (byte >= kOpCount) return fmt::format("{:04x}  .byte {}", at, byte);
+  const Op op = static_cast<Op>(byte);
+  if (at + static_cast<uint32_t>(instructionSize(op)) > img.code.size())
+    return fmt::format("{:04x}  {} (truncated)", at, info(op).name);
+  const CostTable costs = makeCostTable(calibratedKnobs());
+  const auto [name, operands, cost] = instructionParts(img, costs, img.returnFrames(), at);
+  return fmt::format("{:04x}  {:<8} {}  [{} T-states]", at, name, operands, cost);
+}
 
 std::string disassemble(const Image& img) {
   const CostTable costs = makeCostTable(calibratedKnobs());
@@ -182,18 +216,8 @@ std::string disassemble(const Image& img) {
       out += fmt::format("  {:04x}        {} (truncated)\n", at, info(op).name);
       break;
     }
-    std::string operands = operandText(info(op).shape, img, at + 1);
-    const std::string note = annotate(img, op, at + 1);
-    if (!note.empty()) operands += fmt::format("  ({})", note);
-    std::string cost = costText(costs, op, img, at + 1);
-    if (op == Op::RET && returnFrames[at] >= 0)
-      cost = fmt::format("{}", costs.op[static_cast<int>(op)] + costs.autoFrameRet);
-    if (op == Op::COPY) {  // LDIR repeats for every byte but the last
-      const uint32_t n = img.code[at + 1] | (img.code[at + 2] << 8);
-      cost = fmt::format("{}",
-                         costs.op[static_cast<int>(op)] + (n > 1 ? n - 1 : 0) * costs.ldirRepeat);
-    }
-    out += fmt::format("  {:04x}  {:>11}  {:<8} {}\n", at, cost, info(op).name, operands);
+    const auto [name, operands, cost] = instructionParts(img, costs, returnFrames, at);
+    out += fmt::format("  {:04x}  {:>11}  {:<8} {}\n", at, cost, name, operands);
     at += static_cast<uint32_t>(size);
   }
   return out;

@@ -94,6 +94,31 @@ struct Symbol {
   std::string type;  // C type for people, e.g. "unsigned long", "struct pt *"
   Value value;
   int line;
+  // The data's type in Image::types (-1: none, a function's); for an auto
+  // or parameter, the last line of the block it is declared in (it is in
+  // scope from `line` to there).
+  int32_t typeId = -1;
+  int scopeEnd = 0;
+  bool parameter = false;  // a function's parameter (Auto in #class auto, else Param)
+};
+
+// A data type, for readers that take memory apart (the debugger's print,
+// --watch): scalars as Symbol::Value reads them, pointers, arrays, structs
+// and unions with their members' offsets. Indices refer to Image::types.
+struct TypeInfo {
+  enum class Kind : uint8_t { Void, Scalar, Pointer, Array, Struct, Union, Function };
+  Kind kind = Kind::Void;
+  Symbol::Value scalar = Symbol::Value::Aggregate;  // Scalar and Pointer
+  uint32_t size = 0;
+  int32_t base = -1;  // Pointer: pointee; Array: element; Function: return
+  int32_t count = 0;  // Array: elements (0: unknown, "[]")
+  std::string name;   // as C spells it: "struct pt", "char[8]"
+  struct Field {
+    std::string name;
+    uint32_t offset;
+    int32_t type;
+  };
+  std::vector<Field> fields;  // Struct, Union
 };
 
 struct Image {
@@ -111,6 +136,7 @@ struct Image {
   std::vector<uint8_t> initialised;
   std::vector<VectorBinding> vectors;
   std::vector<Symbol> symbols;
+  std::vector<TypeInfo> types;  // Symbol::typeId
   TimerBlock timer;
   // Code addresses a costatement may resume at (yield and waitfor points),
   // sorted: a lastlocADDR that is not one of them is a fault.

@@ -750,6 +750,15 @@ bool Vm::sameMachine(const Vm& other) const {
   return mine == *other.s_;
 }
 
+bool Vm::sameProgramState(const Vm& other) const {
+  State mine = comparable(*s_, *other.s_);
+  mine.copyCounters(*other.s_);
+  mine.measure = other.s_->measure;
+  mine.loops = other.s_->loops;
+  mine.resumeAtBreakpoint = other.s_->resumeAtBreakpoint;
+  return mine == *other.s_;
+}
+
 void Vm::fillMemory(const std::function<uint64_t()>& next) {
   State& s = *s_;
   const auto& init = s.image->initialised;
@@ -814,6 +823,46 @@ std::vector<Vm::Frame> Vm::frames() const {
   }
   handlersAt(SIZE_MAX);
   return out;
+}
+std::vector<Vm::Activation> Vm::activations() const {
+  const State& s = *s_;
+  const Image& img = *s.image;
+  // A function has a frame once its first instruction, an ENTER, has run.
+  auto entered = [&](uint32_t at) {
+    const Symbol* f = img.functionAt(at);
+    return f && f->address < img.code.size() &&
+           img.code[f->address] == static_cast<uint8_t>(Op::ENTER) && at != f->address;
+  };
+  const std::vector<Frame> outer = frames();
+  std::vector<Activation> out;
+  out.reserve(outer.size() + 1);
+  uint32_t fp = s.mfp;
+  size_t call = s.calls.size(), handler = s.ints.size();
+  uint32_t at = s.lib.active ? s.lib.pc : s.pc;
+  bool inHandler = !s.ints.empty() && s.ints.back().callDepth == static_cast<int>(s.calls.size());
+  for (size_t k = outer.size() + 1; k-- > 0;) {
+    const bool framed = entered(at);
+    out.push_back({at, fp, framed, inHandler});
+    if (k == 0) break;
+    const Frame& f = outer[k - 1];
+    if (f.interrupted) {
+      // Acceptance saved the interrupted code's IX below its PC.
+      --handler;
+      fp = s.rd16(static_cast<uint16_t>(s.ints[handler].msp - kInterruptFpOffset));
+    } else {
+      --call;
+      if (framed) fp = s.rd16(static_cast<uint16_t>(s.calls[call].saved - kSavedFpBytes));
+    }
+    at = f.at;
+    inHandler = handler > 0 && s.ints[handler - 1].callDepth == static_cast<int>(call);
+  }
+  return out;
+}
+int Vm::evalDepth() const { return s_->sp; }
+bool Vm::inLibraryCall() const { return s_->lib.active; }
+uint32_t Vm::evalSlot(int fromTop) const {
+  const int i = s_->sp - 1 - fromTop;
+  return i >= 0 && i < kEvalSlots ? s_->eval[static_cast<size_t>(i)] : 0;
 }
 uint8_t Vm::read8(uint16_t a) const { return s_->rd8(a); }
 void Vm::write8(uint16_t a, uint8_t v) { s_->wr8(a, v); }

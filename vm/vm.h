@@ -133,6 +133,12 @@ class Vm {
   // aside. sameMachine leaves the counters out.
   bool operator==(const Vm& other) const;
   bool sameMachine(const Vm& other) const;
+  // sameMachine less what fast-forward learns as it runs (a delay loop's
+  // measured pass, a measurement under way) and whether the VM stopped at
+  // its breakpoint last: a state reached by another path (a debugger's
+  // replay from a snapshot) has the same memory, registers, stacks,
+  // requests and clock, and goes on the same.
+  bool sameProgramState(const Vm& other) const;
 
   // Executes every instruction that starts before `until`. A bus access
   // does not end the run: what the host does on one (a port B write, a
@@ -179,6 +185,26 @@ class Vm {
     bool interrupted;
   };
   std::vector<Frame> frames() const;
+  // The same calls and handlers as a debugger walks them, innermost first,
+  // the current instruction's function first: where each one is (pc(), or
+  // the CALL it made, or the instruction its handler interrupted) and its
+  // frame pointer IX (its autos are at fp + their offset), valid once its
+  // function's ENTER has run (`framed`; a function without one has none).
+  // `handler`: the activation is an interrupt handler's.
+  struct Activation {
+    uint32_t pc;
+    uint32_t fp;
+    bool framed;
+    bool handler;
+  };
+  std::vector<Activation> activations() const;
+  // The expression stack's depth in slots, and its top slots (for a
+  // debugger's `info registers`).
+  int evalDepth() const;
+  // A library call is under way (its steps have boundaries between them).
+  bool inLibraryCall() const;
+  uint32_t evalSlot(int fromTop) const;
+
   // The LIB instruction of the latest library call: during a routine's
   // bus access (Bus::serialSend, ...) the call that made it, which pc() is
   // no longer once the routine's effect has begun.
@@ -223,5 +249,8 @@ class Vm {
 
 // Disassembly of an image, interleaving source lines (vm/disasm.cpp).
 std::string disassemble(const Image& image);
+// The instruction at `codeAddress` as one line of that listing: address,
+// name, operands and T-states (the debugger's stepi).
+std::string disassembleAt(const Image& image, uint32_t codeAddress);
 
 }  // namespace simbot::vm
