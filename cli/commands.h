@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "batch/bench_metrics.h"
+#include "runs/play.h"
 
 namespace simbot::cli {
 
@@ -30,5 +31,12 @@ void addThresholdOptions(CLI::App& cmd, batch::MetricThresholds& thresholds);
 Subcommand addTournamentCommand(CLI::App& app);
 Subcommand addExplainCommand(CLI::App& app);  // cli/explain_command.cpp
 Subcommand addSweepCommand(CLI::App& app);    // cli/sweep_command.cpp
+// simbot debug (cli/debug_command.cpp): commands from --batch FILE, the
+// terminal or stdin; `robot` the one held first ("A" or "B").
+int debugCommand(const std::vector<std::string>& programs, const runs::RunOptions& o,
+                 const std::string& batch, const std::string& robot);
+// simbot dap (cli/dap_command.cpp): the debugger over the Debug Adapter
+// Protocol on stdin and stdout.
+int dapCommand();
 
 }  // namespace simbot::cli

@@ -314,6 +314,27 @@ int main(int argc, char** argv) {
   view->add_option("-o,--output", viewOut,
                    "the page to write (default: beside the trace, with .html for its extension)");
 
+  runs::RunOptions debugOptions;
+  std::vector<std::string> debugPrograms;
+  std::string debugBatch, debugRobot = "A";
+  auto* debugCmd = app.add_subcommand(
+      "debug",
+      "stop a robot and look at it: breakpoints, stepping both ways in simulated time, any "
+      "variable (gdb's commands; README \"Debugging\")");
+  debugCmd->add_option("PROGRAMS", debugPrograms, "robot A's program, and B's for a match")
+      ->required()
+      ->expected(1, 2);
+  addRunOptions(debugCmd, debugOptions, runs::kDebug);
+  debugCmd->add_option("--batch", debugBatch,
+                       "read the commands from this file, echoing each (a transcript)");
+  debugCmd->add_option("--robot", debugRobot, "the robot held at the start: A (default) or B")
+      ->check(CLI::IsMember({"A", "B"}));
+  addWarningOptions(debugCmd);
+  auto* dapCmd = app.add_subcommand(
+      "dap",
+      "the debugger for VS Code: the Debug Adapter Protocol on stdin and stdout (the launch "
+      "request names the programs; docs/vscode.md)");
+
   const auto bench = simbot::cli::addBenchCommand(app);
   const auto compare = simbot::cli::addCompareCommand(app);
   const auto tournament = simbot::cli::addTournamentCommand(app);
@@ -341,7 +362,7 @@ int main(int argc, char** argv) {
   }
   try {
     // -Wno-NAME and -Werror, on every command that compiles a program.
-    for (CLI::App* cmd : {solo, match, profile, bench.app, tournament.app, compare.app})
+    for (CLI::App* cmd : {solo, match, profile, debugCmd, bench.app, tournament.app, compare.app})
       if (*cmd) {
         compiler::Options options;
         runs::parseWarningOptions(cmd->remaining(), options, cmd->get_name());
@@ -351,6 +372,8 @@ int main(int argc, char** argv) {
     if (*solo) return soloCommand(soloProgram, soloOptions);
     if (*match) return matchCommand(programA, programB, matchOptions);
     if (*profile) return profileCommand(profileProgram, profileOptions, profileTop);
+    if (*debugCmd) return cli::debugCommand(debugPrograms, debugOptions, debugBatch, debugRobot);
+    if (*dapCmd) return cli::dapCommand();
     if (*view) return viewCommand(viewTrace, viewOut);
     if (*bench.app) return bench.run();
     if (*compare.app) return compare.run();

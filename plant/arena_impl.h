@@ -275,7 +275,7 @@ struct Arena::Impl {
 
   // ---- the calls that changed the arena, when it keeps them (a copy
   // makes them again: arena_journal.h)
-  std::unique_ptr<Journal> journal;
+  std::shared_ptr<Journal> journal;  // shared with Arena::Mark
 
   // ---- statistics
   IntegratorStats acc{};

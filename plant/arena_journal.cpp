@@ -49,10 +49,13 @@ class Replayed final : public RandomBits {
 
 }  // namespace
 
-void Journal::replay(Arena& arena) const {
+void Journal::replay(Arena& arena, std::size_t callCount, std::size_t drawCount) const {
+  callCount = std::min(callCount, calls.size());
+  drawCount = std::min(drawCount, draws.size());
   std::size_t cursor = 0;
   Replayed gunLuck(draws, cursor, 0), muzzle(draws, cursor, 1), dispersion(draws, cursor, 2);
-  for (const Call& c : calls) {
+  for (std::size_t k = 0; k < callCount; ++k) {
+    const Call& c = calls[k];
     switch (c.kind) {
       case Kind::SetWheels:
         arena.setWheels(c.robot, c.frame, c.tick);
@@ -78,7 +81,7 @@ void Journal::replay(Arena& arena) const {
         break;
     }
   }
-  if (cursor != draws.size())
+  if (cursor != drawCount)
     throw std::logic_error("an arena's replay drew fewer words than the arena did");
 }
 
@@ -88,7 +91,19 @@ void Arena::keepJournal() {
   if (impl_->journal) return;
   if (impl_->now != 0 || impl_->segTick != 0)
     throw std::logic_error("an arena keeps its journal from its first call");
-  impl_->journal = std::make_unique<arena_detail::Journal>(impl_->cfg);
+  impl_->journal = std::make_shared<arena_detail::Journal>(impl_->cfg);
+}
+
+Arena::Mark Arena::mark() const {
+  const auto& journal = impl_->journal;
+  if (!journal) throw std::logic_error("an arena is marked only when it keeps its journal");
+  return Mark{journal, journal->calls.size(), journal->draws.size()};
+}
+
+Arena::Arena(const Mark& mark) {
+  impl_ = std::make_unique<Impl>(mark.journal->initial);
+  keepJournal();
+  mark.journal->replay(*this, mark.calls, mark.draws);
 }
 
 Arena::Arena(const Arena& other) {

@@ -83,7 +83,9 @@ struct Journal {
   };
 
   // Makes every call again on `arena` (new, of configuration `initial`).
-  void replay(Arena& arena) const;
+  // The first `calls` calls and `draws` draws (all: the whole journal).
+  void replay(Arena& arena, std::size_t callCount = SIZE_MAX,
+              std::size_t drawCount = SIZE_MAX) const;
 };
 
 }  // namespace simbot::plant::arena_detail

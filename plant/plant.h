@@ -29,6 +29,10 @@
 
 namespace simbot::plant {
 
+namespace arena_detail {
+struct Journal;
+}
+
 // ---------------------------------------------------------------- time
 // The clock is defined once, in timebase/tick.h.
 using timebase::kTicksPerSecond;
@@ -414,6 +418,16 @@ class Arena {
   // can be copied (std::logic_error otherwise).
   void keepJournal();
   Arena(const Arena& other);
+  // Where an arena that keeps its journal is now, without copying it: an
+  // arena made from the mark is the arena as it was then (it replays the
+  // calls before the mark; later calls to the marked arena leave the mark
+  // as it was). A debugger's snapshots cost one mark each.
+  struct Mark {
+    std::shared_ptr<const arena_detail::Journal> journal;
+    std::size_t calls = 0, draws = 0;
+  };
+  Mark mark() const;
+  explicit Arena(const Mark& mark);
   Arena& operator=(const Arena& other);
 
   int robotCount() const;

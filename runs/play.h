@@ -42,7 +42,7 @@ vm::Image compileProgramText(const std::string& source, const std::string& name)
 config::Profile loadNamedProfile(const std::string& nameOrPath);
 
 // Where a run option is offered (runs/run_options.def).
-enum RunOptionUse : unsigned { kSolo = 1, kMatch = 2, kProfile = 4, kPython = 8 };
+enum RunOptionUse : unsigned { kSolo = 1, kMatch = 2, kProfile = 4, kPython = 8, kDebug = 16 };
 
 struct RunOptions {
 #define RUN_OPTION(member, Type, flag, keyword, where, help) Type member{};

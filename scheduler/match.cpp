@@ -139,6 +139,8 @@ Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs, ui
 Robot::Robot(const Robot& other, Match& m)
     : reloadPending(other.reloadPending),
       faultSeen(other.faultSeen),
+      debugLook(other.debugLook),
+      debugBreakpoints(other.debugBreakpoints),
       lineInjections(other.lineInjections),
       lineHits(other.lineHits),
       watches(other.watches),
@@ -184,40 +186,94 @@ void Robot::reload(Tick t) {
 }
 
 void Robot::runTo(Tick horizon) {
+  if (match.debugger() && index == match.debugRobot()) return debugRunTo(horizon);
   const bool tracing = match.tracing();
   for (;;) {
     if (tracing) takeSnapshots();
     if (now() >= horizon) return;
     const vm::Stop stop = board.cpu.run(tracing ? std::min(horizon, nextSnapshot) : horizon);
-    if (stop == vm::Stop::Fault) {
-      const vm::Fault* f = board.cpu.fault();
-      const Tick at = f->tick;
-      if (!faultSeen) {
-        faultSeen = true;
-        auto [calls, depth] = faultChain();
-        FaultInfo info{f->message, timebase::secondsFromTicks(at), f->line, depth, calls};
-        if (!result.fault) result.fault = info;
-        result.faults.push_back(info);
-        if (tracing)
-          match.emit(at, trace::rec::Fault{index, f->message, f->line, depth, std::move(calls)});
-        if (match.observer()) match.observer()->onHalt(index, at);
-        match.faulted(index, at);
-      }
-      return;
-    }
-    if (stop != vm::Stop::Breakpoint) continue;
-    if (board.cpu.pc() == mainReturn) {
-      result.exited = true;
-      result.exitTick = now();
-      if (tracing) match.emit(now(), trace::rec::Exit{index});
-      if (match.observer()) match.observer()->onHalt(index, now());
-    }
-    if (auto it = lineInjections.find(board.cpu.pc()); it != lineInjections.end()) {
-      const int hit = ++lineHits[board.cpu.pc()];
-      for (int k : it->second)
-        if (match.injection(k).count == hit) inject(now(), match.injection(k));
+    if (stop == vm::Stop::Fault) return noteFault();
+    if (stop == vm::Stop::Breakpoint) {
+      noteBreakpoint();
+      if (DebugHook* hook = match.debugger()) hook->otherBreakpoint(match, index);
     }
   }
+}
+
+void Robot::noteFault() {
+  if (faultSeen) return;
+  faultSeen = true;
+  const vm::Fault* f = board.cpu.fault();
+  const Tick at = f->tick;
+  auto [calls, depth] = faultChain();
+  FaultInfo info{f->message, timebase::secondsFromTicks(at), f->line, depth, calls};
+  if (!result.fault) result.fault = info;
+  result.faults.push_back(info);
+  if (match.tracing())
+    match.emit(at, trace::rec::Fault{index, f->message, f->line, depth, std::move(calls)});
+  if (match.observer()) match.observer()->onHalt(index, at);
+  match.faulted(index, at);
+  debugEvent(at, DebugEvent::Fault);
+}
+
+void Robot::noteBreakpoint() {
+  if (board.cpu.pc() == mainReturn) {
+    result.exited = true;
+    result.exitTick = now();
+    if (match.tracing()) match.emit(now(), trace::rec::Exit{index});
+    if (match.observer()) match.observer()->onHalt(index, now());
+  }
+  if (auto it = lineInjections.find(board.cpu.pc()); it != lineInjections.end()) {
+    const int hit = ++lineHits[board.cpu.pc()];
+    for (int k : it->second)
+      if (match.injection(k).count == hit) inject(now(), match.injection(k));
+  }
+}
+
+// The debugged robot runs as runTo runs it, stopping where the debugger
+// asks (DebugHook): each run of the VM ends at the horizon, a sample tick,
+// the debugger's tick or the next instruction when stepping. A halted VM
+// (main returned) is never stepped: its clock runs on without boundaries.
+void Robot::debugRunTo(Tick horizon) {
+  DebugHook& hook = *match.debugger();
+  const bool tracing = match.tracing();
+  for (;;) {
+    if (tracing) takeSnapshots();
+    if (now() >= horizon || board.cpu.fault()) return;
+    const bool stepping = hook.stepping() && !board.cpu.halted();
+    if (debugLook || (!stepping && hook.until() <= now())) {
+      debugLook = false;
+      look(hook);
+      continue;
+    }
+    Tick until = tracing ? std::min(horizon, nextSnapshot) : horizon;
+    until = std::min(until, stepping ? now() + 1 : hook.until());
+    const vm::Stop stop = board.cpu.run(until);
+    if (stop == vm::Stop::Fault) {
+      noteFault();
+      look(hook);
+      return;
+    }
+    if (stop == vm::Stop::Breakpoint) noteBreakpoint();
+    if (stop == vm::Stop::Breakpoint || stop == vm::Stop::Host || (stepping && !board.cpu.halted()))
+      look(hook);
+  }
+}
+
+void Robot::look(DebugHook& hook) {
+  match.bringOthersTo(index, now());
+  hook.boundary(match);
+}
+
+void Robot::debugEvent(Tick t, DebugEvent e) {
+  DebugHook* hook = match.debugger();
+  if (!hook || !hook->event(index, t, e)) return;
+  Robot& held = match.debugged();
+  // Inside the held robot's own run: it stops at its next boundary.
+  if (&held == this && e != DebugEvent::Fault && !match.betweenRounds())
+    board.cpu.stopAtNextBoundary();
+  else
+    held.debugLook = true;
 }
 
 // The VM's state at its first boundary at or after each sample tick it has
@@ -242,11 +298,27 @@ Robot::Snapshot Robot::snapshotFor(Tick t) {
 
 // ---- match ------------------------------------------------------------------
 
-Match::Match(const Match& other)
+namespace {
+
+// The plant of a copy (each return a prvalue: the member is made in place).
+plant::Arena arenaFor(const plant::Arena& other, const plant::Arena::Mark* mark,
+                      const plant::ArenaConfig& config, bool fresh) {
+  if (mark) return plant::Arena(*mark);
+  if (fresh) return plant::Arena(config);
+  return plant::Arena(other);
+}
+
+}  // namespace
+
+Match::Match(const Match& other) : Match(other, nullptr, false) {}
+Match::Match(const Match& other, const plant::Arena::Mark* mark)
+    : Match(other, mark, mark == nullptr) {}
+
+Match::Match(const Match& other, const plant::Arena::Mark* mark, bool freshArena)
     : config_(other.config_),
       costs_(other.costs_),
       arenaConfig_(other.arenaConfig_),
-      arena_(other.arena_),
+      arena_(arenaFor(other.arena_, mark, other.arenaConfig_, freshArena)),
       trace_(other.trace_),
       coin_(other.coin_),
       queue_(other.queue_),
@@ -263,7 +335,26 @@ Match::Match(const Match& other)
       rounds_(other.rounds_),
       subRounds_(other.subRounds_),
       clock_(other.clock_) {
+  if (freshArena) arena_.keepJournal();
   for (const auto& r : other.robots_) robots_.push_back(std::make_unique<Robot>(*r, *this));
+  orderRobots();
+}
+
+void Match::orderRobots() {
+  runOrder_.clear();
+  if (config_.debugger)
+    runOrder_.push_back(robots_.at(static_cast<size_t>(config_.debugRobot)).get());
+  for (const auto& r : robots_)
+    if (!config_.debugger || r->index != config_.debugRobot) runOrder_.push_back(r.get());
+}
+
+void Match::bringOthersTo(int robot, Tick t) {
+  for (const auto& r : robots_)
+    if (r->index != robot && !r->vm().fault() && r->now() < t) r->runTo(t);
+}
+
+plant::Pose Match::pose(int robot, Tick t) const {
+  return arena_.pose(robot, std::clamp(t, arena_.lastReinitTick(), arena_.now()));
 }
 
 Tick Match::earliestClock() const {
@@ -280,29 +371,41 @@ Tick Match::earliestAction() const {
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 
-// --watch VAR: a global, or a static local as FUNCTION.VAR, of any robot
-// whose program has it; scalars only. The value is read from the robot's
-// memory when the record is made (for samples: at the end of the round that
-// contains the sample tick, at most 9,600 ticks later).
+// --watch EXPR: a global, a static local as FUNCTION.VAR (both read
+// directly), or any lvalue the debugger's print takes (inspect.h: autos in
+// scope, members, elements, slices, through pointers), of every robot whose
+// program has the names it uses. The value is read from the robot's memory
+// when the record is made (for samples: at the robot's first boundary at
+// or after the sample tick).
 void Match::resolveWatches() {
   for (const auto& name : config_.watches) {
     bool found = false;
     for (auto& r : robots_) {
       for (const auto& s : r->spec.image.symbols) {
-        if (s.name != name) continue;
-        if (s.kind != vm::Symbol::Kind::Global && s.kind != vm::Symbol::Kind::Static &&
-            s.kind != vm::Symbol::Kind::Param)
-          throw std::invalid_argument("--watch " + name + ": only globals and static locals " +
-                                      "can be watched ('" + name + "' is an auto variable)");
-        if (s.value == vm::Symbol::Value::Aggregate || s.value == vm::Symbol::Value::Code)
-          throw std::invalid_argument("--watch " + name + ": only scalar variables can be watched");
-        r->watches.push_back({name, static_cast<uint16_t>(s.address), s.value});
+        if (s.name != name ||
+            (s.kind != vm::Symbol::Kind::Global && s.kind != vm::Symbol::Kind::Static) ||
+            s.value == vm::Symbol::Value::Aggregate || s.value == vm::Symbol::Value::Code)
+          continue;
+        r->watches.push_back({name, static_cast<uint16_t>(s.address), s.value, nullptr});
         found = true;
       }
     }
+    if (found) continue;
+    std::shared_ptr<const inspect::Expression> expression;
+    try {
+      expression = std::make_shared<const inspect::Expression>(name);
+    } catch (const inspect::Error& e) {
+      throw std::invalid_argument("--watch " + name + ": " + e.what());
+    }
+    for (auto& r : robots_) {
+      if (!inspect::namesExist(r->spec.image, *expression)) continue;
+      r->watches.push_back({name, 0, vm::Symbol::Value::Aggregate, expression});
+      found = true;
+    }
     if (!found)
-      throw std::invalid_argument("--watch " + name + ": no such global or static variable " +
-                                  "(a static local is FUNCTION.NAME)");
+      throw std::invalid_argument("--watch " + name +
+                                  ": a name in it is no variable of any robot's program (a "
+                                  "static or auto of a function is NAME or FUNCTION::NAME)");
   }
 }
 
@@ -529,6 +632,10 @@ void Match::handlePlantEvents(Tick t, const plant::EventList& events) {
       continue;
     }
     if (trace_.on()) emit(t, plantRecord(e));
+    if (config_.debugger &&
+        (e.kind == plant::EventKind::Contact || e.kind == plant::EventKind::BallLaunch))
+      robots_[static_cast<size_t>(e.robot)]->debugEvent(
+          t, e.kind == plant::EventKind::Contact ? DebugEvent::Contact : DebugEvent::Shot);
   }
 }
 
@@ -622,7 +729,7 @@ void Match::rounds(Tick pause) {
       horizon = std::min(horizon, step.tick);
       {
         const PartScope vms(clock_, PartClock::Vm);
-        for (auto& r : robots_) r->runTo(horizon);
+        for (Robot* r : runOrder_) r->runTo(horizon);
       }
       if (horizon == step.tick || !inputs_.empty() || (config_.stopWhenAllExited && allExited()))
         break;
@@ -813,5 +920,50 @@ MatchRun::~MatchRun() = default;
 bool MatchRun::runUntil(Tick tick) { return match_->runUntil(tick); }
 Tick MatchRun::now() const { return match_->roundStart(); }
 MatchResult MatchRun::finish() { return match_->end(); }
+const MatchView& MatchRun::view() const { return *match_; }
+
+void MatchRun::setDebugBreakpoints(int robot, const std::vector<uint32_t>& addresses) {
+  detail::Robot& r = match_->robot(robot);
+  if (r.debugBreakpoints == addresses) return;
+  auto ownedByMatch = [&](uint32_t a) { return a == r.mainReturn || r.lineInjections.count(a); };
+  for (uint32_t a : r.debugBreakpoints)
+    if (!ownedByMatch(a)) r.vm().setBreakpoint(a, false);
+  for (uint32_t a : addresses) r.vm().setBreakpoint(a, true);
+  r.debugBreakpoints = addresses;
+}
+
+MatchRun::Snapshot::Snapshot() = default;
+MatchRun::Snapshot::Snapshot(Snapshot&&) noexcept = default;
+MatchRun::Snapshot& MatchRun::Snapshot::operator=(Snapshot&&) noexcept = default;
+MatchRun::Snapshot::~Snapshot() = default;
+Tick MatchRun::Snapshot::now() const { return match_->roundStart(); }
+Tick MatchRun::Snapshot::robotClock(int robot) const { return match_->robotClock(robot); }
+
+MatchRun::Snapshot MatchRun::snapshot() const {
+  Snapshot s;
+  s.mark_ = match_->arena().mark();
+  s.match_ = std::make_unique<detail::Match>(*match_, nullptr);
+  return s;
+}
+
+void MatchRun::restore(const Snapshot& snapshot) {
+  match_ = std::make_unique<detail::Match>(*snapshot.match_, &snapshot.mark_);
+}
+
+std::string_view debugEventName(DebugEvent e) {
+  switch (e) {
+    case DebugEvent::FrameLatched:
+      return "frame";
+    case DebugEvent::EdgeAccepted:
+      return "edge";
+    case DebugEvent::Contact:
+      return "contact";
+    case DebugEvent::Shot:
+      return "shot";
+    case DebugEvent::Fault:
+      return "fault";
+  }
+  return "?";
+}
 
 }  // namespace simbot::scheduler

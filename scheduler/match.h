@@ -137,6 +137,50 @@ struct MatchObserver {
   virtual void onReload(int /*robot*/, Tick) {}
 };
 
+// What a debugger sees of a match stopped at one of its robot's
+// instruction boundaries (DebugHook) or over (MatchRun::view).
+class MatchView {
+ public:
+  virtual ~MatchView() = default;
+  virtual int robotCount() const = 0;
+  virtual const vm::Vm& vm(int robot) const = 0;
+  virtual const RobotSpec& spec(int robot) const = 0;
+  // The arena at `t` (a tick the plant has reached and not left behind:
+  // the debugged robot's clock at a stop): each robot's pose, wheel speeds,
+  // last eye readings, port lines, the latched motor command and the
+  // serial link, one line per item.
+  virtual std::string describe(Tick t) const = 0;
+  // The robots' poses at `t` (as describe's).
+  virtual plant::Pose pose(int robot, Tick t) const = 0;
+};
+
+// Happenings a debugger may stop at (break on an event).
+enum class DebugEvent : uint8_t { FrameLatched, EdgeAccepted, Contact, Shot, Fault };
+std::string_view debugEventName(DebugEvent e);  // "frame", "edge", "contact", "shot", "fault"
+
+// A debugger's hold on one robot (simbot debug; MatchConfig::debugger).
+// The match calls boundary() at that robot's instruction boundaries
+// inside the rounds, at the exact tick, with the other robots run up to
+// the same tick first: before every instruction while stepping(), else at
+// the first boundary at or after until(), at its VM's breakpoints, after
+// an event() that asked to look, and at its fault. boundary() may throw:
+// the match is then abandoned (the debugger restores a snapshot). On
+// return the robot goes on: stepping() must be true or until() past its
+// clock. Nothing here changes what the match does.
+class DebugHook {
+ public:
+  virtual ~DebugHook() = default;
+  virtual bool stepping() const = 0;
+  virtual Tick until() const = 0;
+  virtual void boundary(const MatchView& view) = 0;
+  // At tick t (inside or between the rounds); true: look at the debugged
+  // robot's next boundary.
+  virtual bool event(int robot, Tick t, DebugEvent e) = 0;
+  // Another robot stopped at one of its VM's breakpoints (MatchRun::
+  // setDebugBreakpoints), at its boundary inside a round.
+  virtual void otherBreakpoint(const MatchView& view, int robot) = 0;
+};
+
 struct MatchConfig {
   std::vector<RobotSpec> robots;  // 1 (solo) or 2
   plant::ArenaConfig arena;
@@ -171,6 +215,10 @@ struct MatchConfig {
   // The run can be copied (MatchRun): the plant keeps the journal its copy
   // replays. Off: nothing is kept.
   bool snapshots = false;
+  // simbot debug: the hook that holds robot `debugRobot` (not owned; needs
+  // snapshots). That robot runs first in each round.
+  DebugHook* debugger = nullptr;
+  int debugRobot = 0;
 };
 
 // A reload waits at least this long, so that the bytes a faulted robot's
@@ -274,6 +322,33 @@ class MatchRun {
   Tick now() const;
   // Runs to the end: the result, as runMatch's.
   MatchResult finish();
+  // The state between rounds (after runUntil returned), for a debugger.
+  const MatchView& view() const;
+  // A debugger's breakpoints in robot `robot`'s program (code addresses):
+  // they replace its earlier ones; the match's own (main's return, line
+  // injections) stay.
+  void setDebugBreakpoints(int robot, const std::vector<uint32_t>& addresses);
+
+  // A snapshot that costs a copy of both boards and the scheduler's state
+  // but not of the plant (a mark in its journal: Arena::Mark); restoring
+  // it replays the plant. The snapshot stays valid whatever this run does
+  // later, restores included.
+  class Snapshot {
+   public:
+    Snapshot(Snapshot&&) noexcept;
+    Snapshot& operator=(Snapshot&&) noexcept;
+    ~Snapshot();
+    Tick now() const;  // the snapshot's MatchRun::now()
+    Tick robotClock(int robot) const;
+
+   private:
+    friend class MatchRun;
+    Snapshot();
+    std::unique_ptr<detail::Match> match_;
+    plant::Arena::Mark mark_;
+  };
+  Snapshot snapshot() const;
+  void restore(const Snapshot& snapshot);
 
  private:
   std::unique_ptr<detail::Match> match_;

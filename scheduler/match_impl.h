@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "board/board.h"
+#include "inspect/inspect.h"
 #include "plant/motor_receiver.h"
 #include "scheduler/event_queue.h"
 #include "scheduler/match.h"
@@ -98,6 +99,16 @@ class Robot : public vm::Bus {
 
   // Runs the VM to `horizon` (its clock ends at or after it).
   void runTo(Tick horizon);
+  // The same for the robot a debugger holds (MatchConfig::debugger).
+  void debugRunTo(Tick horizon);
+  void noteFault();                        // the VM faulted: record it once
+  void noteBreakpoint();                   // the VM stopped at one of the match's breakpoints
+  void look(scheduler::DebugHook& hook);   // the debugger looks at this boundary
+  bool debugLook = false;                  // an event asked the debugger to look
+  std::vector<uint32_t> debugBreakpoints;  // MatchRun::setDebugBreakpoints
+  // An event for the debugger at t: if it wants to look, at the next
+  // boundary of the robot it holds.
+  void debugEvent(Tick t, DebugEvent e);
   void byteDone(Tick t);
   // Port A's edge lines: low while the plant says so or an injection holds.
   void updateEdgeLines(Tick t);
@@ -106,13 +117,17 @@ class Robot : public vm::Bus {
   // Executions of each injection point, over the whole run (a reload does
   // not restart the count).
   std::map<uint32_t, int> lineHits;
+  // A global or static read directly, or (`expression`) any lvalue the
+  // debugger's print takes, read from the innermost frame.
   struct Watch {
     std::string name;
     uint16_t address;
     vm::Symbol::Value value;
+    std::shared_ptr<const inspect::Expression> expression;
   };
   std::vector<Watch> watches;
   trace::Watch watchedValues() const;
+  trace::WatchValue expressionValue(const inspect::Expression& e) const;
   void scheduleSerial(Tick t);
 
   // Where a send came from (traced runs only, so an untraced run builds no
@@ -174,7 +189,7 @@ class Robot : public vm::Bus {
   std::map<uint16_t, CoState> costates;
 };
 
-class Match {
+class Match : public MatchView {
  public:
   explicit Match(const MatchConfig& config)
       : config_(config),
@@ -195,6 +210,7 @@ class Match {
           fmt::format("a reload must wait at least {} ticks (the serial port's two characters)",
                       kMinReloadDelay));
     resolveWatches();
+    orderRobots();
     queue_.schedule(config.endTick, EventClass::EndOfRound, {QueuedEvent::Kind::EndOfRound, 0, 0});
     for (size_t i = 0; i < config.robots.size(); ++i) {
       for (const DriveLeg& leg : config.robots[i].path)
@@ -240,6 +256,10 @@ class Match {
   // A snapshot: every part of `other`, its robots' boards talking to this
   // match's robots, its plant copied by replay (MatchConfig::snapshots).
   Match(const Match& other);
+  // The same with the plant made from `mark` (Arena::Mark), or, with none,
+  // a fresh plant that stands for a mark kept beside this copy
+  // (MatchRun::Snapshot).
+  Match(const Match& other, const plant::Arena::Mark* mark);
   Match& operator=(const Match&) = delete;
 
   // The whole run (runUntil and end).
@@ -256,6 +276,9 @@ class Match {
   bool serialBytesInRound(Tick horizon);
 
   plant::Arena& arena() { return arena_; }
+  const plant::Arena& arena() const { return arena_; }
+  Robot& debugged() { return *robots_[static_cast<size_t>(config_.debugRobot)]; }
+  Robot& robot(int i) { return *robots_[static_cast<size_t>(i)]; }
   PartClock& clock() { return clock_; }
   bool tracing() const { return trace_.on(); }
   bool profiling() const { return config_.profile; }
@@ -283,11 +306,27 @@ class Match {
     return config_.robots[static_cast<size_t>(robot)].name;
   }
   MatchObserver* observer() const { return config_.observer; }
+  DebugHook* debugger() const { return config_.debugger; }
+  int debugRobot() const { return config_.debugRobot; }
+  // The robots other than `robot` run up to t (inside a round, before a
+  // debugger looks at `robot` at t).
+  void bringOthersTo(int robot, Tick t);
+  Tick robotClock(int robot) const { return robots_[static_cast<size_t>(robot)]->now(); }
+
+  // MatchView
+  int robotCount() const override { return static_cast<int>(robots_.size()); }
+  const vm::Vm& vm(int robot) const override { return robots_[static_cast<size_t>(robot)]->vm(); }
+  const RobotSpec& spec(int robot) const override {
+    return config_.robots[static_cast<size_t>(robot)];
+  }
+  std::string describe(Tick t) const override;
+  plant::Pose pose(int robot, Tick t) const override;
   const plant::RobotParams& robotParams(int robot) const {
     return arenaConfig_.robots[static_cast<size_t>(robot)].params;
   }
 
  private:
+  Match(const Match& other, const plant::Arena::Mark* mark, bool freshArena);
   Tick earliestClock() const;
   // The earliest tick at which a robot that has not faulted can act:
   // the least of their Vm::quietUntil (match ticks).
@@ -314,6 +353,9 @@ class Match {
   plant::SplitMix64 coin_;
   EventQueue<QueuedEvent> queue_;
   std::vector<std::unique_ptr<Robot>> robots_;
+  // The order robots run in a round: the one a debugger holds first.
+  std::vector<Robot*> runOrder_;
+  void orderRobots();
   std::vector<PlantInput> inputs_;
   std::vector<std::string> warnings_;
   std::vector<bool> fired_ = std::vector<bool>(config_.injections.size());

@@ -180,6 +180,7 @@ void Robot::byteDone(Tick t) {
       ++result.framesLatched;
       const PartScope plant(match.clock(), PartClock::Plant);
       match.arena().setWheels(index, *frame->command, t);
+      debugEvent(t, DebugEvent::FrameLatched);
     } else {
       ++result.framesRejected;
     }
@@ -193,12 +194,34 @@ void Robot::byteDone(Tick t) {
   scheduleSerial(t);
 }
 
+// A --watch expression's value now, from the innermost frame: a number
+// for a scalar, the debugger's text for an aggregate, null when it names
+// an auto that is not in scope here.
+trace::WatchValue Robot::expressionValue(const inspect::Expression& e) const {
+  try {
+    const inspect::Scope scope(board.cpu);
+    const inspect::Value v = e.evaluate(scope);
+    int64_t integer = 0;
+    double real = 0;
+    bool isFloat = false;
+    if (inspect::scalar(scope, v, integer, real, isFloat))
+      return isFloat ? trace::WatchValue{real} : trace::WatchValue{integer};
+    return inspect::format(scope, v);
+  } catch (const inspect::Error&) {
+    return nullptr;
+  }
+}
+
 // Each watched variable's value as its C type reads it (the compiler's
 // vm::Symbol::Value; resolveWatches admits scalars only).
 trace::Watch Robot::watchedValues() const {
   using V = vm::Symbol::Value;
   trace::Watch values;
   for (const auto& w : watches) {
+    if (w.expression) {
+      values.emplace_back(w.name, expressionValue(*w.expression));
+      continue;
+    }
     trace::WatchValue v;
     switch (w.value) {
       case V::Char:
@@ -284,6 +307,7 @@ void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
   if (match.observer()) match.observer()->onInterruptAccepted(index, t, irq);
   if (irq == vm::Irq::Pio) {
     board.pio.accepted();
+    debugEvent(t, DebugEvent::EdgeAccepted);
     match.inputs().push_back({t, index, PlantInput::Kind::EdgeHandler, 0, plant::Bumper::Front});
   }
   // The BIOS timer service (1,024 a second) is counted, not traced.

@@ -15,6 +15,7 @@ quickstart=(
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev
   libboost-math-dev            # distributions and quantiles for the statistics
   libjs-three                  # three.js r111, inlined in replay pages
+  libreadline-dev              # simbot debug's line editing and history
 )
 packages=(
   "${quickstart[@]}"

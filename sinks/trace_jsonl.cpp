@@ -129,8 +129,12 @@ trace::Entry traceEntry(const json& j) {
         e.watch.emplace_back(name, value.get<std::int64_t>());
       else if (value.is_number())
         e.watch.emplace_back(name, value.get<double>());
+      else if (value.is_string())
+        e.watch.emplace_back(name, value.get<std::string>());
+      else if (value.is_null())
+        e.watch.emplace_back(name, nullptr);
       else
-        throw std::invalid_argument("watched values must be numbers");
+        throw std::invalid_argument("watched values must be numbers, strings or null");
     }
   }
   return e;

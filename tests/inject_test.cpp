@@ -207,10 +207,61 @@ TEST(Inject, WatchedValuesAsTheirTypesReadThem) {
   EXPECT_EQ(last->at("l"), -100000);
   EXPECT_EQ(last->at("ul"), 3000000000LL);
   EXPECT_EQ(last->at("f"), 1.5);
-  for (const char* aggregate : {"s", "a", "main"}) {
-    c.watches = {aggregate};
-    EXPECT_THROW(testkit::runTraced(c), std::invalid_argument) << aggregate;
+  // Any lvalue simbot debug's print takes (issue 26): an aggregate as the
+  // debugger prints it, a member through a pointer, a slice; a function or
+  // a name no program has is refused.
+  c.watches = {"s", "a", "p->x", "a[1]@2", "i * 2"};
+  std::optional<nlohmann::json> more;
+  for (const auto& line : testkit::runTraced(c).trace) {
+    const auto j = nlohmann::json::parse(line);
+    if (j.at("type") == "sample" && j.contains("watch")) more = j.at("watch");
   }
+  ASSERT_TRUE(more.has_value());
+  EXPECT_EQ(more->at("s"), "{x = 0, y = 0}");
+  EXPECT_EQ(more->at("a"), "{0, 0, 0}");
+  EXPECT_EQ(more->at("p->x"), 0);
+  EXPECT_EQ(more->at("a[1]@2"), "{0, 0}");
+  EXPECT_EQ(more->at("i * 2"), -4);
+  for (const char* refused : {"main", "nosuch.x", "s.", "x"}) {
+    c.watches = {refused};
+    EXPECT_THROW(testkit::runTraced(c), std::invalid_argument) << refused;
+  }
+}
+
+// A watched auto is read from the innermost frame when it is in scope
+// there, and is null elsewhere (#class auto: f's n lives on the stack).
+TEST(Inject, WatchedAutosAreNullOutOfScope) {
+  const char* source =
+      "#class auto\n"
+      "int f(int n) { int k; for (k = 0; k < 2000; k++); return n + k; }\n"
+      "main()\n"
+      "{\n"
+      "    int r;\n"
+      "    while (1) r = f(7);\n"
+      "}\n";
+  scheduler::MatchConfig c = soloConfig({});
+  c.robots[0] = {"A", "autos.dc", testkit::compileOrDie(source, "autos.dc")};
+  c.endTick = scheduler::kTicksPerSecond;
+  c.stopWhenAllExited = false;
+  c.watches = {"n", "r"};
+  int inF = 0, inMain = 0;
+  for (const auto& line : testkit::runTraced(c).trace) {
+    const auto j = nlohmann::json::parse(line);
+    if (j.at("type") != "sample" || !j.contains("watch")) continue;
+    const auto& w = j.at("watch");
+    if (w.at("n").is_null()) {
+      // main's frame: no n; r is its auto, once main's ENTER has made the
+      // frame (not yet at tick 0, at the start-up code's first instruction).
+      ++inMain;
+      EXPECT_EQ(w.at("r").is_null(), j.at("t") == 0) << j.dump();
+    } else {
+      ++inF;  // f's frame: n is 7, main's r is not in scope
+      EXPECT_EQ(w.at("n"), 7);
+      EXPECT_TRUE(w.at("r").is_null());
+    }
+  }
+  EXPECT_GT(inF, 0);
+  EXPECT_EQ(inMain + inF, 21);  // 20 Hz samples from 0 to 1 s
 }
 
 TEST(Inject, ParsesWhenForms) {

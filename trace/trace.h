@@ -139,9 +139,11 @@ int robotOf(const Record& record);
 // definition (tests/trace_test.cpp checks that the page holds it).
 std::string recordsMarkdown();
 
-// Values of --watch variables, read from the robot's memory when the
-// record was made: integers, or float for float variables.
-using WatchValue = std::variant<std::int64_t, double>;
+// Values of --watch expressions, read from the robot's memory when the
+// record was made: integers, float for a float, the debugger's text for an
+// aggregate (a struct, an array, buf as its string and bytes), null when
+// the expression names an auto that is not in scope there.
+using WatchValue = std::variant<std::int64_t, double, std::string, std::nullptr_t>;
 using Watch = std::vector<std::pair<std::string, WatchValue>>;
 
 struct Entry {

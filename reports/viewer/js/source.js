@@ -71,7 +71,8 @@ function createSourcePanel(container, robot) {
     if (robot.watch.length) {
       watch.textContent = robot.watch.map((w) => {
         const k = lastAtOrBefore(w.t, t);
-        return `${w.name} = ${k < 0 ? '?' : w.v[k]}`;
+        const value = k < 0 ? '?' : w.v[k] === null ? '(not in scope)' : w.v[k];
+        return `${w.name} = ${value}`;
       }).join('    ');
     }
   }

@@ -1,0 +1,270 @@
+// The debugger: a match (or a solo run) held at one robot's instruction
+// boundaries, in simulated time, forwards and backwards (simbot debug,
+// simbot dap).
+//
+// A position is the held robot's clock at one of its instruction
+// boundaries: every instruction costs T-states, so the tick names the
+// boundary, and a match is deterministic, so it names the whole match's
+// state there (the other robot run up to the same tick, the plant's dense
+// output at it). Going forward, the match runs with a scheduler::DebugHook
+// that stops the held robot where a command says. Going back, the session
+// restores the latest snapshot before the target (MatchRun::Snapshot, one
+// every kSnapshotInterval of the held robot's time, taken as the run
+// first passes it) and runs forward to the target's tick: a state reached
+// backwards is the state reached forwards. Commands that look back for a
+// place (reverse-step, reverse-continue) first replay the snapshots'
+// windows recording where the robot was, then go to the place found.
+//
+// A Controller (the terminal's command interpreter, the DAP server) is
+// asked what to do at every stop; the session's accessors serve it there.
+#pragma once
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "inspect/inspect.h"
+#include "scheduler/match.h"
+#include "timebase/tick.h"
+
+namespace simbot::debug {
+
+using timebase::Tick;
+
+// A command the session refuses (a line with no code, an unknown name): one
+// line for the user; the session stays where it was.
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Snapshots are taken this often (the held robot's time); a reverse command
+// replays at most a few such windows. 0.5 s: 360 in a 180-s match.
+inline constexpr Tick kSnapshotInterval = timebase::kTicksPerSecond / 2;
+
+struct Breakpoint {
+  enum class Kind : uint8_t { Line, Function, Time, Event };
+  int id = 0;
+  Kind kind = Kind::Line;
+  int robot = 0;         // Line, Function: the program it is in
+  int line = 0;          // Line, Function: where it stops
+  uint32_t address = 0;  // Line, Function: the instruction it stops before
+  std::string function;  // Function: its name; Line: the function the line is in
+  Tick tick = 0;         // Time: the first boundary at or after it
+  scheduler::DebugEvent event{};
+  std::shared_ptr<inspect::Expression> condition;  // none: always
+  int ignore = 0;                                  // hits still to pass over
+  int hits = 0;
+  bool temporary = false;
+  bool enabled = true;
+  bool passed = false;  // Time: its tick has been reached
+};
+
+struct Watchpoint {
+  int id = 0;
+  int robot = 0;
+  std::shared_ptr<inspect::Expression> expression;
+  inspect::Value object;  // what it watches: fixed when it is set
+  // An object on the stack (an auto's) is watched while the call it lives
+  // in has not returned: the call depth it was set at (-1: a global's).
+  int callDepth = -1;
+  std::vector<uint8_t> value;
+  std::string text;  // the value as printed
+  bool valid = false;
+  int hits = 0;
+};
+
+// Why the session stopped, for the controller to report.
+struct Stop {
+  enum class Kind : uint8_t {
+    Entry,       // the program's first instruction
+    Breakpoint,  // `breakpoint`
+    Watchpoint,  // `breakpoint` is the watchpoint's id; old and new values
+    Event,       // `event`
+    Step,        // a step, next, finish, until or stepi ended
+    Time,        // advance TIME, a tick breakpoint
+    Fault,       // the held robot faulted
+    Goto,        // reached by goto, a reverse command or a change of robot
+    End,         // the match is over
+  };
+  Kind kind = Kind::Entry;
+  int breakpoint = 0;
+  scheduler::DebugEvent event{};
+  int eventRobot = 0;
+  std::string oldValue, newValue;  // Watchpoint
+  int writtenAt = 0;               // Watchpoint: the line that wrote it
+  std::string note;                // more to say (a reverse search that found nothing)
+};
+
+// How to go on from a stop.
+struct Resume {
+  enum class Kind : uint8_t {
+    Continue,
+    Step,
+    Next,
+    Finish,
+    StepInstruction,
+    Until,        // next, but not back to an earlier line of a loop
+    AdvanceLine,  // to `line` in this frame, or its return
+    AdvanceTime,  // to `tick`
+    ReverseStep,
+    ReverseNext,
+    ReverseStepInstruction,
+    ReverseContinue,
+    ReverseFinish,
+    Goto,     // to `tick`
+    Restart,  // from the start, on to the first breakpoint
+    Hold,     // hold robot `robot` at this tick
+    Quit,
+  };
+  Kind kind = Kind::Continue;
+  Tick tick = 0;
+  int line = 0;
+  int robot = 0;
+};
+
+struct FrameInfo {
+  std::string function;  // "" if the address is in no function
+  int line = 0;
+  uint32_t pc = 0;
+  bool handler = false;      // an interrupt handler's activation
+  bool interrupted = false;  // the code a handler interrupted (the next frame in)
+  std::string arguments;     // "n=3, p=0x1234"
+};
+
+class Session;
+
+class Controller {
+ public:
+  virtual ~Controller() = default;
+  // The session stopped: inspect it through its accessors, change its
+  // breakpoints, and say how to go on.
+  virtual Resume stopped(Session& session, const Stop& why) = 0;
+};
+
+class Session final : private scheduler::DebugHook {
+ public:
+  // `programs` as given (the files of robots A and B), for names in
+  // breakpoints and listings; `held` the robot held first.
+  Session(scheduler::MatchConfig config, std::vector<std::string> programs, int held = 0);
+  ~Session() override;
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  // Runs the session until the controller quits (or its input ends).
+  void run(Controller& controller);
+
+  // ---- at a stop ----
+  int robot() const { return held_; }
+  int robotCount() const { return static_cast<int>(config_.robots.size()); }
+  std::string robotName(int robot) const;
+  const std::string& program(int robot) const;
+  Tick now() const;  // the held robot's clock
+  bool over() const { return over_; }
+  const scheduler::MatchView& view() const;
+  const vm::Vm& vm(int robot) const;
+  // Names and evaluation from the selected frame of the held robot.
+  int frame() const { return frame_; }
+  void selectFrame(int frame);  // Error if there is no such frame
+  inspect::Scope scope() const;
+  inspect::Scope scope(int robot, int frame) const;
+  std::vector<FrameInfo> backtrace(int robot) const;
+  std::string source(int robot, int line) const;  // the text of a source line
+  int lineCount(int robot) const;
+  // The robot a "B:12", "fig92.dc:12" or "12" names, and the rest ("12").
+  int robotOf(std::string& where) const;
+
+  // ---- breakpoints, watchpoints ----
+  // LINE in `robot`'s program (moved to the next line with code), FUNCTION
+  // (its first instruction), a tick, an event. Error if there is none.
+  const Breakpoint& breakAtLine(int robot, int line, bool temporary = false);
+  const Breakpoint& breakAtFunction(int robot, const std::string& name, bool temporary = false);
+  const Breakpoint& breakAtTick(Tick tick, bool temporary = false);
+  const Breakpoint& breakAtEvent(scheduler::DebugEvent event, bool temporary = false);
+  void setCondition(int id, const std::string& expression);  // "" removes it
+  void setIgnore(int id, int count);
+  void setEnabled(int id, bool enabled);
+  void remove(int id);  // a breakpoint or a watchpoint
+  void removeAll();
+  const std::vector<Breakpoint>& breakpoints() const { return breakpoints_; }
+  // A data breakpoint on an lvalue of the held robot, evaluated now.
+  const Watchpoint& watch(const std::string& expression);
+  const std::vector<Watchpoint>& watchpoints() const { return watchpoints_; }
+  // Messages about the other robots since the last stop (a fault of one).
+  std::vector<std::string> takeNotices();
+
+ private:
+  struct Rewind;
+  struct ScanDone {};
+  struct Mode {
+    Resume::Kind kind = Resume::Kind::Goto;
+    Tick tick = 0;  // Goto, AdvanceTime: the target
+    int line = 0;   // AdvanceLine
+    // Where the command started: the clock, line and depths.
+    Tick startTick = 0;
+    int startLine = 0, startCalls = 0, startInts = 0;
+    Stop arrival;  // Goto: the stop to report there
+  };
+  struct Boundary {
+    Tick tick;
+    int line, calls, ints;
+    bool hit;  // a breakpoint, watchpoint or event would stop here
+  };
+  struct Scan {
+    Tick end = 0;
+    bool stepping = true;
+    bool hits = false;  // record breakpoint hits (reverse-continue)
+    std::vector<Boundary> boundaries;
+  };
+
+  // scheduler::DebugHook
+  bool stepping() const override;
+  Tick until() const override;
+  void boundary(const scheduler::MatchView& view) override;
+  bool event(int robot, Tick t, scheduler::DebugEvent e) override;
+  void otherBreakpoint(const scheduler::MatchView& view, int robot) override;
+
+  void forward();
+  void takeSnapshot();
+  void restoreBefore(Tick target, bool inclusive);
+  void applyBreakpoints();
+  void startMode(const Resume& how, const Stop& arrival = {});
+  bool shouldStop(Stop& why);
+  bool breakpointHit(int robot, Stop& why, bool counting);
+  bool watchpointHit(Stop& why);
+  void refreshWatchpoints();
+  void park(const Stop& why);
+  void handle(const Resume& how);
+  void perform(const Rewind& rewind);
+  std::vector<Boundary> scanWindow(Tick from, Tick end, bool stepping, bool hits);
+  std::optional<Tick> searchBack(const Rewind& rewind);
+  Breakpoint& addBreakpoint(Breakpoint b);
+  Breakpoint* findBreakpoint(int id);
+
+  scheduler::MatchConfig config_;
+  std::vector<std::string> programs_;
+  int held_ = 0;
+  Controller* controller_ = nullptr;
+  std::unique_ptr<scheduler::MatchRun> run_;
+  std::map<int64_t, scheduler::MatchRun::Snapshot> snapshots_;  // by kSnapshotInterval
+  const scheduler::MatchView* view_ = nullptr;                  // at a stop inside a round
+  bool over_ = false;
+  int frame_ = 0;
+  Mode mode_;
+  std::optional<Scan> scan_;
+  std::vector<Breakpoint> breakpoints_;
+  std::vector<Watchpoint> watchpoints_;
+  int nextId_ = 1;
+  Tick lastStop_ = -1;
+  bool leftLine_ = false;  // AdvanceLine: the robot has been off the line
+  uint32_t lastPc_ = 0;    // the instruction run before this boundary (watchpoints' writer)
+  std::optional<Stop> eventStop_;
+  std::vector<std::string> notices_;
+};
+
+// "12.5s", "20ms", "123456" (ticks), "1e-3s": a time the user wrote.
+// Error if it is none.
+Tick parseTime(const std::string& text);
+
+}  // namespace simbot::debug
