@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <csignal>
 #include <iostream>
 #include <sstream>
 
@@ -47,9 +49,19 @@ int debugCommand(const std::vector<std::string>& programs, const runs::RunOption
     lines = debug::streamLines(std::cin, false);
   }
   debug::Console console(*lines, std::cout);
+  // At a terminal, Ctrl-C stops the command that is running (as in gdb)
+  // instead of the program.
+  static std::atomic<bool> interrupted{false};
+  const bool terminal = batch.empty() && isatty(STDIN_FILENO);
+  if (terminal) {
+    struct sigaction action {};
+    action.sa_handler = [](int) { interrupted.store(true); };
+    sigemptyset(&action.sa_mask);
+    ::sigaction(SIGINT, &action, nullptr);
+  }
   try {
     debug::Session session(config, paths, held);
-    session.run(console);
+    session.run(console, terminal ? &interrupted : nullptr);
   } catch (const std::invalid_argument& e) {
     throw sinks::UserError(fmt::format("simbot: {}\n", e.what()));
   }

@@ -59,8 +59,10 @@ Session::~Session() = default;
 
 // ---- running ------------------------------------------------------------------
 
-void Session::run(Controller& controller) {
+void Session::run(Controller& controller, std::atomic<bool>* interrupt) {
   controller_ = &controller;
+  interrupt_ = interrupt;
+  config_.stop = interrupt;
   config_.snapshots = true;
   config_.debugger = this;
   config_.debugRobot = held_;
@@ -95,6 +97,16 @@ void Session::run(Controller& controller) {
       }
     } catch (const Rewind& r) {
       perform(r);
+    } catch (const scheduler::Stopped&) {
+      // Ctrl-C: the round that was to start did not; hold the robot where
+      // it is (replayed from a snapshot, as any place is reached).
+      interrupt->store(false);
+      Rewind r;
+      r.how.kind = Resume::Kind::Goto;
+      r.how.tick = now();
+      r.from = r.how.tick;
+      perform(r);
+      mode_.arrival.note = "Interrupted.";
     } catch (const Quit&) {
       return;
     }
@@ -413,6 +425,8 @@ void Session::park(const Stop& why) {
 
 void Session::handle(const Resume& how) {
   if (how.kind == Resume::Kind::Quit) throw Quit{};
+  // A Ctrl-C at the prompt is not meant for the command that follows.
+  if (interrupt_) interrupt_->store(false);
   if (!reverse(how.kind)) {
     startMode(how);
     return;

@@ -18,6 +18,7 @@
 // A Controller (the terminal's command interpreter, the DAP server) is
 // asked what to do at every stop; the session's accessors serve it there.
 #pragma once
+#include <atomic>
 #include <map>
 #include <memory>
 #include <optional>
@@ -153,7 +154,10 @@ class Session final : private scheduler::DebugHook {
   Session& operator=(const Session&) = delete;
 
   // Runs the session until the controller quits (or its input ends).
-  void run(Controller& controller);
+  // `interrupt` (may be null; Ctrl-C at a terminal sets it) stops a
+  // command that is running: the robot is held where the match got to,
+  // at the start of its next round.
+  void run(Controller& controller, std::atomic<bool>* interrupt = nullptr);
 
   // ---- at a stop ----
   int robot() const { return held_; }
@@ -246,6 +250,7 @@ class Session final : private scheduler::DebugHook {
   std::vector<std::string> programs_;
   int held_ = 0;
   Controller* controller_ = nullptr;
+  std::atomic<bool>* interrupt_ = nullptr;
   std::unique_ptr<scheduler::MatchRun> run_;
   std::map<int64_t, scheduler::MatchRun::Snapshot> snapshots_;  // by kSnapshotInterval
   const scheduler::MatchView* view_ = nullptr;                  // at a stop inside a round
