@@ -343,6 +343,7 @@ int main(int argc, char** argv) {
   addWarningOptions(compare.app);
   const auto explain = simbot::cli::addExplainCommand(app);
   const auto sweep = simbot::cli::addSweepCommand(app);
+  addWarningOptions(sweep.app);
 
   files::removeTemporariesOnSignals();
   try {
@@ -362,7 +363,8 @@ int main(int argc, char** argv) {
   }
   try {
     // -Wno-NAME and -Werror, on every command that compiles a program.
-    for (CLI::App* cmd : {solo, match, profile, debugCmd, bench.app, tournament.app, compare.app})
+    for (CLI::App* cmd :
+         {solo, match, profile, debugCmd, bench.app, tournament.app, compare.app, sweep.app})
       if (*cmd) {
         compiler::Options options;
         runs::parseWarningOptions(cmd->remaining(), options, cmd->get_name());

@@ -34,6 +34,7 @@ struct SweepOptions {
   std::string file, out, shard = "1/1", dask;
   int threads = 0;
   bool noHeader = false, resume = false;
+  std::vector<std::string> warningOptions;  // -Wno-NAME, -Werror (main() applies them)
 };
 
 std::string defaultOut(const SweepOptions& o) {
@@ -94,6 +95,10 @@ int runSweepCommand(SweepOptions& o) {
   if (o.resume)
     batch::checkResumeSettings(settingsPath, settings, fmt::format("the sweep in '{}'", o.out));
   if (!o.dask.empty()) {
+    if (!o.warningOptions.empty())
+      throw sinks::UserError(
+          "simbot: sweep: -W options apply to this process's compiles; the Dask workers compile "
+          "with the default warnings (leave them out with --dask)\n");
     // The Dask driver writes the table and keeps no fingerprints: an
     // earlier run's are removed, so that a later --resume refuses the
     // table rather than mix its rows with another version's.
@@ -146,7 +151,10 @@ Subcommand addSweepCommand(CLI::App& app) {
   cmd->add_option("--dask", o->dask,
                   "run on a Dask cluster through the Python module: tcp://HOST:PORT, or "
                   "local:N for a local cluster of N worker processes");
-  return {cmd, [o] { return guarded([&] { return runSweepCommand(*o); }); }};
+  return {cmd, [o, cmd] {
+            o->warningOptions = cmd->remaining();
+            return guarded([&] { return runSweepCommand(*o); });
+          }};
 }
 
 }  // namespace simbot::cli
