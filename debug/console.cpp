@@ -208,7 +208,8 @@ void Console::report(Session& s, const Stop& why) {
       return;
     }
     case Stop::Kind::End:
-      out_ << fmt::format("The match is over at tick {} ({}).\n", s.now(), seconds(s.now()));
+      out_ << fmt::format("The match is over at tick {} ({}).\n", s.matchTick(),
+                          seconds(s.matchTick()));
       return;
     case Stop::Kind::Step:
     case Stop::Kind::Time:
@@ -297,7 +298,8 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
     if (n > 1) {
       // continue N: pass over the breakpoint that stopped us N - 1 more times.
       for (const Breakpoint& b : s.breakpoints())
-        if (b.address == s.vm(s.robot()).pc() && b.robot == s.robot())
+        if ((b.kind == Breakpoint::Kind::Line || b.kind == Breakpoint::Kind::Function) &&
+            b.address == s.vm(s.robot()).pc() && b.robot == s.robot())
           s.setIgnore(b.id, static_cast<int>(n - 1));
     }
     return resume(K::Continue);
@@ -321,7 +323,8 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
       return true;
     }
     std::string where = args;
-    const int robot = s.robotOf(where);
+    // A bare line is the held robot's.
+    const int robot = where.find(':') == std::string::npos ? s.robot() : s.robotOf(where);
     long lineNumber = 0;
     if (robot != s.robot() || !integer(where, lineNumber))
       throw Error(fmt::format("{} takes a line of the held robot's program or a time", command));

@@ -73,8 +73,14 @@ void Session::run(Controller& controller, std::atomic<bool>* interrupt) {
   mode_.kind = Resume::Kind::Goto;
   mode_.tick = 0;
   mode_.arrival.kind = Stop::Kind::Entry;
+  std::optional<Rewind> pending;
   for (;;) {
     try {
+      if (pending) {
+        const Rewind r = *pending;
+        pending.reset();
+        perform(r);
+      }
       forward();
       over_ = true;
       view_ = &run_->view();
@@ -85,28 +91,32 @@ void Session::run(Controller& controller, std::atomic<bool>* interrupt) {
         const Resume how = controller_->stopped(*this, end);
         if (how.kind == Resume::Kind::Quit) return;
         if (reverse(how.kind)) {
+          if (interrupt_) interrupt_->store(false);
           Rewind r{how, now(), 0, 0, 0, {}};
           const vm::Vm& v = vm(held_);
           r.line = v.line();
           r.calls = v.callDepth();
           r.ints = v.interruptDepth();
           over_ = false;
-          perform(r);
+          pending = r;
           break;
         }
       }
     } catch (const Rewind& r) {
-      perform(r);
+      pending = r;
     } catch (const scheduler::Stopped&) {
-      // Ctrl-C: the round that was to start did not; hold the robot where
-      // it is (replayed from a snapshot, as any place is reached).
+      // Ctrl-C (also during a search back): the round that was to start
+      // did not; hold the robot where it is (replayed from a snapshot, as
+      // any place is reached).
       interrupt->store(false);
+      scan_.reset();
       Rewind r;
       r.how.kind = Resume::Kind::Goto;
       r.how.tick = now();
       r.from = r.how.tick;
-      perform(r);
-      mode_.arrival.note = "Interrupted.";
+      r.arrival.kind = Stop::Kind::Goto;
+      r.arrival.note = "Interrupted.";
+      pending = r;
     } catch (const Quit&) {
       return;
     }
@@ -135,6 +145,9 @@ void Session::takeSnapshot() {
 void Session::restoreBefore(Tick target, bool inclusive) {
   for (auto it = snapshots_.rbegin(); it != snapshots_.rend(); ++it) {
     const Tick clock = it->second.robotClock(held_);
+    // After its fault the held robot's clock stands still: a place past
+    // it is reached from before the fault, and is the fault.
+    if (it->second.robotFaulted(held_)) continue;
     if (clock < target || (inclusive && clock == target)) {
       run_->restore(it->second);
       applyBreakpoints();
@@ -169,6 +182,8 @@ void Session::startMode(const Resume& how, const Stop& arrival) {
   mode_.startLine = v.line();
   mode_.startCalls = v.callDepth();
   mode_.startInts = v.interruptDepth();
+  // finish from an outer frame: as if from that frame.
+  if (how.kind == Resume::Kind::Finish) mode_.startCalls -= frame_;
   mode_.arrival = arrival;
   leftLine_ = v.line() != how.line;
 }
@@ -189,7 +204,19 @@ bool Session::stepping() const {
 }
 
 Tick Session::until() const {
-  if (scan_) return scan_->end;
+  if (scan_) {
+    Tick u = scan_->end;
+    // A search for breakpoint hits stops where time breakpoints fall.
+    if (scan_->hits) {
+      // Past the last boundary recorded: the first boundary at or after
+      // the tick is looked at, and recorded as a hit, before it moves on.
+      const Tick seen =
+          scan_->boundaries.empty() ? scan_->start - 1 : scan_->boundaries.back().tick;
+      for (const Breakpoint& b : breakpoints_)
+        if (b.kind == Breakpoint::Kind::Time && b.enabled && b.tick > seen) u = std::min(u, b.tick);
+    }
+    return u;
+  }
   if (mode_.kind == Resume::Kind::Goto) return mode_.tick;
   Tick u = INT64_MAX;
   if (mode_.kind == Resume::Kind::AdvanceTime) u = mode_.tick;
@@ -207,6 +234,12 @@ void Session::boundary(const scheduler::MatchView& view) {
     if (scan_->hits) {
       Stop why;
       b.hit = eventStop_.has_value() || breakpointHit(held_, why, false) || watchpointHit(why);
+      // A time breakpoint stops at the first boundary at or after its tick.
+      const Tick before =
+          scan_->boundaries.empty() ? scan_->start - 1 : scan_->boundaries.back().tick;
+      for (const Breakpoint& t : breakpoints_)
+        b.hit |=
+            t.kind == Breakpoint::Kind::Time && t.enabled && t.tick > before && t.tick <= b.tick;
       eventStop_.reset();
     }
     scan_->boundaries.push_back(b);
@@ -228,7 +261,7 @@ bool Session::event(int robot, Tick t, DebugEvent e) {
       }
     return false;
   }
-  if (e == DebugEvent::Fault && robot != held_) {
+  if (e == DebugEvent::Fault && robot != held_ && mode_.kind != Resume::Kind::Goto) {
     const vm::Fault* f = run_->view().vm(robot).fault();
     notices_.push_back(fmt::format("robot {} faulted at tick {} ({:.6f} s), line {}: {}",
                                    robotName(robot), t, timebase::secondsFromTicks(t),
@@ -306,7 +339,8 @@ bool Session::watchpointHit(Stop& why) {
   if (v.inLibraryCall()) return false;
   for (size_t k = 0; k < watchpoints_.size(); ++k) {
     Watchpoint& w = watchpoints_[k];
-    if (w.callDepth >= 0 && v.callDepth() < w.callDepth) {
+    if (w.robot != held_) continue;  // watched while its robot is held
+    if (w.depth >= 0 && v.callDepth() + v.interruptDepth() < w.depth) {
       if (scan_) continue;
       why.kind = Stop::Kind::Watchpoint;
       why.breakpoint = w.id;
@@ -322,7 +356,11 @@ bool Session::watchpointHit(Stop& why) {
     w.value = std::move(now);
     w.valid = true;
     const std::string before = w.text;
-    w.text = inspect::format(s, w.object);
+    try {
+      w.text = inspect::format(s, w.object);
+    } catch (const inspect::Error& e) {
+      w.text = fmt::format("<{}>", e.what());
+    }
     if (first) continue;
     if (!scan_) ++w.hits;
     why.kind = Stop::Kind::Watchpoint;
@@ -339,7 +377,11 @@ void Session::refreshWatchpoints() {
   for (Watchpoint& w : watchpoints_) {
     const inspect::Scope s(vm(w.robot));
     w.value = inspect::bytes(s, w.object);
-    w.text = inspect::format(s, w.object);
+    try {
+      w.text = inspect::format(s, w.object);
+    } catch (const inspect::Error& e) {
+      w.text = fmt::format("<{}>", e.what());
+    }
     w.valid = true;
   }
 }
@@ -447,9 +489,12 @@ void Session::perform(const Rewind& rewind) {
       mode_ = Mode{};
       mode_.kind = Resume::Kind::Continue;
       lastStop_ = -1;
+      for (Breakpoint& b : breakpoints_) b.passed = false;
+      for (Watchpoint& w : watchpoints_) w.valid = false;
       return;
     case Resume::Kind::Goto:
       target = std::max<Tick>(rewind.how.tick, 0);
+      arrival.note = rewind.arrival.note;
       break;
     case Resume::Kind::Hold:
       held_ = rewind.how.robot;
@@ -478,7 +523,7 @@ void Session::perform(const Rewind& rewind) {
 // meets them: each one when stepping, else at breakpoints and events only.
 std::vector<Session::Boundary> Session::scanWindow(Tick from, Tick end, bool stepping, bool hits) {
   restoreBefore(from, true);
-  scan_ = Scan{end, stepping, hits, {}};
+  scan_ = Scan{end, stepping, hits, {}, run_->view().vm(held_).now()};
   for (Watchpoint& w : watchpoints_) w.valid = false;
   try {
     forward();
@@ -582,6 +627,7 @@ const scheduler::MatchView& Session::view() const { return view_ ? *view_ : run_
 const vm::Vm& Session::vm(int robot) const { return view().vm(robot); }
 
 Tick Session::now() const { return vm(held_).now(); }
+Tick Session::matchTick() const { return run_->now(); }
 
 void Session::selectFrame(int frame) {
   const auto count = static_cast<int>(vm(held_).activations().size());
@@ -798,11 +844,9 @@ const Watchpoint& Session::watch(const std::string& expression) {
     w.object = w.expression->evaluate(s);
     if (!w.object.inMemory)
       throw Error(fmt::format("'{}' is not an object in memory: nothing to watch", expression));
-    const vm::Image& img = s.image();
-    const bool global =
-        w.object.address >= vm::kDataBase && w.object.address < vm::kDataBase + img.data.size();
-    // An auto of the selected frame's call: watched while that call lasts.
-    if (!global) w.callDepth = vm(held_).callDepth() - (frame_ > 0 ? frame_ : 0);
+    // An auto: watched while the activation holding it lasts (its index
+    // from the outermost, where calls and handlers both count).
+    if (w.object.frame >= 0) w.depth = static_cast<int>(s.activations.size()) - 1 - w.object.frame;
     w.value = inspect::bytes(s, w.object);
     w.text = inspect::format(s, w.object);
     w.valid = true;

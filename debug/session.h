@@ -67,9 +67,10 @@ struct Watchpoint {
   int robot = 0;
   std::shared_ptr<inspect::Expression> expression;
   inspect::Value object;  // what it watches: fixed when it is set
-  // An object on the stack (an auto's) is watched while the call it lives
-  // in has not returned: the call depth it was set at (-1: a global's).
-  int callDepth = -1;
+  // An object on the stack (an auto's) is watched while the activation it
+  // lives in has not returned: that activation's index counted from the
+  // outermost (calls and handlers; -1: a global's or a static's).
+  int depth = -1;
   std::vector<uint8_t> value;
   std::string text;  // the value as printed
   bool valid = false;
@@ -164,7 +165,8 @@ class Session final : private scheduler::DebugHook {
   int robotCount() const { return static_cast<int>(config_.robots.size()); }
   std::string robotName(int robot) const;
   const std::string& program(int robot) const;
-  Tick now() const;  // the held robot's clock
+  Tick now() const;        // the held robot's clock
+  Tick matchTick() const;  // where the match is: its end once it is over
   bool over() const { return over_; }
   const scheduler::MatchView& view() const;
   const vm::Vm& vm(int robot) const;
@@ -220,6 +222,7 @@ class Session final : private scheduler::DebugHook {
     bool stepping = true;
     bool hits = false;  // record breakpoint hits (reverse-continue)
     std::vector<Boundary> boundaries;
+    Tick start = 0;  // the held robot's clock at the window's snapshot
   };
 
   // scheduler::DebugHook

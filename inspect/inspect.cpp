@@ -414,6 +414,7 @@ Value objectOf(const Scope& s, const Found& found) {
                       "has not run)",
                       sym.name));
     v.address = static_cast<uint16_t>(act.fp + sym.address);
+    v.frame = found.frame;
   } else {
     v.address = static_cast<uint16_t>(sym.address);
   }
@@ -464,6 +465,11 @@ int64_t integerOf(const Scope& s, const Node& n, const char* what) {
 
 // The element type and address of an array or pointer value.
 void elements(const Scope& s, const Value& v, int32_t& element, uint16_t& base) {
+  if (v.type < 0 && v.pointee >= 0) {
+    element = v.pointee;
+    base = static_cast<uint16_t>(v.integer);
+    return;
+  }
   if (v.type < 0) throw Error("a number cannot be indexed or dereferenced");
   const TypeInfo& t = typeOf(s, v.type);
   if (t.kind == TypeInfo::Kind::Array) {
@@ -496,7 +502,48 @@ Value member(const Scope& s, Value v, const std::string& name) {
   throw Error(fmt::format("{} has no member '{}'", t.name, name));
 }
 
+// The type an address points at: a pointer object's target, an array's
+// element, an &x's; -1 for anything else.
+int32_t pointeeOf(const Scope& s, const Value& v) {
+  if (v.type < 0) return v.pointee;
+  if (v.count > 0) return -1;
+  const TypeInfo& t = typeOf(s, v.type);
+  if (t.kind != TypeInfo::Kind::Pointer && t.kind != TypeInfo::Kind::Array) return -1;
+  if (t.base < 0) return -1;
+  const TypeInfo& target = typeOf(s, t.base);
+  return target.kind == TypeInfo::Kind::Void || target.kind == TypeInfo::Kind::Function ? -1
+                                                                                        : t.base;
+}
+
 Value arith(const std::string& op, const Scope& s, const Value& a, const Value& b) {
+  // Address arithmetic, as C scales it: p + n, n + p, p - n.
+  if (op == "-" && pointeeOf(s, a) >= 0 && pointeeOf(s, b) >= 0) {
+    // p - q: the elements between them.
+    int64_t ia = 0, ib = 0;
+    double r = 0;
+    bool f = false;
+    numberOf(s, a, ia, r, f);
+    numberOf(s, b, ib, r, f);
+    const int64_t size = std::max<int64_t>(1, typeOf(s, pointeeOf(s, a)).size);
+    return number((ia - ib) / size);
+  }
+  if (op == "+" || op == "-") {
+    const int32_t pa = pointeeOf(s, a), pb = op == "+" ? pointeeOf(s, b) : -1;
+    if ((pa >= 0) != (pb >= 0)) {
+      const Value& address = pa >= 0 ? a : b;
+      const Value& offset = pa >= 0 ? b : a;
+      int64_t base = 0, n = 0;
+      double r = 0;
+      bool f = false;
+      if (!numberOf(s, address, base, r, f) || !numberOf(s, offset, n, r, f) || f)
+        throw Error(fmt::format("'{}' of an address needs an integer", op));
+      const int32_t target = pa >= 0 ? pa : pb;
+      const int64_t size = typeOf(s, target).size;
+      Value out = number(static_cast<uint16_t>(base + (op == "+" ? n : -n) * size));
+      out.pointee = target;
+      return out;
+    }
+  }
   int64_t ia = 0, ib = 0;
   double ra = 0, rb = 0;
   bool fa = false, fb = false;
@@ -552,7 +599,9 @@ Value eval(const Scope& s, const Node& n) {
       }
       if (n.op == "&") {
         if (!a.inMemory) throw Error("'&' of a value that is not in memory");
-        return number(a.address);
+        Value address = number(a.address);
+        address.pointee = a.type;
+        return address;
       }
       int64_t i = 0;
       double r = 0;
@@ -629,6 +678,7 @@ std::string quoted(const Scope& s, uint16_t a, int limit, bool& ended) {
 }
 
 std::string formatNumber(const Value& v) {
+  if (v.pointee >= 0) return fmt::format("0x{:04X}", static_cast<uint16_t>(v.integer));
   return v.isFloat ? fmt::format("{}", v.real) : fmt::format("{}", v.integer);
 }
 
@@ -764,6 +814,10 @@ std::string format(const Scope& scope, const Value& value) {
 }
 
 std::string typeName(const Scope& scope, const Value& value) {
+  if (value.type < 0 && value.pointee >= 0) {
+    const std::string target = typeOf(scope, value.pointee).name;
+    return target + (target.back() == '*' ? "*" : " *");
+  }
   if (value.type < 0) return value.isFloat ? "double" : "long";
   const std::string name = typeOf(scope, value.type).name;
   return value.count > 0 ? fmt::format("{}[{}]", name, value.count) : name;

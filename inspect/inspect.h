@@ -51,7 +51,9 @@ struct Value {
   int32_t type = -1;  // vm::Image::types; -1: a number
   bool inMemory = false;
   uint16_t address = 0;
-  int count = 0;  // a slice: this many elements of `type` from address
+  int count = 0;         // a slice: this many elements of `type` from address
+  int frame = -1;        // an auto: the activation (Scope::activations) holding it
+  int32_t pointee = -1;  // a number that is an address (&x, p + 1): the type there
   bool isFloat = false;
   int64_t integer = 0;
   double real = 0;

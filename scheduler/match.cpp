@@ -255,8 +255,17 @@ void Robot::debugRunTo(Tick horizon) {
       return;
     }
     if (stop == vm::Stop::Breakpoint) noteBreakpoint();
-    if (stop == vm::Stop::Breakpoint || stop == vm::Stop::Host || (stepping && !board.cpu.halted()))
+    if (stop == vm::Stop::Breakpoint || stop == vm::Stop::Host ||
+        (stepping && !board.cpu.halted())) {
+      // At or past the horizon the round's events there (serial bytes,
+      // roots, requests) are still to come: looked at in the next round,
+      // after them, as any place reached there is.
+      if (now() >= horizon) {
+        debugLook = true;
+        return;
+      }
       look(hook);
+    }
   }
 }
 
@@ -383,7 +392,8 @@ void Match::resolveWatches() {
     for (auto& r : robots_) {
       for (const auto& s : r->spec.image.symbols) {
         if (s.name != name ||
-            (s.kind != vm::Symbol::Kind::Global && s.kind != vm::Symbol::Kind::Static) ||
+            (s.kind != vm::Symbol::Kind::Global && s.kind != vm::Symbol::Kind::Static &&
+             s.kind != vm::Symbol::Kind::Param) ||
             s.value == vm::Symbol::Value::Aggregate || s.value == vm::Symbol::Value::Code)
           continue;
         r->watches.push_back({name, static_cast<uint16_t>(s.address), s.value, nullptr});
@@ -516,11 +526,17 @@ bool Match::advancePlantTo(Tick t, plant::AdvanceResult& step) {
 void Match::applyInputs() {
   // Stable by tick, in place: std::stable_sort would allocate a buffer every
   // round with inputs; a round has a handful, mostly in order already.
+  // A debugger holding robot B runs B first in each round: ties in tick
+  // go by robot, so that the robots' inputs reach the plant in the order
+  // the usual run order (A, then B) gives them.
+  const bool byRobot = config_.debugger && config_.debugRobot != 0;
   for (auto it = inputs_.begin(); it != inputs_.end(); ++it)
-    std::rotate(
-        std::upper_bound(inputs_.begin(), it, *it,
-                         [](const PlantInput& a, const PlantInput& b) { return a.tick < b.tick; }),
-        it, it + 1);
+    std::rotate(std::upper_bound(inputs_.begin(), it, *it,
+                                 [byRobot](const PlantInput& a, const PlantInput& b) {
+                                   return a.tick < b.tick ||
+                                          (byRobot && a.tick == b.tick && a.robot < b.robot);
+                                 }),
+                it, it + 1);
   for (const auto& w : inputs_) {
     // An earlier input of this round may have re-initialised the plant at
     // its tick: integrate up to this one. Plant events at this tick come
@@ -948,6 +964,12 @@ MatchRun::Snapshot MatchRun::snapshot() const {
 
 void MatchRun::restore(const Snapshot& snapshot) {
   match_ = std::make_unique<detail::Match>(*snapshot.match_, &snapshot.mark_);
+  // The held robot's boundary at the snapshot is the first it looks at.
+  if (match_->debugger()) match_->robot(match_->debugRobot()).debugLook = true;
+}
+
+bool MatchRun::Snapshot::robotFaulted(int robot) const {
+  return match_->vm(robot).fault() != nullptr;
 }
 
 std::string_view debugEventName(DebugEvent e) {

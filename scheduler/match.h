@@ -340,6 +340,7 @@ class MatchRun {
     ~Snapshot();
     Tick now() const;  // the snapshot's MatchRun::now()
     Tick robotClock(int robot) const;
+    bool robotFaulted(int robot) const;
 
    private:
     friend class MatchRun;
@@ -348,6 +349,7 @@ class MatchRun {
     plant::Arena::Mark mark_;
   };
   Snapshot snapshot() const;
+  // With a debugger, it then looks at its robot's first boundary.
   void restore(const Snapshot& snapshot);
 
  private:

@@ -179,16 +179,17 @@ TEST(Inject, WatchedValuesAsTheirTypesReadThem) {
       "unsigned long ul;\n"
       "float f;\n"
       "int a[3];\n"
+      "int twice(int n) { return n * 2; }\n"
       "main()\n"
       "{\n"
-      "    p = &s; c = 200; i = -2; u = 65534; l = -100000L; ul = 3000000000UL; f = 1.5;\n"
+      "    p = &s; c = 200; i = twice(-1); u = 65534; l = -100000L; ul = 3000000000UL; f = 1.5;\n"
       "    while (1);\n"
       "}\n";
   scheduler::MatchConfig c = soloConfig({});
   c.robots[0] = {"A", "types.dc", testkit::compileOrDie(source, "types.dc")};
   c.endTick = scheduler::kTicksPerSecond;
   c.stopWhenAllExited = false;
-  c.watches = {"p", "c", "i", "u", "l", "ul", "f"};
+  c.watches = {"p", "c", "i", "u", "l", "ul", "f", "twice.n"};
   const auto r = testkit::runTraced(c);
   std::optional<nlohmann::json> last;
   for (const auto& line : r.trace) {
@@ -207,6 +208,7 @@ TEST(Inject, WatchedValuesAsTheirTypesReadThem) {
   EXPECT_EQ(last->at("l"), -100000);
   EXPECT_EQ(last->at("ul"), 3000000000LL);
   EXPECT_EQ(last->at("f"), 1.5);
+  EXPECT_EQ(last->at("twice.n"), -1);  // a static function's parameter, FUNCTION.NAME
   // Any lvalue simbot debug's print takes (issue 26): an aggregate as the
   // debugger prints it, a member through a pointer, a slice; a function or
   // a name no program has is refused.
