@@ -777,8 +777,23 @@ struct DapServer::Impl {
     respond(m, body);
   }
 
+  // The client sends the whole list each time: a data breakpoint it sent
+  // before (same dataId) is kept as it is, with the object it was set on
+  // and its hit count, not evaluated again in this stop's scope.
   void setDataBreakpoints(Session& s, const json& m, const json& args) {
-    removeAll(s, dataBreakpoints);
+    std::map<std::string, int> kept;
+    for (const Watchpoint& w : s.watchpoints())
+      for (int id : dataBreakpoints)
+        if (w.id == id) kept[w.expression->text()] = id;
+    std::vector<int> dropped;
+    for (int id : dataBreakpoints) {
+      bool wanted = false;
+      for (const json& b : args.value("breakpoints", json::array()))
+        wanted |= kept.count(text(b, "dataId")) && kept[text(b, "dataId")] == id;
+      if (!wanted) dropped.push_back(id);
+    }
+    removeAll(s, dropped);
+    dataBreakpoints.clear();
     json answers = json::array();
     for (const json& b : args.value("breakpoints", json::array())) {
       json answer = {{"verified", false}};
@@ -786,7 +801,12 @@ struct DapServer::Impl {
         const std::string access = text(b, "accessType");
         if (!access.empty() && access != "write")
           throw Error(fmt::format("only writes are watched (not {} access)", access));
-        const Watchpoint& w = s.watch(text(b, "dataId"));
+        const std::string dataId = text(b, "dataId");
+        const Watchpoint* existing = nullptr;
+        if (const auto it = kept.find(dataId); it != kept.end())
+          for (const Watchpoint& w : s.watchpoints())
+            if (w.id == it->second) existing = &w;
+        const Watchpoint& w = existing ? *existing : s.watch(dataId);
         dataBreakpoints.push_back(w.id);
         answer = {{"id", w.id},
                   {"verified", true},

@@ -33,9 +33,13 @@ std::string Match::describe(Tick t) const {
                        st.pose.y_ft, st.pose.heading_deg);
     out += fmt::format("  wheels     left {:.3f} ft/s  right {:.3f} ft/s\n", st.left_fps,
                        st.right_fps);
-    out += fmt::format("  eyes       last ad_rd8 left {}  right {} ({} and {} reads)\n",
-                       r->board.lastAdValue[0], r->board.lastAdValue[1], r->board.adReads[0],
-                       r->board.adReads[1]);
+    // What the photodetectors see at this tick (the plant's optics, before
+    // the A/D's noise), and what the program last read.
+    const plant::EyeReadings eyes = arena_.eyeReadings(r->index, at);
+    out += fmt::format(
+        "  eyes       now left {}  right {}; last ad_rd8 left {}  right {} ({} and {} reads)\n",
+        eyes.left, eyes.right, r->board.lastAdValue[0], r->board.lastAdValue[1],
+        r->board.adReads[0], r->board.adReads[1]);
     out += fmt::format(
         "  port A     edge lines 0x{:02X} (fore {}, aft {}), PIO interrupt {}, vector 0x{:02X}\n",
         r->board.edgeLines, (r->board.edgeLines & 0x02) ? "high" : "low",

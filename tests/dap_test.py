@@ -280,6 +280,15 @@ check(nothing.get("dataId") is None and nothing.get("description"), f"dataBreakp
 r = c.request("setDataBreakpoints", {"breakpoints": [{"dataId": info["dataId"], "accessType": "write"}]})
 dbs = r["body"]["breakpoints"]
 check(len(dbs) == 1 and dbs[0]["verified"], f"setDataBreakpoints: {dbs}")
+# The client sends the whole list again on any change: the same dataId
+# keeps its data breakpoint (same id), a new one is added beside it.
+again = c.request("setDataBreakpoints", {"breakpoints": [
+    {"dataId": info["dataId"], "accessType": "write"}, {"dataId": "cnt", "accessType": "write"}]})
+kept = again["body"]["breakpoints"]
+check(len(kept) == 2 and kept[0].get("id") == dbs[0].get("id") and kept[1]["verified"]
+      and kept[1].get("id") != dbs[0].get("id"), f"setDataBreakpoints again: {kept}")
+r = c.request("setDataBreakpoints", {"breakpoints": [{"dataId": info["dataId"], "accessType": "write"}]})
+check(r["body"]["breakpoints"][0].get("id") == dbs[0].get("id"), f"setDataBreakpoints dropping cnt: {r}")
 old = c.evaluate("buf", top["id"])["result"]
 c.request("continue", {"threadId": 1})
 stop = c.stopped("data breakpoint")
