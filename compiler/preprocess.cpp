@@ -28,10 +28,15 @@ namespace {
 
 constexpr int kMaxExpandDepth = 32;
 constexpr size_t kMaxMacroNesting = 200;
-constexpr long kMaxExpandedTokens = 500'000;  // produced or collected as arguments
+// Tokens macro expansion may produce in a file (or collect as arguments):
+// the course's programs name ports and constants (a token or two each), and
+// a file of doubling macros must fail within the fuzzer's 10-s limit in its
+// unoptimised sanitizer build (2.4 s there at these limits; 12 s at 500,000
+// tokens and 2,000,000 names).
+constexpr long kMaxExpandedTokens = 100'000;
 // Names held by all the hide sets made (each set is also charged 4 names for
-// its own keeping): about 32 bytes a name, so at most some 64 MB.
-constexpr long kMaxHideNames = 2'000'000;
+// its own keeping): about 32 bytes a name, so at most some 13 MB.
+constexpr long kMaxHideNames = 400'000;
 constexpr size_t kMaxCondDepth = 200;
 
 constexpr std::array<std::string_view, 12> kLibraries = {
