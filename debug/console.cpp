@@ -75,24 +75,6 @@ long count(const std::string& args, long otherwise = 1) {
   return n;
 }
 
-std::string seconds(Tick t) { return fmt::format("{:.6f} s", timebase::secondsFromTicks(t)); }
-
-std::optional<DebugEvent> eventNamed(const std::string& name) {
-  for (DebugEvent e : {DebugEvent::FrameLatched, DebugEvent::EdgeAccepted, DebugEvent::Contact,
-                       DebugEvent::Shot, DebugEvent::Fault})
-    if (name == scheduler::debugEventName(e)) return e;
-  return std::nullopt;
-}
-
-bool isTime(const std::string& s) {
-  return !s.empty() && std::isdigit(static_cast<unsigned char>(s[0])) && s.back() == 's';
-}
-
-std::string baseName(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
 const char* const kHelp = R"(Commands (gdb's where they fit; an empty line repeats the last one):
   break LOCATION [if COND]   stop at a line (12, B:12, FILE:12), a function or handler (INT1,
                              B:fire), a time (12.5s, 20ms, tick 115200000) or an event (frame,
@@ -202,14 +184,14 @@ void Console::report(Session& s, const Stop& why) {
     case Stop::Kind::Fault: {
       const vm::Fault* f = s.vm(s.robot()).fault();
       out_ << fmt::format("Robot {} faulted at tick {} ({}), line {}: {}\n", robot,
-                          f ? f->tick : s.now(), seconds(f ? f->tick : s.now()), f ? f->line : 0,
-                          f ? f->message : "");
+                          f ? f->tick : s.now(), secondsText(f ? f->tick : s.now()),
+                          f ? f->line : 0, f ? f->message : "");
       backtrace(s);
       return;
     }
     case Stop::Kind::End:
       out_ << fmt::format("The match is over at tick {} ({}).\n", s.matchTick(),
-                          seconds(s.matchTick()));
+                          secondsText(s.matchTick()));
       return;
     case Stop::Kind::Step:
     case Stop::Kind::Time:
@@ -220,7 +202,7 @@ void Console::report(Session& s, const Stop& why) {
   if (why.kind == Stop::Kind::Step && last_.kind == Resume::Kind::StepInstruction) {
     const vm::Image& img = s.vm(s.robot()).image();
     out_ << fmt::format("ran     {}\n", vm::disassembleAt(img, lastPc_));
-    out_ << fmt::format("clock   {} ({}), +{} T-states\n", s.now(), seconds(s.now()),
+    out_ << fmt::format("clock   {} ({}), +{} T-states\n", s.now(), secondsText(s.now()),
                         s.now() - lastTick_);
     out_ << fmt::format("next    {}\n", vm::disassembleAt(img, s.vm(s.robot()).pc()));
   }
@@ -234,9 +216,9 @@ void Console::showLocation(Session& s, int robot) {
   if (frames.empty()) return;
   const FrameInfo& f = frames[static_cast<size_t>(robot == s.robot() ? s.frame() : 0)];
   out_ << fmt::format("{} at tick {} ({}): {}({}) at {}:{}{}\n", s.robotName(robot),
-                      s.vm(robot).now(), seconds(s.vm(robot).now()),
+                      s.vm(robot).now(), secondsText(s.vm(robot).now()),
                       f.function.empty() ? "<startup>" : f.function, f.arguments,
-                      baseName(s.program(robot)), f.line, f.handler ? " [interrupt handler]" : "");
+                      fileName(s.program(robot)), f.line, f.handler ? " [interrupt handler]" : "");
   out_ << fmt::format("{}\t{}\n", f.line, s.source(robot, f.line));
   listRobot_ = robot;
   listLine_ = f.line;
@@ -265,7 +247,7 @@ void Console::backtrace(Session& s) {
     const FrameInfo& f = frames[k];
     out_ << fmt::format(
         "{}#{:<2} {}({}) at {}:{}{}{}\n", static_cast<int>(k) == s.frame() ? "*" : " ", k,
-        f.function.empty() ? "<startup>" : f.function, f.arguments, baseName(s.program(s.robot())),
+        f.function.empty() ? "<startup>" : f.function, f.arguments, fileName(s.program(s.robot())),
         f.line, f.handler ? " [interrupt handler]" : "",
         f.interrupted ? " [interrupted here]" : "");
   }
@@ -317,7 +299,7 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
       if (command == "advance") throw Error("advance needs a line or a time");
       return resume(K::Until);
     }
-    if (isTime(args)) {
+    if (looksLikeTime(args)) {
       resume(K::AdvanceTime);
       how.tick = s.now() + parseTime(args);
       return true;
@@ -474,30 +456,7 @@ void Console::breakCommand(Session& s, std::string args, bool temporary) {
     // Here: the held robot's current line.
     args = fmt::format("{}:{}", s.robotName(s.robot()), s.vm(s.robot()).line());
   }
-  const Breakpoint* b = nullptr;
-  std::string where = args;
-  const bool named = where.find(':') != std::string::npos;
-  const int robot = s.robotOf(where);
-  long lineNumber = 0;
-  if (where.rfind("tick ", 0) == 0 && !named) {
-    long tick = 0;
-    if (!integer(trim(where.substr(5)), tick) || tick < 0)
-      throw Error(fmt::format("'{}' is not a tick count", trim(where.substr(5))));
-    b = &s.breakAtTick(tick, temporary);
-  } else if (isTime(where) && !named) {
-    b = &s.breakAtTick(parseTime(where), temporary);
-  } else if (integer(where, lineNumber)) {
-    b = &s.breakAtLine(robot, static_cast<int>(lineNumber), temporary);
-  } else if (const auto e = eventNamed(where); e && !named) {
-    bool function = false;
-    for (const vm::Symbol& sym : s.vm(robot).image().symbols)
-      function |= sym.name == where &&
-                  (sym.kind == vm::Symbol::Kind::Function || sym.kind == vm::Symbol::Kind::Handler);
-    b = function ? &s.breakAtFunction(robot, where, temporary) : &s.breakAtEvent(*e, temporary);
-  } else {
-    b = &s.breakAtFunction(robot, where, temporary);
-  }
-  const int id = b->id;
+  const int id = s.breakAt(args, temporary).id;
   if (temporary) temporaries_.insert(id);
   if (!condition.empty()) s.setCondition(id, condition);
   for (const Breakpoint& x : s.breakpoints()) {
@@ -507,13 +466,13 @@ void Console::breakCommand(Session& s, std::string args, bool temporary) {
       case Breakpoint::Kind::Line:
       case Breakpoint::Kind::Function:
         out_ << fmt::format("{} {} at {}:{} ({}{}, robot {}){}\n", kind, x.id,
-                            baseName(s.program(x.robot)), x.line,
+                            fileName(s.program(x.robot)), x.line,
                             x.kind == Breakpoint::Kind::Function ? "entry of " : "in ",
                             x.function.empty() ? "??" : x.function + "()", s.robotName(x.robot),
                             condition.empty() ? "" : " if " + condition);
         break;
       case Breakpoint::Kind::Time:
-        out_ << fmt::format("{} {} at tick {} ({})\n", kind, x.id, x.tick, seconds(x.tick));
+        out_ << fmt::format("{} {} at tick {} ({})\n", kind, x.id, x.tick, secondsText(x.tick));
         break;
       case Breakpoint::Kind::Event:
         out_ << fmt::format("{} {} on every {} event\n", kind, x.id,
@@ -536,11 +495,11 @@ void Console::info(Session& s, const std::string& what) {
       switch (b.kind) {
         case Breakpoint::Kind::Line:
         case Breakpoint::Kind::Function:
-          place = fmt::format("{}:{} in {}() (robot {})", baseName(s.program(b.robot)), b.line,
+          place = fmt::format("{}:{} in {}() (robot {})", fileName(s.program(b.robot)), b.line,
                               b.function, s.robotName(b.robot));
           break;
         case Breakpoint::Kind::Time:
-          place = fmt::format("tick {} ({})", b.tick, seconds(b.tick));
+          place = fmt::format("tick {} ({})", b.tick, secondsText(b.tick));
           break;
         case Breakpoint::Kind::Event:
           place = fmt::format("every {} event", scheduler::debugEventName(b.event));
@@ -565,7 +524,7 @@ void Console::info(Session& s, const std::string& what) {
   if (what == "registers" || what == "r") {
     const std::vector<vm::Vm::Activation> acts = v.activations();
     out_ << fmt::format("pc      0x{:04X}  {}\n", v.pc(), vm::disassembleAt(v.image(), v.pc()));
-    out_ << fmt::format("clock   {} ({})\n", v.now(), seconds(v.now()));
+    out_ << fmt::format("clock   {} ({})\n", v.now(), secondsText(v.now()));
     out_ << fmt::format("IFF1    {}  (interrupts {})\n", v.interruptsEnabled() ? 1 : 0,
                         v.interruptsEnabled() ? "enabled" : "disabled");
     if (!acts.empty() && acts[0].framed)

@@ -23,11 +23,6 @@ using nlohmann::json;
 
 constexpr size_t kMaxMessageBytes = 16u << 20;
 
-std::string baseName(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
 std::string absolutePath(const std::string& path) {
   std::error_code ec;
   const auto a = std::filesystem::absolute(path, ec);
@@ -48,8 +43,6 @@ std::string trim(const std::string& s) {
   return s.substr(a, b - a + 1);
 }
 
-std::string seconds(Tick t) { return fmt::format("{:.6f} s", timebase::secondsFromTicks(t)); }
-
 // A hit condition: "N", ">=N" or "==N" stop from the N-th hit on, ">N"
 // after the N-th. The hits to pass over first.
 int hitsToIgnore(const std::string& text) {
@@ -67,18 +60,6 @@ int hitsToIgnore(const std::string& text) {
     throw Error(
         fmt::format("hit condition '{}': write a count N (stop from the N-th hit on)", text));
   return n - 1 + extra;
-}
-
-std::optional<scheduler::DebugEvent> eventNamed(const std::string& name) {
-  using scheduler::DebugEvent;
-  for (DebugEvent e : {DebugEvent::FrameLatched, DebugEvent::EdgeAccepted, DebugEvent::Contact,
-                       DebugEvent::Shot, DebugEvent::Fault})
-    if (name == scheduler::debugEventName(e)) return e;
-  return std::nullopt;
-}
-
-bool isTime(const std::string& s) {
-  return !s.empty() && std::isdigit(static_cast<unsigned char>(s[0])) && s.back() == 's';
 }
 
 // An expression a member or element is appended to: a bare name or postfix
@@ -390,7 +371,7 @@ struct DapServer::Impl {
   void report(Session& s, const Stop& why) {
     const int robot = s.robot();
     const std::string where =
-        fmt::format("robot {} at tick {} ({})", s.robotName(robot), s.now(), seconds(s.now()));
+        fmt::format("robot {} at tick {} ({})", s.robotName(robot), s.now(), secondsText(s.now()));
     json body = {{"threadId", robot + 1}, {"allThreadsStopped", true}};
     std::string reason, description, detail;
     switch (why.kind) {
@@ -426,7 +407,7 @@ struct DapServer::Impl {
         const vm::Fault* f = s.vm(robot).fault();
         description =
             fmt::format("robot {} faulted at tick {} ({}), line {}", s.robotName(robot),
-                        f ? f->tick : s.now(), seconds(f ? f->tick : s.now()), f ? f->line : 0);
+                        f ? f->tick : s.now(), secondsText(f ? f->tick : s.now()), f ? f->line : 0);
         detail = f ? f->message : "";
         log(fmt::format("{}: {}\n", description, detail));
         break;
@@ -434,7 +415,7 @@ struct DapServer::Impl {
       case Stop::Kind::End:
         reason = "step";
         description = fmt::format("the match is over at tick {} ({}): only going back is possible",
-                                  s.now(), seconds(s.now()));
+                                  s.now(), secondsText(s.now()));
         log(description + "\n");
         break;
       case Stop::Kind::Step:
@@ -486,7 +467,7 @@ struct DapServer::Impl {
       for (int r = 0; r < s.robotCount(); ++r)
         threads.push_back(
             {{"id", r + 1},
-             {"name", fmt::format("{} ({})", s.robotName(r), baseName(s.program(r)))}});
+             {"name", fmt::format("{} ({})", s.robotName(r), fileName(s.program(r)))}});
       respond(m, {{"threads", threads}});
       return false;
     }
@@ -598,12 +579,12 @@ struct DapServer::Impl {
       if (samePath(path, s.program(r))) found.push_back(r);
     if (found.empty())
       for (int r = 0; r < s.robotCount(); ++r)
-        if (baseName(path) == baseName(s.program(r))) found.push_back(r);
+        if (fileName(path) == fileName(s.program(r))) found.push_back(r);
     return found;
   }
 
   json sourceOf(const Session& s, int robot) const {
-    return {{"name", baseName(s.program(robot))}, {"path", absolutePath(s.program(robot))}};
+    return {{"name", fileName(s.program(robot))}, {"path", absolutePath(s.program(robot))}};
   }
 
   // Condition and hit count of breakpoint `id` (Error: the caller removes it).
@@ -631,7 +612,7 @@ struct DapServer::Impl {
       const int line = b.value("line", 0);
       json answer = {{"verified", false}, {"line", line}, {"source", source}};
       if (robots.empty()) {
-        answer["message"] = fmt::format("{} is not a program of this run", baseName(path));
+        answer["message"] = fmt::format("{} is not a program of this run", fileName(path));
         answers.push_back(answer);
         continue;
       }
@@ -659,23 +640,11 @@ struct DapServer::Impl {
     respond(m, {{"breakpoints", answers}});
   }
 
-  // A function breakpoint's name: FUNCTION or ROBOT:FUNCTION (a handler
-  // too), a time (12.5s, 20ms), or an event (frame, edge, contact, shot,
-  // fault), as the terminal's `break` takes them.
-  int functionBreakpoint(Session& s, const std::string& name) {
-    std::string where = trim(name);
-    const bool named = where.find(':') != std::string::npos;
-    const int robot = s.robotOf(where);
-    if (isTime(where) && !named) return s.breakAtTick(parseTime(where)).id;
-    if (const auto e = eventNamed(where); e && !named) {
-      bool function = false;
-      for (const vm::Symbol& sym : s.vm(robot).image().symbols)
-        function |= sym.name == where && (sym.kind == vm::Symbol::Kind::Function ||
-                                          sym.kind == vm::Symbol::Kind::Handler);
-      if (!function) return s.breakAtEvent(*e).id;
-    }
-    return s.breakAtFunction(robot, where).id;
-  }
+  // A function breakpoint's name: any location the terminal's `break`
+  // takes (Session::breakAt): FUNCTION or ROBOT:FUNCTION (a handler too), a
+  // time (12.5s, 20ms, tick N), an event (frame, edge, contact, shot,
+  // fault), or a line.
+  int functionBreakpoint(Session& s, const std::string& name) { return s.breakAt(trim(name)).id; }
 
   void setFunctionBreakpoints(Session& s, const json& m, const json& args) {
     removeAll(s, functionBreakpoints);

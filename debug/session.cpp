@@ -33,11 +33,6 @@ bool reverse(Resume::Kind k) {
   }
 }
 
-std::string baseName(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
 }  // namespace
 
 // Thrown out of the match from a stop: the command goes back in time (or
@@ -694,7 +689,7 @@ int Session::robotOf(std::string& where) const {
   for (int r = 0; r < robotCount(); ++r) {
     std::string upper = prefix;
     for (char& ch : upper) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-    if (upper == robotName(r) || prefix == program(r) || prefix == baseName(program(r))) {
+    if (upper == robotName(r) || prefix == program(r) || prefix == fileName(program(r))) {
       where = where.substr(colon + 1);
       return r;
     }
@@ -790,6 +785,36 @@ const Breakpoint& Session::breakAtEvent(DebugEvent event, bool temporary) {
   return addBreakpoint(std::move(b));
 }
 
+const Breakpoint& Session::breakAt(const std::string& location, bool temporary) {
+  std::string where = location;
+  const bool named = where.find(':') != std::string::npos;
+  const int robot = robotOf(where);
+  if (!named && where.rfind("tick ", 0) == 0) {
+    const std::string count = where.substr(5);
+    Tick tick = 0;
+    const auto [end, error] = std::from_chars(count.data(), count.data() + count.size(), tick);
+    if (count.empty() || error != std::errc() || end != count.data() + count.size() || tick < 0)
+      throw Error(fmt::format("'{}' is not a tick count", count));
+    return breakAtTick(tick, temporary);
+  }
+  if (!named && looksLikeTime(where)) return breakAtTick(parseTime(where), temporary);
+  int line = 0;
+  const auto [end, error] = std::from_chars(where.data(), where.data() + where.size(), line);
+  if (!where.empty() && error == std::errc() && end == where.data() + where.size())
+    return breakAtLine(robot, line, temporary);
+  if (!named)
+    for (DebugEvent e : {DebugEvent::FrameLatched, DebugEvent::EdgeAccepted, DebugEvent::Contact,
+                         DebugEvent::Shot, DebugEvent::Fault}) {
+      if (where != scheduler::debugEventName(e)) continue;
+      for (const vm::Symbol& sym : config_.robots[static_cast<size_t>(robot)].image.symbols)
+        if (sym.name == where &&
+            (sym.kind == vm::Symbol::Kind::Function || sym.kind == vm::Symbol::Kind::Handler))
+          return breakAtFunction(robot, where, temporary);
+      return breakAtEvent(e, temporary);
+    }
+  return breakAtFunction(robot, where, temporary);
+}
+
 void Session::setCondition(int id, const std::string& expression) {
   Breakpoint* b = findBreakpoint(id);
   if (!b) throw Error(fmt::format("no breakpoint {}", id));
@@ -860,6 +885,17 @@ const Watchpoint& Session::watch(const std::string& expression) {
 }
 
 // ---- times ------------------------------------------------------------------
+
+bool looksLikeTime(const std::string& word) {
+  return !word.empty() && std::isdigit(static_cast<unsigned char>(word[0])) && word.back() == 's';
+}
+
+std::string secondsText(Tick t) { return fmt::format("{:.6f} s", timebase::secondsFromTicks(t)); }
+
+std::string fileName(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
 
 Tick parseTime(const std::string& text) {
   std::string digits = text;

@@ -188,6 +188,12 @@ class Session final : private scheduler::DebugHook {
   const Breakpoint& breakAtFunction(int robot, const std::string& name, bool temporary = false);
   const Breakpoint& breakAtTick(Tick tick, bool temporary = false);
   const Breakpoint& breakAtEvent(scheduler::DebugEvent event, bool temporary = false);
+  // A location as `break` (and DAP's function breakpoints) write it:
+  // "tick N", a time (12.5s, 20ms), a LINE or a FUNCTION (a handler too),
+  // each of them after "B:" or "FILE:" for another robot's program (lines
+  // and functions are A's otherwise), or an event (frame, edge, contact,
+  // shot, fault; a function of that name wins).
+  const Breakpoint& breakAt(const std::string& location, bool temporary = false);
   void setCondition(int id, const std::string& expression);  // "" removes it
   void setIgnore(int id, int count);
   void setEnabled(int id, bool enabled);
@@ -274,5 +280,11 @@ class Session final : private scheduler::DebugHook {
 // "12.5s", "20ms", "123456" (ticks), "1e-3s": a time the user wrote.
 // Error if it is none.
 Tick parseTime(const std::string& text);
+// Whether a word is written as a time with a unit (12.5s, 20ms), not a line.
+bool looksLikeTime(const std::string& word);
+// "1.500000 s", as stops and breakpoints show a tick's time.
+std::string secondsText(Tick t);
+// A program's file name without its directories, as listings show it.
+std::string fileName(const std::string& path);
 
 }  // namespace simbot::debug
