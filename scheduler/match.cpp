@@ -144,6 +144,7 @@ Robot::Robot(const Robot& other, Match& m)
       lineInjections(other.lineInjections),
       lineHits(other.lineHits),
       watches(other.watches),
+      tickStart(other.tickStart),
       snapshots(other.snapshots),
       nextSnapshot(other.nextSnapshot),
       spec(other.spec),
@@ -153,6 +154,7 @@ Robot::Robot(const Robot& other, Match& m)
       receiver(other.receiver),
       serialEventAt(other.serialEventAt),
       serialIsrAccepted(other.serialIsrAccepted),
+      serialIsrWatch(other.serialIsrWatch),
       lastSend(other.lastSend),
       sendBefore(other.sendBefore),
       result(other.result),
@@ -423,7 +425,7 @@ void Match::emit(Tick t, trace::Record record) {
   const int robot = trace::robotOf(record);
   trace::Watch watch;
   if (robot >= 0 && robot < static_cast<int>(robots_.size()))
-    watch = robots_[static_cast<size_t>(robot)]->watchedValues();
+    watch = robots_[static_cast<size_t>(robot)]->tracedWatch(t);
   trace_.emit(t, std::move(record), std::move(watch));
 }
 
@@ -474,13 +476,13 @@ void Match::emitSetup() {
   }
 }
 
-void Match::applyReflex(Tick t, int robot, plant::Bumper side) {
+void Match::applyReflex(Tick t, int robot, plant::Bumper side, const trace::Watch* watch) {
   sampleUpTo(t);
   const plant::EventList events = [&] {
     const PartScope plant(clock_, PartClock::Plant);
     return arena_.triggerReflex(robot, side, t);
   }();
-  handlePlantEvents(t, events);
+  handlePlantEvents(t, events, watch, robot);
 }
 
 // Leg `leg` of a robot's scripted path starts at t; leg == path size is
@@ -546,8 +548,9 @@ void Match::applyInputs() {
       sampleUpTo(w.tick);
       handlePlantEvents(w.tick, step.events);
     }
+    const trace::Watch* watch = w.watch.empty() ? nullptr : &w.watch;
     if (w.kind == PlantInput::Kind::Reflex) {
-      applyReflex(w.tick, w.robot, w.bumper);
+      applyReflex(w.tick, w.robot, w.bumper, watch);
       continue;
     }
     if (w.kind == PlantInput::Kind::EdgeHandler) {
@@ -556,7 +559,7 @@ void Match::applyInputs() {
         const PartScope plant(clock_, PartClock::Plant);
         return arena_.edgeHandlerEntered(w.robot, w.tick);
       }();
-      handlePlantEvents(w.tick, events);
+      handlePlantEvents(w.tick, events, watch, w.robot);
       continue;
     }
     sampleUpTo(w.tick);
@@ -567,10 +570,20 @@ void Match::applyInputs() {
     }();
     for (const auto& e : immediate) {
       if (config_.observer) config_.observer->onPlantEvent(w.tick, e);
-      if (trace_.on()) emit(w.tick, plantRecord(e));
+      emitPlant(w.tick, e, watch, w.robot);
     }
   }
   inputs_.clear();
+}
+
+// A plant event's record at t, with `watch` (robot `watchRobot`'s values at
+// t, taken when it was there) for that robot's records.
+void Match::emitPlant(Tick t, const plant::Event& e, const trace::Watch* watch, int watchRobot) {
+  if (!trace_.on()) return;
+  if (watch && e.robot == watchRobot)
+    emit(t, plantRecord(e), *watch);
+  else
+    emit(t, plantRecord(e));
 }
 
 // The trace record of a plant event.
@@ -631,7 +644,8 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
   throw std::logic_error("plant event without a trace record");
 }
 
-void Match::handlePlantEvents(Tick t, const plant::EventList& events) {
+void Match::handlePlantEvents(Tick t, const plant::EventList& events, const trace::Watch* watch,
+                              int watchRobot) {
   for (const auto& e : events) {
     if (config_.observer) config_.observer->onPlantEvent(t, e);
     if (e.kind == plant::EventKind::EdgeEnter || e.kind == plant::EventKind::EdgeLeave) {
@@ -643,11 +657,11 @@ void Match::handlePlantEvents(Tick t, const plant::EventList& events) {
       else
         r.board.plantLow &= static_cast<uint8_t>(~bit);
       // The plant's record first, then the port's (in emission order).
-      if (trace_.on()) emit(t, plantRecord(e));
+      emitPlant(t, e, watch, watchRobot);
       r.updateEdgeLines(t);
       continue;
     }
-    if (trace_.on()) emit(t, plantRecord(e));
+    emitPlant(t, e, watch, watchRobot);
     if (config_.debugger &&
         (e.kind == plant::EventKind::Contact || e.kind == plant::EventKind::BallLaunch))
       robots_[static_cast<size_t>(e.robot)]->debugEvent(

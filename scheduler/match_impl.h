@@ -51,6 +51,10 @@ struct PlantInput {
   enum class Kind : uint8_t { PortB, Reflex, EdgeHandler } kind;
   uint8_t value;  // port B
   plant::Bumper bumper;
+  // The robot's watched variables at `tick` (traced runs that watch some):
+  // the plant's records of this input are made after the robot has run on
+  // to the round's end, and carry the values of their own tick.
+  trace::Watch watch = {};
 };
 
 class Match;
@@ -127,6 +131,12 @@ class Robot : public vm::Bus {
   };
   std::vector<Watch> watches;
   trace::Watch watchedValues() const;
+  // The values a record at tick t made now carries, in a traced run that
+  // watches variables (else nothing, no allocation): the memory at the
+  // start of tick t (docs/trace.md, "watch"), which is what it holds now
+  // unless a library call's effect at t changed it (`tickStart`).
+  trace::Watch tracedWatch(Tick t) const;
+  std::optional<std::pair<Tick, trace::Watch>> tickStart;
   trace::WatchValue expressionValue(const inspect::Expression& e) const;
   void scheduleSerial(Tick t);
 
@@ -149,7 +159,7 @@ class Robot : public vm::Bus {
   // faults are rare): the calls and handlers not yet returned from, then the
   // faulting instruction; depth counts the calls and handlers.
   std::pair<std::string, int> faultChain() const;
-  [[gnu::noinline]] void traceSend(Tick t, uint16_t cc);
+  [[gnu::noinline]] void traceSend(Tick t, int count);
   [[gnu::noinline]] void traceOverwrite(Tick t, const board::OverwrittenSend& overwritten);
 
   // Where the program was at each sample tick (traced runs): taken at the
@@ -175,6 +185,9 @@ class Robot : public vm::Bus {
   plant::MotorReceiver receiver;
   Tick serialEventAt = -1;
   Tick serialIsrAccepted = 0;
+  // The watched variables as the serial service found them: its record, made
+  // when it returns, is at its acceptance tick (docs/trace.md, "watch").
+  trace::Watch serialIsrWatch;
   // The latest send and the one before it: a frame_overwritten names both.
   SendSite lastSend, sendBefore;
   RobotResult result;
@@ -299,7 +312,7 @@ class Match : public MatchView {
   EventQueue<QueuedEvent>& queue() { return queue_; }
   std::vector<PlantInput>& inputs() { return inputs_; }
   bool betweenRounds() const { return betweenRounds_; }
-  void applyReflex(Tick t, int robot, plant::Bumper side);
+  void applyReflex(Tick t, int robot, plant::Bumper side, const trace::Watch* watch = nullptr);
   void startLeg(Tick t, int robot, int leg);
   const Injection& injection(int k) const { return config_.injections[static_cast<size_t>(k)]; }
   const std::string& name(int robot) const {
@@ -341,7 +354,11 @@ class Match : public MatchView {
   void resolveWatches();
   void emitSetup();
   trace::Record plantRecord(const plant::Event& e) const;
-  void handlePlantEvents(Tick t, const plant::EventList& events);
+  // `watch` (may be null): robot `watchRobot`'s watched variables at t, for
+  // its records, when it has run past t since.
+  void handlePlantEvents(Tick t, const plant::EventList& events,
+                         const trace::Watch* watch = nullptr, int watchRobot = -1);
+  void emitPlant(Tick t, const plant::Event& e, const trace::Watch* watch, int watchRobot);
   void sampleUpTo(Tick t);
   void finish(MatchResult& result);
 

@@ -26,7 +26,8 @@ void Robot::out(Tick t, uint16_t port, uint8_t value) {
       board.pio.writeData(value);
       return;
     case vm::kPortPIODB:
-      match.inputs().push_back({t, index, PlantInput::Kind::PortB, value, plant::Bumper::Front});
+      match.inputs().push_back(
+          {t, index, PlantInput::Kind::PortB, value, plant::Bumper::Front, tracedWatch(t)});
       if (match.tracing()) match.emit(t, trace::rec::PortB{index, value});
       return;
     case vm::kPortENB485:
@@ -125,10 +126,10 @@ std::pair<std::string, int> Robot::faultChain() const {
 
 // The records of a send, kept out of serialSend so that an untraced run's
 // path stays as short as it was.
-void Robot::traceSend(Tick t, uint16_t cc) {
+void Robot::traceSend(Tick t, int count) {
   SendSite site = sendSite(t);
-  match.emit(t, trace::rec::SerialSend{index, board.cpu.read8(cc), site.line, site.function,
-                                       site.callerLine, site.callerFunction, site.calls});
+  match.emit(t, trace::rec::SerialSend{index, count, site.line, site.function, site.callerLine,
+                                       site.callerFunction, site.calls});
   sendBefore = std::exchange(lastSend, std::move(site));
 }
 
@@ -143,7 +144,12 @@ void Robot::traceOverwrite(Tick t, const board::OverwrittenSend& overwritten) {
 }
 
 void Robot::serialSend(Tick t, uint16_t buf, uint16_t cc) {
-  if (match.tracing()) traceSend(t, cc);  // *cc as the program set it
+  // The call's effect (the library takes buf[0], *cc counts it) happens at
+  // T0, so the records made at T0 carry the values from before it
+  // (docs/trace.md, "watch"); the next boundary shows it.
+  if (match.tracing() && !watches.empty() && !(tickStart && tickStart->first == t))
+    tickStart.emplace(t, watchedValues());
+  if (match.tracing()) traceSend(t, board.cpu.read8(cc));  // *cc as the program set it
   if (const auto overwritten = board.serialSend(t, buf, cc)) {
     ++result.framesOverwritten;
     if (match.tracing()) traceOverwrite(t, *overwritten);
@@ -214,6 +220,11 @@ trace::WatchValue Robot::expressionValue(const inspect::Expression& e) const {
 
 // Each watched variable's value as its C type reads it (the compiler's
 // vm::Symbol::Value; resolveWatches admits scalars only).
+trace::Watch Robot::tracedWatch(Tick t) const {
+  if (!match.tracing() || watches.empty()) return {};
+  return tickStart && tickStart->first == t ? tickStart->second : watchedValues();
+}
+
 trace::Watch Robot::watchedValues() const {
   using V = vm::Symbol::Value;
   trace::Watch values;
@@ -284,7 +295,7 @@ void Robot::inject(Tick t, const Injection& injection) {
       if (match.betweenRounds())
         match.applyReflex(t, index, side);
       else
-        match.inputs().push_back({t, index, PlantInput::Kind::Reflex, 0, side});
+        match.inputs().push_back({t, index, PlantInput::Kind::Reflex, 0, side, tracedWatch(t)});
       return;
     }
   }
@@ -308,12 +319,15 @@ void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
   if (irq == vm::Irq::Pio) {
     board.pio.accepted();
     debugEvent(t, DebugEvent::EdgeAccepted);
-    match.inputs().push_back({t, index, PlantInput::Kind::EdgeHandler, 0, plant::Bumper::Front});
+    match.inputs().push_back(
+        {t, index, PlantInput::Kind::EdgeHandler, 0, plant::Bumper::Front, tracedWatch(t)});
   }
   // The BIOS timer service (1,024 a second) is counted, not traced.
   if (!match.tracing() || irq == vm::Irq::Timer) return;
   if (irq == vm::Irq::SerialTx) {
-    serialIsrAccepted = t;  // traced as one span when it returns
+    // Traced as one span when it returns, with the values it found.
+    serialIsrAccepted = t;
+    serialIsrWatch = tracedWatch(t);
     return;
   }
   const vm::Symbol* fn = spec.image.functionAt(pc);
@@ -324,7 +338,8 @@ void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
 
 void Robot::interruptReturned(Tick t, vm::Irq irq) {
   if (irq == vm::Irq::SerialTx) {
-    if (match.tracing()) match.emit(serialIsrAccepted, trace::rec::SerialIsr{index, t});
+    if (match.tracing())
+      match.emit(serialIsrAccepted, trace::rec::SerialIsr{index, t}, std::move(serialIsrWatch));
     return;
   }
   if (irq != vm::Irq::Pio) return;
