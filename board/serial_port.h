@@ -73,6 +73,11 @@ class SerialPort {
     if (tsrBusy_ && tdrFull_ && tdr_ == 0) return tsrDoneAt_ + kTicksPerChar;
     return std::nullopt;
   }
+  // The library has a send under way (TIE): it fetches the next byte from
+  // `pointer()` on each transmit interrupt while *countAddress() is not 0.
+  bool libraryActive() const { return tie_; }
+  uint16_t countAddress() const { return ccAddress_; }
+  uint16_t pointer() const { return pointer_; }
   // The byte in the TSR (on the wire until nextByteDone()).
   uint8_t shifting() const { return tsr_; }
   uint64_t bytesSent() const { return bytesSent_; }

@@ -55,6 +55,13 @@ std::string trim(const std::string& s) {
 }
 
 // The first word and the rest.
+// "EXPR if COND" (break and watch): the two, trimmed; COND "" when absent.
+std::pair<std::string, std::string> splitCondition(const std::string& s) {
+  const auto at = (" " + s + " ").find(" if ");
+  if (at == std::string::npos) return {trim(s), ""};
+  return {trim(s.substr(0, at)), trim(s.substr(std::min(s.size(), at + 3)))};
+}
+
 std::pair<std::string, std::string> split(const std::string& s) {
   const std::string t = trim(s);
   const auto space = t.find_first_of(" \t");
@@ -173,8 +180,12 @@ void Console::report(Session& s, const Stop& why) {
     }
     case Stop::Kind::Watchpoint:
       if (why.oldValue.empty() && why.newValue.empty()) break;
-      out_ << fmt::format("Watchpoint {}: written by line {}\nOld value = {}\nNew value = {}\n",
-                          why.breakpoint, why.writtenAt, why.oldValue, why.newValue);
+      // Going backwards the robot stands before the write, and the old
+      // value is the later one (gdb's order in the direction of travel).
+      out_ << fmt::format("Watchpoint {}: written by {}{}\nOld value = {}\nNew value = {}\n",
+                          why.breakpoint, why.writer,
+                          why.reverse ? " (going backwards: stopped before that write)" : "",
+                          why.oldValue, why.newValue);
       break;
     case Stop::Kind::Event:
       out_ << fmt::format("Breakpoint {} ({}: robot {} {}).\n", why.breakpoint,
@@ -215,10 +226,14 @@ void Console::showLocation(Session& s, int robot) {
   const std::vector<FrameInfo> frames = s.backtrace(robot);
   if (frames.empty()) return;
   const FrameInfo& f = frames[static_cast<size_t>(robot == s.robot() ? s.frame() : 0)];
-  out_ << fmt::format("{} at tick {} ({}): {}({}) at {}:{}{}\n", s.robotName(robot),
+  // A library call whose effect is due at this tick (a time gone to: the
+  // events of the tick come first); a step makes it happen.
+  const bool due = robot == s.robot() && s.frame() == 0 && s.vm(robot).effectPending();
+  out_ << fmt::format("{} at tick {} ({}): {}({}) at {}:{}{}{}\n", s.robotName(robot),
                       s.vm(robot).now(), secondsText(s.vm(robot).now()),
                       f.function.empty() ? "<startup>" : f.function, f.arguments,
-                      fileName(s.program(robot)), f.line, f.handler ? " [interrupt handler]" : "");
+                      fileName(s.program(robot)), f.line, f.handler ? " [interrupt handler]" : "",
+                      due ? " [the library call's effect is due at this tick]" : "");
   out_ << fmt::format("{}\t{}\n", f.line, s.source(robot, f.line));
   listRobot_ = robot;
   listLine_ = f.line;
@@ -335,9 +350,9 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
       for (char& ch : upper) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
       if (upper == s.robotName(r)) {
         if (r == s.robot()) throw Error(fmt::format("robot {} is held already", upper));
+        // The robots stay where they are: nothing runs (Session::anchor).
         resume(K::Hold);
         how.robot = r;
-        how.tick = s.now();
         return true;
       }
     }
@@ -348,11 +363,16 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
     return false;
   }
   if (command == "watch") {
-    if (args.empty()) throw Error("watch needs an expression");
-    const Watchpoint& w = s.watch(args);
-    out_ << fmt::format("Watchpoint {}: {} (now {})\n", w.id, args, w.text);
+    auto [expression, condition] = splitCondition(args);
+    if (expression.empty()) throw Error("watch needs an expression");
+    const Watchpoint& w = s.watch(expression, condition);
+    out_ << fmt::format("Watchpoint {}: {} (now {}){}\n", w.id, expression, w.text,
+                        condition.empty() ? "" : " if " + condition);
     return false;
   }
+  if (command == "rwatch" || command == "awatch")
+    throw Error(command +
+                ": not supported by simbot (a watchpoint stops where its value changes: watch)");
   if (command == "delete" || command == "d") {
     if (args.empty()) {
       s.removeAll();
@@ -448,10 +468,7 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
 
 void Console::breakCommand(Session& s, std::string args, bool temporary) {
   std::string condition;
-  if (const auto at = args.find(" if "); at != std::string::npos) {
-    condition = trim(args.substr(at + 4));
-    args = trim(args.substr(0, at));
-  }
+  std::tie(args, condition) = splitCondition(args);
   if (args.empty()) {
     // Here: the held robot's current line.
     args = fmt::format("{}:{}", s.robotName(s.robot()), s.vm(s.robot()).line());
@@ -513,8 +530,14 @@ void Console::info(Session& s, const std::string& what) {
     }
     for (const Watchpoint& w : s.watchpoints())
       out_ << fmt::format(
-          "{:<4} {:<11} {:<4} {} (now {}){}\n", w.id, "watchpoint", "y", w.expression->text(),
-          w.text, w.hits ? fmt::format(", hit {} time{}", w.hits, w.hits == 1 ? "" : "s") : "");
+          "{:<4} {:<11} {:<4} {}{} (now {}){}{}{}\n", w.id, "watchpoint", w.enabled ? "y" : "n",
+          s.robotCount() > 1 ? fmt::format("{}: ", s.robotName(w.robot)) : "", w.expression->text(),
+          w.text, w.condition ? " if " + w.condition->text() : "",
+          w.hits ? fmt::format(", hit {} time{}", w.hits, w.hits == 1 ? "" : "s") : "",
+          w.ignore ? fmt::format(", ignore next {}", w.ignore) : "");
+    for (const Watchpoint& w : s.watchpoints())
+      if (!w.writer.empty())
+        out_ << fmt::format("     watchpoint {} last written by {}\n", w.id, w.writer);
     return;
   }
   if (what == "display") {

@@ -17,6 +17,18 @@ namespace {
 // The session ends: thrown out of the match from a stop.
 struct Quit {};
 
+// A watched object's bytes (no allocation once `bytes` has its size).
+void readInto(const vm::Vm& v, const Watchpoint& w, std::vector<uint8_t>& bytes) {
+  bytes.resize(w.size);
+  for (uint32_t k = 0; k < w.size; ++k) bytes[k] = v.read8(static_cast<uint16_t>(w.address + k));
+}
+
+bool unchanged(const vm::Vm& v, const Watchpoint& w, const std::vector<uint8_t>& bytes) {
+  for (uint32_t k = 0; k < w.size; ++k)
+    if (v.read8(static_cast<uint16_t>(w.address + k)) != bytes[k]) return false;
+  return true;
+}
+
 bool reverse(Resume::Kind k) {
   switch (k) {
     case Resume::Kind::ReverseStep:
@@ -42,6 +54,9 @@ struct Session::Rewind {
   Tick from = 0;  // where the command was given: the held robot's clock
   int line = 0, calls = 0, ints = 0;
   Stop arrival;
+  // Hold: the other robot stopped at its own breakpoint at how.tick (the
+  // match is brought to that tick), not a move of the hold at a stop.
+  bool atOtherBreakpoint = false;
 };
 
 Session::Session(scheduler::MatchConfig config, std::vector<std::string> programs, int held)
@@ -80,6 +95,7 @@ void Session::run(Controller& controller, std::atomic<bool>* interrupt) {
       over_ = true;
       view_ = &run_->view();
       frame_ = 0;
+      anchor_ = now();
       for (;;) {
         Stop end;
         end.kind = Stop::Kind::End;
@@ -177,6 +193,7 @@ void Session::startMode(const Resume& how, const Stop& arrival) {
   mode_.startLine = v.line();
   mode_.startCalls = v.callDepth();
   mode_.startInts = v.interruptDepth();
+  mode_.startPending = v.effectPending();
   // finish from an outer frame: as if from that frame.
   if (how.kind == Resume::Kind::Finish) mode_.startCalls -= frame_;
   mode_.arrival = arrival;
@@ -196,6 +213,17 @@ bool Session::stepping() const {
     default:
       return true;
   }
+}
+
+Tick Session::othersTo(Tick clock) const {
+  return !scan_ && mode_.kind == Resume::Kind::Goto && mode_.anchored ? std::min(clock, mode_.tick)
+                                                                      : clock;
+}
+
+bool Session::settles() const {
+  if (scan_) return scan_->stepping;
+  if (mode_.kind == Resume::Kind::Goto) return mode_.settled;
+  return stepping();
 }
 
 Tick Session::until() const {
@@ -224,26 +252,64 @@ void Session::boundary(const scheduler::MatchView& view) {
   view_ = &view;
   const vm::Vm& v = view.vm(held_);
   if (scan_) {
-    if (v.now() >= scan_->end) throw ScanDone{};
-    Boundary b{v.now(), v.line(), v.callDepth(), v.interruptDepth(), false};
+    if (v.now() >= scan_->end) {
+      // The window's last instruction may have changed a watched value:
+      // going backwards, that change stops before it.
+      Stop why;
+      if (scan_->hits && !scan_->boundaries.empty() && watchpointHit(why)) reverseWatchHit(why);
+      throw ScanDone{};
+    }
+    Boundary b{v.now(), v.line(), v.callDepth(), v.interruptDepth(), false, !v.effectPending()};
     if (scan_->hits) {
       Stop why;
-      b.hit = eventStop_.has_value() || breakpointHit(held_, why, false) || watchpointHit(why);
+      if (eventStop_) {
+        why = *eventStop_;
+        b.hit = true;
+      } else if (breakpointHit(held_, why, false)) {
+        b.hit = true;
+      } else if (!scan_->boundaries.empty() && watchpointHit(why)) {
+        reverseWatchHit(why);
+        why = Stop{};
+      }
       // A time breakpoint stops at the first boundary at or after its tick.
       const Tick before =
           scan_->boundaries.empty() ? scan_->start - 1 : scan_->boundaries.back().tick;
       for (const Breakpoint& t : breakpoints_)
-        b.hit |=
-            t.kind == Breakpoint::Kind::Time && t.enabled && t.tick > before && t.tick <= b.tick;
+        if (!b.hit && t.kind == Breakpoint::Kind::Time && t.enabled && t.tick > before &&
+            t.tick <= b.tick) {
+          b.hit = true;
+          why.kind = Stop::Kind::Breakpoint;
+          why.breakpoint = t.id;
+        }
       eventStop_.reset();
+      if (b.hit) scan_->stops.emplace(b.tick, why);
     }
     scan_->boundaries.push_back(b);
-    lastPc_ = v.pc();
+    noteBoundary(v);
     return;
   }
   Stop why;
   if (shouldStop(why)) park(why);
-  lastPc_ = vm(held_).pc();
+  noteBoundary(vm(held_));
+}
+
+// Going backwards a change stops before what made it (the instruction or
+// service at the boundary before the one that saw it), and the later value
+// is the old one.
+void Session::reverseWatchHit(Stop why) {
+  std::swap(why.oldValue, why.newValue);
+  why.reverse = true;
+  scan_->boundaries.back().hit = true;
+  scan_->stops.emplace(scan_->boundaries.back().tick, std::move(why));
+}
+
+// What the next boundary's watchpoints compare with: this one.
+void Session::noteBoundary(const vm::Vm& v) {
+  lastPc_ = v.pc();
+  lastTick_ = v.now();
+  lastInterrupts_ = v.stats().interrupts;
+  for (Watchpoint& w : watchpoints_)
+    if (w.robot == held_) readInto(v, w, w.seen);
 }
 
 bool Session::event(int robot, Tick t, DebugEvent e) {
@@ -251,7 +317,7 @@ bool Session::event(int robot, Tick t, DebugEvent e) {
     if (!scan_->hits) return false;
     for (const Breakpoint& b : breakpoints_)
       if (b.enabled && b.kind == Breakpoint::Kind::Event && b.event == e) {
-        eventStop_ = Stop{};
+        eventStop_ = eventStopOf(b, robot, t);
         return true;
       }
     return false;
@@ -270,13 +336,7 @@ bool Session::event(int robot, Tick t, DebugEvent e) {
       --b.ignore;
       continue;
     }
-    Stop why;
-    why.kind = Stop::Kind::Event;
-    why.breakpoint = b.id;
-    why.event = e;
-    why.eventRobot = robot;
-    why.note = fmt::format("at tick {}", t);
-    eventStop_ = why;
+    eventStop_ = eventStopOf(b, robot, t);
     return true;
   }
   return false;
@@ -295,7 +355,18 @@ void Session::otherBreakpoint(const scheduler::MatchView& view, int robot) {
   r.how.tick = view.vm(robot).now();
   r.from = r.how.tick;
   r.arrival = why;
+  r.atOtherBreakpoint = true;
   throw r;
+}
+
+Stop Session::eventStopOf(const Breakpoint& b, int robot, Tick t) {
+  Stop why;
+  why.kind = Stop::Kind::Event;
+  why.breakpoint = b.id;
+  why.event = b.event;
+  why.eventRobot = robot;
+  why.note = fmt::format("at tick {}", t);
+  return why;
 }
 
 bool Session::breakpointHit(int robot, Stop& why, bool counting) {
@@ -314,11 +385,12 @@ bool Session::breakpointHit(int robot, Stop& why, bool counting) {
         why.note = fmt::format("error in the condition of breakpoint {}: {}", b.id, e.what());
       }
     }
-    if (!counting) return true;
-    ++b.hits;
-    if (b.ignore > 0) {
-      --b.ignore;
-      continue;
+    if (counting) {
+      ++b.hits;
+      if (b.ignore > 0) {
+        --b.ignore;
+        continue;
+      }
     }
     why.kind = Stop::Kind::Breakpoint;
     why.breakpoint = b.id;
@@ -331,10 +403,15 @@ bool Session::watchpointHit(Stop& why) {
   if (watchpoints_.empty()) return false;
   const vm::Vm& v = vm(held_);
   // A library routine writes over several steps: judged once it is done.
-  if (v.inLibraryCall()) return false;
+  // An interrupt service accepted between two of its steps (the serial
+  // library's transmit service, the BIOS timer's: atomic) is judged at
+  // once, on what changed since the step before.
+  const bool serviced = serviceRan(v);
+  const bool inLibrary = v.inLibraryCall();
+  if (inLibrary && !serviced) return false;
   for (size_t k = 0; k < watchpoints_.size(); ++k) {
     Watchpoint& w = watchpoints_[k];
-    if (w.robot != held_) continue;  // watched while its robot is held
+    if (w.robot != held_ || !w.enabled) continue;  // watched while its robot is held
     if (w.depth >= 0 && v.callDepth() + v.interruptDepth() < w.depth) {
       if (scan_) continue;
       why.kind = Stop::Kind::Watchpoint;
@@ -344,39 +421,90 @@ bool Session::watchpointHit(Stop& why) {
       watchpoints_.erase(watchpoints_.begin() + static_cast<std::ptrdiff_t>(k));
       return true;
     }
-    const inspect::Scope s(v);
-    std::vector<uint8_t> now = inspect::bytes(s, w.object);
-    if (w.valid && now == w.value) continue;
+    if (w.valid && unchanged(v, w, inLibrary ? w.seen : w.value)) continue;
     const bool first = !w.valid;
-    w.value = std::move(now);
+    readInto(v, w, w.value);
     w.valid = true;
     const std::string before = w.text;
-    try {
-      w.text = inspect::format(s, w.object);
-    } catch (const inspect::Error& e) {
-      w.text = fmt::format("<{}>", e.what());
-    }
+    w.text = valueText(v, w);
     if (first) continue;
-    if (!scan_) ++w.hits;
+    w.writer = writer(v);
+    if (w.condition) {
+      try {
+        const inspect::Scope s = scope(held_, 0);
+        if (!inspect::truth(s, w.condition->evaluate(s))) continue;
+      } catch (const inspect::Error& e) {
+        why.note = fmt::format("error in the condition of watchpoint {}: {}", w.id, e.what());
+      }
+    }
+    if (!scan_) {
+      ++w.hits;
+      if (w.ignore > 0) {
+        --w.ignore;
+        continue;
+      }
+    }
     why.kind = Stop::Kind::Watchpoint;
     why.breakpoint = w.id;
     why.oldValue = before;
     why.newValue = w.text;
-    why.writtenAt = v.image().lineAt(lastPc_);
+    why.writtenAt = serviced ? 0 : v.image().lineAt(lastPc_);
+    why.writer = w.writer;
     return true;
   }
   return false;
 }
 
+// Whether an atomic interrupt service (the serial library's transmit
+// service, the BIOS timer's) was accepted since the boundary before.
+bool Session::serviceRan(const vm::Vm& v) const {
+  const auto& irqs = v.stats().interrupts;
+  for (vm::Irq irq : {vm::Irq::SerialTx, vm::Irq::Timer})
+    if (irqs[static_cast<size_t>(irq)] != lastInterrupts_[static_cast<size_t>(irq)]) return true;
+  return false;
+}
+
+// Who made a change seen at this boundary: the service accepted at the
+// boundary before, or the instruction that ran there (and the handler it
+// ran in).
+std::string Session::writer(const vm::Vm& v) const {
+  const vm::Image& img = v.image();
+  const vm::Symbol* fn = img.functionAt(lastPc_);
+  const std::string where =
+      fmt::format("line {}{}", img.lineAt(lastPc_), fn ? fmt::format(" in {}()", fn->name) : "");
+  const auto& irqs = v.stats().interrupts;
+  const auto ran = [&](vm::Irq irq) {
+    return irqs[static_cast<size_t>(irq)] != lastInterrupts_[static_cast<size_t>(irq)];
+  };
+  if (ran(vm::Irq::SerialTx))
+    return fmt::format(
+        "the serial library's transmit interrupt (serial_tx), accepted at tick {} during {}",
+        lastTick_, where);
+  if (ran(vm::Irq::Timer))
+    return fmt::format("the BIOS timer service (PRT0), accepted at tick {} during {}", lastTick_,
+                       where);
+  if (fn && fn->kind == vm::Symbol::Kind::Handler) return where + " [interrupt handler]";
+  if (v.interruptDepth() > 0)
+    for (const vm::Vm::Activation& a : v.activations())
+      if (a.handler) {
+        const vm::Symbol* h = img.functionAt(a.pc);
+        return fmt::format("{} [in interrupt handler {}()]", where, h ? h->name : "?");
+      }
+  return where;
+}
+
+std::string Session::valueText(const vm::Vm& v, const Watchpoint& w) const {
+  try {
+    return inspect::format(inspect::Scope(v), w.object);
+  } catch (const inspect::Error& e) {
+    return fmt::format("<{}>", e.what());
+  }
+}
+
 void Session::refreshWatchpoints() {
   for (Watchpoint& w : watchpoints_) {
-    const inspect::Scope s(vm(w.robot));
-    w.value = inspect::bytes(s, w.object);
-    try {
-      w.text = inspect::format(s, w.object);
-    } catch (const inspect::Error& e) {
-      w.text = fmt::format("<{}>", e.what());
-    }
+    readInto(vm(w.robot), w, w.value);
+    w.text = valueText(vm(w.robot), w);
     w.valid = true;
   }
 }
@@ -413,7 +541,7 @@ bool Session::shouldStop(Stop& why) {
   why.kind = Stop::Kind::Step;
   switch (mode_.kind) {
     case Resume::Kind::StepInstruction:
-      return t > mode_.startTick;
+      return t > mode_.startTick || (mode_.startPending && !v.effectPending());
     case Resume::Kind::Step: {
       if (line <= 0 ||
           (line == mode_.startLine && calls == mode_.startCalls && ints == mode_.startInts))
@@ -444,6 +572,8 @@ bool Session::shouldStop(Stop& why) {
 void Session::park(const Stop& why) {
   frame_ = 0;
   lastStop_ = now();
+  anchor_ =
+      mode_.kind == Resume::Kind::Goto && mode_.anchored ? std::min(mode_.tick, now()) : now();
   eventStop_.reset();
   for (Breakpoint& b : breakpoints_)
     if (b.kind == Breakpoint::Kind::Time) b.passed = b.tick <= lastStop_;
@@ -478,6 +608,8 @@ void Session::perform(const Rewind& rewind) {
   Stop arrival;
   arrival.kind = Stop::Kind::Goto;
   Tick target = rewind.from;
+  bool anchored = false;
+  bool settled = false;
   switch (rewind.how.kind) {
     case Resume::Kind::Restart:
       restoreBefore(0, true);
@@ -494,12 +626,19 @@ void Session::perform(const Rewind& rewind) {
     case Resume::Kind::Hold:
       held_ = rewind.how.robot;
       config_.debugRobot = held_;
-      target = rewind.how.tick;
+      anchored = !rewind.atOtherBreakpoint;
+      target = anchored ? anchor_ : rewind.how.tick;
       arrival = rewind.arrival.kind == Stop::Kind::Entry ? arrival : rewind.arrival;
       break;
     default:
       if (const auto found = searchBack(rewind)) {
-        target = *found;
+        target = found->tick;
+        settled = found->settled;
+        if (found->why) {
+          // What stopped the robot going backwards, as a forward stop says it.
+          arrival = *found->why;
+          countHit(arrival);
+        }
       } else {
         arrival.note = "no earlier place to go back to: the robot stays where it was";
       }
@@ -510,15 +649,18 @@ void Session::perform(const Rewind& rewind) {
   mode_.kind = Resume::Kind::Goto;
   mode_.tick = target;
   mode_.arrival = arrival;
+  mode_.anchored = anchored;
+  mode_.settled = settled;
   lastStop_ = -1;
 }
 
 // Every boundary of the held robot from the latest snapshot whose held clock
 // is at or before `from` up to (not including) `end`, as a forward run
 // meets them: each one when stepping, else at breakpoints and events only.
-std::vector<Session::Boundary> Session::scanWindow(Tick from, Tick end, bool stepping, bool hits) {
+std::vector<Session::Boundary> Session::scanWindow(Tick from, Tick end, bool stepping, bool hits,
+                                                   std::map<Tick, Stop>* stops) {
   restoreBefore(from, true);
-  scan_ = Scan{end, stepping, hits, {}, run_->view().vm(held_).now()};
+  scan_ = Scan{end, stepping, hits, {}, {}, run_->view().vm(held_).now()};
   for (Watchpoint& w : watchpoints_) w.valid = false;
   try {
     forward();
@@ -528,25 +670,40 @@ std::vector<Session::Boundary> Session::scanWindow(Tick from, Tick end, bool ste
     throw;
   }
   std::vector<Boundary> found = std::move(scan_->boundaries);
+  if (stops) stops->merge(scan_->stops);
   scan_.reset();
   return found;
 }
 
-std::optional<Tick> Session::searchBack(const Rewind& rw) {
+void Session::countHit(const Stop& why) {
+  if (why.kind != Stop::Kind::Breakpoint && why.kind != Stop::Kind::Event &&
+      why.kind != Stop::Kind::Watchpoint)
+    return;
+  if (Breakpoint* b = findBreakpoint(why.breakpoint)) ++b->hits;
+  for (Watchpoint& w : watchpoints_)
+    if (w.id == why.breakpoint) ++w.hits;
+}
+
+std::optional<Session::Found> Session::searchBack(const Rewind& rw) {
   const Resume::Kind kind = rw.how.kind;
   const Tick c = rw.from;
   const int depthNow = rw.calls + rw.ints;
+  std::map<Tick, Stop> stops;  // reverse-continue: what each hit reports
+  const auto hitAt = [&](const Boundary& b) { return Found{b.tick, b.settled, stops.at(b.tick)}; };
   if (kind == Resume::Kind::ReverseContinue && watchpoints_.empty()) {
     // Breakpoints cost nothing to find: one pass from the start.
-    const std::vector<Boundary> all = scanWindow(0, c, false, true);
+    const std::vector<Boundary> all = scanWindow(0, c, false, true, &stops);
     for (auto it = all.rbegin(); it != all.rend(); ++it)
-      if (it->hit && it->tick < c) return it->tick;
+      if (it->hit && it->tick < c) return hitAt(*it);
     return std::nullopt;
   }
   const bool stepping = true;
   const bool hits = kind == Resume::Kind::ReverseContinue;
   std::vector<Boundary> history;  // every boundary before c found so far, in order
   Tick windowEnd = c;
+  const auto at = [](const Boundary& b) {
+    return std::optional<Found>(Found{b.tick, b.settled, std::nullopt});
+  };
   for (;;) {
     // The window before windowEnd: from the latest snapshot before it.
     Tick start = -1;
@@ -555,9 +712,8 @@ std::optional<Tick> Session::searchBack(const Rewind& rw) {
         start = it->second.robotClock(held_);
         break;
       }
-    if (start < 0)
-      return history.empty() ? std::nullopt : std::optional<Tick>(history.front().tick);
-    std::vector<Boundary> window = scanWindow(start, windowEnd, stepping, hits);
+    if (start < 0) return history.empty() ? std::nullopt : at(history.front());
+    std::vector<Boundary> window = scanWindow(start, windowEnd, stepping, hits, &stops);
     history.insert(history.begin(), window.begin(), window.end());
     windowEnd = start;
     const bool complete = snapshots_.begin()->second.robotClock(held_) >= start;
@@ -567,44 +723,69 @@ std::optional<Tick> Session::searchBack(const Rewind& rw) {
     }
     switch (kind) {
       case Resume::Kind::ReverseStepInstruction:
-        return history.back().tick;
+        return at(history.back());
       case Resume::Kind::ReverseContinue:
         for (auto it = history.rbegin(); it != history.rend(); ++it)
-          if (it->hit) return it->tick;
+          if (it->hit) return hitAt(*it);
         break;
       case Resume::Kind::ReverseFinish:
         for (auto it = history.rbegin(); it != history.rend(); ++it)
-          if (it->calls + it->ints < depthNow) return it->tick;
+          if (it->calls + it->ints < depthNow) return at(*it);
         break;
-      default: {
-        // reverse-step, reverse-next: back over the rest of this line, then
-        // to the start of the line before it (reverse-next passes over
-        // deeper calls and handlers). Out of a handler, back to the
-        // instruction it interrupted.
-        const bool over = kind == Resume::Kind::ReverseNext;
-        std::vector<size_t> seen;
-        for (size_t k = 0; k < history.size(); ++k)
-          if (!over || history[k].calls + history[k].ints <= depthNow) seen.push_back(k);
-        auto same = [&](size_t a, int line, int calls, int ints) {
-          const Boundary& b = history[a];
-          return b.line == line && b.calls == calls && b.ints == ints;
-        };
-        ptrdiff_t i = static_cast<ptrdiff_t>(seen.size()) - 1;
-        while (i >= 0 && same(seen[static_cast<size_t>(i)], rw.line, rw.calls, rw.ints)) --i;
-        if (i < 0) break;
-        const Boundary& prev = history[seen[static_cast<size_t>(i)]];
-        if (prev.ints != rw.ints) return prev.tick;
-        while (i > 0 && same(seen[static_cast<size_t>(i - 1)], prev.line, prev.calls, prev.ints))
-          --i;
-        if (i > 0 || complete) return history[seen[static_cast<size_t>(i)]].tick;
+      default:
+        if (const auto k = lineBefore(history, rw, complete)) return at(history[*k]);
         break;
-      }
     }
     if (complete) {
       const bool toStart = (kind == Resume::Kind::ReverseStep || kind == Resume::Kind::ReverseNext);
-      return toStart ? std::optional<Tick>(history.front().tick) : std::nullopt;
+      return toStart ? at(history.front()) : std::nullopt;
     }
   }
+}
+
+// reverse-step, reverse-next (gdb's rules): from the middle of a line, back
+// to where the robot entered it; from its start, to the start of the line
+// before it (reverse-next passes over deeper calls and handlers). Out of a
+// handler's first line, back to the instruction it interrupted. Handlers
+// that interrupted the line on the way do not end it. Nothing while
+// `history` (every boundary before the command's, oldest first) may not
+// yet reach back far enough (not `complete`).
+std::optional<size_t> Session::lineBefore(const std::vector<Boundary>& history, const Rewind& rw,
+                                          bool complete) const {
+  const bool over = rw.how.kind == Resume::Kind::ReverseNext;
+  const int depthNow = rw.calls + rw.ints;
+  std::vector<size_t> seen;
+  for (size_t k = 0; k < history.size(); ++k)
+    if (!over || history[k].calls + history[k].ints <= depthNow) seen.push_back(k);
+  const auto same = [&](size_t a, int line, int calls, int ints) {
+    const Boundary& b = history[a];
+    return b.line == line && b.calls == calls && b.ints == ints;
+  };
+  // Back from seen[i] over the rest of the run of `line` it is in (and
+  // handlers nested in that run); the run's first boundary, if known.
+  const auto runStart = [&](ptrdiff_t i, int line, int calls, int ints) -> std::optional<size_t> {
+    ptrdiff_t first = i;
+    bool ended = false;  // something before the run is in the history
+    for (ptrdiff_t k = i - 1; k >= 0 && !ended; --k) {
+      const Boundary& b = history[seen[static_cast<size_t>(k)]];
+      if (b.ints > ints && b.calls >= calls) continue;  // a handler inside the line
+      if (same(seen[static_cast<size_t>(k)], line, calls, ints))
+        first = k;
+      else
+        ended = true;
+    }
+    // Else the run may go on before the history, unless that is the start.
+    if (!ended && !complete) return std::nullopt;
+    return seen[static_cast<size_t>(first)];
+  };
+  const auto i = static_cast<ptrdiff_t>(seen.size()) - 1;
+  if (i < 0) return std::nullopt;
+  // The middle of a line: its start first.
+  if (same(seen[static_cast<size_t>(i)], rw.line, rw.calls, rw.ints))
+    return runStart(i, rw.line, rw.calls, rw.ints);
+  const Boundary& prev = history[seen[static_cast<size_t>(i)]];
+  if (prev.ints != rw.ints) return seen[static_cast<size_t>(i)];
+  return runStart(i, prev.line, prev.calls, prev.ints);
 }
 
 // ---- at a stop ------------------------------------------------------------------
@@ -815,30 +996,38 @@ const Breakpoint& Session::breakAt(const std::string& location, bool temporary) 
   return breakAtFunction(robot, where, temporary);
 }
 
+Trigger& Session::trigger(int id) {
+  if (Breakpoint* b = findBreakpoint(id)) return *b;
+  for (Watchpoint& w : watchpoints_)
+    if (w.id == id) return w;
+  throw Error(fmt::format("no breakpoint or watchpoint {}", id));
+}
+
 void Session::setCondition(int id, const std::string& expression) {
-  Breakpoint* b = findBreakpoint(id);
-  if (!b) throw Error(fmt::format("no breakpoint {}", id));
+  Trigger& t = trigger(id);
   if (expression.empty()) {
-    b->condition.reset();
+    t.condition.reset();
     return;
   }
   try {
-    b->condition = std::make_shared<inspect::Expression>(expression);
+    t.condition = std::make_shared<inspect::Expression>(expression);
   } catch (const inspect::Error& e) {
     throw Error(e.what());
   }
 }
 
-void Session::setIgnore(int id, int count) {
-  Breakpoint* b = findBreakpoint(id);
-  if (!b) throw Error(fmt::format("no breakpoint {}", id));
-  b->ignore = std::max(count, 0);
-}
+void Session::setIgnore(int id, int count) { trigger(id).ignore = std::max(count, 0); }
 
 void Session::setEnabled(int id, bool enabled) {
-  Breakpoint* b = findBreakpoint(id);
-  if (!b) throw Error(fmt::format("no breakpoint {}", id));
-  b->enabled = enabled;
+  Trigger& t = trigger(id);
+  if (enabled && !t.enabled)
+    for (Watchpoint& w : watchpoints_)
+      if (w.id == id) {
+        // Compared from the value it has when enabled again.
+        readInto(vm(w.robot), w, w.value);
+        w.text = valueText(vm(w.robot), w);
+      }
+  t.enabled = enabled;
   applyBreakpoints();
 }
 
@@ -861,10 +1050,11 @@ void Session::removeAll() {
   applyBreakpoints();
 }
 
-const Watchpoint& Session::watch(const std::string& expression) {
+const Watchpoint& Session::watch(const std::string& expression, const std::string& condition) {
   Watchpoint w;
   try {
     w.expression = std::make_shared<inspect::Expression>(expression);
+    if (!condition.empty()) w.condition = std::make_shared<inspect::Expression>(condition);
     const inspect::Scope s = scope();
     w.object = w.expression->evaluate(s);
     if (!w.object.inMemory)
@@ -872,7 +1062,10 @@ const Watchpoint& Session::watch(const std::string& expression) {
     // An auto: watched while the activation holding it lasts (its index
     // from the outermost, where calls and handlers both count).
     if (w.object.frame >= 0) w.depth = static_cast<int>(s.activations.size()) - 1 - w.object.frame;
-    w.value = inspect::bytes(s, w.object);
+    w.address = w.object.address;
+    w.size = static_cast<uint32_t>(inspect::bytes(s, w.object).size());
+    readInto(s.vm, w, w.value);
+    w.seen = w.value;
     w.text = inspect::format(s, w.object);
     w.valid = true;
   } catch (const inspect::Error& e) {

@@ -18,6 +18,7 @@
 // A Controller (the terminal's command interpreter, the DAP server) is
 // asked what to do at every stop; the session's accessors serve it there.
 #pragma once
+#include <array>
 #include <atomic>
 #include <map>
 #include <memory>
@@ -44,9 +45,19 @@ struct Error : std::runtime_error {
 // replays at most a few such windows. 0.5 s: 360 in a 180-s match.
 inline constexpr Tick kSnapshotInterval = timebase::kTicksPerSecond / 2;
 
-struct Breakpoint {
-  enum class Kind : uint8_t { Line, Function, Time, Event };
+// What breakpoints and watchpoints share: one numbering, a condition, an
+// ignore count, an enable switch and a hit count (gdb's condition,
+// ignore, enable, disable and delete take either).
+struct Trigger {
   int id = 0;
+  std::shared_ptr<inspect::Expression> condition;  // none: always
+  int ignore = 0;                                  // hits still to pass over
+  int hits = 0;
+  bool enabled = true;
+};
+
+struct Breakpoint : Trigger {
+  enum class Kind : uint8_t { Line, Function, Time, Event };
   Kind kind = Kind::Line;
   int robot = 0;         // Line, Function: the program it is in
   int line = 0;          // Line, Function: where it stops
@@ -54,16 +65,14 @@ struct Breakpoint {
   std::string function;  // Function: its name; Line: the function the line is in
   Tick tick = 0;         // Time: the first boundary at or after it
   scheduler::DebugEvent event{};
-  std::shared_ptr<inspect::Expression> condition;  // none: always
-  int ignore = 0;                                  // hits still to pass over
-  int hits = 0;
   bool temporary = false;
-  bool enabled = true;
   bool passed = false;  // Time: its tick has been reached
 };
 
-struct Watchpoint {
-  int id = 0;
+// A data breakpoint: a change of its object's value is a hit when the
+// condition holds then (a change ignored or not stopped at is still the
+// value compared with next).
+struct Watchpoint : Trigger {
   int robot = 0;
   std::shared_ptr<inspect::Expression> expression;
   inspect::Value object;  // what it watches: fixed when it is set
@@ -71,10 +80,13 @@ struct Watchpoint {
   // lives in has not returned: that activation's index counted from the
   // outermost (calls and handlers; -1: a global's or a static's).
   int depth = -1;
-  std::vector<uint8_t> value;
-  std::string text;  // the value as printed
+  uint16_t address = 0;  // the object's bytes: fixed when it is set
+  uint32_t size = 0;
+  std::vector<uint8_t> value;  // as last reported (or when it was set)
+  std::vector<uint8_t> seen;   // at the held robot's latest boundary
+  std::string text;            // the value as printed
   bool valid = false;
-  int hits = 0;
+  std::string writer;  // who made the last change seen (Stop::writer)
 };
 
 // Why the session stopped, for the controller to report.
@@ -94,9 +106,16 @@ struct Stop {
   int breakpoint = 0;
   scheduler::DebugEvent event{};
   int eventRobot = 0;
-  std::string oldValue, newValue;  // Watchpoint
-  int writtenAt = 0;               // Watchpoint: the line that wrote it
-  std::string note;                // more to say (a reverse search that found nothing)
+  std::string oldValue, newValue;  // Watchpoint, in the direction of travel
+  int writtenAt = 0;               // Watchpoint: the line that wrote it (0: a service)
+  // Watchpoint: who wrote it, as a sentence's object: "line 195 in INT1()
+  // [interrupt handler]", "the serial library's transmit interrupt ...".
+  std::string writer;
+  // Reached going backwards (reverse-continue): the robot stands at the
+  // boundary before the instruction or service that made the change, so
+  // the old value is the later one.
+  bool reverse = false;
+  std::string note;  // more to say (a reverse search that found nothing)
 };
 
 // How to go on from a stop.
@@ -117,7 +136,7 @@ struct Resume {
     ReverseFinish,
     Goto,     // to `tick`
     Restart,  // from the start, on to the first breakpoint
-    Hold,     // hold robot `robot` at this tick
+    Hold,     // hold robot `robot` where it stands (Session::anchor)
     Quit,
   };
   Kind kind = Kind::Continue;
@@ -167,6 +186,11 @@ class Session final : private scheduler::DebugHook {
   const std::string& program(int robot) const;
   Tick now() const;        // the held robot's clock
   Tick matchTick() const;  // where the match is: its end once it is over
+  // The tick this stop is at: every robot stands at its first instruction
+  // boundary at or after it. The held robot's clock, unless the hold moved
+  // to this robot from another (robot B): the tick the other stopped at,
+  // which a move back returns to (no robot runs on when the hold moves).
+  Tick anchor() const { return anchor_; }
   bool over() const { return over_; }
   const scheduler::MatchView& view() const;
   const vm::Vm& vm(int robot) const;
@@ -194,14 +218,16 @@ class Session final : private scheduler::DebugHook {
   // and functions are A's otherwise), or an event (frame, edge, contact,
   // shot, fault; a function of that name wins).
   const Breakpoint& breakAt(const std::string& location, bool temporary = false);
+  // Each of these takes a breakpoint's or a watchpoint's number.
   void setCondition(int id, const std::string& expression);  // "" removes it
   void setIgnore(int id, int count);
   void setEnabled(int id, bool enabled);
-  void remove(int id);  // a breakpoint or a watchpoint
+  void remove(int id);
   void removeAll();
   const std::vector<Breakpoint>& breakpoints() const { return breakpoints_; }
-  // A data breakpoint on an lvalue of the held robot, evaluated now.
-  const Watchpoint& watch(const std::string& expression);
+  // A data breakpoint on an lvalue of the held robot, evaluated now, with
+  // an optional condition (watch EXPR if COND).
+  const Watchpoint& watch(const std::string& expression, const std::string& condition = "");
   const std::vector<Watchpoint>& watchpoints() const { return watchpoints_; }
   // Messages about the other robots since the last stop (a fault of one).
   std::vector<std::string> takeNotices();
@@ -213,27 +239,46 @@ class Session final : private scheduler::DebugHook {
     Resume::Kind kind = Resume::Kind::Goto;
     Tick tick = 0;  // Goto, AdvanceTime: the target
     int line = 0;   // AdvanceLine
-    // Where the command started: the clock, line and depths.
+    // Where the command started: the clock, line and depths, and whether a
+    // library call's effect was still due there (a step makes it happen).
     Tick startTick = 0;
     int startLine = 0, startCalls = 0, startInts = 0;
+    bool startPending = false;
+    // Goto: to the boundary after a library call's effect due at `tick` (a
+    // place a step or a breakpoint reached), not to the tick before it.
+    bool settled = false;
     Stop arrival;  // Goto: the stop to report there
+    // Goto after the hold moved: the other robots stop at `tick` (they
+    // stand where they stood), the held robot at its first boundary at or
+    // after it.
+    bool anchored = false;
   };
   struct Boundary {
     Tick tick;
     int line, calls, ints;
-    bool hit;  // a breakpoint, watchpoint or event would stop here
+    bool hit;      // a breakpoint, watchpoint or event would stop here
+    bool settled;  // no library effect was still due there (Mode::settled)
   };
   struct Scan {
     Tick end = 0;
     bool stepping = true;
     bool hits = false;  // record breakpoint hits (reverse-continue)
     std::vector<Boundary> boundaries;
-    Tick start = 0;  // the held robot's clock at the window's snapshot
+    std::map<Tick, Stop> stops;  // what each hit would report, by its boundary's tick
+    Tick start = 0;              // the held robot's clock at the window's snapshot
+  };
+  // A place found going backwards, and what to report there.
+  struct Found {
+    Tick tick;
+    bool settled;
+    std::optional<Stop> why;
   };
 
   // scheduler::DebugHook
   bool stepping() const override;
   Tick until() const override;
+  Tick othersTo(Tick clock) const override;
+  bool settles() const override;
   void boundary(const scheduler::MatchView& view) override;
   bool event(int robot, Tick t, scheduler::DebugEvent e) override;
   void otherBreakpoint(const scheduler::MatchView& view, int robot) override;
@@ -250,10 +295,21 @@ class Session final : private scheduler::DebugHook {
   void park(const Stop& why);
   void handle(const Resume& how);
   void perform(const Rewind& rewind);
-  std::vector<Boundary> scanWindow(Tick from, Tick end, bool stepping, bool hits);
-  std::optional<Tick> searchBack(const Rewind& rewind);
+  std::vector<Boundary> scanWindow(Tick from, Tick end, bool stepping, bool hits,
+                                   std::map<Tick, Stop>* stops = nullptr);
+  std::optional<size_t> lineBefore(const std::vector<Boundary>& history, const Rewind& rw,
+                                   bool complete) const;
+  bool serviceRan(const vm::Vm& v) const;
+  std::string valueText(const vm::Vm& v, const Watchpoint& w) const;
+  Stop eventStopOf(const Breakpoint& b, int robot, Tick t);
+  std::optional<Found> searchBack(const Rewind& rewind);
+  std::string writer(const vm::Vm& v) const;
+  void noteBoundary(const vm::Vm& v);
+  void reverseWatchHit(Stop why);
+  void countHit(const Stop& why);
   Breakpoint& addBreakpoint(Breakpoint b);
   Breakpoint* findBreakpoint(int id);
+  Trigger& trigger(int id);  // a breakpoint or watchpoint; Error if none
 
   scheduler::MatchConfig config_;
   std::vector<std::string> programs_;
@@ -271,8 +327,14 @@ class Session final : private scheduler::DebugHook {
   std::vector<Watchpoint> watchpoints_;
   int nextId_ = 1;
   Tick lastStop_ = -1;
+  Tick anchor_ = 0;
   bool leftLine_ = false;  // AdvanceLine: the robot has been off the line
-  uint32_t lastPc_ = 0;    // the instruction run before this boundary (watchpoints' writer)
+  // The boundary before this one (watchpoints' writer): its instruction,
+  // tick, and the interrupts accepted by then (an atomic service, the
+  // serial library's or the timer's, ran in between when they differ).
+  uint32_t lastPc_ = 0;
+  Tick lastTick_ = 0;
+  std::array<uint64_t, vm::kIrqCount> lastInterrupts_{};
   std::optional<Stop> eventStop_;
   std::vector<std::string> notices_;
 };

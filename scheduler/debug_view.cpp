@@ -17,6 +17,40 @@ std::string byteText(uint8_t b) {
   return fmt::format("0x{:02X}", b);
 }
 
+// The bytes the serial library has still to fetch, and why they wait: the
+// transmit interrupt is what fetches each one (DESIGN.md "Serial link").
+std::string waitingBytes(const Robot& r) {
+  const board::SerialPort& serial = r.board.serial;
+  const vm::Vm& cpu = r.vm();
+  if (!serial.libraryActive()) return "";
+  const int count = cpu.read8(serial.countAddress());
+  if (count == 0) return "";
+  std::string why;
+  if (!cpu.pending(vm::Irq::SerialTx)) {
+    why = "the port takes the next when its data register empties";
+  } else if (cpu.interruptsEnabled()) {
+    why = "the transmit interrupt is pending, accepted at the next boundary";
+  } else if (cpu.interruptDepth() > 0) {
+    // The innermost handler in service (the instruction it interrupted is
+    // in the activation after it).
+    std::string handler = "?";
+    for (const vm::Vm::Activation& a : cpu.activations())
+      if (a.handler) {
+        const vm::Symbol* fn = r.spec.image.functionAt(a.pc);
+        handler = fn ? fn->name : "?";
+        break;
+      }
+    why = fmt::format(
+        "the transmit interrupt is pending and interrupts are disabled: handler {}() is in "
+        "service and has not called EI()",
+        handler);
+  } else {
+    why = "the transmit interrupt is pending and interrupts are disabled (DI, IFF1 = 0)";
+  }
+  return fmt::format("{} byte{} waiting at 0x{:04X} (*cc at 0x{:04X}): {}", count,
+                     count == 1 ? "" : "s", serial.pointer(), serial.countAddress(), why);
+}
+
 }  // namespace
 
 std::string Match::describe(Tick t) const {
@@ -51,6 +85,8 @@ std::string Match::describe(Tick t) const {
       link += fmt::format(", shifting {} until tick {}", byteText(serial.shifting()), *done);
     out += fmt::format("  serial     {}, {} bytes sent, receiver holds \"{}\"\n", link,
                        serial.bytesSent(), r->receiver.pending());
+    if (const std::string waiting = waitingBytes(*r); !waiting.empty())
+      out += "             " + waiting + "\n";
     out += fmt::format("  guns       {} shots, {} hits\n", arena_.shots(r->index),
                        arena_.hits(r->index));
   }

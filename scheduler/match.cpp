@@ -243,7 +243,9 @@ void Robot::debugRunTo(Tick horizon) {
     if (tracing) takeSnapshots();
     if (now() >= horizon || board.cpu.fault()) return;
     const bool stepping = hook.stepping() && !board.cpu.halted();
-    if (debugLook || (!stepping && hook.until() <= now())) {
+    // A step from a library call's last tick ends after its effect.
+    if (debugLook || (!stepping && hook.until() <= now()) ||
+        (stepping && board.cpu.effectPending())) {
       debugLook = false;
       look(hook);
       continue;
@@ -272,7 +274,11 @@ void Robot::debugRunTo(Tick horizon) {
 }
 
 void Robot::look(DebugHook& hook) {
-  match.bringOthersTo(index, now());
+  if (hook.settles() && board.cpu.effectPending()) {
+    board.cpu.settle();
+    if (board.cpu.fault()) noteFault();
+  }
+  match.bringOthersTo(index, hook.othersTo(now()));
   hook.boundary(match);
 }
 

@@ -161,17 +161,28 @@ std::string_view debugEventName(DebugEvent e);  // "frame", "edge", "contact", "
 // A debugger's hold on one robot (simbot debug; MatchConfig::debugger).
 // The match calls boundary() at that robot's instruction boundaries
 // inside the rounds, at the exact tick, with the other robots run up to
-// the same tick first: before every instruction while stepping(), else at
-// the first boundary at or after until(), at its VM's breakpoints, after
-// an event() that asked to look, and at its fault. boundary() may throw:
-// the match is then abandoned (the debugger restores a snapshot). On
-// return the robot goes on: stepping() must be true or until() past its
-// clock. Nothing here changes what the match does.
+// othersTo(its clock) first (each to its first boundary at or after that
+// tick): before every instruction while stepping(), else at the first
+// boundary at or after until(), at its VM's breakpoints, after an event()
+// that asked to look, and at its fault. boundary() may throw: the match
+// is then abandoned (the debugger restores a snapshot). On return the
+// robot goes on: stepping() must be true or until() past its clock.
+// Nothing here changes what the match does.
 class DebugHook {
  public:
   virtual ~DebugHook() = default;
   virtual bool stepping() const = 0;
   virtual Tick until() const = 0;
+  // The tick the other robots are brought to when the debugged robot
+  // stops at `clock`: `clock` itself, or an earlier tick when the hold
+  // moved to this robot from another that stopped there (the robots then
+  // stand where they stood, none of them run on).
+  virtual Tick othersTo(Tick clock) const { return clock; }
+  // Whether a look first makes a library call's effect due at the robot's
+  // clock happen (Vm::settle: the boundary after the call, where a step
+  // ends); else the robot is looked at as it is at that tick, the effect
+  // still to come after the events of the tick (where a time is gone to).
+  virtual bool settles() const { return stepping(); }
   virtual void boundary(const MatchView& view) = 0;
   // At tick t (inside or between the rounds); true: look at the debugged
   // robot's next boundary.

@@ -60,7 +60,7 @@ poses = re.findall(r"^A: x (.*)$", out, re.M)
 check(len(poses) == 3 and len(set(poses)) == 1, f"ICEMAN's pose differs: {poses}")
 source = open(os.path.join(SOURCE, "../shared/programs/iceman.dc")).read().splitlines()
 copied = set(re.findall(r'strcpy\(buf, *"(\w+)"\)', "\n".join(source)))
-writes = re.findall(r"^Watchpoint \d+: written by line (\d+)\nOld value = (.*)\nNew value = "
+writes = re.findall(r"^Watchpoint \d+: written by line (\d+)[^\n]*\nOld value = (.*)\nNew value = "
                     r"\"(\w*)\"", out, re.M)
 check(len(writes) == 3, f"expected 3 watchpoint stops, got {len(writes)}")
 for line, old, new in writes:

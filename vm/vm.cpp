@@ -860,6 +860,16 @@ std::vector<Vm::Activation> Vm::activations() const {
 }
 int Vm::evalDepth() const { return s_->sp; }
 bool Vm::inLibraryCall() const { return s_->lib.active; }
+bool Vm::effectPending() const { return s_->lib.awaitingBegin && !s_->fault; }
+
+void Vm::settle() {
+  State& s = *s_;
+  if (!effectPending()) return;
+  // What run() does at the boundary before the effect (the timer's tick
+  // was taken when run() stopped here).
+  if (s.now >= s.nextTimer) s.timerTick();
+  s.libBegin();
+}
 uint32_t Vm::evalSlot(int fromTop) const {
   const int i = s_->sp - 1 - fromTop;
   return i >= 0 && i < kEvalSlots ? s_->eval[static_cast<size_t>(i)] : 0;

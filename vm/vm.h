@@ -203,6 +203,13 @@ class Vm {
   int evalDepth() const;
   // A library call is under way (its steps have boundaries between them).
   bool inLibraryCall() const;
+  // A library call's effect (what it does to the bus, the serial library,
+  // memory) is due now: run() stopped at the call's last tick, where the
+  // host's events of that tick come first. settle() makes it happen, as the
+  // next run() would before anything else; the robot then stands at the
+  // instruction boundary after the call (a debugger's step ends there).
+  bool effectPending() const;
+  void settle();
   uint32_t evalSlot(int fromTop) const;
 
   // The LIB instruction of the latest library call: during a routine's
