@@ -64,18 +64,7 @@ void Parser::externalDeclaration() {
 //            | "root" | "xmem" | "interrupt" | "reti" | "nodebug" | "debug")+
 // No type word means int (K&R: "register x;", "static y = 1;").
 Type* Parser::declspec(VarAttr* attr) {
-  enum : int {
-    VOID = 1 << 0,
-    CHAR = 1 << 2,
-    SHORT = 1 << 4,
-    INT = 1 << 6,
-    LONG = 1 << 8,
-    FLOAT = 1 << 10,
-    DOUBLE = 1 << 12,
-    OTHER = 1 << 14,
-    SIGNED = 1 << 16,
-    UNSIGNED = 1 << 18,
-  };
+  using namespace typeword;
   Type* ty = tyInt();
   int counter = 0;
   for (;;) {
@@ -122,7 +111,7 @@ Type* Parser::declspec(VarAttr* attr) {
     if (td) {
       if (counter) break;  // a second name is the declarator
       ty = td;
-      counter += OTHER;
+      counter += kOther;
       advance();
       continue;
     }
@@ -130,72 +119,35 @@ Type* Parser::declspec(VarAttr* attr) {
       if (counter) fail(pos, "invalid combination of type specifiers");
       advance();
       ty = w == "enum" ? enumSpecifier() : structDecl(w == "union");
-      counter += OTHER;
+      counter += kOther;
       continue;
     }
     if (w == "void")
-      counter += VOID;
+      counter += kVoid;
     else if (w == "char")
-      counter += CHAR;
+      counter += kChar;
     else if (w == "short")
-      counter += SHORT;
+      counter += kShort;
     else if (w == "int")
-      counter += INT;
+      counter += kInt;
     else if (w == "long") {
-      if (counter & LONG) fail(pos, "long long is not supported");
-      counter += LONG;
+      if (counter & kLong) fail(pos, "long long is not supported");
+      counter += kLong;
     } else if (w == "float")
-      counter += FLOAT;
+      counter += kFloat;
     else if (w == "double")
-      counter += DOUBLE;
+      counter += kDouble;
     else if (w == "signed")
-      counter |= SIGNED;
+      counter |= kSigned;
     else if (w == "unsigned")
-      counter |= UNSIGNED;
+      counter |= kUnsigned;
 
-    switch (counter) {
-      case VOID:
-        ty = tyVoid();
-        break;
-      case CHAR:
-      case UNSIGNED + CHAR:
-        ty = tyChar();
-        break;
-      case SIGNED + CHAR:
-        ty = tySChar();
-        break;
-      case SHORT:
-      case SHORT + INT:
-      case SIGNED + SHORT:
-      case SIGNED + SHORT + INT:
-      case INT:
-      case SIGNED:
-      case SIGNED + INT:
-        ty = tyInt();
-        break;
-      case UNSIGNED + SHORT:
-      case UNSIGNED + SHORT + INT:
-      case UNSIGNED:
-      case UNSIGNED + INT:
-        ty = tyUInt();
-        break;
-      case LONG:
-      case LONG + INT:
-      case SIGNED + LONG:
-      case SIGNED + LONG + INT:
-        ty = tyLong();
-        break;
-      case UNSIGNED + LONG:
-      case UNSIGNED + LONG + INT:
-        ty = tyULong();
-        break;
-      case FLOAT:
-      case DOUBLE:
-      case LONG + DOUBLE:
-        ty = tyFloat();
-        break;
-      default:
-        fail(pos, "invalid combination of type specifiers");
+    if (counter == kVoid) {
+      ty = tyVoid();
+    } else if (const std::optional<Arith> a = typeWordsArith(counter)) {
+      ty = arithType(*a);
+    } else {
+      fail(pos, "invalid combination of type specifiers");
     }
     advance();
   }

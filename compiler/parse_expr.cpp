@@ -360,21 +360,8 @@ Node* Parser::primary() {
       NumberValue v = parseNumber(t);
       advance();
       if (v.isFloat) return fnum(v.fvalue, pos);
-      uint64_t x = v.value;
-      Type* ty;
-      if (v.suffixU && v.suffixL)
-        ty = tyULong();
-      else if (v.suffixU)
-        ty = x <= 0xFFFF ? tyUInt() : tyULong();
-      else if (v.suffixL)
-        ty = x <= 0x7FFFFFFF ? tyLong() : tyULong();
-      else if (v.decimal)
-        ty = x <= 0x7FFF ? tyInt() : x <= 0x7FFFFFFF ? tyLong() : tyULong();
-      else
-        ty = x <= 0x7FFF       ? tyInt()
-             : x <= 0xFFFF     ? tyUInt()
-             : x <= 0x7FFFFFFF ? tyLong()
-                               : tyULong();
+      const uint64_t x = v.value;
+      Type* ty = arithType(constantArith(x, v.decimal, v.suffixU, v.suffixL));
       return num(static_cast<int64_t>(x), ty, pos);
     }
     case TokKind::Char: {

@@ -14,6 +14,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "compiler/arith.h"
 #include "compiler/ast.h"
 #include "vm/bytecode.h"
 #include "vm/image.h"
@@ -43,7 +44,9 @@ inline const std::unordered_set<std::string_view> kDeclWords = {
     "extern", "auto",     "register",  "const", "volatile", "shared",  "protected",
     "root",   "xmem",     "interrupt", "reti",  "nodebug",  "debug"};
 
-// Type rules shared by the parser's parts (types.cpp).
+// Type rules shared by the parser's parts (types.cpp), on compiler/arith.h's.
+Arith arithOf(const Type* t);              // an arithmetic type's kind
+Type* arithType(Arith a);                  // and back
 int64_t wrapTo(int64_t v, const Type* t);  // v as type t holds it
 Type* promote(Type* t);                    // char to int
 Type* commonType(Type* a, Type* b);        // the usual arithmetic conversions

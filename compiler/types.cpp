@@ -175,37 +175,54 @@ namespace detail {
 // checks of operands, pointer arithmetic, assignment. The parser builds
 // every typed node through these.
 
-int64_t wrapTo(int64_t v, const Type* t) {
+Arith arithOf(const Type* t) {
   switch (t->kind) {
     case TypeKind::Char:
-      return v & 0xFF;
+      return Arith::Char;
     case TypeKind::SChar:
-      return static_cast<int8_t>(static_cast<uint8_t>(v & 0xFF));
+      return Arith::SChar;
     case TypeKind::Int:
-      return static_cast<int16_t>(static_cast<uint16_t>(v & 0xFFFF));
+      return Arith::Int;
+    case TypeKind::UInt:
+      return Arith::UInt;
     case TypeKind::Long:
-      return static_cast<int32_t>(static_cast<uint32_t>(v & 0xFFFFFFFF));
+      return Arith::Long;
     case TypeKind::ULong:
-      return v & 0xFFFFFFFF;
+      return Arith::ULong;
     default:
-      return v & 0xFFFF;  // unsigned, pointers
+      return Arith::Float;
   }
 }
 
-Type* promote(Type* t) {
-  return t->kind == TypeKind::Char || t->kind == TypeKind::SChar ? tyInt() : t;
-}
-
-// The usual arithmetic conversions.
-Type* commonType(Type* a, Type* b) {
-  a = promote(a);
-  b = promote(b);
-  if (a->kind == TypeKind::Float || b->kind == TypeKind::Float) return tyFloat();
-  if (a->kind == TypeKind::ULong || b->kind == TypeKind::ULong) return tyULong();
-  if (a->kind == TypeKind::Long || b->kind == TypeKind::Long) return tyLong();
-  if (a->kind == TypeKind::UInt || b->kind == TypeKind::UInt) return tyUInt();
+Type* arithType(Arith a) {
+  switch (a) {
+    case Arith::Char:
+      return tyChar();
+    case Arith::SChar:
+      return tySChar();
+    case Arith::Int:
+      return tyInt();
+    case Arith::UInt:
+      return tyUInt();
+    case Arith::Long:
+      return tyLong();
+    case Arith::ULong:
+      return tyULong();
+    case Arith::Float:
+      return tyFloat();
+  }
   return tyInt();
 }
+
+int64_t wrapTo(int64_t v, const Type* t) {
+  if (isInteger(t)) return wrapArith(v, arithOf(t));
+  return wrapArith(v, Arith::UInt);  // pointers
+}
+
+Type* promote(Type* t) { return isInteger(t) ? arithType(promoteArith(arithOf(t))) : t; }
+
+// The usual arithmetic conversions.
+Type* commonType(Type* a, Type* b) { return arithType(commonArith(arithOf(a), arithOf(b))); }
 
 const char* opSpelling(NodeKind k) {
   switch (k) {
@@ -278,11 +295,8 @@ Node* Parser::castTo(Node* e, Type* to, Pos pos) {
       return num(e->ival, to, e->pos);
     if (e->kind == NodeKind::Num && to->kind == TypeKind::Float)
       return fnum(static_cast<double>(e->ival), e->pos);
-    if (e->kind == NodeKind::FNum && isInteger(to)) {
-      double t = std::trunc(static_cast<double>(e->fval));
-      int64_t v = (t > -9.0e18 && t < 9.0e18) ? static_cast<int64_t>(t) : 0;
-      return num(v, to, e->pos);
-    }
+    if (e->kind == NodeKind::FNum && isInteger(to))
+      return num(floatToInteger(e->fval, arithOf(to)), to, e->pos);
   }
   Node* n = newNode(NodeKind::Cast, pos, to);
   n->lhs = e;
@@ -336,7 +350,6 @@ Node* Parser::fold(NodeKind k, Node* l, Node* r, Pos pos, Type* ty) {
     }
   }
   int64_t a = l->ival, b = r->ival;
-  bool isLong = l->type->size == 4;
   switch (k) {
     case NodeKind::Add:
       return num(a + b, ty, pos);
@@ -348,7 +361,9 @@ Node* Parser::fold(NodeKind k, Node* l, Node* r, Pos pos, Type* ty) {
     case NodeKind::Div:
     case NodeKind::Mod:
       if (b == 0) fail(pos, "division by zero in constant expression");
-      return num(k == NodeKind::Div ? a / b : a % b, ty, pos);
+      return num(
+          k == NodeKind::Div ? divideArith(a, b, arithOf(ty)) : remainderArith(a, b, arithOf(ty)),
+          ty, pos);
     case NodeKind::BitAnd:
       return num(a & b, ty, pos);
     case NodeKind::BitOr:
@@ -356,10 +371,9 @@ Node* Parser::fold(NodeKind k, Node* l, Node* r, Pos pos, Type* ty) {
     case NodeKind::BitXor:
       return num(a ^ b, ty, pos);
     case NodeKind::Shl:
-      return num(static_cast<int64_t>(static_cast<uint64_t>(a) << (b & (isLong ? 31 : 15))), ty,
-                 pos);
+      return num(shiftLeft(a, b, arithOf(ty)), ty, pos);
     case NodeKind::Shr:
-      return num(a >> (b & (isLong ? 31 : 15)), ty, pos);
+      return num(shiftRight(a, b, arithOf(ty)), ty, pos);
     case NodeKind::Eq:
       return num(a == b, tyInt(), pos);
     case NodeKind::Ne:

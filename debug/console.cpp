@@ -93,13 +93,16 @@ const char* const kHelp = R"(Commands (gdb's where they fit; an empty line repea
   continue [N], step [N], next [N], finish, until [LINE], advance LINE|TIME, stepi [N]
   reverse-step, reverse-next, reverse-stepi, reverse-continue, reverse-finish
   goto TIME|TICK             to the first boundary at or after it (forwards or backwards)
-  print EXPR, display EXPR, undisplay N, ptype EXPR
+  print[/F] EXPR, display[/F] EXPR, undisplay N, ptype EXPR|TYPE, whatis EXPR|TYPE
+  x/NFU ADDRESS              N units (U: b, h, w) of memory in format F from ADDRESS
   backtrace, frame N, up [N], down [N], list [LOCATION]
   info breakpoints|watchpoints|display|registers|arena|pose|locals|args|frame|line
   robot A|B                  hold the other robot at this tick
   quit
-Expressions: globals, statics, autos of the selected frame (FUNCTION::NAME for another
-function's), s.m, p->m, a[i], *p, &x, a[i]@n (n elements), arithmetic and comparisons.
+Expressions: C's, computed as the robot's code would (int 16 bits that wrap, char unsigned):
+globals, statics, autos of the selected frame (FUNCTION::NAME for another function's), s.m,
+p->m, a[i], *p, &x, casts, sizeof, ?:, a[i]@n (n elements). Formats F: x d u o t c a z
+(a number's bits at its own width), and for x also s.
 )";
 
 }  // namespace
@@ -249,11 +252,21 @@ void Console::showDisplays(Session& s) {
   }
 }
 
+// "EXPR" or "/F EXPR" (print/x, display/x). A display (labelled) shows
+// its format, as gdb's does; print shows the expression alone.
 void Console::printExpression(Session& s, const std::string& expression, const std::string& label) {
+  inspect::Format how;
+  std::string text = expression;
+  if (!text.empty() && text[0] == '/') {
+    const auto [letters, rest] = split(text);
+    how = inspect::parseFormat(letters, false);
+    text = rest;
+    if (text.empty()) throw Error("print needs an expression");
+  }
   const inspect::Scope scope = s.scope();
-  const inspect::Value v = inspect::Expression(expression).evaluate(scope);
-  out_ << fmt::format("{}{} ({}) = {}\n", label, expression, inspect::typeName(scope, v),
-                      inspect::format(scope, v));
+  const inspect::Value v = inspect::Expression(text).evaluate(scope);
+  out_ << fmt::format("{}{} ({}) = {}\n", label, label.empty() ? text : expression,
+                      inspect::typeName(scope, v), inspect::format(scope, v, how));
 }
 
 void Console::backtrace(Session& s) {
@@ -407,25 +420,48 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
     out_ << fmt::format("Will ignore the next {} crossings of breakpoint {}.\n", k, n);
     return false;
   }
-  if (command == "print" || command == "p" || command == "output") {
-    if (args.empty()) throw Error("print needs an expression");
-    printExpression(s, args, "");
+  // gdb's format letters follow a slash: print/x EXPR, display/x EXPR, x/4xb ADDRESS.
+  const std::string verb = command.substr(0, command.find('/'));
+  const std::string letters = command.substr(verb.size());
+  const std::string formatted = letters.empty() ? args : trim(letters + " " + args);
+  if (verb == "print" || verb == "p" || verb == "output") {
+    if (formatted.empty()) throw Error("print needs an expression");
+    printExpression(s, formatted, "");
+    return false;
+  }
+  if (verb == "x") {
+    std::string spec = letters, address = args;
+    if (spec.empty() && !args.empty() && args[0] == '/') {
+      const auto parts = split(args);
+      spec = parts.first;
+      address = parts.second;
+    }
+    const inspect::Format shown = inspect::parseFormat(spec, true);
+    if (address.empty()) throw Error("x needs an address");
+    const inspect::Scope scope = s.scope();
+    out_ << inspect::examine(scope, inspect::Expression(address).evaluate(scope), shown);
     return false;
   }
   if (command == "ptype" || command == "whatis") {
-    const inspect::Scope scope = s.scope();
-    const inspect::Value v = inspect::Expression(args).evaluate(scope);
-    out_ << fmt::format("type = {}\n", inspect::typeName(scope, v));
+    if (args.empty()) throw Error(command + " needs an expression or a type");
+    out_ << fmt::format("type = {}\n", inspect::describeType(s.scope(), args, command == "ptype"));
     return false;
   }
-  if (command == "display") {
-    if (args.empty()) {
+  if (verb == "display") {
+    if (formatted.empty()) {
       showDisplays(s);
       return false;
     }
-    inspect::Expression check(args);  // a bad expression is refused now
-    displays_.push_back({nextDisplay_++, args});
-    printExpression(s, args, fmt::format("{}: ", displays_.back().first));
+    // A bad expression or format is refused now.
+    if (formatted[0] == '/') {
+      const auto [spec, rest] = split(formatted);
+      inspect::parseFormat(spec, false);
+      inspect::Expression check(rest);
+    } else {
+      inspect::Expression check(formatted);
+    }
+    displays_.push_back({nextDisplay_++, formatted});
+    printExpression(s, formatted, fmt::format("{}: ", displays_.back().first));
     return false;
   }
   if (command == "undisplay") {

@@ -1064,7 +1064,7 @@ const Watchpoint& Session::watch(const std::string& expression, const std::strin
     if (w.object.frame >= 0) w.depth = static_cast<int>(s.activations.size()) - 1 - w.object.frame;
     w.address = w.object.address;
     w.size = static_cast<uint32_t>(inspect::bytes(s, w.object).size());
-    readInto(s.vm, w, w.value);
+    readInto(*s.vm, w, w.value);
     w.seen = w.value;
     w.text = inspect::format(s, w.object);
     w.valid = true;

@@ -417,6 +417,12 @@ void Match::resolveWatches() {
     }
     for (auto& r : robots_) {
       if (!inspect::namesExist(r->spec.image, *expression)) continue;
+      // One that can never be evaluated (1/0) is refused, not recorded as null.
+      try {
+        inspect::check(r->spec.image, *expression);
+      } catch (const inspect::Error& e) {
+        throw std::invalid_argument("--watch " + name + ": " + e.what());
+      }
       r->watches.push_back({name, 0, vm::Symbol::Value::Aggregate, expression});
       found = true;
     }
