@@ -259,7 +259,8 @@ void Session::boundary(const scheduler::MatchView& view) {
       if (scan_->hits && !scan_->boundaries.empty() && watchpointHit(why)) reverseWatchHit(why);
       throw ScanDone{};
     }
-    Boundary b{v.now(), v.line(), v.callDepth(), v.interruptDepth(), false, !v.effectPending()};
+    Boundary b{v.now(), v.line(),           v.callDepth(),    v.interruptDepth(),
+               false,   !v.effectPending(), v.inLibraryCall()};
     if (scan_->hits) {
       Stop why;
       if (eventStop_) {
@@ -299,8 +300,14 @@ void Session::boundary(const scheduler::MatchView& view) {
 void Session::reverseWatchHit(Stop why) {
   std::swap(why.oldValue, why.newValue);
   why.reverse = true;
-  scan_->boundaries.back().hit = true;
-  scan_->stops.emplace(scan_->boundaries.back().tick, std::move(why));
+  // A library call's writes are judged once it is done: before the call.
+  // A service's (writtenAt 0) happened in the last step alone.
+  auto& seen = scan_->boundaries;
+  size_t k = seen.size() - 1;
+  if (why.writtenAt != 0)
+    while (k > 0 && seen[k].inLibrary) --k;
+  seen[k].hit = true;
+  scan_->stops.emplace(seen[k].tick, std::move(why));
 }
 
 // What the next boundary's watchpoints compare with: this one.

@@ -256,8 +256,9 @@ class Session final : private scheduler::DebugHook {
   struct Boundary {
     Tick tick;
     int line, calls, ints;
-    bool hit;      // a breakpoint, watchpoint or event would stop here
-    bool settled;  // no library effect was still due there (Mode::settled)
+    bool hit;        // a breakpoint, watchpoint or event would stop here
+    bool settled;    // no library effect was still due there (Mode::settled)
+    bool inLibrary;  // between two steps of a library call
   };
   struct Scan {
     Tick end = 0;
@@ -305,7 +306,7 @@ class Session final : private scheduler::DebugHook {
   std::optional<Found> searchBack(const Rewind& rewind);
   std::string writer(const vm::Vm& v) const;
   void noteBoundary(const vm::Vm& v);
-  void reverseWatchHit(Stop why);
+  void reverseWatchHit(Stop why);  // a watchpoint hit of a scan, going backwards
   void countHit(const Stop& why);
   Breakpoint& addBreakpoint(Breakpoint b);
   Breakpoint* findBreakpoint(int id);

@@ -8,8 +8,8 @@ at tick 83143727): a breakpoint on INT1's first line (191); the stop, its
 stack (INT1 at 191 over platform at 220), scopes and variables (the global
 buf, a char[9], with its 9 elements), evaluate in two frames, next, then
 stepBack to the same line and values, a data breakpoint on buf that stops
-where it is written with a new value, reverseContinue back to the
-breakpoint, disconnect.
+where it is written with a new value, reverseContinue back before that
+write and then to the breakpoint, disconnect.
 
 Session 2 (the same match, 20 s, stopOnEntry): the entry stop; breakpoints
 refused with a message (no such line, a bad condition, no such function);
@@ -301,7 +301,16 @@ check(frames[0]["line"] == 195 and "written by line 195" in stop.get("descriptio
       f"the write at line 195: {frames[0]}, {stop}")
 watch_tick = tick_of(stop)
 
-# reverseContinue: back to the breakpoint before the write.
+# reverseContinue: back over the write first (the data breakpoint stops
+# before it, as gdb's reverse-continue does: buf as it was, the values in
+# the order they are met going back), then to the breakpoint.
+c.request("reverseContinue", {"threadId": 1})
+stop = c.stopped("data breakpoint")
+check(stop.get("hitBreakpointIds") == [dbs[0].get("id")] and tick_of(stop) < watch_tick,
+      f"reverseContinue to the write: {stop}")
+frames = c.frames()
+check(frames[0]["line"] == 195 and c.evaluate("buf", frames[0]["id"])["result"] == old,
+      f"before the write: {frames[0]}")
 c.request("reverseContinue", {"threadId": 1})
 stop = c.stopped("breakpoint")
 check(tick_of(stop) == 83143727 and tick_of(stop) < watch_tick, f"reverseContinue: {stop}")
