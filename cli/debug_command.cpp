@@ -66,7 +66,9 @@ int debugCommand(const std::vector<std::string>& programs, const runs::RunOption
     throw sinks::UserError(fmt::format("simbot: {}\n", e.what()));
   }
   std::cout.flush();
-  return !batch.empty() && console.errors() > 0 ? 1 : 0;
+  // Commands read from a file or a pipe that failed make the run fail, as
+  // a script's would; at a terminal the user saw each error and went on.
+  return !terminal && console.errors() > 0 ? 1 : 0;
 }
 
 }  // namespace simbot::cli

@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <climits>
+#include <cstdint>
 #include <cstdlib>
 #include <istream>
 #include <ostream>
@@ -75,12 +77,20 @@ bool integer(const std::string& s, long& value) {
   return error == std::errc() && end == s.data() + s.size();
 }
 
-long count(const std::string& args, long otherwise = 1) {
-  long n = otherwise;
-  if (!args.empty() && (!integer(args, n) || n < 1))
-    throw Error(fmt::format("'{}' is not a count", args));
-  return n;
+// A whole number the user wrote for `what`, in [lo, hi]; one line if not.
+int number(const std::string& s, const std::string& what, int lo, int hi = INT_MAX) {
+  long long v = 0;
+  const auto [end, error] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (s.empty() || end != s.data() + s.size() ||
+      (error != std::errc() && error != std::errc::result_out_of_range))
+    throw Error(fmt::format("'{}' is not {}", s, what));
+  if (error == std::errc::result_out_of_range || v < lo || v > hi)
+    throw Error(fmt::format("{} is {} to {}: '{}' is out of range", what, lo, hi, s));
+  return static_cast<int>(v);
 }
+
+// A repeat count (step 3, up 2): 1 if none.
+int count(const std::string& args) { return args.empty() ? 1 : number(args, "a count", 1); }
 
 const char* const kHelp = R"(Commands (gdb's where they fit; an empty line repeats the last one):
   break LOCATION [if COND]   stop at a line (12, B:12, FILE:12), a function or handler (INT1,
@@ -295,7 +305,7 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
     return true;
   };
   auto repeated = [&](K kind) {
-    repeat_ = static_cast<int>(count(args)) - 1;
+    repeat_ = count(args) - 1;
     return resume(kind);
   };
   if (command == "help" || command == "h") {
@@ -304,13 +314,13 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
   }
   if (command == "quit" || command == "q") return resume(K::Quit);
   if (command == "continue" || command == "c") {
-    const long n = count(args);
+    const int n = count(args);
     if (n > 1) {
       // continue N: pass over the breakpoint that stopped us N - 1 more times.
       for (const Breakpoint& b : s.breakpoints())
         if ((b.kind == Breakpoint::Kind::Line || b.kind == Breakpoint::Kind::Function) &&
             b.address == s.vm(s.robot()).pc() && b.robot == s.robot())
-          s.setIgnore(b.id, static_cast<int>(n - 1));
+          s.setIgnore(b.id, n - 1);
     }
     return resume(K::Continue);
   }
@@ -339,7 +349,7 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
     if (robot != s.robot() || !integer(where, lineNumber))
       throw Error(fmt::format("{} takes a line of the held robot's program or a time", command));
     resume(K::AdvanceLine);
-    how.line = static_cast<int>(lineNumber);
+    how.line = number(where, "a line", 1, s.lineCount(robot));
     return true;
   }
   if (command == "reverse-step" || command == "rs") return resume(K::ReverseStep);
@@ -393,30 +403,26 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
     }
     std::istringstream ids(args);
     for (std::string id; ids >> id;) {
-      long n = 0;
-      if (!integer(id, n)) throw Error(fmt::format("'{}' is not a breakpoint number", id));
-      s.remove(static_cast<int>(n));
+      s.remove(number(id, "a breakpoint number", 1));
     }
     return false;
   }
   if (command == "disable" || command == "enable") {
-    long n = 0;
-    if (!integer(args, n)) throw Error(command + " needs a breakpoint number");
-    s.setEnabled(static_cast<int>(n), command == "enable");
+    if (args.empty()) throw Error(command + " needs a breakpoint number");
+    s.setEnabled(number(args, "a breakpoint number", 1), command == "enable");
     return false;
   }
   if (command == "condition") {
     auto [id, expression] = split(args);
-    long n = 0;
-    if (!integer(id, n)) throw Error("condition needs a breakpoint number");
-    s.setCondition(static_cast<int>(n), expression);
+    if (id.empty()) throw Error("condition needs a breakpoint number");
+    s.setCondition(number(id, "a breakpoint number", 1), expression);
     return false;
   }
   if (command == "ignore") {
     auto [id, times] = split(args);
-    long n = 0, k = 0;
-    if (!integer(id, n) || !integer(times, k)) throw Error("ignore needs a breakpoint and a count");
-    s.setIgnore(static_cast<int>(n), static_cast<int>(k));
+    if (id.empty() || times.empty()) throw Error("ignore needs a breakpoint and a count");
+    const int n = number(id, "a breakpoint number", 1), k = number(times, "an ignore count", 0);
+    s.setIgnore(n, k);
     out_ << fmt::format("Will ignore the next {} crossings of breakpoint {}.\n", k, n);
     return false;
   }
@@ -465,8 +471,8 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
     return false;
   }
   if (command == "undisplay") {
-    long n = 0;
-    if (!integer(args, n)) throw Error("undisplay needs a display number");
+    if (args.empty()) throw Error("undisplay needs a display number");
+    const int n = number(args, "a display number", 1);
     const auto before = displays_.size();
     displays_.erase(std::remove_if(displays_.begin(), displays_.end(),
                                    [&](const auto& d) { return d.first == n; }),
@@ -479,15 +485,16 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
     return false;
   }
   if (command == "frame" || command == "f" || command == "up" || command == "down") {
-    int target = s.frame();
-    if (command == "up") target += static_cast<int>(count(args));
-    if (command == "down") target -= static_cast<int>(count(args));
-    if ((command == "frame" || command == "f") && !args.empty()) {
-      long n = 0;
-      if (!integer(args, n)) throw Error("frame needs a frame number");
-      target = static_cast<int>(n);
-    }
-    s.selectFrame(target);
+    // Counted in 64 bits: up 2147483647 from frame 1 is no frame, not frame 0.
+    const int64_t frames = static_cast<int64_t>(s.vm(s.robot()).activations().size());
+    int64_t target = s.frame();
+    if (command == "up") target += count(args);
+    if (command == "down") target -= count(args);
+    if ((command == "frame" || command == "f") && !args.empty())
+      target = number(args, "a frame number", 0);
+    if (target < 0 || target >= frames)
+      throw Error(fmt::format("no frame {} (frames 0 to {})", target, frames - 1));
+    s.selectFrame(static_cast<int>(target));
     showLocation(s, s.robot());
     return false;
   }
@@ -646,7 +653,7 @@ void Console::list(Session& s, std::string args) {
     robot = s.robotOf(args);
     long n = 0;
     if (integer(args, n)) {
-      center = static_cast<int>(n);
+      center = number(args, "a line number", 1, std::max(1, s.lineCount(robot)));
     } else {
       bool found = false;
       for (const vm::Symbol& sym : s.vm(robot).image().symbols)

@@ -277,6 +277,35 @@ check(stop(answers[0][1]) == ("A", T0, "platform", 17) and "effect is due" in an
 check(value(answers[1][1]) == 9 and value(answers[3][1]) == 8, "cc before and after the effect")
 check(stop(answers[2][1]) == ("A", T0, "platform", 18), f"stepi over the effect: {answers[2][1]}")
 
+# ---- 7. Counts and numbers the user writes ----------------------------------
+#
+# The audit's reproducers (each was signed overflow, UB, or a wrong value):
+# every count is 1 to 2^31 - 1, every number a breakpoint, display, frame
+# or line that exists; each refusal is one line and the session goes on.
+# noei.dc has 46 lines and one frame at the start; an ignore count of
+# 2^31 - 1 is taken. A script or a pipe with a refused command exits 1.
+expected = {
+    "stepi 2147483648": "error: a count is 1 to 2147483647: '2147483648' is out of range",
+    "up 2147483647": "error: no frame 2147483647 (frames 0 to 0)",
+    "list 2147483647": "error: a line number is 1 to 46: '2147483647' is out of range",
+    "ignore 1 99999999999":
+        "error: an ignore count is 0 to 2147483647: '99999999999' is out of range",
+    "frame 4294967296": "error: a frame number is 0 to 2147483647: '4294967296' is out of range",
+    "ignore 1 2147483647": "Will ignore the next 2147483647 crossings of breakpoint 1.",
+    "delete 99999999999999999999999": "error: a breakpoint number is 1 to 2147483647: "
+                                      "'99999999999999999999999' is out of range",
+    "undisplay -1": "error: a display number is 1 to 2147483647: '-1' is out of range",
+    "continue 0": "error: a count is 1 to 2147483647: '0' is out of range",
+    "print buf[9223372036854775807]": "error: ",
+}
+answers = session(["tests/debug/noei.dc"], "break 17\n" + "\n".join(expected) + "\n", status=1)
+for command, answer in answers[1:]:
+    check(answer.strip().startswith(expected[command]) and len(answer.strip().splitlines()) == 1,
+          f"{command}: {answer.strip()!r}")
+piped = subprocess.run([SIMBOT, "debug", "tests/debug/pacer.dc"], input="stepi 2147483648\n",
+                       cwd=SOURCE, capture_output=True, text=True, timeout=60)
+check(piped.returncode == 1, f"piped commands with an error: exit {piped.returncode}")
+
 for f in failures:
     print("FAIL:", f)
 if failures:
