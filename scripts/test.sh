@@ -18,6 +18,7 @@ phase() {
 }
 mark=$SECONDS
 mapfile -t sources < <(find compiler vm board plant scheduler config trace sinks reports runs batch cli tests bench fuzz \
+  debug inspect files stats timebase python \
   -path tests/browser/node_modules -prune -o \( -name '*.cpp' -o -name '*.h' \) -print | sort)
 clang-format --dry-run --Werror "${sources[@]}"
 phase "set-up and layout check"
