@@ -97,7 +97,7 @@ const char* const kHelp = R"(Commands (gdb's where they fit; an empty line repea
                              B:fire), a time (12.5s, 20ms, tick 115200000) or an event (frame,
                              edge, contact, shot, fault)
   tbreak LOCATION            the same, once
-  watch EXPR                 stop when the value of an lvalue changes
+  watch [B:]EXPR [if COND]   stop when the value of an lvalue (of robot B) changes
   delete [N...], disable N, enable N, condition N [COND], ignore N COUNT
   run                        from the start, on to the first breakpoint
   continue [N], step [N], next [N], finish, until [LINE], advance LINE|TIME, stepi [N]
@@ -387,8 +387,18 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
   }
   if (command == "watch") {
     auto [expression, condition] = splitCondition(args);
+    // "B:EXPR": the other robot's variable, read in its innermost frame
+    // (FUNCTION::NAME keeps its two colons).
+    int robot = s.robot();
+    for (int r = 0; r < s.robotCount(); ++r) {
+      const std::string prefix = s.robotName(r) + ":";
+      if (expression.rfind(prefix, 0) == 0 && expression.compare(prefix.size(), 1, ":") != 0) {
+        robot = r;
+        expression = trim(expression.substr(prefix.size()));
+      }
+    }
     if (expression.empty()) throw Error("watch needs an expression");
-    const Watchpoint& w = s.watch(expression, condition);
+    const Watchpoint& w = s.watch(expression, condition, robot);
     out_ << fmt::format("Watchpoint {}: {} (now {}){}\n", w.id, expression, w.text,
                         condition.empty() ? "" : " if " + condition);
     return false;

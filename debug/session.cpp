@@ -256,7 +256,8 @@ void Session::boundary(const scheduler::MatchView& view) {
       // The window's last instruction may have changed a watched value:
       // going backwards, that change stops before it.
       Stop why;
-      if (scan_->hits && !scan_->boundaries.empty() && watchpointHit(why)) reverseWatchHit(why);
+      if (scan_->hits && !scan_->boundaries.empty() && watchpointHit(held_, why))
+        reverseWatchHit(why);
       throw ScanDone{};
     }
     Boundary b{v.now(), v.line(),           v.callDepth(),    v.interruptDepth(),
@@ -268,7 +269,7 @@ void Session::boundary(const scheduler::MatchView& view) {
         b.hit = true;
       } else if (breakpointHit(held_, why, false)) {
         b.hit = true;
-      } else if (!scan_->boundaries.empty() && watchpointHit(why)) {
+      } else if (!scan_->boundaries.empty() && watchpointHit(held_, why)) {
         reverseWatchHit(why);
         why = Stop{};
       }
@@ -286,12 +287,12 @@ void Session::boundary(const scheduler::MatchView& view) {
       if (b.hit) scan_->stops.emplace(b.tick, why);
     }
     scan_->boundaries.push_back(b);
-    noteBoundary(v);
+    noteBoundary(held_, v);
     return;
   }
   Stop why;
   if (shouldStop(why)) park(why);
-  noteBoundary(vm(held_));
+  noteBoundary(held_, vm(held_));
 }
 
 // Going backwards a change stops before what made it (the instruction or
@@ -311,12 +312,13 @@ void Session::reverseWatchHit(Stop why) {
 }
 
 // What the next boundary's watchpoints compare with: this one.
-void Session::noteBoundary(const vm::Vm& v) {
-  lastPc_ = v.pc();
-  lastTick_ = v.now();
-  lastInterrupts_ = v.stats().interrupts;
+void Session::noteBoundary(int robot, const vm::Vm& v) {
+  LastBoundary& last = last_.at(static_cast<size_t>(robot));
+  last.pc = v.pc();
+  last.tick = v.now();
+  last.interrupts = v.stats().interrupts;
   for (Watchpoint& w : watchpoints_)
-    if (w.robot == held_) readInto(v, w, w.seen);
+    if (w.robot == robot) readInto(v, w, w.seen);
 }
 
 bool Session::event(int robot, Tick t, DebugEvent e) {
@@ -356,6 +358,30 @@ void Session::otherBreakpoint(const scheduler::MatchView& view, int robot) {
   if (!breakpointHit(robot, why, true)) return;
   // Hold that robot from here: the match goes back to a snapshot and runs
   // to this tick with it held (every robot at the same tick again).
+  Rewind r;
+  r.how.kind = Resume::Kind::Hold;
+  r.how.robot = robot;
+  r.how.tick = view.vm(robot).now();
+  r.from = r.how.tick;
+  r.arrival = why;
+  r.atOtherBreakpoint = true;
+  throw r;
+}
+
+bool Session::watching(int robot) const {
+  if (robot == held_ || scan_ || mode_.kind == Resume::Kind::Goto) return false;
+  return std::any_of(watchpoints_.begin(), watchpoints_.end(),
+                     [&](const Watchpoint& w) { return w.robot == robot && w.enabled; });
+}
+
+// A boundary of a robot not held that has watchpoints: a change there holds
+// that robot from here, as its breakpoint does.
+void Session::otherBoundary(const scheduler::MatchView& view, int robot) {
+  view_ = &view;
+  Stop why;
+  const bool hit = watchpointHit(robot, why);
+  noteBoundary(robot, view.vm(robot));
+  if (!hit) return;
   Rewind r;
   r.how.kind = Resume::Kind::Hold;
   r.how.robot = robot;
@@ -406,19 +432,19 @@ bool Session::breakpointHit(int robot, Stop& why, bool counting) {
   return false;
 }
 
-bool Session::watchpointHit(Stop& why) {
+bool Session::watchpointHit(int robot, Stop& why) {
   if (watchpoints_.empty()) return false;
-  const vm::Vm& v = vm(held_);
+  const vm::Vm& v = vm(robot);
   // A library routine writes over several steps: judged once it is done.
   // An interrupt service accepted between two of its steps (the serial
   // library's transmit service, the BIOS timer's: atomic) is judged at
   // once, on what changed since the step before.
-  const bool serviced = serviceRan(v);
+  const bool serviced = serviceRan(robot, v);
   const bool inLibrary = v.inLibraryCall();
   if (inLibrary && !serviced) return false;
   for (size_t k = 0; k < watchpoints_.size(); ++k) {
     Watchpoint& w = watchpoints_[k];
-    if (w.robot != held_ || !w.enabled) continue;  // watched while its robot is held
+    if (w.robot != robot || !w.enabled) continue;
     if (w.depth >= 0 && v.callDepth() + v.interruptDepth() < w.depth) {
       if (scan_) continue;
       why.kind = Stop::Kind::Watchpoint;
@@ -435,10 +461,10 @@ bool Session::watchpointHit(Stop& why) {
     const std::string before = w.text;
     w.text = valueText(v, w);
     if (first) continue;
-    w.writer = writer(v);
+    w.writer = writer(robot, v);
     if (w.condition) {
       try {
-        const inspect::Scope s = scope(held_, 0);
+        const inspect::Scope s = scope(robot, 0);
         if (!inspect::truth(s, w.condition->evaluate(s))) continue;
       } catch (const inspect::Error& e) {
         why.note = fmt::format("error in the condition of watchpoint {}: {}", w.id, e.what());
@@ -455,7 +481,7 @@ bool Session::watchpointHit(Stop& why) {
     why.breakpoint = w.id;
     why.oldValue = before;
     why.newValue = w.text;
-    why.writtenAt = serviced ? 0 : v.image().lineAt(lastPc_);
+    why.writtenAt = serviced ? 0 : v.image().lineAt(last_.at(static_cast<size_t>(robot)).pc);
     why.writer = w.writer;
     return true;
   }
@@ -464,31 +490,33 @@ bool Session::watchpointHit(Stop& why) {
 
 // Whether an atomic interrupt service (the serial library's transmit
 // service, the BIOS timer's) was accepted since the boundary before.
-bool Session::serviceRan(const vm::Vm& v) const {
+bool Session::serviceRan(int robot, const vm::Vm& v) const {
   const auto& irqs = v.stats().interrupts;
+  const auto& before = last_.at(static_cast<size_t>(robot)).interrupts;
   for (vm::Irq irq : {vm::Irq::SerialTx, vm::Irq::Timer})
-    if (irqs[static_cast<size_t>(irq)] != lastInterrupts_[static_cast<size_t>(irq)]) return true;
+    if (irqs[static_cast<size_t>(irq)] != before[static_cast<size_t>(irq)]) return true;
   return false;
 }
 
 // Who made a change seen at this boundary: the service accepted at the
 // boundary before, or the instruction that ran there (and the handler it
 // ran in).
-std::string Session::writer(const vm::Vm& v) const {
+std::string Session::writer(int robot, const vm::Vm& v) const {
+  const LastBoundary& last = last_.at(static_cast<size_t>(robot));
   const vm::Image& img = v.image();
-  const vm::Symbol* fn = img.functionAt(lastPc_);
+  const vm::Symbol* fn = img.functionAt(last.pc);
   const std::string where =
-      fmt::format("line {}{}", img.lineAt(lastPc_), fn ? fmt::format(" in {}()", fn->name) : "");
+      fmt::format("line {}{}", img.lineAt(last.pc), fn ? fmt::format(" in {}()", fn->name) : "");
   const auto& irqs = v.stats().interrupts;
   const auto ran = [&](vm::Irq irq) {
-    return irqs[static_cast<size_t>(irq)] != lastInterrupts_[static_cast<size_t>(irq)];
+    return irqs[static_cast<size_t>(irq)] != last.interrupts[static_cast<size_t>(irq)];
   };
   if (ran(vm::Irq::SerialTx))
     return fmt::format(
         "the serial library's transmit interrupt (serial_tx), accepted at tick {} during {}",
-        lastTick_, where);
+        last.tick, where);
   if (ran(vm::Irq::Timer))
-    return fmt::format("the BIOS timer service (PRT0), accepted at tick {} during {}", lastTick_,
+    return fmt::format("the BIOS timer service (PRT0), accepted at tick {} during {}", last.tick,
                        where);
   if (fn && fn->kind == vm::Symbol::Kind::Handler) return where + " [interrupt handler]";
   if (v.interruptDepth() > 0)
@@ -534,7 +562,7 @@ bool Session::shouldStop(Stop& why) {
     return true;
   }
   if (t != lastStop_ && breakpointHit(held_, why, true)) return true;
-  if (watchpointHit(why)) return true;
+  if (watchpointHit(held_, why)) return true;
   for (Breakpoint& b : breakpoints_) {
     if (b.kind != Breakpoint::Kind::Time || !b.enabled || b.passed || t < b.tick) continue;
     b.passed = true;
@@ -585,6 +613,9 @@ void Session::park(const Stop& why) {
   for (Breakpoint& b : breakpoints_)
     if (b.kind == Breakpoint::Kind::Time) b.passed = b.tick <= lastStop_;
   refreshWatchpoints();
+  // The robots not held compare their watched values from here on.
+  for (int r = 0; r < robotCount(); ++r)
+    if (r != held_) noteBoundary(r, vm(r));
   // A temporary breakpoint goes once it has stopped the robot.
   if (why.kind == Stop::Kind::Breakpoint || why.kind == Stop::Kind::Event)
     if (const Breakpoint* b = findBreakpoint(why.breakpoint); b && b->temporary) {
@@ -1057,12 +1088,15 @@ void Session::removeAll() {
   applyBreakpoints();
 }
 
-const Watchpoint& Session::watch(const std::string& expression, const std::string& condition) {
+const Watchpoint& Session::watch(const std::string& expression, const std::string& condition,
+                                 int robot) {
+  if (robot < 0) robot = held_;
+  if (robot >= robotCount()) throw Error("there is no such robot");
   Watchpoint w;
   try {
     w.expression = std::make_shared<inspect::Expression>(expression);
     if (!condition.empty()) w.condition = std::make_shared<inspect::Expression>(condition);
-    const inspect::Scope s = scope();
+    const inspect::Scope s = robot == held_ ? scope() : scope(robot, 0);
     w.object = w.expression->evaluate(s);
     if (!w.object.inMemory)
       throw Error(fmt::format("'{}' is not an object in memory: nothing to watch", expression));
@@ -1079,7 +1113,7 @@ const Watchpoint& Session::watch(const std::string& expression, const std::strin
     throw Error(e.what());
   }
   w.id = nextId_++;
-  w.robot = held_;
+  w.robot = robot;
   watchpoints_.push_back(std::move(w));
   return watchpoints_.back();
 }

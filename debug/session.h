@@ -225,9 +225,13 @@ class Session final : private scheduler::DebugHook {
   void remove(int id);
   void removeAll();
   const std::vector<Breakpoint>& breakpoints() const { return breakpoints_; }
-  // A data breakpoint on an lvalue of the held robot, evaluated now, with
-  // an optional condition (watch EXPR if COND).
-  const Watchpoint& watch(const std::string& expression, const std::string& condition = "");
+  // A data breakpoint on an lvalue of `robot` (-1: the held one), evaluated
+  // now in its selected frame (another robot's: its innermost), with an
+  // optional condition (watch EXPR if COND). Another robot's watchpoints
+  // stop the match going forwards (the session then holds that robot);
+  // going backwards only the held robot's are looked for.
+  const Watchpoint& watch(const std::string& expression, const std::string& condition = "",
+                          int robot = -1);
   const std::vector<Watchpoint>& watchpoints() const { return watchpoints_; }
   // Messages about the other robots since the last stop (a fault of one).
   std::vector<std::string> takeNotices();
@@ -283,6 +287,8 @@ class Session final : private scheduler::DebugHook {
   void boundary(const scheduler::MatchView& view) override;
   bool event(int robot, Tick t, scheduler::DebugEvent e) override;
   void otherBreakpoint(const scheduler::MatchView& view, int robot) override;
+  bool watching(int robot) const override;
+  void otherBoundary(const scheduler::MatchView& view, int robot) override;
 
   void forward();
   void takeSnapshot();
@@ -291,7 +297,7 @@ class Session final : private scheduler::DebugHook {
   void startMode(const Resume& how, const Stop& arrival = {});
   bool shouldStop(Stop& why);
   bool breakpointHit(int robot, Stop& why, bool counting);
-  bool watchpointHit(Stop& why);
+  bool watchpointHit(int robot, Stop& why);
   void refreshWatchpoints();
   void park(const Stop& why);
   void handle(const Resume& how);
@@ -300,12 +306,12 @@ class Session final : private scheduler::DebugHook {
                                    std::map<Tick, Stop>* stops = nullptr);
   std::optional<size_t> lineBefore(const std::vector<Boundary>& history, const Rewind& rw,
                                    bool complete) const;
-  bool serviceRan(const vm::Vm& v) const;
+  bool serviceRan(int robot, const vm::Vm& v) const;
   std::string valueText(const vm::Vm& v, const Watchpoint& w) const;
   Stop eventStopOf(const Breakpoint& b, int robot, Tick t);
   std::optional<Found> searchBack(const Rewind& rewind);
-  std::string writer(const vm::Vm& v) const;
-  void noteBoundary(const vm::Vm& v);
+  std::string writer(int robot, const vm::Vm& v) const;
+  void noteBoundary(int robot, const vm::Vm& v);
   void reverseWatchHit(Stop why);  // a watchpoint hit of a scan, going backwards
   void countHit(const Stop& why);
   Breakpoint& addBreakpoint(Breakpoint b);
@@ -330,12 +336,16 @@ class Session final : private scheduler::DebugHook {
   Tick lastStop_ = -1;
   Tick anchor_ = 0;
   bool leftLine_ = false;  // AdvanceLine: the robot has been off the line
-  // The boundary before this one (watchpoints' writer): its instruction,
-  // tick, and the interrupts accepted by then (an atomic service, the
-  // serial library's or the timer's, ran in between when they differ).
-  uint32_t lastPc_ = 0;
-  Tick lastTick_ = 0;
-  std::array<uint64_t, vm::kIrqCount> lastInterrupts_{};
+  // Each robot's boundary before this one (watchpoints' writer): its
+  // instruction, tick, and the interrupts accepted by then (an atomic
+  // service, the serial library's or the timer's, ran in between when they
+  // differ).
+  struct LastBoundary {
+    uint32_t pc = 0;
+    Tick tick = 0;
+    std::array<uint64_t, vm::kIrqCount> interrupts{};
+  };
+  std::array<LastBoundary, 2> last_{};
   std::optional<Stop> eventStop_;
   std::vector<std::string> notices_;
 };

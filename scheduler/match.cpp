@@ -188,17 +188,29 @@ void Robot::reload(Tick t) {
 }
 
 void Robot::runTo(Tick horizon) {
-  if (match.debugger() && index == match.debugRobot()) return debugRunTo(horizon);
+  DebugHook* hook = match.debugger();
+  if (hook && index == match.debugRobot()) return debugRunTo(horizon);
   const bool tracing = match.tracing();
   for (;;) {
     if (tracing) takeSnapshots();
     if (now() >= horizon) return;
-    const vm::Stop stop = board.cpu.run(tracing ? std::min(horizon, nextSnapshot) : horizon);
+    // A debugger's data breakpoint on this robot: one instruction at a time.
+    const bool watched = hook && !board.cpu.halted() && hook->watching(index);
+    if (watched && board.cpu.effectPending()) {
+      board.cpu.settle();
+      if (board.cpu.fault()) return noteFault();
+      hook->otherBoundary(match, index);
+      continue;
+    }
+    Tick until = tracing ? std::min(horizon, nextSnapshot) : horizon;
+    if (watched) until = std::min(until, now() + 1);
+    const vm::Stop stop = board.cpu.run(until);
     if (stop == vm::Stop::Fault) return noteFault();
     if (stop == vm::Stop::Breakpoint) {
       noteBreakpoint();
-      if (DebugHook* hook = match.debugger()) hook->otherBreakpoint(match, index);
+      if (hook) hook->otherBreakpoint(match, index);
     }
+    if (watched) hook->otherBoundary(match, index);
   }
 }
 

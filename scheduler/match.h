@@ -190,6 +190,12 @@ class DebugHook {
   // Another robot stopped at one of its VM's breakpoints (MatchRun::
   // setDebugBreakpoints), at its boundary inside a round.
   virtual void otherBreakpoint(const MatchView& view, int robot) = 0;
+  // While watching(robot), another robot runs one instruction at a time and
+  // otherBoundary() looks at each of its boundaries (a data breakpoint on
+  // it); a library call's effect due there is made to happen first, as in
+  // a step. otherBoundary() may throw as boundary() does.
+  virtual bool watching(int /*robot*/) const { return false; }
+  virtual void otherBoundary(const MatchView& /*view*/, int /*robot*/) {}
 };
 
 struct MatchConfig {

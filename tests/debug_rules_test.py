@@ -112,6 +112,23 @@ check(got.get("print a") == [3, 3, 3] and got.get("print b") == [2, 2, 3],
       f"A's counters: a {got.get('print a')} b {got.get('print b')}")
 check(got.get("print c") == [9, 12], f"B's counter: {got.get('print c')}")
 
+# ---- 5. A watchpoint on the robot not held ----------------------------------
+#
+# `watch B:c if c == 30` with A held: B's c reaches 30 at the STGW of its
+# pass j = 9 (3 a pass), which ends 165 into the pass (DBG 68, LDGW 29,
+# PUSHW 22, ADDW 18, STGW 28): 86 + 9 * 175 + 165 = 1,826, where B stands
+# before its JMP (line 7). The match then holds B there.
+answers = dict(enumerate(session(["tests/debug/pacer.dc", "tests/debug/walker.dc"], """\
+watch B:c if c == 30
+continue
+info breakpoints
+""", "--seconds", "1")))
+check("Watchpoint 1: c (now 0) if c == 30" in answers[0][1], f"watch B:c: {answers[0][1]}")
+check(re.search(r"Watchpoint 1: written by line 8 in main\(\)\nOld value = 27\nNew value = 30",
+                answers[1][1]) and stop(answers[1][1]) == ("B", 1826, "main", 7),
+      f"B's watchpoint: {answers[1][1]}")
+check("B: c (now 30) if c == 30, hit 1 time" in answers[2][1], f"info: {answers[2][1]}")
+
 # ---- 3. Writers, waiting bytes, and going back over them ---------------------
 #
 # tests/debug/noei.dc, an edge injected at 1 s. E = the handler's first
