@@ -1,19 +1,21 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/) with clang, ASan and UBSan into
 # build-fuzz/, and runs each for SECONDS (default 60): the compiler, the VM
-# (through a solo run) and the TOML loaders, each starting from the shipped
-# programs or configurations and the saved regressions. A crash, a leak, a
-# timeout or undefined behaviour fails the script; the input is left in
-# build-fuzz/fuzzing/ (copy it to fuzz/regressions/TARGET/ once fixed).
+# (through a solo run), the TOML loaders and simbot dap's server, each
+# starting from the shipped programs or configurations and the saved
+# regressions (for dap: DAP sessions, well and badly formed). A crash, a
+# leak, a timeout or undefined behaviour fails the script; the input is
+# left in build-fuzz/fuzzing/ (copy it to fuzz/regressions/TARGET/ once
+# fixed).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
-# Debug (-O0), and only the three targets: with UBSan, clang's optimiser
+# Debug (-O0), and only the four targets: with UBSan, clang's optimiser
 # spends 420-475 s on vm/vm.cpp alone at -O1 or -O2 (41 s at -O0); the
 # campaigns are short, so build time outweighs executions per second.
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DSIMBOT_FUZZ=ON \
   -DSIMBOT_BENCHMARKS=OFF > build-fuzz.configure.log 2>&1 || { cat build-fuzz.configure.log; exit 1; }
-cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_compiler fuzz_vm fuzz_config
+cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_compiler fuzz_vm fuzz_config fuzz_dap
 work=build-fuzz/fuzzing
 mkdir -p "$work"
 shared=../shared/programs
@@ -22,7 +24,11 @@ run() {  # TARGET SEEDS...
   shift
   mkdir -p "$work/corpus-$target"
   local dict=()
-  [ "$target" = config ] || dict=(-dict=fuzz/dynamic_c.dict)
+  case $target in
+    config) ;;
+    dap) dict=(-dict=fuzz/dap.dict) ;;
+    *) dict=(-dict=fuzz/dynamic_c.dict) ;;
+  esac
   build-fuzz/bin/fuzz_"$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
     -max_len=8192 -print_final_stats=1 "${dict[@]}" -artifact_prefix="$work/$target-" \
     "$work/corpus-$target" fuzz/regressions/"$target" "$@" > "$work/$target.log" 2>&1
@@ -32,8 +38,11 @@ run compiler programs tests/programs tests/errors "$shared" & compiler=$!
 run vm programs tests/programs "$shared" & vm=$!
 wait "$compiler" || { status=1; echo "fuzz: the compiler target failed (log: $work/compiler.log)"; }
 wait "$vm" || { status=1; echo "fuzz: the vm target failed (log: $work/vm.log)"; }
-run config profiles profiles/hardware scenarios || { status=1; echo "fuzz: the config target failed (log: $work/config.log)"; }
-for target in compiler vm config; do
+run config profiles profiles/hardware scenarios & config=$!
+run dap & dap=$!
+wait "$config" || { status=1; echo "fuzz: the config target failed (log: $work/config.log)"; }
+wait "$dap" || { status=1; echo "fuzz: the dap target failed (log: $work/dap.log)"; }
+for target in compiler vm config dap; do
   grep -E "stat::number_of_executed_units|stat::average_exec_per_sec" "$work/$target.log" |
     tr '\n' ' ' | sed "s/^/fuzz $target: /"
   echo
