@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <filesystem>
 #include <iostream>
 #include <streambuf>
 
@@ -53,6 +54,11 @@ class FdBuffer final : public std::streambuf {
 };
 
 debug::Launched launch(const debug::LaunchRequest& r) {
+  if (!r.cwd.empty()) {
+    std::error_code ec;
+    std::filesystem::current_path(r.cwd, ec);
+    if (ec) throw debug::Error(fmt::format("cwd '{}': {}", r.cwd, ec.message()));
+  }
   runs::RunOptions o;
   o.seconds = r.seconds;
   o.seed = r.seed;

@@ -10,10 +10,13 @@
 #include <charconv>
 #include <filesystem>
 #include <istream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <set>
+
+#include "debug/dap_wire.h"
 
 namespace simbot::debug {
 
@@ -21,7 +24,15 @@ namespace {
 
 using nlohmann::json;
 
-constexpr size_t kMaxMessageBytes = 16u << 20;
+// The largest line number, frame id and variables reference a request
+// may name (a program has far fewer lines; ids are this adapter's).
+constexpr int64_t kMaxLine = std::numeric_limits<int32_t>::max();
+constexpr int64_t kMaxId = std::numeric_limits<int64_t>::max();
+// Breakpoints one request may set (a client sends one file's, or all its
+// function or data breakpoints), and the longest source path it may name
+// (Linux's PATH_MAX): each answer echoes its source.
+constexpr size_t kMaxBreakpoints = 1000;
+constexpr size_t kMaxPathBytes = 4096;
 
 std::string absolutePath(const std::string& path) {
   std::error_code ec;
@@ -87,10 +98,19 @@ bool isForward(Resume::Kind k) {
          k == Resume::Kind::Finish || k == Resume::Kind::StepInstruction;
 }
 
+// A string argument, "" when absent (Error if it is not a string).
 std::string text(const json& args, const char* key) {
-  if (!args.is_object() || !args.contains(key) || args[key].is_null()) return "";
-  if (!args[key].is_string()) throw Error(fmt::format("'{}' must be a string", key));
-  return args[key].get<std::string>();
+  return stringArgument(args, key).value_or("");
+}
+
+// A request's array of breakpoints (Error if it is not one, or too
+// long; empty when absent).
+const json& list(const json& args, const char* key) {
+  static const json none = json::array();
+  const json* a = arrayArgument(args, key);
+  if (a && a->size() > kMaxBreakpoints)
+    throw Error(fmt::format("'{}': at most {} in one request", key, kMaxBreakpoints));
+  return a ? *a : none;
 }
 
 }  // namespace
@@ -109,6 +129,7 @@ struct DapServer::Impl {
   std::istream& input;
   std::ostream& output;
   Launcher launcher;
+  std::unique_ptr<DapInbox> inbox;  // while serve() runs
   int64_t seq = 1;
   LaunchRequest launchRequest;
   bool configured = false;  // configurationDone came
@@ -125,51 +146,13 @@ struct DapServer::Impl {
   int64_t nextHandle = 1;
   std::optional<Resume> pending;  // a step for another robot, after the hold moves
   Resume::Kind last = Resume::Kind::Continue;
+  std::optional<Stop> pauseStop;  // a stop a pause made, reported as it is answered
+  bool quitByInterrupt = false;   // a disconnect or terminate ended the session as it ran
 
   Impl(std::istream& i, std::ostream& o, Launcher l)
       : input(i), output(o), launcher(std::move(l)) {}
 
   // ---- the wire ---------------------------------------------------------------
-
-  // The next message; false at the end of the stream.
-  bool read(json& message) {
-    for (;;) {
-      size_t length = 0;
-      bool haveLength = false;
-      std::string line;
-      for (;;) {
-        if (!std::getline(input, line)) return false;
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (line.empty()) {
-          if (haveLength) break;
-          continue;
-        }
-        const auto colon = line.find(':');
-        if (colon == std::string::npos) continue;
-        std::string name = line.substr(0, colon);
-        for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-        if (name != "content-length") continue;
-        const std::string value = trim(line.substr(colon + 1));
-        const auto [end, error] =
-            std::from_chars(value.data(), value.data() + value.size(), length);
-        haveLength = error == std::errc() && end == value.data() + value.size();
-      }
-      if (length > kMaxMessageBytes) {
-        input.ignore(static_cast<std::streamsize>(length));
-        log(fmt::format("simbot dap: a message of {} bytes ignored (the limit is {})\n", length,
-                        kMaxMessageBytes));
-        continue;
-      }
-      std::string body(length, '\0');
-      if (!input.read(body.data(), static_cast<std::streamsize>(length))) return false;
-      message = json::parse(body, nullptr, false);
-      if (message.is_discarded() || !message.is_object()) {
-        log("simbot dap: a message that is not a JSON object ignored\n");
-        continue;
-      }
-      return true;
-    }
-  }
 
   void send(json message) {
     message["seq"] = seq++;
@@ -178,20 +161,20 @@ struct DapServer::Impl {
     output.flush();
   }
 
-  void respond(const json& request, const json& body = json::object()) {
+  void respond(const DapIncoming& request, const json& body = json::object()) {
     json r = {{"type", "response"},
-              {"request_seq", request.value("seq", 0)},
+              {"request_seq", request.seq},
               {"success", true},
-              {"command", request.value("command", "")}};
+              {"command", request.command}};
     if (!body.is_null()) r["body"] = body;
     send(std::move(r));
   }
 
-  void fail(const json& request, const std::string& message) {
+  void fail(const DapIncoming& request, const std::string& message) {
     send({{"type", "response"},
-          {"request_seq", request.value("seq", 0)},
+          {"request_seq", std::max<int64_t>(request.seq, 0)},
           {"success", false},
-          {"command", request.value("command", "")},
+          {"command", request.command},
           {"message", message}});
   }
 
@@ -201,8 +184,17 @@ struct DapServer::Impl {
     send(std::move(e));
   }
 
-  void log(const std::string& line) {
-    event("output", {{"category", "console"}, {"output", line}});
+  void log(const std::string& line, const char* category = "console") {
+    event("output", {{"category", category}, {"output", line}});
+  }
+
+  // A message that cannot be used: an error response when it names a
+  // request, else a line on the client's stderr.
+  void answerProblem(const DapIncoming& m) {
+    if (m.seq >= 0 || !m.command.empty())
+      fail(m, m.problem);
+    else
+      log("simbot dap: " + m.problem + "\n", "stderr");
   }
 
   void terminated() {
@@ -235,79 +227,86 @@ struct DapServer::Impl {
     if (const std::string p = text(args, "profile"); !p.empty()) r.profile = p;
     if (const std::string robot = text(args, "robot"); !robot.empty()) r.robot = robot;
     r.cwd = text(args, "cwd");
-    if (args.contains("seconds") && !args["seconds"].is_null()) {
-      if (!args["seconds"].is_number() || args["seconds"].get<double>() <= 0)
-        throw Error("'seconds' must be a positive number");
-      r.seconds = args["seconds"].get<double>();
+    if (const std::optional<double> seconds = numberArgument(args, "seconds")) {
+      if (!(*seconds > 0)) throw Error("'seconds' must be a positive number");
+      r.seconds = *seconds;
     }
-    if (args.contains("seed") && !args["seed"].is_null()) {
-      if (!args["seed"].is_number_unsigned())
-        throw Error("'seed' must be a whole number, 0 or more");
-      r.seed = args["seed"].get<uint64_t>();
-    }
-    if (args.contains("stopOnEntry")) {
-      if (!args["stopOnEntry"].is_boolean()) throw Error("'stopOnEntry' must be true or false");
-      r.stopOnEntry = args["stopOnEntry"].get<bool>();
-    }
+    r.seed = unsignedArgument(args, "seed");
+    r.stopOnEntry = boolArgument(args, "stopOnEntry").value_or(false);
     return r;
   }
 
   int serve(DapServer& self) {
-    json m;
-    while (!disconnected && read(m)) {
-      if (m.value("type", "") != "request") continue;
-      const std::string command = m.value("command", "");
-      const json args = m.contains("arguments") ? m["arguments"] : json::object();
-      if (command == "initialize") {
-        respond(m, capabilities());
-      } else if (command == "launch") {
-        if (terminatedSent) {
-          fail(m, "this adapter has run its session; start another");
-          continue;
-        }
-        std::optional<Launched> run;
-        int held = -1;
-        try {
-          launchRequest = launchArguments(args);
-          if (!launchRequest.cwd.empty()) {
-            std::error_code ec;
-            std::filesystem::current_path(launchRequest.cwd, ec);
-            if (ec) throw Error(fmt::format("cwd '{}': {}", launchRequest.cwd, ec.message()));
-          }
-          run = launcher(launchRequest);
-          for (size_t i = 0; i < run->config.robots.size(); ++i)
-            if (run->config.robots[i].name == launchRequest.robot) held = static_cast<int>(i);
-          if (held < 0)
-            throw Error(fmt::format("'robot': this run has no robot '{}'", launchRequest.robot));
-        } catch (const std::exception& e) {
-          fail(m, trim(e.what()));
-          continue;
-        }
-        respond(m);
-        event("initialized");
-        try {
-          Session session(run->config, run->programs, held);
-          session.run(self);
-        } catch (const std::exception& e) {
-          log(trim(e.what()) + "\n");
-        }
-        handles.clear();
-        if (disconnected) return 0;
-        terminated();
-      } else if (command == "disconnect") {
-        respond(m);
-        return 0;
-      } else if (command == "attach") {
-        fail(m, "simbot dap launches its run (request \"launch\"); it does not attach");
-      } else if (command == "threads") {
-        respond(m, {{"threads", json::array()}});
-      } else if (command == "setExceptionBreakpoints") {
-        respond(m, {{"breakpoints", json::array()}});
-      } else {
-        fail(m, terminatedSent ? "the session is over" : "launch first");
+    inbox = std::make_unique<DapInbox>(input);
+    while (!disconnected) {
+      const DapIncoming m = inbox->take();
+      if (m.kind == DapIncoming::Kind::End) break;
+      if (m.kind == DapIncoming::Kind::Problem) {
+        answerProblem(m);
+        continue;
+      }
+      try {
+        serveOne(self, m);
+      } catch (const Error& e) {
+        fail(m, e.what());
+      } catch (const std::exception& e) {
+        fail(m, fmt::format("bad request: {}", e.what()));
       }
     }
+    inbox.reset();
     return 0;
+  }
+
+  // One request before (or after) the session.
+  void serveOne(DapServer& self, const DapIncoming& m) {
+    const std::string& command = m.command;
+    if (command == "initialize") {
+      respond(m, capabilities());
+    } else if (command == "launch") {
+      if (terminatedSent) return fail(m, "this adapter has run its session; start another");
+      std::optional<Launched> run;
+      int held = -1;
+      try {
+        launchRequest = launchArguments(m.arguments);
+        run = launcher(launchRequest);
+        for (size_t i = 0; i < run->config.robots.size(); ++i)
+          if (run->config.robots[i].name == launchRequest.robot) held = static_cast<int>(i);
+        if (held < 0)
+          throw Error(fmt::format("'robot': this run has no robot '{}'", launchRequest.robot));
+      } catch (const std::exception& e) {
+        return fail(m, trim(e.what()));
+      }
+      respond(m);
+      event("initialized");
+      // A pause or disconnect that came before the launch is not meant to
+      // stop the run at its first round (one waiting is read at the
+      // first stop).
+      inbox->interrupt()->store(false);
+      try {
+        Session session(run->config, run->programs, held);
+        session.run(self, inbox->interrupt());
+      } catch (const std::exception& e) {
+        log(trim(e.what()) + "\n");
+      }
+      handles.clear();
+      // The terminate that stopped the session sends the event as it is
+      // answered, next.
+      if (!disconnected && !quitByInterrupt) terminated();
+    } else if (command == "disconnect") {
+      respond(m);
+      disconnected = true;
+    } else if (command == "terminate") {
+      respond(m);
+      terminated();
+    } else if (command == "attach") {
+      fail(m, "simbot dap launches its run (request \"launch\"); it does not attach");
+    } else if (command == "threads") {
+      respond(m, {{"threads", json::array()}});
+    } else if (command == "setExceptionBreakpoints") {
+      respond(m, {{"breakpoints", json::array()}});
+    } else {
+      fail(m, terminatedSent ? "the session is over" : "launch first");
+    }
   }
 
   // ---- at a stop --------------------------------------------------------------
@@ -323,14 +322,24 @@ struct DapServer::Impl {
         return how;
       }
     }
-    if (configured || why.kind != Stop::Kind::Entry) {
+    // A stop the client's disconnect or terminate made is not reported;
+    // one its pause made (the session holds the robot with a goto) is
+    // reported as the pause is answered.
+    pauseStop.reset();
+    if (!inbox->quitWaiting() && (configured || why.kind != Stop::Kind::Entry)) {
       configured = true;
-      report(s, why);
+      if (why.kind == Stop::Kind::Goto && inbox->pauseNext())
+        pauseStop = why;
+      else
+        report(s, why);
     }
-    json m;
     for (;;) {
-      if (!read(m)) return quit();
-      if (m.value("type", "") != "request") continue;
+      const DapIncoming m = inbox->take();
+      if (m.kind == DapIncoming::Kind::End) return quit();
+      if (m.kind == DapIncoming::Kind::Problem) {
+        answerProblem(m);
+        continue;
+      }
       const bool wasConfigured = configured;
       Resume how;
       bool resumes = false;
@@ -368,7 +377,7 @@ struct DapServer::Impl {
     return it == dapId.end() ? sessionId : it->second;
   }
 
-  void report(Session& s, const Stop& why) {
+  void report(Session& s, const Stop& why, bool paused = false) {
     const int robot = s.robot();
     const std::string where =
         fmt::format("robot {} at tick {} ({})", s.robotName(robot), s.now(), secondsText(s.now()));
@@ -445,17 +454,16 @@ struct DapServer::Impl {
       description += ": " + why.note;
       log(why.note + "\n");
     }
-    body["reason"] = reason;
+    body["reason"] = paused ? "pause" : reason;
     body["description"] = description;
     if (!detail.empty()) body["text"] = detail;
     event("stopped", body);
   }
 
   // One request at a stop; true with `how` set when it resumes the robot.
-  bool dispatch(Session& s, const json& m, Resume& how) {
-    const std::string command = m.value("command", "");
-    const json args =
-        m.contains("arguments") && m["arguments"].is_object() ? m["arguments"] : json::object();
+  bool dispatch(Session& s, const DapIncoming& m, Resume& how) {
+    const std::string& command = m.command;
+    const json& args = m.arguments;
     using K = Resume::Kind;
     if (command == "configurationDone") {
       configured = true;
@@ -488,9 +496,16 @@ struct DapServer::Impl {
       return false;
     }
     if (command == "pause") {
-      fail(m,
-           "pause is not supported: set a breakpoint (a line, a function, or a time such as "
-           "12.5s as a function breakpoint)");
+      // The reader thread stopped the running command as the pause came:
+      // the stop it made is reported now, after the answer.
+      if (pauseStop) {
+        respond(m);
+        report(s, *pauseStop, true);
+        pauseStop.reset();
+      } else {
+        fail(m, fmt::format("the match is stopped already (robot {} at tick {})",
+                            s.robotName(s.robot()), s.now()));
+      }
       return false;
     }
     if (command == "disconnect") {
@@ -509,7 +524,7 @@ struct DapServer::Impl {
       fail(m, fmt::format("'{}': the session is running already", command));
       return false;
     }
-    const bool instruction = args.value("granularity", "") == "instruction";
+    const bool instruction = text(args, "granularity") == "instruction";
     how = Resume{};
     if (command == "continue") {
       how.kind = K::Continue;
@@ -524,23 +539,21 @@ struct DapServer::Impl {
     } else if (command == "reverseContinue") {
       how.kind = K::ReverseContinue;
     } else {
-      fail(m, fmt::format("'{}' is not supported", command));
+      fail(m, fmt::format("'{}' is not supported", excerpt(command)));
       return false;
     }
+    // A step of the other robot's thread: hold that robot at this tick,
+    // then step it.
+    int robot = s.robot();
+    if (const std::optional<int64_t> thread = threadArgument(s, args);
+        thread && command != "continue" && command != "reverseContinue")
+      robot = static_cast<int>(*thread - 1);
     if (s.over() && isForward(how.kind)) {
       // The match has no more to run: the client's session ends here (it
       // may still step back until it disconnects).
       respond(m, command == "continue" ? json{{"allThreadsContinued", true}} : json::object());
       terminated();
       return false;
-    }
-    // A step of the other robot's thread: hold that robot at this tick,
-    // then step it.
-    int robot = s.robot();
-    if (command != "continue" && command != "reverseContinue" && args.contains("threadId")) {
-      robot = args["threadId"].get<int>() - 1;
-      if (robot < 0 || robot >= s.robotCount())
-        throw Error(fmt::format("no thread {}", args["threadId"].dump()));
     }
     const vm::Vm& v = s.vm(robot);
     if (how.kind == K::Finish && v.callDepth() + v.interruptDepth() == 0)
@@ -554,6 +567,11 @@ struct DapServer::Impl {
       how.tick = s.now();
     }
     return true;
+  }
+
+  // A request's threadId: 1 to the number of robots (Error otherwise).
+  static std::optional<int64_t> threadArgument(const Session& s, const json& args) {
+    return integerArgument(args, "threadId", 1, s.robotCount());
   }
 
   // ---- breakpoints --------------------------------------------------------------
@@ -594,23 +612,38 @@ struct DapServer::Impl {
       s.setIgnore(id, hitsToIgnore(h));
   }
 
-  void setBreakpoints(Session& s, const json& m, const json& args) {
-    const json source = args.value("source", json::object());
+  void setBreakpoints(Session& s, const DapIncoming& m, const json& args) {
+    const json* given = objectArgument(args, "source");
+    const json source = given ? *given : json::object();
     std::string path = text(source, "path");
     if (path.empty()) path = text(source, "name");
+    if (path.size() > kMaxPathBytes)
+      throw Error(fmt::format("'source': a path of at most {} bytes", kMaxPathBytes));
+    // Each breakpoint's fields are read before any is set: a request
+    // refused as a whole changes nothing.
+    json wanted = json::array();
+    if (arrayArgument(args, "breakpoints")) {
+      wanted = list(args, "breakpoints");
+    } else {
+      for (const json& line : list(args, "lines")) wanted.push_back({{"line", line}});
+    }
+    std::vector<int> lines;
+    for (const json& b : wanted) {
+      if (!b.is_object()) throw Error("'breakpoints' must be an array of objects");
+      const std::optional<int64_t> line = integerArgument(b, "line", 1, kMaxLine);
+      if (!line) throw Error("a breakpoint needs its 'line'");
+      lines.push_back(static_cast<int>(*line));
+      text(b, "condition");
+      text(b, "hitCondition");
+    }
     std::vector<int>& ids = lineBreakpoints[path];
     removeAll(s, ids);
     const std::vector<int> robots = robotsOf(s, path);
-    json wanted = json::array();
-    if (args.contains("breakpoints")) {
-      wanted = args["breakpoints"];
-    } else if (args.contains("lines")) {
-      for (const json& line : args["lines"]) wanted.push_back({{"line", line}});
-    }
     json answers = json::array();
-    for (const json& b : wanted) {
-      const int line = b.value("line", 0);
-      json answer = {{"verified", false}, {"line", line}, {"source", source}};
+    for (size_t k = 0; k < wanted.size(); ++k) {
+      const json& b = wanted[k];
+      const int line = lines[k];
+      json answer = {{"verified", false}, {"line", line}, {"source", {{"path", path}}}};
       if (robots.empty()) {
         answer["message"] = fmt::format("{} is not a program of this run", fileName(path));
         answers.push_back(answer);
@@ -646,10 +679,17 @@ struct DapServer::Impl {
   // fault), or a line.
   int functionBreakpoint(Session& s, const std::string& name) { return s.breakAt(trim(name)).id; }
 
-  void setFunctionBreakpoints(Session& s, const json& m, const json& args) {
+  void setFunctionBreakpoints(Session& s, const DapIncoming& m, const json& args) {
+    const json& wanted = list(args, "breakpoints");
+    for (const json& b : wanted) {
+      if (!b.is_object()) throw Error("'breakpoints' must be an array of objects");
+      text(b, "name");
+      text(b, "condition");
+      text(b, "hitCondition");
+    }
     removeAll(s, functionBreakpoints);
     json answers = json::array();
-    for (const json& b : args.value("breakpoints", json::array())) {
+    for (const json& b : wanted) {
       const std::string name = text(b, "name");
       json answer = {{"verified", false}};
       std::vector<int> made;
@@ -676,35 +716,34 @@ struct DapServer::Impl {
 
   // The robot and frame a frame id names (Error if none at this stop).
   std::pair<int, int> frameOf(const Session& s, int64_t id) const {
-    const auto robot = static_cast<int>(id / kDapFrameStride);
-    const auto frame = static_cast<int>(id % kDapFrameStride);
-    if (id < 0 || robot >= s.robotCount() || frame >= static_cast<int>(s.backtrace(robot).size()))
+    const int64_t robot = id / kDapFrameStride, frame = id % kDapFrameStride;
+    if (id < 0 || robot >= s.robotCount() ||
+        frame >= static_cast<int64_t>(s.backtrace(static_cast<int>(robot)).size()))
       throw Error(fmt::format("no frame {} at this stop", id));
-    return {robot, frame};
+    return {static_cast<int>(robot), static_cast<int>(frame)};
   }
 
   // The robot and frame of a request's frameId, or the held robot's
   // selected frame.
   std::pair<int, int> frameArgument(const Session& s, const json& args) const {
-    if (args.contains("frameId") && !args["frameId"].is_null())
-      return frameOf(s, args["frameId"].get<int64_t>());
+    if (const std::optional<int64_t> id = integerArgument(args, "frameId", 0, kMaxId))
+      return frameOf(s, *id);
     return {s.robot(), s.frame()};
   }
 
   const Handle& handle(const json& args) const {
-    const int64_t ref = args.value("variablesReference", int64_t{0});
+    const int64_t ref = integerArgument(args, "variablesReference", 0, kMaxId).value_or(0);
     const auto it = handles.find(ref);
     if (it == handles.end())
       throw Error(fmt::format("no variables reference {} at this stop", ref));
     return it->second;
   }
 
-  void dataBreakpointInfo(Session& s, const json& m, const json& args) {
+  void dataBreakpointInfo(Session& s, const DapIncoming& m, const json& args) {
     const std::string name = text(args, "name");
     int robot = s.robot(), frame = s.frame();
     std::string expression = name;
-    if (args.contains("variablesReference") && !args["variablesReference"].is_null() &&
-        args["variablesReference"].get<int64_t>() != 0) {
+    if (integerArgument(args, "variablesReference", 0, kMaxId).value_or(0) != 0) {
       const Handle& h = handle(args);
       robot = h.robot;
       frame = h.frame;
@@ -749,7 +788,13 @@ struct DapServer::Impl {
   // The client sends the whole list each time: a data breakpoint it sent
   // before (same dataId) is kept as it is, with the object it was set on
   // and its hit count, not evaluated again in this stop's scope.
-  void setDataBreakpoints(Session& s, const json& m, const json& args) {
+  void setDataBreakpoints(Session& s, const DapIncoming& m, const json& args) {
+    const json& wantedList = list(args, "breakpoints");
+    for (const json& b : wantedList) {
+      if (!b.is_object()) throw Error("'breakpoints' must be an array of objects");
+      text(b, "dataId");
+      text(b, "accessType");
+    }
     std::map<std::string, int> kept;
     for (const Watchpoint& w : s.watchpoints())
       for (int id : dataBreakpoints)
@@ -757,14 +802,14 @@ struct DapServer::Impl {
     std::vector<int> dropped;
     for (int id : dataBreakpoints) {
       bool wanted = false;
-      for (const json& b : args.value("breakpoints", json::array()))
+      for (const json& b : wantedList)
         wanted |= kept.count(text(b, "dataId")) && kept[text(b, "dataId")] == id;
       if (!wanted) dropped.push_back(id);
     }
     removeAll(s, dropped);
     dataBreakpoints.clear();
     json answers = json::array();
-    for (const json& b : args.value("breakpoints", json::array())) {
+    for (const json& b : wantedList) {
       json answer = {{"verified", false}};
       try {
         const std::string access = text(b, "accessType");
@@ -790,16 +835,16 @@ struct DapServer::Impl {
 
   // ---- frames and variables -------------------------------------------------------
 
-  void stackTrace(Session& s, const json& m, const json& args) {
-    const int robot = args.value("threadId", s.robot() + 1) - 1;
-    if (robot < 0 || robot >= s.robotCount()) throw Error(fmt::format("no thread {}", robot + 1));
+  void stackTrace(Session& s, const DapIncoming& m, const json& args) {
+    const int robot = static_cast<int>(threadArgument(s, args).value_or(s.robot() + 1) - 1);
     const std::vector<FrameInfo> frames = s.backtrace(robot);
-    const auto total = static_cast<int>(frames.size());
-    const int start = std::clamp(args.value("startFrame", 0), 0, total);
-    const int levels = args.value("levels", 0);
-    const int end = levels > 0 ? std::min(total, start + levels) : total;
+    const auto total = static_cast<int64_t>(frames.size());
+    const int64_t start =
+        std::min(total, integerArgument(args, "startFrame", 0, kMaxId).value_or(0));
+    const int64_t levels = integerArgument(args, "levels", 0, kMaxId).value_or(0);
+    const int64_t end = levels > 0 && levels < total - start ? start + levels : total;
     json out = json::array();
-    for (int k = start; k < end; ++k) {
+    for (int64_t k = start; k < end; ++k) {
       const FrameInfo& f = frames[static_cast<size_t>(k)];
       std::string name =
           fmt::format("{}({})", f.function.empty() ? "<startup>" : f.function, f.arguments);
@@ -821,7 +866,7 @@ struct DapServer::Impl {
     return ref;
   }
 
-  void scopes(Session& s, const json& m, const json& args) {
+  void scopes(Session& s, const DapIncoming& m, const json& args) {
     const auto [robot, frame] = frameArgument(s, args);
     Handle locals;
     locals.kind = Handle::Kind::Locals;
@@ -860,7 +905,7 @@ struct DapServer::Impl {
     return v;
   }
 
-  void variables(Session& s, const json& m, const json& args) {
+  void variables(Session& s, const DapIncoming& m, const json& args) {
     const Handle h = handle(args);
     const inspect::Scope scope = s.scope(h.robot, h.frame);
     json out = json::array();
@@ -886,16 +931,16 @@ struct DapServer::Impl {
         break;
     }
     const auto total = static_cast<int64_t>(out.size());
-    const int64_t start = std::clamp<int64_t>(args.value("start", int64_t{0}), 0, total);
-    const int64_t count = args.value("count", int64_t{0});
+    const int64_t start = std::min(total, integerArgument(args, "start", 0, kMaxId).value_or(0));
+    const int64_t count = integerArgument(args, "count", 0, kMaxId).value_or(0);
     if (start > 0 || count > 0) {
-      const int64_t end = count > 0 ? std::min(total, start + count) : total;
+      const int64_t end = count > 0 && count < total - start ? start + count : total;
       out = json(std::vector<json>(out.begin() + start, out.begin() + end));
     }
     respond(m, {{"variables", out}});
   }
 
-  void evaluate(Session& s, const json& m, const json& args) {
+  void evaluate(Session& s, const DapIncoming& m, const json& args) {
     const std::string expression = trim(text(args, "expression"));
     if (expression.empty()) throw Error("evaluate needs an expression");
     const auto [robot, frame] = frameArgument(s, args);
@@ -918,6 +963,15 @@ int DapServer::serve() { return impl_->serve(*this); }
 
 Resume DapServer::stopped(Session& session, const Stop& why) {
   return impl_->stopped(session, why);
+}
+
+void DapServer::resuming() { impl_->inbox->resuming(); }
+
+// A disconnect or terminate stopped the command: the session ends without
+// holding the robot (a replay from a snapshot) first.
+bool DapServer::quitOnInterrupt() {
+  impl_->quitByInterrupt = impl_->inbox->quitWaiting();
+  return impl_->quitByInterrupt;
 }
 
 }  // namespace simbot::debug

@@ -13,6 +13,12 @@
 // until one resumes the robot (continue, next, stepIn, stepOut, stepBack,
 // reverseContinue) or ends the session (disconnect, terminate).
 //
+// Requests are read on a thread of their own (dap_wire.h), and checked
+// there: one that cannot be used is answered with an error and the session
+// goes on. While the match runs they wait for the next stop, but
+// disconnect and terminate end the session at once and pause stops the
+// match where it got to (the session's interrupt flag).
+//
 // Threads are the robots: thread 1 is A, thread 2 is B; the `stopped`
 // event names the held robot's. A stack frame's id is its index in its
 // robot's backtrace (0 innermost) plus kDapFrameStride times the robot's
@@ -43,7 +49,7 @@ struct LaunchRequest {
   std::string scenario;
   std::string robot = "A";  // the robot held first
   bool stopOnEntry = false;
-  std::string cwd;  // relative paths are taken from here (the server changes to it)
+  std::string cwd;  // relative paths are taken from here (the launcher changes to it)
 };
 
 // The run a launch request names: its configuration and each robot's file
@@ -69,6 +75,8 @@ class DapServer final : public Controller {
   int serve();
 
   Resume stopped(Session& session, const Stop& why) override;
+  void resuming() override;
+  bool quitOnInterrupt() override;
 
  private:
   struct Impl;

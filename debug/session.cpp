@@ -103,6 +103,7 @@ void Session::run(Controller& controller, std::atomic<bool>* interrupt) {
         if (how.kind == Resume::Kind::Quit) return;
         if (reverse(how.kind)) {
           if (interrupt_) interrupt_->store(false);
+          controller_->resuming();
           Rewind r{how, now(), 0, 0, 0, {}};
           const vm::Vm& v = vm(held_);
           r.line = v.line();
@@ -120,6 +121,7 @@ void Session::run(Controller& controller, std::atomic<bool>* interrupt) {
       // did not; hold the robot where it is (replayed from a snapshot, as
       // any place is reached).
       interrupt->store(false);
+      if (controller_->quitOnInterrupt()) return;
       scan_.reset();
       Rewind r;
       r.how.kind = Resume::Kind::Goto;
@@ -632,6 +634,7 @@ void Session::handle(const Resume& how) {
   if (how.kind == Resume::Kind::Quit) throw Quit{};
   // A Ctrl-C at the prompt is not meant for the command that follows.
   if (interrupt_) interrupt_->store(false);
+  controller_->resuming();
   if (!reverse(how.kind)) {
     startMode(how);
     return;

@@ -162,6 +162,15 @@ class Controller {
   // The session stopped: inspect it through its accessors, change its
   // breakpoints, and say how to go on.
   virtual Resume stopped(Session& session, const Stop& why) = 0;
+  // The session goes on after a stop, its interrupt flag cleared (a
+  // Ctrl-C typed while stopped() decided is not for the next command): a
+  // controller that sets the flag from another thread sets it again here
+  // if a request to stop came in that time (simbot dap's disconnect).
+  virtual void resuming() {}
+  // The interrupt flag stopped a running command: true ends the session
+  // there (run() returns at once), false holds the robot where the match
+  // got to and reports that stop.
+  virtual bool quitOnInterrupt() { return false; }
 };
 
 class Session final : private scheduler::DebugHook {

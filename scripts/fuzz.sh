@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/) with clang, ASan and UBSan into
 # build-fuzz/, and runs each for SECONDS (default 60): the compiler, the VM
-# (through a solo run), the TOML loaders and the debugger's expressions,
-# each starting from the shipped programs, configurations or debugger
-# scripts and the saved regressions. A crash, a leak, a
-# timeout or undefined behaviour fails the script; the input is left in
-# build-fuzz/fuzzing/ (copy it to fuzz/regressions/TARGET/ once fixed).
+# (through a solo run), the TOML loaders, the debugger's expressions and
+# simbot dap's server, each starting from the shipped programs,
+# configurations or debugger scripts and the saved regressions (for dap: DAP
+# sessions, well and badly formed). A crash, a leak, a timeout or undefined
+# behaviour fails the script; the input is left in build-fuzz/fuzzing/ (copy
+# it to fuzz/regressions/TARGET/ once fixed).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
@@ -14,7 +15,8 @@ seconds=${1:-60}
 # campaigns are short, so build time outweighs executions per second.
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DSIMBOT_FUZZ=ON \
   -DSIMBOT_BENCHMARKS=OFF > build-fuzz.configure.log 2>&1 || { cat build-fuzz.configure.log; exit 1; }
-cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_compiler fuzz_vm fuzz_config fuzz_inspect
+cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_compiler fuzz_vm fuzz_config fuzz_inspect \
+  fuzz_dap
 work=build-fuzz/fuzzing
 mkdir -p "$work"
 shared=../shared/programs
@@ -24,8 +26,10 @@ run() {  # TARGET SEEDS...
   mkdir -p "$work/corpus-$target"
   local dict=()
   case $target in
-    compiler | vm) dict=(-dict=fuzz/dynamic_c.dict) ;;
+    config) ;;
     inspect) dict=(-dict=fuzz/inspect.dict) ;;
+    dap) dict=(-dict=fuzz/dap.dict) ;;
+    *) dict=(-dict=fuzz/dynamic_c.dict) ;;
   esac
   build-fuzz/bin/fuzz_"$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
     -max_len=8192 -print_final_stats=1 "${dict[@]}" -artifact_prefix="$work/$target-" \
@@ -37,10 +41,13 @@ run vm programs tests/programs "$shared" & vm=$!
 wait "$compiler" || { status=1; echo "fuzz: the compiler target failed (log: $work/compiler.log)"; }
 wait "$vm" || { status=1; echo "fuzz: the vm target failed (log: $work/vm.log)"; }
 run config profiles profiles/hardware scenarios & config=$!
+# The second wave runs three targets on the two cores: each its full time.
 run inspect tests/debug & inspect=$!
+run dap & dap=$!
 wait "$config" || { status=1; echo "fuzz: the config target failed (log: $work/config.log)"; }
 wait "$inspect" || { status=1; echo "fuzz: the inspect target failed (log: $work/inspect.log)"; }
-for target in compiler vm config inspect; do
+wait "$dap" || { status=1; echo "fuzz: the dap target failed (log: $work/dap.log)"; }
+for target in compiler vm config inspect dap; do
   grep -E "stat::number_of_executed_units|stat::average_exec_per_sec" "$work/$target.log" |
     tr '\n' ' ' | sed "s/^/fuzz $target: /"
   echo

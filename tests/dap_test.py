@@ -17,6 +17,22 @@ a hit count (the second entry into INT1); stepping robot B's thread (the
 hold moves to B); a condition that is never true runs the match to its
 end; continuing past the end ends the session (terminated).
 
+Session 3 (what a broken or hostile client sends, after the robustness
+audit of issue 38): a request whose arguments nest 150,000 arrays (300 KB),
+one with 350,000 empty objects (1 MB), {"type": 5}, {"seq": "abc"}, arguments that are not an object, a missing
+command, Content-Length "abc", negative, huge or too large for its body,
+a header block without one, an unknown header, a body that is not JSON, a
+line that is not a header; then arguments of the wrong type or range at a
+stop. Each is answered (an error response where the request's seq or
+command can be read, else an `output` event on stderr) and the next good
+request is answered. Session 4: a body the input ends inside.
+
+Session 5 (a continue in a 600-s match that steps every instruction for
+a data breakpoint that never fires: a minute or more): pause stops it at
+once (the answer, then a `stopped` event with reason "pause"); terminate
+stops it at once; disconnect during it ends the adapter within 2 s (the
+time is printed).
+
 Every response's success and contents are checked.
 """
 import json
@@ -26,6 +42,7 @@ import re
 import subprocess
 import sys
 import threading
+import time
 
 SIMBOT, ICEMAN, FIG92 = sys.argv[1:4]
 ICEMAN = os.path.abspath(ICEMAN)
@@ -51,6 +68,7 @@ class Client:
         self.seq = 1
         self.messages = queue.Queue()
         self.events = []  # every event seen, in order
+        self.responses = []  # responses seen while waiting for another
         self.stderr = b""
         threading.Thread(target=self._read, daemon=True).start()
         threading.Thread(target=self._drain, daemon=True).start()
@@ -102,6 +120,49 @@ class Client:
         self.proc.stdin.flush()
         return message["seq"]
 
+    def raw(self, data):
+        """Bytes as they are, framing and all."""
+        if TRACE:
+            print("->", data[:200])
+        self.proc.stdin.write(data)
+        self.proc.stdin.flush()
+
+    def next_seq(self):
+        self.seq += 1
+        return self.seq - 1
+
+    def response(self, request_seq, command=None):
+        """The response to request_seq (events and other responses on the way
+        are kept)."""
+        def wanted(m):
+            return m.get("request_seq") == request_seq and (command is None or m.get("command") == command)
+        for k, m in enumerate(self.responses):
+            if wanted(m):
+                return self.responses.pop(k)
+        while True:
+            m = self._next()
+            if m.get("type") == "event":
+                self.events.append(m)
+            elif m.get("type") == "response":
+                if wanted(m):
+                    return m
+                self.responses.append(m)
+
+    def refused(self, request_seq, command, words):
+        """An error response to request_seq that names `words`."""
+        m = self.response(request_seq, command)
+        check(m.get("success") is False and words in m.get("message", ""),
+              f"{command} #{request_seq}: wanted an error naming {words!r}, got {m}")
+        return m
+
+    def output(self, words):
+        """The next `output` event on stderr, which must name `words`."""
+        e = self.event("output")["body"]
+        check(e.get("category") == "stderr" and words in e.get("output", ""),
+              f"output: wanted {words!r} on stderr, got {e}")
+        check(e.get("output", "").count("\n") == 1, f"output: one line: {e}")
+        return e
+
     def request(self, command, arguments=None, success=True):
         """The response to one request (events on the way are kept)."""
         seq = self.send(command, arguments)
@@ -110,6 +171,8 @@ class Client:
             if m.get("type") == "event":
                 self.events.append(m)
                 continue
+            if m.get("type") == "response" and m.get("request_seq") != seq:
+                self.responses.append(m)
             if m.get("type") == "response" and m.get("request_seq") == seq:
                 check(m.get("command") == command, f"{command}: response names {m.get('command')}")
                 check(m.get("success") is success,
@@ -384,6 +447,230 @@ c.frames()  # still inspectable
 c.request("continue", {"threadId": 1})
 c.event("terminated")
 c.finish()
+
+# ---- session 3: a broken or hostile client ------------------------------------------
+
+
+def framed(body, header=None):
+    body = body if isinstance(body, bytes) else json.dumps(body).encode()
+    return (header if header is not None else b"Content-Length: %d\r\n\r\n" % len(body)) + body
+
+
+def answered(client, what):
+    """A good request after a bad one is answered."""
+    r = client.request("initialize", {"adapterID": "simbot"})
+    check(r["body"].get("supportsStepBack") is True, f"initialize after {what}: {r}")
+
+
+c = Client()
+# 150,000 nested arrays in a 300-KB request (once a SIGSEGV in a recursive
+# copy): refused as the JSON is parsed, without recursion.
+n = c.next_seq()
+deep = b'{"seq":%d,"type":"request","command":"evaluate","arguments":' % n + \
+    b"[" * 150000 + b"]" * 150000 + b"}"
+check(len(deep) > 300000, f"the nested request is {len(deep)} bytes")
+c.raw(framed(deep))
+c.refused(n, "evaluate", "nested more than 64 deep")
+answered(c, "150,000 nested arrays")
+# The same depth under a key of the arguments object.
+n = c.next_seq()
+c.raw(framed(b'{"seq":%d,"type":"request","command":"launch","arguments":{"program":' % n +
+             b"[" * 150000 + b"]" * 150000 + b"}}"))
+c.refused(n, "launch", "nested more than 64 deep")
+# Wide rather than deep: 350,000 empty objects in 1 MB are built in one
+# pass (nlohmann's parser callback would scan the array at each one's end:
+# hours).
+n = c.next_seq()
+c.raw(framed(b'{"seq":%d,"type":"request","command":"threads","arguments":{"x":[' % n +
+             b"{}," * 350000 + b'{}]}}'))
+check(c.response(n, "threads").get("success") is True, "threads with 350,000 objects in its arguments")
+# Fields of the wrong type (once "internal error", exit 2).
+n = c.next_seq()
+c.raw(framed({"type": 5, "seq": n, "command": "threads"}))
+c.refused(n, "threads", "'type' must be")
+c.raw(framed({"seq": "abc", "type": "request", "command": "threads"}))
+c.refused(0, "threads", "'seq' must be an integer")
+n = c.next_seq()
+c.raw(framed({"seq": n, "type": "request", "command": "threads", "arguments": [1, 2]}))
+c.refused(n, "threads", "'arguments' must be an object")
+n = c.next_seq()
+c.raw(framed({"seq": n, "type": "request", "command": 7}))
+c.refused(n, "", "'command' must be")
+n = c.next_seq()
+c.raw(framed({"seq": n, "type": "request", "command": "launch", "arguments": {"program": 5}}))
+c.refused(n, "launch", "'program' must be a string")
+n = c.next_seq()
+c.raw(framed({"seq": n, "type": "request", "command": "launch",
+              "arguments": {"program": ICEMAN, "stopOnEntry": "yes"}}))
+c.refused(n, "launch", "'stopOnEntry' must be true or false")
+answered(c, "fields of the wrong type")
+# Framing: after a Content-Length that is no count (once the end of all
+# answers), the body is read up to its closing brace and answered.
+for bad in [b"abc", b"-5", b"99999999999999999999999"]:
+    n = c.next_seq()
+    c.raw(framed({"seq": n, "type": "request", "command": "threads"},
+                 b"Content-Length: " + bad + b"\r\n\r\n"))
+    c.refused(n, "threads", "Content-Length")
+    answered(c, b"Content-Length: " + bad)
+    answered(c, b"Content-Length: " + bad + b" (twice)")
+# A count over the 4-MB limit, honest or not: refused, not read.
+n = c.next_seq()
+c.raw(framed({"seq": n, "type": "request", "command": "threads"}, b"Content-Length: 5000000\r\n\r\n"))
+c.refused(n, "threads", "over the limit of 4194304 bytes")
+answered(c, "a Content-Length over the limit")
+# No Content-Length at all, and an unknown header beside a good one.
+n = c.next_seq()
+c.raw(framed({"seq": n, "type": "request", "command": "threads"}, b"X-Thing: 1\r\n\r\n"))
+c.output("header 'X-Thing' ignored")
+c.refused(n, "threads", "without Content-Length")
+n = c.next_seq()
+body = json.dumps({"seq": n, "type": "request", "command": "threads"}).encode()
+c.raw(b"Content-Type: application/json\r\nContent-Length: %d\r\n\r\n" % len(body) + body)
+c.output("header 'Content-Type' ignored")
+check(c.response(n, "threads").get("success") is True, "threads beside an unknown header")
+# A Content-Length larger than its body: the next message is found inside.
+n = c.next_seq()
+body = json.dumps({"seq": n, "type": "request", "command": "threads"}).encode()
+c.raw(b"Content-Length: %d\r\n\r\n" % (len(body) + 30) + body)
+answered(c, "a Content-Length larger than its body")
+c.refused(n, "threads", "a Content-Length of")
+# A body that is not JSON, a line that is not a header, a message that is
+# not an object: a line on stderr each (nothing names a request).
+c.raw(framed(b"hello"))
+c.output("not JSON")
+answered(c, "a body that is not JSON")
+c.raw(b"this is not a header\r\n")
+c.output("is not a header line")
+answered(c, "a line that is not a header")
+c.raw(framed(b"[1, 2, 3]"))
+c.output("must be a JSON object")
+c.raw(framed(b"{}"))
+c.output("'type' must be")
+answered(c, "messages that are not requests")
+
+# Arguments of the wrong type or range at a stop.
+c.request("launch", {"program": ICEMAN, "seconds": 5, "stopOnEntry": True})
+c.event("initialized")
+c.request("configurationDone")
+c.stopped("entry")
+frames = c.frames()
+for arguments, words in [
+        ({"threadId": "1"}, "'threadId' must be an integer from 1 to 1"),
+        ({"threadId": 2}, "'threadId' must be an integer from 1 to 1"),
+        ({"threadId": 1, "levels": -1}, "'levels' must be an integer"),
+        ({"threadId": 1, "startFrame": 1.5}, "'startFrame' must be an integer")]:
+    r = c.request("stackTrace", arguments, success=False)
+    check(words in r.get("message", ""), f"stackTrace {arguments}: {r.get('message')!r}")
+big = 2**63 - 1
+r = c.request("stackTrace", {"threadId": 1, "startFrame": 1, "levels": big})
+check(len(r["body"]["stackFrames"]) == len(frames) - 1, f"stackTrace levels 2^63-1: {r['body']}")
+r = c.request("stackTrace", {"threadId": 1, "startFrame": big})
+check(r["body"]["stackFrames"] == [], f"stackTrace startFrame 2^63-1: {r['body']}")
+for arguments, words in [({"frameId": 1e300}, "'frameId' must be an integer"),
+                         ({"frameId": 2**62}, "no frame"),
+                         ({"frameId": -1}, "'frameId' must be an integer"),
+                         ({"frameId": 2**64}, "'frameId' must be an integer")]:
+    r = c.request("scopes", arguments, success=False)
+    check(words in r.get("message", ""), f"scopes {arguments}: {r.get('message')!r}")
+scopes = c.request("scopes", {"frameId": frames[0]["id"]})["body"]["scopes"]
+globals_ref = scopes[1]["variablesReference"]
+everything = c.request("variables", {"variablesReference": globals_ref})["body"]["variables"]
+r = c.request("variables", {"variablesReference": globals_ref, "start": 1, "count": big})
+check(r["body"]["variables"] == everything[1:], "variables start 1, count 2^63-1")
+for arguments, words in [({"variablesReference": -1}, "'variablesReference' must be"),
+                         ({"variablesReference": "1"}, "'variablesReference' must be"),
+                         ({"variablesReference": globals_ref, "count": -3}, "'count' must be")]:
+    r = c.request("variables", arguments, success=False)
+    check(words in r.get("message", ""), f"variables {arguments}: {r.get('message')!r}")
+for arguments, words in [({"source": {"path": ICEMAN}, "breakpoints": [{"line": "abc"}]}, "'line' must be"),
+                         ({"source": {"path": ICEMAN}, "breakpoints": [{"line": 1e300}]}, "'line' must be"),
+                         ({"source": {"path": ICEMAN}, "breakpoints": [{"line": 0}]}, "'line' must be"),
+                         ({"source": {"path": ICEMAN}, "breakpoints": [7]}, "array of objects"),
+                         ({"source": {"path": ICEMAN}, "breakpoints": {"line": 3}}, "must be an array"),
+                         ({"source": "iceman.dc", "breakpoints": []}, "'source' must be an object"),
+                         ({"source": {"path": ICEMAN}, "breakpoints": [{"line": 191, "condition": 1}]},
+                          "'condition' must be a string"),
+                         ({"source": {"path": ICEMAN}, "breakpoints": [{"line": 191}] * 1001},
+                          "at most 1000")]:
+    r = c.request("setBreakpoints", arguments, success=False)
+    check(words in r.get("message", ""), f"setBreakpoints {str(arguments)[:80]}: {r.get('message')!r}")
+r = c.request("setFunctionBreakpoints", {"breakpoints": [{"name": 3}]}, success=False)
+check("'name' must be a string" in r.get("message", ""), f"setFunctionBreakpoints: {r}")
+r = c.request("next", {"threadId": 2**32 + 1}, success=False)
+check("'threadId'" in r.get("message", ""), f"next threadId 2^32+1: {r}")
+r = c.request("evaluate", {"expression": 5}, success=False)
+check("'expression' must be a string" in r.get("message", ""), f"evaluate 5: {r}")
+r = c.request("evaluate", {"expression": "(" * 400 + "1" + ")" * 400}, success=False)
+check("nested too deeply" in r.get("message", ""), f"evaluate of 400 parentheses: {r.get('message', '')[:80]}")
+# Still at the entry, still answering.
+check(c.evaluate("count", frames[0]["id"])["result"] is not None, "evaluate after the refusals")
+c.finish()
+check(b"internal error" not in c.stderr, f"stderr: {c.stderr[-300:]!r}")
+
+# ---- session 4: the input ends inside a message -----------------------------------
+
+c = Client()
+answered(c, "nothing")
+c.raw(b'Content-Length: 100\r\n\r\n{"seq": 9')
+c.proc.stdin.close()
+c.output("the input ended 9 bytes into a message of 100")
+check(c.proc.wait(timeout=TIMEOUT) == 0, "exit status after a truncated message")
+
+# ---- session 5: pause, terminate and disconnect while a long match runs ------------
+
+LONG = {"program": ICEMAN, "opponent": FIG92, "seed": 3, "seconds": 600, "stopOnEntry": True}
+
+
+def run_long():
+    """A continue that runs for a minute or more in any build: a data
+    breakpoint on ICEMAN's global i, which it declares and never writes,
+    makes the session step every instruction (the 600-s match alone runs in
+    about a second here: too short to stop for sure in its middle)."""
+    client = Client()
+    start(client, LONG)
+    client.request("configurationDone")
+    client.stopped("entry")
+    r = client.request("setDataBreakpoints", {"breakpoints": [{"dataId": "i", "accessType": "write"}]})
+    check(r["body"]["breakpoints"][0].get("verified") is True, f"a data breakpoint on i: {r['body']}")
+    client.request("continue", {"threadId": 1})
+    time.sleep(0.5)
+    check(not any(e["event"] == "stopped" for e in client.events), "the long match runs")
+    return client
+
+
+c = run_long()
+c.request("pause", {"threadId": 1})
+stop = c.stopped("pause")
+paused_at = tick_of(stop)
+check(0 < paused_at < 600 * 9216000, f"paused inside the match: {stop}")
+check(c.frames()[0]["line"] > 0, "frames at the pause")
+c.request("pause", {"threadId": 1}, success=False)  # stopped already
+c.finish()
+
+c = run_long()
+began = time.monotonic()
+c.request("terminate")
+c.event("terminated")
+terminate_s = time.monotonic() - began
+check(terminate_s < 2, f"terminate during a continue took {terminate_s:.3f} s")
+c.finish()
+
+c = run_long()
+began = time.monotonic()
+n = c.send("disconnect", {"terminateDebuggee": True})
+r = c.response(n, "disconnect")
+check(r.get("success") is True, f"disconnect: {r}")
+try:
+    status = c.proc.wait(timeout=TIMEOUT)
+except subprocess.TimeoutExpired:
+    c.proc.kill()
+    raise SystemExit("FAIL: simbot dap did not exit after disconnect")
+disconnect_s = time.monotonic() - began
+check(status == 0, f"exit status {status} after disconnect")
+check(disconnect_s < 2, f"disconnect during a continue took {disconnect_s:.3f} s to exit")
+check(not any(e["event"] == "stopped" for e in c.events), "no stopped event before the disconnect's answer")
+print(f"disconnect during a continue: exit {disconnect_s:.3f} s after it was sent; "
+      f"terminate answered in {terminate_s:.3f} s")
 
 if failures:
     print(f"{len(failures)} check(s) failed")
