@@ -387,16 +387,8 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
   }
   if (command == "watch") {
     auto [expression, condition] = splitCondition(args);
-    // "B:EXPR": the other robot's variable, read in its innermost frame
-    // (FUNCTION::NAME keeps its two colons).
-    int robot = s.robot();
-    for (int r = 0; r < s.robotCount(); ++r) {
-      const std::string prefix = s.robotName(r) + ":";
-      if (expression.rfind(prefix, 0) == 0 && expression.compare(prefix.size(), 1, ":") != 0) {
-        robot = r;
-        expression = trim(expression.substr(prefix.size()));
-      }
-    }
+    // "B:EXPR": the other robot's variable, read in its innermost frame.
+    const int robot = s.robotOfExpression(expression);
     if (expression.empty()) throw Error("watch needs an expression");
     const Watchpoint& w = s.watch(expression, condition, robot);
     out_ << fmt::format("Watchpoint {}: {} (now {}){}\n", w.id, expression, w.text,

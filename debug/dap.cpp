@@ -140,7 +140,8 @@ struct DapServer::Impl {
   // breakpoint in each; the client knows it by the first one's id.
   std::map<std::string, std::vector<int>> lineBreakpoints;  // by source path
   std::vector<int> functionBreakpoints, dataBreakpoints;
-  std::map<int, int> dapId;  // session id -> the id the client knows
+  std::map<int, std::string> dataIds;  // a data breakpoint's session id -> the client's dataId
+  std::map<int, int> dapId;            // session id -> the id the client knows
   std::set<int> functionIds;
   std::map<int64_t, Handle> handles;
   int64_t nextHandle = 1;
@@ -402,14 +403,26 @@ struct DapServer::Impl {
         if (why.oldValue.empty() && why.newValue.empty()) {
           description = fmt::format("data breakpoint {}: {}", why.breakpoint, where);
         } else {
-          description = fmt::format("data breakpoint {}: written by line {}, {}", why.breakpoint,
-                                    why.writtenAt, where);
+          // Going backwards the robot stands before the write, the later
+          // value first (as simbot debug says it).
+          const std::string back =
+              why.reverse ? " (going backwards: stopped before that write)" : "";
+          description = fmt::format("data breakpoint {}: written by {}{}, {}", why.breakpoint,
+                                    why.writer, back, where);
           detail = fmt::format("old value = {}\nnew value = {}", why.oldValue, why.newValue);
-          log(fmt::format(
-              "Data breakpoint {}: written by line {}\nOld value = {}\nNew value = {}\n",
-              why.breakpoint, why.writtenAt, why.oldValue, why.newValue));
+          log(fmt::format("Data breakpoint {}: written by {}{}\nOld value = {}\nNew value = {}\n",
+                          why.breakpoint, why.writer, back, why.oldValue, why.newValue));
         }
-        body["hitBreakpointIds"] = json::array({why.breakpoint});
+        if (why.removed) {
+          // The adapter removed it (its variable's call returned): the
+          // client is told, as for any breakpoint it did not remove itself.
+          std::erase(dataBreakpoints, why.removed);
+          dataIds.erase(why.removed);
+          event("breakpoint", {{"reason", "removed"},
+                               {"breakpoint", {{"id", why.removed}, {"verified", false}}}});
+        } else {
+          body["hitBreakpointIds"] = json::array({why.breakpoint});
+        }
         break;
       case Stop::Kind::Fault: {
         reason = "exception";
@@ -441,7 +454,8 @@ struct DapServer::Impl {
             reason = "step";
             break;
           case Resume::Kind::ReverseContinue:
-            reason = why.note.empty() ? "breakpoint" : "goto";
+            // A hit reports as a breakpoint (above); this is the start.
+            reason = "goto";
             break;
           default:
             reason = "goto";
@@ -490,7 +504,7 @@ struct DapServer::Impl {
     if (command == "stackTrace") return stackTrace(s, m, args), false;
     if (command == "scopes") return scopes(s, m, args), false;
     if (command == "variables") return variables(s, m, args), false;
-    if (command == "evaluate") return evaluate(s, m, args), false;
+    if (command == "evaluate") return evaluate(s, m, args, how);
     if (command == "source") {
       fail(m, "the sources are the programs' files: open them by their paths");
       return false;
@@ -561,10 +575,10 @@ struct DapServer::Impl {
     respond(m, command == "continue" ? json{{"allThreadsContinued", true}} : json::object());
     if (robot != s.robot()) {
       pending = how;
+      // The robots stay where they are (Session::anchor), then it steps.
       how = Resume{};
       how.kind = K::Hold;
       how.robot = robot;
-      how.tick = s.now();
     }
     return true;
   }
@@ -584,6 +598,7 @@ struct DapServer::Impl {
         // A temporary one gone, a watchpoint whose call returned.
       }
       dapId.erase(id);
+      dataIds.erase(id);
       functionIds.erase(id);
     }
     ids.clear();
@@ -760,21 +775,14 @@ struct DapServer::Impl {
       std::tie(robot, frame) = frameArgument(s, args);
     }
     json body = {{"dataId", nullptr}, {"description", ""}};
-    if (robot != s.robot()) {
-      body["description"] = fmt::format(
-          "only the held robot's variables can be watched (robot {}, thread {}); step robot {}'s "
-          "thread first",
-          s.robotName(s.robot()), s.robot() + 1, s.robotName(robot));
-      respond(m, body);
-      return;
-    }
     try {
       const inspect::Scope scope = s.scope(robot, frame);
       const inspect::Value v = inspect::Expression(expression).evaluate(scope);
       if (!v.inMemory) {
         body["description"] = fmt::format("'{}' is not an object in memory", expression);
       } else {
-        body = {{"dataId", expression},
+        // The robot goes with it: a data breakpoint on either robot.
+        body = {{"dataId", s.robotName(robot) + ":" + expression},
                 {"description", fmt::format("{} ({})", expression, inspect::typeName(scope, v))},
                 {"accessTypes", json::array({"write"})},
                 {"canPersist", false}};
@@ -796,9 +804,7 @@ struct DapServer::Impl {
       text(b, "accessType");
     }
     std::map<std::string, int> kept;
-    for (const Watchpoint& w : s.watchpoints())
-      for (int id : dataBreakpoints)
-        if (w.id == id) kept[w.expression->text()] = id;
+    for (int id : dataBreakpoints) kept[dataIds[id]] = id;
     std::vector<int> dropped;
     for (int id : dataBreakpoints) {
       bool wanted = false;
@@ -820,8 +826,11 @@ struct DapServer::Impl {
         if (const auto it = kept.find(dataId); it != kept.end())
           for (const Watchpoint& w : s.watchpoints())
             if (w.id == it->second) existing = &w;
-        const Watchpoint& w = existing ? *existing : s.watch(dataId);
+        std::string expression = dataId;
+        const int robot = s.robotOfExpression(expression);
+        const Watchpoint& w = existing ? *existing : s.watch(expression, "", robot);
         dataBreakpoints.push_back(w.id);
+        dataIds[w.id] = dataId;
         answer = {{"id", w.id},
                   {"verified", true},
                   {"message", fmt::format("{} (now {})", w.expression->text(), w.text)}};
@@ -940,9 +949,21 @@ struct DapServer::Impl {
     respond(m, {{"variables", out}});
   }
 
-  void evaluate(Session& s, const DapIncoming& m, const json& args) {
+  // An expression's value; in the debug console (context "repl") also
+  // `goto TIME` or `goto TICK` (a time as simbot debug's goto takes it),
+  // which goes there, either way, and stops: true with `how` set.
+  bool evaluate(Session& s, const DapIncoming& m, const json& args, Resume& how) {
     const std::string expression = trim(text(args, "expression"));
     if (expression.empty()) throw Error("evaluate needs an expression");
+    if (text(args, "context") == "repl" && expression.rfind("goto ", 0) == 0) {
+      how = Resume{};
+      how.kind = Resume::Kind::Goto;
+      how.tick = parseTime(trim(expression.substr(5)));
+      respond(m, {{"result", fmt::format("going to tick {} ({})", how.tick, secondsText(how.tick))},
+                  {"variablesReference", 0}});
+      last = how.kind;
+      return true;
+    }
     const auto [robot, frame] = frameArgument(s, args);
     const inspect::Scope scope = s.scope(robot, frame);
     const inspect::Value v = inspect::Expression(expression).evaluate(scope);
@@ -951,6 +972,7 @@ struct DapServer::Impl {
     respond(m, {{"result", result},
                 {"type", inspect::typeName(scope, v)},
                 {"variablesReference", var["variablesReference"]}});
+    return false;
   }
 };
 

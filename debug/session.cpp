@@ -453,6 +453,7 @@ bool Session::watchpointHit(int robot, Stop& why) {
       why.breakpoint = w.id;
       why.note =
           fmt::format("watchpoint {} deleted: the call its variable lived in returned", w.id);
+      why.removed = w.id;
       watchpoints_.erase(watchpoints_.begin() + static_cast<std::ptrdiff_t>(k));
       return true;
     }
@@ -917,6 +918,18 @@ int Session::robotOf(std::string& where) const {
     }
   }
   throw Error(fmt::format("no robot or program '{}' in this run", prefix));
+}
+
+int Session::robotOfExpression(std::string& expression) const {
+  for (int r = 0; r < robotCount(); ++r) {
+    const std::string prefix = robotName(r) + ":";
+    if (expression.rfind(prefix, 0) == 0 && expression.compare(prefix.size(), 1, ":") != 0) {
+      expression.erase(0, prefix.size());
+      expression.erase(0, expression.find_first_not_of(" \t"));
+      return r;
+    }
+  }
+  return held_;
 }
 
 std::vector<std::string> Session::takeNotices() { return std::exchange(notices_, {}); }

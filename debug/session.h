@@ -115,6 +115,9 @@ struct Stop {
   // boundary before the instruction or service that made the change, so
   // the old value is the later one.
   bool reverse = false;
+  // A watchpoint the session removed at this stop (0: none): the call its
+  // variable lived in returned.
+  int removed = 0;
   std::string note;  // more to say (a reverse search that found nothing)
 };
 
@@ -213,6 +216,9 @@ class Session final : private scheduler::DebugHook {
   int lineCount(int robot) const;
   // The robot a "B:12", "fig92.dc:12" or "12" names, and the rest ("12").
   int robotOf(std::string& where) const;
+  // The robot an expression names with "A:" or "B:" before it (FUNCTION::
+  // NAME keeps its two colons), that prefix taken off; else the held one.
+  int robotOfExpression(std::string& expression) const;
 
   // ---- breakpoints, watchpoints ----
   // LINE in `robot`'s program (moved to the next line with code), FUNCTION

@@ -9,13 +9,19 @@ stack (INT1 at 191 over platform at 220), scopes and variables (the global
 buf, a char[9], with its 9 elements), evaluate in two frames, next, then
 stepBack to the same line and values, a data breakpoint on buf that stops
 where it is written with a new value, reverseContinue back before that
-write and then to the breakpoint, disconnect.
+write and then to the breakpoint (each stop with its hitBreakpointIds),
+evaluate "goto 9s" in the debug console, disconnect.
 
 Session 2 (the same match, 20 s, stopOnEntry): the entry stop; breakpoints
 refused with a message (no such line, a bad condition, no such function);
 a hit count (the second entry into INT1); stepping robot B's thread (the
-hold moves to B); a condition that is never true runs the match to its
-end; continuing past the end ends the session (terminated).
+hold moves to B); a data breakpoint on A's buf set while B is held stops A;
+a condition that is never true runs the match to its end; continuing past
+the end ends the session (terminated).
+
+Session 2b (tests/debug/inspect.dc alone): a data breakpoint on an auto is
+removed by the adapter when its call returns: a `breakpoint` event, reason
+removed, and a stop there with no hit.
 
 Session 3 (what a broken or hostile client sends, after the robustness
 audit of issue 38): a request whose arguments nest 150,000 arrays (300 KB),
@@ -336,7 +342,7 @@ check(c.evaluate("data", top["id"])["result"] == before["data"], "data after ste
 scopes = c.request("scopes", {"frameId": top["id"]})["body"]["scopes"]
 info = c.request("dataBreakpointInfo", {"variablesReference": scopes[1]["variablesReference"],
                                         "name": "buf"})["body"]
-check(info.get("dataId") == "buf", f"dataBreakpointInfo buf: {info}")
+check(info.get("dataId") == "A:buf", f"dataBreakpointInfo buf: {info}")
 check("write" in info.get("accessTypes", []), f"dataBreakpointInfo access: {info}")
 nothing = c.request("dataBreakpointInfo", {"name": "1 + 2", "frameId": top["id"]})["body"]
 check(nothing.get("dataId") is None and nothing.get("description"), f"dataBreakpointInfo of a number: {nothing}")
@@ -377,9 +383,16 @@ check(frames[0]["line"] == 195 and c.evaluate("buf", frames[0]["id"])["result"] 
 c.request("reverseContinue", {"threadId": 1})
 stop = c.stopped("breakpoint")
 check(tick_of(stop) == 83143727 and tick_of(stop) < watch_tick, f"reverseContinue: {stop}")
+check(stop.get("hitBreakpointIds") == [bp_id], f"reverseContinue's breakpoint id: {stop}")
 frames = c.frames()
 check(frames[0]["name"].startswith("INT1(") and frames[0]["line"] == 191, f"after reverseContinue: {frames[0]}")
 check(c.evaluate("buf", frames[0]["id"])["result"] == old, "buf as it was before the write")
+
+# Going to a time from the debug console: evaluate "goto 9s" (repl).
+r = c.request("evaluate", {"expression": "goto 9s", "context": "repl"})
+check(r["success"] and "going to tick 82944000" in r["body"]["result"], f"goto 9s: {r}")
+stop = c.stopped("goto")
+check(82944000 <= tick_of(stop) < 82944000 + 1000, f"goto 9s: {stop}")
 c.finish()
 
 # ---- session 2 -----------------------------------------------------------------
@@ -421,11 +434,21 @@ b_globals = {v["name"] for v in
              c.request("variables", {"variablesReference": scopes[1]["variablesReference"]})["body"]["variables"]}
 check({"ammo", "left", "right", "sum"} <= b_globals, f"B's globals: {sorted(b_globals)}")
 info = c.request("dataBreakpointInfo", {"name": "ammo", "frameId": frames[0]["id"]})["body"]
-check(info.get("dataId") == "ammo", f"B's ammo: {info}")
+check(info.get("dataId") == "B:ammo", f"B's ammo: {info}")
 a_frames = c.frames(thread=1)
 info = c.request("dataBreakpointInfo", {"name": "buf", "frameId": a_frames[0]["id"]})["body"]
-check(info.get("dataId") is None, f"A's variable while B is held: {info}")
+check(info.get("dataId") == "A:buf", f"A's variable while B is held: {info}")
 c.request("setFunctionBreakpoints", {"breakpoints": []})
+# A data breakpoint on A's buf while B is held: A's first strcpy into buf
+# stops A (thread 1).
+r = c.request("setDataBreakpoints", {"breakpoints": [{"dataId": "A:buf", "accessType": "write"}]})
+a_buf = r["body"]["breakpoints"][0]
+check(a_buf.get("verified"), f"A:buf set while B is held: {a_buf}")
+c.request("continue", {"threadId": 2})
+stop = c.stopped("data breakpoint", thread=1)
+check(stop.get("hitBreakpointIds") == [a_buf.get("id")] and "written by line" in
+      stop.get("description", ""), f"A's buf written with B held: {stop}")
+c.request("setDataBreakpoints", {"breakpoints": []})
 
 # Stepping A's thread moves the hold back to A.
 c.request("next", {"threadId": 1})
@@ -446,6 +469,42 @@ check(tick_of(stop) >= 20 * 9216000, f"the end at 20 s: {stop}")
 c.frames()  # still inspectable
 c.request("continue", {"threadId": 1})
 c.event("terminated")
+c.finish()
+
+# ---- session 2b: a data breakpoint on an auto, removed by the adapter -----------------
+
+# tests/debug/inspect.dc (#class auto): at depth()'s first entry, a data
+# breakpoint on its auto `twice` stops where line 29 writes it (n = 3:
+# twice = 6); the deeper calls write their own `twice`; when this call
+# returns the adapter removes the breakpoint, says so with a `breakpoint`
+# event (reason removed) and stops there, with no hit.
+c = Client()
+start(c, {"program": os.path.join(os.path.dirname(os.path.abspath(__file__)), "debug/inspect.dc"),
+          "seconds": 1, "stopOnEntry": True})
+c.request("configurationDone")
+c.stopped("entry")
+fb = c.request("setFunctionBreakpoints", {"breakpoints": [{"name": "depth"}]})["body"]["breakpoints"][0]
+c.request("continue", {"threadId": 1})
+c.stopped("function breakpoint")
+top = c.frames()[0]
+c.request("setFunctionBreakpoints", {"breakpoints": []})
+info = c.request("dataBreakpointInfo", {"name": "twice", "frameId": top["id"]})["body"]
+check(info.get("dataId") == "A:twice", f"dataBreakpointInfo of depth's twice: {info}")
+r = c.request("setDataBreakpoints", {"breakpoints": [{"dataId": "A:twice", "accessType": "write"}]})
+auto_id = r["body"]["breakpoints"][0].get("id")
+c.request("continue", {"threadId": 1})
+stop = c.stopped("data breakpoint")
+check(stop.get("hitBreakpointIds") == [auto_id] and
+      c.evaluate("twice", c.frames()[0]["id"])["result"] == "6", f"depth's twice written: {stop}")
+c.request("continue", {"threadId": 1})
+removed = c.event("breakpoint")["body"]
+check(removed.get("reason") == "removed" and removed["breakpoint"].get("id") == auto_id,
+      f"the auto's data breakpoint removed: {removed}")
+stop = c.stopped("data breakpoint")
+check("hitBreakpointIds" not in stop and "deleted" in stop.get("description", ""),
+      f"the stop where depth() returned: {stop}")
+c.request("continue", {"threadId": 1})
+c.stopped("step")  # the end of the run
 c.finish()
 
 # ---- session 3: a broken or hostile client ------------------------------------------
