@@ -252,7 +252,17 @@ class Session final : private scheduler::DebugHook {
   std::vector<std::string> takeNotices();
 
  private:
-  struct Rewind;
+  // Thrown out of the match from a stop: the command goes back in time (or
+  // moves the hold), which the session does from its snapshots.
+  struct Rewind {
+    Resume how;
+    Tick from = 0;  // where the command was given: the held robot's clock
+    int line = 0, calls = 0, ints = 0;
+    Stop arrival;
+    // Hold: the other robot stopped at its own breakpoint at how.tick (the
+    // match is brought to that tick), not a move of the hold at a stop.
+    bool atOtherBreakpoint = false;
+  };
   struct ScanDone {};
   struct Mode {
     Resume::Kind kind = Resume::Kind::Goto;
