@@ -383,27 +383,6 @@ TEST(Vm, RetiGoesWhereTheSavedPcLeads) {
   }
 }
 
-// A struct assignment's LDIR repeats for every byte but the last (Zilog's
-// 14 T-states repeating, 12 for the last: z180.def): COPY of 10 bytes, on
-// the table with no wait states and no refresh, is POP 9 + EX DE,HL 3 +
-// LD rr,nn 9 + LDIR 9 x 14 + 12 + POP 9 = 168, after the two PUSHW.
-TEST(Vm, CopyChargesLdirForEveryByte) {
-  static const vm::CostTable plain = vm::makeCostTable(vm::uncalibratedKnobs());
-  Assembler a;
-  const uint16_t src = a.data(10), dst = a.data(10);
-  a.op(Op::PUSHW, dst).op(Op::PUSHW, src).bind("copy").op(Op::COPY, 10).bind("end").op(Op::HALT);
-  const auto img = a.finish();
-  TestHost host;
-  vm::Vm v(img, host, plain);
-  v.setBreakpoint(a.label("copy"));
-  ASSERT_EQ(v.run(1'000'000), Stop::Breakpoint);
-  const vm::Tick before = v.now();
-  v.setBreakpoint(a.label("copy"), false);
-  v.setBreakpoint(a.label("end"));
-  ASSERT_EQ(v.run(1'000'000), Stop::Breakpoint);
-  EXPECT_EQ(v.now() - before, 9 + 3 + 9 + 9 * 14 + 12 + 9);
-}
-
 TEST(Vm, LibraryCallIsChargedOneCall) {
   // PUSHW 20 x 2, then outport's sequence alone: POP 9; POP 9; CALL 16;
   // LD C,L 4; OUT (C),A 10 + 1 I/O wait; RET 9 = 58. The write happens at
@@ -589,34 +568,6 @@ TEST(Vm, LongOperationIsInterruptibleEvery100Tstates) {
   EXPECT_EQ(host.events[0].pc, 2u * vm::instructionSize(Op::PUSHL));
   EXPECT_EQ(v.read32(result), 1000000u / 7);
   EXPECT_EQ(v.read16(counter), 1);
-}
-
-TEST(Vm, StrcpyIsInterruptibleAndCompletesAfterTheHandler) {
-  Assembler a;
-  const uint16_t counter = a.data(2);
-  const std::string text(120, 'x');
-  const uint16_t src = a.string(text);
-  const uint16_t dst = a.data(200);
-  a.op(Op::PUSHW, dst).op(Op::PUSHW, src).lib(vm::Lib::STRCPY, 2).op(Op::POP).op(Op::HALT);
-  countingHandler(a, counter);
-  const auto img = a.finish();
-  TestHost host;
-  vm::Vm v(img, host, costs());
-  const vm::Tick callEnd =
-      2 * cost(Op::PUSHW) + cost(Op::LIB) + costs().libCall[static_cast<int>(vm::Lib::STRCPY)];
-  host.schedule(callEnd + 150, Irq::Pio);
-  host.runUntil(v, 100'000);
-  ASSERT_FALSE(host.events.empty());
-  // Every byte but the last loops back (its JR NZ taken): the steps before
-  // the handler are of whole looping bytes.
-  const uint32_t unit = costs().libStepLooping[static_cast<int>(vm::Lib::STRCPY)];
-  const uint32_t perStep = 100 / unit;
-  vm::Tick boundary = callEnd;
-  while (boundary < callEnd + 150) boundary += perStep * unit;
-  EXPECT_EQ(host.events[0].tick, boundary);
-  EXPECT_LE(perStep * unit, 100u);
-  for (size_t i = 0; i <= text.size(); ++i)
-    EXPECT_EQ(v.read8(static_cast<uint16_t>(dst + i)), i < text.size() ? 'x' : 0);
 }
 
 TEST(Vm, HaltedVmStillTakesInterrupts) {

@@ -77,6 +77,8 @@ CostTable makeCostTable(const CostKnobs& knobs) {
   }
   t.autoFrameRet = resolve(kAutoRetSeq, knobs);
   t.ldirRepeat = resolve(sequenceCost("LDIR", 1), knobs);
+  t.copyHead = resolve(kCopyHeadCost, knobs);
+  t.copyLast = t.op[static_cast<int>(Op::COPY)] - t.copyHead;
   t.interruptAccept = resolve(kAcceptSeq, knobs);
   t.serialIsr = resolve(kSerialIsrSeq, knobs) + static_cast<uint32_t>(knobs.serialIsrTstates);
   for (int p = 0; p < kTimerIsrPaths; ++p) t.timerIsr[p] = resolve(kTimerPathSeq[p], knobs);

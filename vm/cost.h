@@ -284,6 +284,14 @@ inline constexpr auto kLibAtomic = [] {
   return a;
 }();
 
+// COPY's sequence up to its LDIR: the head that runs before the first byte.
+inline constexpr SeqCost kCopyHeadCost = [] {
+  const std::string_view seq = kOpInfo[static_cast<int>(Op::COPY)].z180;
+  const auto ldir = seq.find("LDIR");
+  if (ldir == std::string_view::npos) throw "COPY's sequence has an LDIR";
+  return sequenceCost(seq.substr(0, ldir));
+}();
+
 // The RST 28h debug hook's body, run at every statement of a debug build
 // (the RST itself is in the DBG opcode's sequence): PUSH AF; LD A,(nn);
 // OR A; JR NZ,to_debugger (not taken: no debugger is attached); POP AF; RET.
@@ -373,8 +381,12 @@ struct CostTable {
   // Added to libCall[] when a call's branch is taken (path 1); 0 but for
   // the routines whose path comes from their argument (abs).
   std::array<int32_t, kLibCount> libTakenDelta{};
-  uint32_t autoFrameRet = 0;     // RET of a frame that ran ENTER: POP IX
-  uint32_t ldirRepeat = 0;       // an LDIR byte after which BC is not yet 0 (COPY)
+  uint32_t autoFrameRet = 0;  // RET of a frame that ran ENTER: POP IX
+  uint32_t ldirRepeat = 0;    // an LDIR byte after which BC is not yet 0 (COPY)
+  // COPY in its parts (vm/instructions.h): the sequence before LDIR, and
+  // the rest of op[COPY] (LDIR's last byte and what follows it).
+  uint32_t copyHead = 0;
+  uint32_t copyLast = 0;
   uint32_t interruptAccept = 0;  // IM2 acknowledge + handler register saves
   uint32_t serialIsr = 0;        // acceptance + library ISR body
   // The timer service along each path (bit 0: no millisecond due, bit 1:

@@ -345,11 +345,16 @@ void Vm::State::libFinish(bool pushResult) {
   if (pushResult) eval[sp++] = lib.result;
 }
 
-// One step of a long library call: at most kMaxStepTstates T-states.
+// One step of a long library call: at most kMaxStepTstates T-states of its
+// call sequence or of a time it waits (A/D, printf), or one unit of its
+// inner loop (a byte copied, compared, set): the Z180's loop is
+// interruptible after every byte (LDIR after each, a JR NZ loop between
+// any two of its instructions), so a handler sees a copy or fill as far as
+// it has gone, not some bytes at a time.
 void Vm::State::libStep() {
   const int id = static_cast<int>(lib.id);
   const uint32_t unit = std::max<uint32_t>(1, costs.libStepLooping[id]);
-  const uint32_t perStep = std::max<uint32_t>(1, kMaxStepTstates / unit);
+  constexpr uint32_t perStep = 1;
   const uint32_t* a = lib.args;
   ++stats.instructions;
   if (lib.setup > 0) {
