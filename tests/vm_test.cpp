@@ -383,6 +383,36 @@ TEST(Vm, RetiGoesWhereTheSavedPcLeads) {
   }
 }
 
+// printf sends one character after another over the debug port, and each
+// console line is stamped with the tick its newline went. Plain table
+// (vm/z180.def): PUSHW 20; printf's call CALL nn 16 + lib_fconv 300 + RET 9
+// = 325, to 345; per character its loop LD A,(HL) 6; CP n 6; JR cc,e 6 (not
+// taken); INC HL 4; CALL nn 16; RET 9 = 47, and the debug port's 1,600
+// (knob printf_char_tstates): 1,647. "first\n" has gone at 345 + 6 x
+// 1,647 = 10,227, "second\n" at 345 + 13 x 1,647 = 21,756, the call's end
+// (they were both stamped 21,756). Calibrated (refresh 2 every 20,
+// + (2t + 10) / 20 per sequence): PUSHW 22, call 325 + 33 = 358 (to 380),
+// per character 47 + 5 + 1,600 = 1,652: 380 + 6 x 1,652 = 10,292 and
+// 380 + 13 x 1,652 = 21,856.
+TEST(Vm, PrintfStampsEachLineWhenItsNewlineIsSent) {
+  struct Case {
+    vm::CostTable table;
+    vm::Tick first, second;
+  };
+  for (const Case& c : {Case{vm::makeCostTable(vm::uncalibratedKnobs()), 10'227, 21'756},
+                        Case{costs(), 10'292, 21'856}}) {
+    Assembler a;
+    const uint16_t text = a.string("first\nsecond\n");
+    a.op(Op::PUSHW, text).lib(vm::Lib::PRINTF, 1).op(Op::POP).op(Op::HALT);
+    const auto img = a.finish();
+    TestHost host;
+    vm::Vm v(img, host, c.table);
+    host.runUntil(v, 100'000);
+    EXPECT_EQ(host.consoleLines, (std::vector<std::string>{"first", "second"}));
+    EXPECT_EQ(host.consoleTicks, (std::vector<vm::Tick>{c.first, c.second}));
+  }
+}
+
 TEST(Vm, LibraryCallIsChargedOneCall) {
   // PUSHW 20 x 2, then outport's sequence alone: POP 9; POP 9; CALL 16;
   // LD C,L 4; OUT (C),A 10 + 1 I/O wait; RET 9 = 58. The write happens at

@@ -60,7 +60,7 @@ struct LibCall {
   // that a bus access is always at a boundary that starts before the
   // horizon (the host never sees an access past the tick it ran us to).
   bool awaitingBegin = false;
-  uint32_t index = 0;      // bytes processed
+  uint32_t index = 0;      // bytes processed (printf: characters sent)
   uint32_t remaining = 0;  // T-states still to burn (A/D, printf)
   uint32_t mark = 0;       // a routine's second phase: where it began
   uint32_t result = 0;
@@ -496,6 +496,9 @@ struct Vm::State {
   void libStep();
   void libFinish(bool pushResult);
   std::string formatPrintf(uint32_t instructionPc, int formatArg);
+  uint32_t printfCharTstates() const;
+  uint32_t printfToLineEnd() const;
+  void printfSent();
 
   template <bool kProfile>
   Stop run(Tick until);
