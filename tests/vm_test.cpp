@@ -180,6 +180,46 @@ TEST(Vm, LongShiftIsInterruptibleAndItsTimeIsKept) {
   EXPECT_EQ(v.now(), shiftEnd + handler);
 }
 
+// A handler's time from acceptance to the end of its RETI, on the two Z180
+// revisions the profile's [controller] cpu chooses between (z180.def:
+// RETI 22 T-states on the Z80180, 12 on the Z8S180). By hand: acceptance
+// INTACK 18 + 4 x PUSH 11 + 2 x PUSH IX 14 = 90; INCGW LD HL,(nn) 15 + INC
+// HL 4 + LD (nn),HL 16 = 35; RETI's sequence 2 x POP IX 12 + 4 x POP 9 +
+// EI 3 + RETI = 63 + 22 = 85 (Z80180) or 63 + 12 = 75 (Z8S180). Plain
+// table: 210 and 200. Calibrated (refresh 2 every 20, + (2t + 10) / 20 per
+// sequence): 99 + 39 + (85 + 9 = 94, or 75 + 8 = 83): 232 and 221.
+TEST(Vm, RetiTakesItsRevisionsTStates) {
+  struct Case {
+    vm::CostKnobs knobs;
+    vm::CpuRevision cpu;
+    vm::Tick handler;
+  };
+  const Case cases[] = {
+      {vm::uncalibratedKnobs(), vm::CpuRevision::Z80180, 210},
+      {vm::uncalibratedKnobs(), vm::CpuRevision::Z8S180, 200},
+      {vm::calibratedKnobs(), vm::CpuRevision::Z80180, 232},
+      {vm::calibratedKnobs(), vm::CpuRevision::Z8S180, 221},
+  };
+  EXPECT_EQ(vm::calibratedKnobs().cpu, vm::CpuRevision::Z80180);  // the default
+  for (const Case& c : cases) {
+    vm::CostKnobs knobs = c.knobs;
+    knobs.cpu = c.cpu;
+    Assembler a;
+    const uint16_t counter = a.data(2);
+    a.op(Op::HALT);
+    countingHandler(a, counter);
+    const auto img = a.finish();
+    TestHost host;
+    vm::Vm v(img, host, vm::makeCostTable(knobs));
+    host.schedule(1000, Irq::Pio);
+    host.runUntil(v, 10'000);
+    ASSERT_EQ(host.events.size(), 2u);
+    EXPECT_EQ(host.events[0].tick, 1000);
+    EXPECT_EQ(host.events[1].tick - host.events[0].tick, c.handler)
+        << (c.cpu == vm::CpuRevision::Z80180 ? "z80180" : "z8s180");
+  }
+}
+
 TEST(Vm, AbsChargesThePathOfItsArgumentsSign) {
   // PUSHW 20, then abs (cost_test.cpp AbsChargesThePathOfItsArgumentsSign):
   // CALL 16; LD A,H 4; OR A 4; JP P 9 taken; RET 9 = 42 when the argument
