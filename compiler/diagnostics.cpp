@@ -44,6 +44,9 @@ const std::vector<WarningInfo>& warningList() {
       {"send-without-delay", "a serial send that can follow another with no delay between"},
       {"implicit-function-declaration", "a call to a function not yet declared"},
       {"unknown-pragma", "a #pragma simbot does not know (ignored, as C89 says)"},
+      {"missing-member-name",
+       "a struct or union member declaration with no declarator (\"int;\"): it declares "
+       "nothing"},
   };
   return list;
 }

@@ -201,14 +201,21 @@ Type* Parser::structDecl(bool isUnion) {
   while (!accept("}")) {
     if (cur().kind == TokKind::Eof) fail(after(prevPos_), "expected '}' at end of input");
     VarAttr attr;
+    const Pos memberPos = cur().pos;
     Type* base = declspec(&attr);
     if (attr.sawStorage || attr.isInterrupt) fail(cur().pos, "storage class in a struct member");
-    // C89's member declaration names at least one member; C11's anonymous
-    // struct or union member (which Dynamic C did not have) would vanish.
+    // C89's grammar wants at least one member declarator; gcc and clang
+    // take "int;" (or "struct U { ... };", which declares the tag U) with a
+    // warning that it declares nothing, and so does simbot. C11's
+    // anonymous struct or union member (which Dynamic C did not have)
+    // would make its members the outer one's: refused, not dropped.
     if (is(";")) {
-      if (isStructLike(base) && base->tag.empty())
+      if (isStructLike(base) && base->tag.empty() && at(i_ - 1).is("}"))
         fail(cur().pos, "anonymous struct or union members are not supported; name the member");
-      fail(cur().pos, "expected member name");
+      diags_.warn(memberPos, "missing-member-name",
+                  "member declaration declares nothing (no member name)");
+      advance();
+      continue;
     }
     for (bool first = true; !accept(";"); first = false) {
       if (!first) expect(",");
@@ -287,21 +294,35 @@ void Parser::declarator(Type* ty, Declarator& d) {
     advance();
     while (is("const") || is("volatile")) advance();
   }
-  if (is("(") && peek(1).is("*")) {
-    // Nested declarator, e.g. "(*p)[3]": the suffix after ")" applies first.
-    size_t start = i_;
-    advance();
-    Declarator dummy;
-    declarator(tyInt(), dummy);
-    expect(")");
-    ty = typeSuffix(ty);
-    size_t end = i_;
-    Pos endPrev = prevPos_;
+  if (startsNestedDeclarator()) {
+    // "(*p)[3]", "(*(getf(void)))(int)", "(x)": the suffix after the ")"
+    // applies first. It is parsed first, then the inner declarator once
+    // with the type it makes (parsing the inner one twice, as this did,
+    // took 2^depth passes: 26 levels of "(*" ran for minutes).
+    const size_t start = i_;
+    size_t close = start;
+    for (int depth = 0;; ++close) {
+      const Token& t = at(close);
+      if (t.kind == TokKind::Eof) break;
+      if (t.is("(")) ++depth;
+      if (t.is(")") && --depth == 0) break;
+    }
+    if (at(close).kind != TokKind::Eof) {
+      i_ = close + 1;
+      prevPos_ = at(close).pos;
+      settle();
+      ty = typeSuffix(ty);
+    }
+    const size_t end = i_;
+    const Pos endPrev = prevPos_;
     i_ = start;
     advance();
     declarator(ty, d);
-    i_ = end;
-    prevPos_ = endPrev;
+    expect(")");
+    if (at(close).kind != TokKind::Eof) {
+      i_ = end;
+      prevPos_ = endPrev;
+    }
     return;
   }
   if (cur().kind == TokKind::Ident && !isKeyword(cur())) {
@@ -313,6 +334,18 @@ void Parser::declarator(Type* ty, Declarator& d) {
     d.pos = cur().pos;
   }
   d.type = typeSuffix(ty);
+}
+
+// A "(" where a declarator's name may stand opens a nested declarator when
+// what follows can only begin one: "*", another "(" (redundant parentheses,
+// "int ((*fp))(void)") or a name that is not a type ("int (x);"). Before a
+// type name or ")" it is the parameter list of an abstract declarator
+// ("int (*)(int)", "int ()").
+bool Parser::startsNestedDeclarator() {
+  if (!is("(")) return false;
+  const Token& next = peek(1);
+  if (next.is("*") || next.is("(")) return true;
+  return next.kind == TokKind::Ident && !isKeyword(next) && !isDeclStart(next);
 }
 
 // type-suffix = "(" func-params | "[" const-expr? "]" type-suffix | (nothing)

@@ -152,6 +152,7 @@ class Parser {
   Type* structDecl(bool isUnion);
   Type* enumSpecifier();
   void declarator(Type* ty, Declarator& d);
+  bool startsNestedDeclarator();
   Type* typeSuffix(Type* ty);
   Type* funcParams(Type* ret);
   Type* abstractTypeName();

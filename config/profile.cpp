@@ -9,8 +9,8 @@
 // toml++'s source positions (parse errors from toml++ are formatted the
 // same way). Values are converted to the internal units at load: ft, s,
 // ft/s, ft/s^2, degrees for user-facing angles, plain ratios and A/D
-// readings; [controller]'s timer service and fast-forward become the VM's
-// typed knobs (Profile::controller).
+// readings; [controller]'s timer service, fast-forward and CPU revision
+// become the VM's typed knobs (Profile::controller).
 //
 // A hardware file has an optional [ports] section (port B bit numbers) and
 // may override the per-robot sections ([robot], [bumper], [eyes], [gun],
@@ -122,14 +122,27 @@ class Checker {
         return;
       case Kind::Choice: {
         const auto word = value->value<std::string>();
-        for (const auto& [choice, service] : keys::kChoices)
-          if (word && *word == choice) {
-            *t.choice = service;
-            return;
+        // One of `words` into `out`, or an error listing them.
+        const auto pick = [&](const auto& words, auto* out) {
+          std::string listed;
+          for (size_t w = 0; w < words.size(); ++w) {
+            if (word && *word == words[w].first) {
+              *out = words[w].second;
+              return;
+            }
+            listed += fmt::format("{}\"{}\"",
+                                  w == 0                  ? ""
+                                  : w + 1 == words.size() ? " or "
+                                                          : ", ",
+                                  words[w].first);
           }
-        fail(value->source(),
-             fmt::format("'{}' must be \"{}\", \"{}\" or \"{}\"", name, keys::kChoices[0].first,
-                         keys::kChoices[1].first, keys::kChoices[2].first));
+          fail(value->source(), fmt::format("'{}' must be {}", name, listed));
+        };
+        if (t.cpu)
+          pick(keys::kCpuChoices, t.cpu);
+        else
+          pick(keys::kChoices, t.choice);
+        return;
       }
       case Kind::Count:
       case Kind::Step:

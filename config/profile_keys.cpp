@@ -134,6 +134,16 @@ const std::vector<KeyDef>& keyTable() {
          return t;
        }},
       {"controller", "fast_forward", Kind::Bool, {0, 0}, true, B(p.controller.fastForward)},
+      {"controller",
+       "cpu",
+       Kind::Choice,
+       {0, 0},
+       true,
+       [](Profile& p, Hardware&) {
+         Target t;
+         t.cpu = &p.controller.cpu;
+         return t;
+       }},
       {"projectile", "gravity", Kind::Accel, {1, 1000}, false, D(p.field.gravity_fps2)},
       {"projectile", "count_floor_skips", Kind::Bool, {0, 0}, false, B(p.field.count_floor_skips)},
       {"referee",

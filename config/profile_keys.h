@@ -46,20 +46,26 @@ struct Bounds {
   bool orZero = false;
 };
 
-// The words a Choice key accepts (only [controller] timer_service) and the
-// timer service each one means.
+// The words a Choice key accepts and what each one means: [controller]
+// timer_service's timer service, and [controller] cpu's Z180 revision.
 inline constexpr std::array<std::pair<const char*, vm::TimerService>, 3> kChoices = {{
     {"auto", vm::TimerService::Auto},
     {"always", vm::TimerService::Always},
     {"never", vm::TimerService::Never},
 }};
+inline constexpr std::array<std::pair<const char*, vm::CpuRevision>, 2> kCpuChoices = {{
+    {"z80180", vm::CpuRevision::Z80180},
+    {"z8s180", vm::CpuRevision::Z8S180},
+}};
 
-// Where one key's value lands: exactly one pointer is set, by the kind.
+// Where one key's value lands: exactly one pointer is set, by the kind (a
+// Choice key's: `choice` or `cpu`).
 struct Target {
   double* d = nullptr;
   int* i = nullptr;
   bool* b = nullptr;
   vm::TimerService* choice = nullptr;
+  vm::CpuRevision* cpu = nullptr;
   std::array<double, 16>* table = nullptr;
 };
 

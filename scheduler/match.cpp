@@ -43,7 +43,8 @@
 // before. The only difference is work: steps taken past an input's tick
 // are thrown away at the re-initialisation, so IntegratorStats' steps and
 // rhs_evals can be higher (by at most the steps of 8 characters per
-// input); no state, event or record depends on them. A ball in flight
+// input), and roots (ARKODE's root returns) too, a root found in those
+// steps being found again; no state, event or record depends on them. A ball in flight
 // keeps the plant to one sub-round because a root with no event (a ball's
 // closest approach) updates the ball's closest distance when the plant
 // reaches it, and one past an input's tick would not be found on the

@@ -70,12 +70,15 @@ struct DriveLeg {
 };
 
 // A robot's controller settings that reach its VM (the profile's
-// [controller] timer_service and fast_forward; config/ reads them).
+// [controller] timer_service, fast_forward and cpu; config/ reads them).
 struct ControllerKnobs {
   vm::TimerService timerService = vm::TimerService::Auto;
   // Delay loops run in one exact step; with MatchConfig::knobs.fastForward
   // off no robot's do.
   bool fastForward = true;
+  // The Z180 revision on its board: the figures of the instructions that
+  // differ between them (vm/z180.def).
+  vm::CpuRevision cpu = vm::CpuRevision::Z80180;
 };
 
 struct RobotSpec {

@@ -17,9 +17,15 @@ namespace simbot::scheduler::detail {
 namespace {
 
 // The match's cost table with this robot's controller's settings (profile
-// [controller]): its timer service, and fast-forward unless it turns it off.
+// [controller]): its timer service, fast-forward unless it turns it off,
+// and its CPU revision (whose figures make a table of their own).
 vm::CostTable robotCosts(const vm::CostTable& costs, const ControllerKnobs& controller) {
   vm::CostTable table = costs;
+  if (controller.cpu != costs.knobs.cpu) {
+    vm::CostKnobs knobs = costs.knobs;
+    knobs.cpu = controller.cpu;
+    table = vm::makeCostTable(knobs);
+  }
   table.knobs.timerService = controller.timerService;
   table.knobs.fastForward = costs.knobs.fastForward && controller.fastForward;
   return table;

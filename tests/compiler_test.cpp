@@ -919,6 +919,18 @@ TEST(CompilerWarnings, UnknownPragma) {
 
 // #if evaluates the operands C evaluates: a division by zero in the right
 // operand of && is not done, one in an evaluated operand is an error.
+// A member declaration that names no member declares nothing (gcc and
+// clang warn likewise), at its first token: col 19 of "struct T { int I;
+// int; };"; "B;" (a typedef of an untagged struct, line 2 col 12) and a
+// tagged "struct U { int x; };" inside W (col 22), which declares U.
+TEST(CompilerWarnings, MissingMemberName) {
+  EXPECT_EQ(warned("struct T { int I; int; };\nstruct T t;\nmain() { t.I = 1; }\n"),
+            Strings{"1:19 missing-member-name"});
+  EXPECT_EQ(warned("typedef struct { int b; } B;\nstruct W { B; int c; struct U { int x; }; };\n"
+                   "struct U u;\nmain() { u.x = sizeof(struct W); }\n"),
+            (Strings{"2:12 missing-member-name", "2:22 missing-member-name"}));
+}
+
 TEST(CompilerErrors, IfDividesOnlyWhatItEvaluates) {
   EXPECT_TRUE(compile("#if 0 && 1 / 0\n#endif\nmain() { }\n", "i.dc").image);
   EXPECT_TRUE(compile("#if 1 ? 1 : 1 % 0\n#endif\nmain() { }\n", "i.dc").image);

@@ -92,10 +92,11 @@ TEST(Timer, CountersFollowDynamicCsRuleAndServiceCostsItsSequence) {
   // the fraction (LD A,(nn) 12, ADD A,n 6, LD r,r 4, AND n 6, LD (nn),A 13,
   // BIT b,r 6, JR cc not taken 6 = 53), MS_TIMER += 1 (92), the second's
   // test (LD HL,(nn) 15, LD r,r 4, AND n 6, OR r 4, JR cc taken 8 = 37),
-  // 3 x POP 27, EI 3, RETI 12: 391 T-states. Calibrated knobs: no memory
-  // wait states; 4 I/O wait states on the two IN0: 399; refresh 2 every 20
-  // adds (399 * 2 + 10) / 20 = 40 (rounded): 439.
-  EXPECT_EQ(serviceTime, 439u);
+  // 3 x POP 27, EI 3, RETI 22 (the Z80180, the default revision): 401
+  // T-states. Calibrated knobs: no memory wait states; 4 I/O wait states on
+  // the two IN0: 409; refresh 2 every 20 adds (409 * 2 + 10) / 20 = 41
+  // (rounded): 450.
+  EXPECT_EQ(serviceTime, 450u);
 }
 
 // Without the timer library (and the knob at auto) no timer interrupt runs:
@@ -278,9 +279,11 @@ main()
 namespace {
 
 scheduler::MatchConfig soloConfig(const std::string& file, vm::TimerService timerService,
-                                  double seconds) {
+                                  double seconds, vm::CpuRevision cpu = vm::CpuRevision::Z80180) {
   auto profile = config::loadProfile(SIMBOT_SOURCE_DIR "/profiles/default.toml");
+  EXPECT_EQ(profile.controller.cpu, vm::CpuRevision::Z80180);
   profile.controller.timerService = timerService;
+  profile.controller.cpu = cpu;
   scheduler::MatchConfig c;
   c.arena = config::makeArenaConfig(profile, 1);
   c.robots.push_back({"A", file, testkit::compileFileOrDie(file)});
@@ -308,6 +311,26 @@ TEST(Timer, ProfileKnobDecidesWhetherTheServiceRuns) {
   const auto neverToggler = scheduler::runMatch(soloConfig(toggler, vm::TimerService::Never, 2));
   EXPECT_FALSE(neverToggler.robots[0].exited);
   EXPECT_EQ(neverToggler.robots[0].interrupts.at("timer"), 0u);
+}
+
+// The profile's [controller] cpu reaches the robot's VM: the BIOS timer
+// service ends in RETI, 22 T-states on the Z80180 and 12 on the Z8S180
+// (vm/z180.def), so with the calibrated refresh (+ (2t + 10) / 20 on the
+// service's t T-states) each service is 10 + 1 = 11 T-states longer on the
+// Z80180, whatever its path. ICEMAN with the service always on takes 2,047
+// services in 2 s on either chip (PRT0 ticks, not the program, decide
+// that): 2,047 x 11 = 22,517 T-states of service apart.
+TEST(Timer, ServiceEndsWithTheChosenRevisionsReti) {
+  const std::string iceman = SIMBOT_SHARED_DIR "/programs/iceman.dc";
+  uint64_t cycles[2] = {};
+  for (const vm::CpuRevision cpu : {vm::CpuRevision::Z80180, vm::CpuRevision::Z8S180}) {
+    auto c = soloConfig(iceman, vm::TimerService::Always, 2, cpu);
+    c.profile = true;
+    const auto r = scheduler::runMatch(c);
+    EXPECT_EQ(r.robots[0].interrupts.at("timer"), 2047u);
+    cycles[static_cast<int>(cpu)] = r.robots[0].timerIsrCycles;
+  }
+  EXPECT_EQ(cycles[0] - cycles[1], 2047u * 11u);
 }
 
 // --trace-costate records only changes of state (Robot::costate). By hand,

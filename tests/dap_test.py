@@ -4,7 +4,7 @@
 Usage: dap_test.py SIMBOT ICEMAN FIG92
 
 Session 1 (ICEMAN vs fig92, seed 3; the edge handler INT1 is entered first
-at tick 83143727): a breakpoint on INT1's first line (191); the stop, its
+at tick 83150170): a breakpoint on INT1's first line (191); the stop, its
 stack (INT1 at 191 over platform at 220), scopes and variables (the global
 buf, a char[9], with its 9 elements), evaluate in two frames, next, then
 stepBack to the same line and values, a data breakpoint on buf that stops
@@ -269,7 +269,7 @@ c.request("setExceptionBreakpoints", {"filters": []})
 c.request("configurationDone")
 stop = c.stopped("breakpoint")
 check(stop.get("hitBreakpointIds") == [bp_id], f"stopped: hitBreakpointIds {stop.get('hitBreakpointIds')}")
-check(tick_of(stop) == 83143727, f"the first entry into INT1 at tick 83143727: {stop}")
+check(tick_of(stop) == 83150170, f"the first entry into INT1 at tick 83150170: {stop}")
 
 threads = c.request("threads")["body"]["threads"]
 check([t["id"] for t in threads] == [1, 2], f"threads: {threads}")
@@ -311,8 +311,8 @@ page = c.request("variables", {"variablesReference": buf["variablesReference"], 
 check([e["name"] for e in page["body"]["variables"]] == ["[2]", "[3]", "[4]"], f"variables paged: {page['body']}")
 
 z = c.evaluate("platform::z", top["id"])
-check(z["result"] == "143" and z["type"] == "int" and z["variablesReference"] == 0, f"platform::z: {z}")
-check(c.evaluate("z", caller["id"])["result"] == "143", "z in platform's frame")
+check(z["result"] == "120" and z["type"] == "int" and z["variablesReference"] == 0, f"platform::z: {z}")
+check(c.evaluate("z", caller["id"])["result"] == "120", "z in platform's frame")
 check(c.evaluate("count", top["id"])["result"] == "1000", "count")
 check(c.evaluate("buf[1]", top["id"])["type"] == "char", "buf[1]'s type")
 bad = c.evaluate("no_such_name", top["id"], success=False)
@@ -320,17 +320,17 @@ check("no_such_name" in bad.get("message", ""), f"evaluate of an unknown name: {
 c.request("pause", {"threadId": 1}, success=False)
 
 # next, then stepBack to the same place and values.
-before = {"line": top["line"], "z": "143", "count": "1000", "data": locals_["data"]["value"],
+before = {"line": top["line"], "z": "120", "count": "1000", "data": locals_["data"]["value"],
           "frames": [(f["name"], f["line"]) for f in frames]}
 c.request("next", {"threadId": 1})
 stop = c.stopped("step")
 after_next = tick_of(stop)
-check(after_next > 83143727, f"next moves the clock: {stop}")
+check(after_next > 83150170, f"next moves the clock: {stop}")
 frames = c.frames()
 check(frames[0]["name"].startswith("INT1(") and frames[0]["line"] == 192, f"after next: {frames[0]}")
 c.request("stepBack", {"threadId": 1})
 stop = c.stopped("step")
-check(tick_of(stop) == 83143727, f"stepBack returns to tick 83143727: {stop}")
+check(tick_of(stop) == 83150170, f"stepBack returns to tick 83150170: {stop}")
 frames = c.frames()
 top = frames[0]
 check([(f["name"], f["line"]) for f in frames] == before["frames"], f"after stepBack: {frames}")
@@ -382,7 +382,7 @@ check(frames[0]["line"] == 195 and c.evaluate("buf", frames[0]["id"])["result"] 
       f"before the write: {frames[0]}")
 c.request("reverseContinue", {"threadId": 1})
 stop = c.stopped("breakpoint")
-check(tick_of(stop) == 83143727 and tick_of(stop) < watch_tick, f"reverseContinue: {stop}")
+check(tick_of(stop) == 83150170 and tick_of(stop) < watch_tick, f"reverseContinue: {stop}")
 check(stop.get("hitBreakpointIds") == [bp_id], f"reverseContinue's breakpoint id: {stop}")
 frames = c.frames()
 check(frames[0]["name"].startswith("INT1(") and frames[0]["line"] == 191, f"after reverseContinue: {frames[0]}")
@@ -456,7 +456,7 @@ stop = c.stopped("step", thread=1)
 
 c.request("continue", {"threadId": 1})
 stop = c.stopped("breakpoint")
-check(tick_of(stop) > 83143727, f"hitCondition 2: the second entry into INT1: {stop}")
+check(tick_of(stop) > 83150170, f"hitCondition 2: the second entry into INT1: {stop}")
 check(c.frames()[0]["line"] == 191, "at INT1's first line")
 
 r = c.request("setBreakpoints", {"source": {"path": ICEMAN},

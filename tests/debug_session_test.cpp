@@ -119,7 +119,7 @@ using K = debug::Resume::Kind;
 // going 5 s past it and back, and by stepping back into the delay loop it
 // interrupted and forward again, the match is the same to the byte. A
 // plain traced run (trace_test's oracle, independent of the debugger)
-// puts that acceptance at tick 83,143,628 on line 220, in platform()'s
+// puts that acceptance at tick 83,150,071 on line 220, in platform()'s
 // `for (z = 0; z < 700; z++);`; the handler's first instruction starts
 // the acceptance's cost later (CostTable::interruptAccept).
 TEST(DebugSession, BackwardsReachesTheStateForwardsReached) {
@@ -134,7 +134,7 @@ TEST(DebugSession, BackwardsReachesTheStateForwardsReached) {
       },
       [&](debug::Session& s, const debug::Stop& why) {
         EXPECT_EQ(why.kind, debug::Stop::Kind::Breakpoint);
-        EXPECT_EQ(s.now(), 83'143'628 + costs.interruptAccept);
+        EXPECT_EQ(s.now(), 83'150'071 + costs.interruptAccept);
         atEntry = placeOf(s, bus);
         return Script::resume(K::Goto, s.now() + 5 * timebase::kTicksPerSecond);
       },
@@ -147,7 +147,7 @@ TEST(DebugSession, BackwardsReachesTheStateForwardsReached) {
         return Script::resume(K::ReverseStep);
       },
       [&](debug::Session& s, const debug::Stop&) {
-        EXPECT_EQ(s.now(), 83'143'628);
+        EXPECT_EQ(s.now(), 83'150'071);
         EXPECT_EQ(s.vm(0).line(), 220);
         EXPECT_EQ(integerOf(s, "z"), integerOf(s, "platform::z"));
         inLoop = placeOf(s, bus);
@@ -286,12 +286,14 @@ TEST(DebugSession, PrintReadsAnyLvalueOfAnyFrame) {
 // A place reached one instruction at a time is the place `goto` reaches,
 // also where a step ends past a round's horizon: the events due there
 // (serial bytes, interrupt requests) come first either way. ICEMAN from
-// 5 s, some hundreds of stepi to tick 46,110,807, a boundary just past a
-// horizon where the serial port's transmit request is due (found by
-// review: a stepped arrival there once showed no request pending), and
-// two places on the way, against goto to each.
+// 5 s, some hundreds of stepi to tick 46,115,570, a boundary just past a
+// horizon where the serial port's transmit request is due (the plain
+// trace's send at 46,105,944, its byte 1 due a character time, 9,600
+// ticks, later: 46,115,544; found by review: a stepped arrival there once
+// showed no request pending), and two places on the way, against goto to
+// each.
 TEST(DebugSession, SteppedAndGoneToAreTheSamePlace) {
-  constexpr timebase::Tick kPastHorizon = 46'110'807;
+  constexpr timebase::Tick kPastHorizon = 46'115'570;
   NoBus bus;
   std::vector<Place> stepped;
   int steps = 0;

@@ -242,15 +242,17 @@ std::vector<std::pair<trace::Tick, trace::Tick>> stallsFromRecords(
 
 // Thesis chapter X: the one-eye dead-lock (one eye at background, 16, the
 // other above ICEMAN's own threshold: `if (x>48 && y>48)`, one eye past 48
-// is not enough to move) is a stall once the robot stands still. Seed 10
-// has one from 55.627 s, on ICEMAN's stop command (its motors' lag has
+// is not enough to move) is a stall once the robot stands still. Seed 28
+// has one from 131.059 s, on ICEMAN's stop command (its motors' lag has
 // decayed: it stands still), with the program in fire()'s delay loops.
-// (Seed 15's window at 3.194..4.308 s, which the old rule called a
-// one-eye stall, is none: ICEMAN drove 1.36 ft through it under cfgrcfgr.)
+// (Seed 10's from 55.627 s moved with issue 38's RETI timing, which
+// changes every match a little: the Z80180's RETI is 10 T-states longer.
+// Seed 15's window at 3.194..4.308 s, which the old rule called a one-eye
+// stall, is none: ICEMAN drove 1.36 ft through it under cfgrcfgr.)
 TEST(Explain, TheOneEyeDeadLockIsAStall) {
   auto c = config({SIMBOT_SHARED_DIR "/programs/iceman.dc", SIMBOT_SHARED_DIR "/programs/fig92.dc"},
                   180);
-  c.seed = 10;
+  c.seed = 28;
   const Traced r = run(c);
   EXPECT_EQ(stallsFromRecords(r.entries, 0).size(),
             static_cast<size_t>(std::count_if(r.report.stalls.begin(), r.report.stalls.end(),
@@ -259,8 +261,8 @@ TEST(Explain, TheOneEyeDeadLockIsAStall) {
   for (const auto& s : r.report.stalls)
     if (s.robot == 0 && s.one_eye && s.eye_left_median == 16) oneEye = &s;
   ASSERT_NE(oneEye, nullptr);
-  EXPECT_GT(oneEye->from / kTps, 55.0);
-  EXPECT_LT(oneEye->from / kTps, 56.0);
+  EXPECT_GT(oneEye->from / kTps, 131.0);
+  EXPECT_LT(oneEye->from / kTps, 132.0);
   EXPECT_GT(oneEye->eye_right_median, 48);
   ASSERT_FALSE(oneEye->lines.empty());
   EXPECT_EQ(oneEye->lines[0].function, "fire");

@@ -54,6 +54,29 @@ TEST(FunctionPointers, MisusesAreErrorsAtTheirColumn) {
                "f.dc:2:28: error: expression is not assignable");
 }
 
+// Redundant parentheses in a declarator are C89's: around a name, around
+// a nested declarator, or both. getf is a function returning a pointer to
+// a function (int, int) -> int, so its result's type is q's, and it is
+// called with two arguments. 150 parentheses around a name, and a nest of 60
+// "(*" (a 60-deep pointer), are parsed once each (each "(*" level used to
+// be parsed twice: 2^60 passes).
+TEST(FunctionPointers, DeclaratorsTakeRedundantParentheses) {
+  const std::string getf =
+      "int add(int a, int b) { return a + b; }\nint (*(getf(void)))(int, int) { return add; }\n";
+  EXPECT_EQ(firstError(getf + "int (x), ((*fp))(void);\nint (*q)(int, int);\n"
+                              "main() { q = getf(); x = q(1, 2); x = sizeof(int (*)(int)); }\n"),
+            "<none>");
+  // getf() is the pointer: called with one argument, not two (col 20).
+  EXPECT_PRED2(startsWith, firstError(getf + "int n;\nmain() { n = getf()(1); }\n"),
+               "f.dc:4:20: error: too few arguments in a call through 'int (*)()' (expected 2, "
+               "got 1)");
+  std::string pointers;
+  for (int i = 0; i < 60; ++i) pointers += "(*";
+  const std::string deep = "int " + std::string(150, '(') + "x" + std::string(150, ')') + ", " +
+                           pointers + "p" + std::string(60, ')') + ";\nmain() { x = 1; p = 0; }\n";
+  EXPECT_EQ(firstError(deep), "<none>");
+}
+
 // The Z180 sequence of a call through a pointer (vm/opcodes.def CALLI):
 // EX DE,HL 3 + POP HL 9 + CALL nn 16 + PUSH DE 11 + RET 9 = 48 T-states
 // (vm/z180.def), stretched by the calibrated DRAM refresh of 2 every 20,

@@ -163,9 +163,9 @@ TEST(MatchOracle, EveryRootEventOfTheIcemanFig92MatchFallsOnTheOraclesTick) {
   }
   ASSERT_EQ(setups, 2);
   // Regression values of the inputs (docs/plant.md, "The integrator":
-  // 1,029 and 8,621 frames latched; tests/match_test.cpp pins them too).
-  EXPECT_EQ(result.robots[0].framesLatched, 1029);
-  EXPECT_EQ(result.robots[1].framesLatched, 8621);
+  // 953 and 8,616 frames latched; tests/match_test.cpp pins them too).
+  EXPECT_EQ(result.robots[0].framesLatched, 953);
+  EXPECT_EQ(result.robots[1].framesLatched, 8616);
 
   // The plant's crossings, as hints of the tick to apply the oracle's own
   // at (a disagreement then stays one event: MatchOracle::kFollowTicks).

@@ -10,7 +10,8 @@ namespace {
 
 // T-states of a sequence with the knobs' wait states and DRAM refresh.
 uint32_t resolve(const SeqCost& c, const CostKnobs& k) {
-  const int base = c.tstates + k.memWaitStates * c.memCycles + k.ioWaitStates * c.ioCycles;
+  const int chip = c.tstates + (k.cpu == CpuRevision::Z8S180 ? c.z8s180Delta : 0);
+  const int base = chip + k.memWaitStates * c.memCycles + k.ioWaitStates * c.ioCycles;
   // Refresh: one cycle of refreshTstates every refreshInterval T-states of
   // CPU time, charged as that average stretch, rounded to the nearest
   // T-state per sequence.
@@ -77,6 +78,8 @@ CostTable makeCostTable(const CostKnobs& knobs) {
   }
   t.autoFrameRet = resolve(kAutoRetSeq, knobs);
   t.ldirRepeat = resolve(sequenceCost("LDIR", 1), knobs);
+  t.copyHead = resolve(kCopyHeadCost, knobs);
+  t.copyLast = t.op[static_cast<int>(Op::COPY)] - t.copyHead;
   t.interruptAccept = resolve(kAcceptSeq, knobs);
   t.serialIsr = resolve(kSerialIsrSeq, knobs) + static_cast<uint32_t>(knobs.serialIsrTstates);
   for (int p = 0; p < kTimerIsrPaths; ++p) t.timerIsr[p] = resolve(kTimerPathSeq[p], knobs);
@@ -109,15 +112,17 @@ CostKnobs uncalibratedKnobs() {
 // they go, the debug hook's 51 T-states as written); the only freedom left
 // is the hardware setting. Predictions (MWI memory / IWI I/O wait states,
 // RCR refresh):
-//   MWI 0, IWI 1, refresh off (before calibration)   8.996 s
-//   MWI 0, IWI 4, refresh off                        8.998 s
-//   MWI 1, IWI 1..4, refresh off                     11.718 s
-//   MWI 0, IWI 4, refresh 2 every 80 / 40            9.231 / 9.465 s
-//   MWI 0, IWI 4, refresh 3 every 80 / 40            9.310 / 9.736 s
-//   MWI 0, IWI 4, refresh 2 every 20                 9.893 s  <- chosen
-//   MWI 0, IWI 4, refresh 3 every 20                 10.322 s
-//   MWI 0, IWI 4, refresh 2 / 3 every 10             10.787 / 11.682 s
-//   (reset state: MWI 3, IWI 4, refresh 3 every 10   22.257 s)
+//   MWI 0, IWI 1, refresh off (before calibration)   9.002 s
+//   MWI 0, IWI 4, refresh off                        9.003 s
+//   MWI 1, IWI 1..4, refresh off                     11.723 s
+//   MWI 0, IWI 4, refresh 2 every 80 / 40            9.237 / 9.470 s
+//   MWI 0, IWI 4, refresh 3 every 80 / 40            9.315 / 9.742 s
+//   MWI 0, IWI 4, refresh 2 every 20                 9.898 s  <- chosen
+//   MWI 0, IWI 4, refresh 3 every 20                 10.328 s
+//   MWI 0, IWI 4, refresh 2 / 3 every 10             10.794 / 11.689 s
+//   (reset state: MWI 3, IWI 4, refresh 3 every 10   22.263 s)
+// (on the default Z80180, RETI 22 T-states; issue 38 moved each by 5-7 ms
+// from the Z8S180's 12, through the serial ISR's RETI on every byte sent)
 // Chosen: the setting nearest 10 s. Memory wait states 0 (the BIOS sets
 // DCNTL for the board's fast SRAM), I/O wait states 4 (DCNTL's reset value:
 // nothing on the I/O bus needs it changed), refresh 2 T-states every 20

@@ -13,9 +13,14 @@
 
 namespace simbot::vm {
 
+// The Z180 revision the board carries (the profile's [controller] cpu):
+// the original Z80180 or the later Z8S180 (and Z8L180), whose figures
+// differ for a few instructions (z180.def Z180_REVISED).
+enum class CpuRevision : uint8_t { Z80180, Z8S180 };
+
 struct Z180Insn {
   std::string_view mnemonic;
-  int tstates;
+  int tstates;  // the Z80180's
   int memCycles;
   int ioCycles;
   // Conditional branches (Z180_BRANCH): tstates/memCycles above are the
@@ -23,23 +28,28 @@ struct Z180Insn {
   bool branch;
   int takenTstates;
   int takenMemCycles;
+  // The Z8S180's T-states less the Z80180's (Z180_REVISED).
+  int z8s180Delta;
 };
 
 inline constexpr Z180Insn kZ180[] = {
-#define Z180_INSN(m, t, mc, io) {m, t, mc, io, false, t, mc},
-#define Z180_BRANCH(m, nt, nmc, tt, tmc) {m, nt, nmc, 0, true, tt, tmc},
+#define Z180_INSN(m, t, mc, io) {m, t, mc, io, false, t, mc, 0},
+#define Z180_BRANCH(m, nt, nmc, tt, tmc) {m, nt, nmc, 0, true, tt, tmc, 0},
+#define Z180_REVISED(m, t, ts, mc, io) {m, t, mc, io, false, t, mc, (ts) - (t)},
 #include "z180.def"
+#undef Z180_REVISED
 #undef Z180_BRANCH
 #undef Z180_INSN
 };
 
 struct SeqCost {
-  int tstates = 0;
+  int tstates = 0;  // on the Z80180
   int memCycles = 0;
   int ioCycles = 0;
   int insns = 0;
-  int branches = 0;  // conditional branches in the sequence (a loop's DJNZ is not one)
-  int loops = 0;     // loop groups "{...}" in the sequence
+  int branches = 0;     // conditional branches in the sequence (a loop's DJNZ is not one)
+  int loops = 0;        // loop groups "{...}" in the sequence
+  int z8s180Delta = 0;  // what the Z8S180 takes more (less: negative)
 };
 
 constexpr SeqCost operator-(SeqCost a, const SeqCost& b) {
@@ -47,6 +57,7 @@ constexpr SeqCost operator-(SeqCost a, const SeqCost& b) {
   a.memCycles -= b.memCycles;
   a.ioCycles -= b.ioCycles;
   a.insns -= b.insns;
+  a.z8s180Delta -= b.z8s180Delta;
   return a;
 }
 
@@ -122,6 +133,7 @@ constexpr SeqCost sequenceCost(std::string_view seq, unsigned taken = 0, int pas
           body.tstates += z.tstates;
           body.memCycles += z.memCycles;
           body.ioCycles += z.ioCycles;
+          body.z8s180Delta += z.z8s180Delta;
           ++body.insns;
         } else if (skipping) {
           break;
@@ -138,6 +150,7 @@ constexpr SeqCost sequenceCost(std::string_view seq, unsigned taken = 0, int pas
           total.tstates += z.tstates;
           total.memCycles += z.memCycles;
           total.ioCycles += z.ioCycles;
+          total.z8s180Delta += z.z8s180Delta;
           ++total.insns;
         }
         break;
@@ -153,6 +166,7 @@ constexpr SeqCost sequenceCost(std::string_view seq, unsigned taken = 0, int pas
           total.memCycles +=
               passes * body.memCycles + (passes - 1) * djnz->takenMemCycles + djnz->memCycles;
           total.ioCycles += passes * body.ioCycles;
+          total.z8s180Delta += passes * body.z8s180Delta;
           total.insns += passes * (body.insns + 1);
         }
       }
@@ -284,6 +298,14 @@ inline constexpr auto kLibAtomic = [] {
   return a;
 }();
 
+// COPY's sequence up to its LDIR: the head that runs before the first byte.
+inline constexpr SeqCost kCopyHeadCost = [] {
+  const std::string_view seq = kOpInfo[static_cast<int>(Op::COPY)].z180;
+  const auto ldir = seq.find("LDIR");
+  if (ldir == std::string_view::npos) throw "COPY's sequence has an LDIR";
+  return sequenceCost(seq.substr(0, ldir));
+}();
+
 // The RST 28h debug hook's body, run at every statement of a debug build
 // (the RST itself is in the DBG opcode's sequence): PUSH AF; LD A,(nn);
 // OR A; JR NZ,to_debugger (not taken: no debugger is attached); POP AF; RET.
@@ -349,6 +371,10 @@ struct CostKnobs {
   int printfCharTstates = 0;
   // Whether the handler epilogue ends with EI before RETI (DESIGN.md).
   bool epilogueEi = true;
+  // Not calibration: the chip on the board (z180.def Z180_REVISED). The
+  // 1997 Tiny Giant's documentation (thesis VI.A cites Zworld 1993)
+  // predates the Z8S180: the original Z80180.
+  CpuRevision cpu = CpuRevision::Z80180;
   // Not calibration: whether PRT0 and the BIOS timer service run.
   TimerService timerService = TimerService::Auto;
   // Not calibration: run marked delay loops in one step where nothing can
@@ -373,8 +399,12 @@ struct CostTable {
   // Added to libCall[] when a call's branch is taken (path 1); 0 but for
   // the routines whose path comes from their argument (abs).
   std::array<int32_t, kLibCount> libTakenDelta{};
-  uint32_t autoFrameRet = 0;     // RET of a frame that ran ENTER: POP IX
-  uint32_t ldirRepeat = 0;       // an LDIR byte after which BC is not yet 0 (COPY)
+  uint32_t autoFrameRet = 0;  // RET of a frame that ran ENTER: POP IX
+  uint32_t ldirRepeat = 0;    // an LDIR byte after which BC is not yet 0 (COPY)
+  // COPY in its parts (vm/instructions.h): the sequence before LDIR, and
+  // the rest of op[COPY] (LDIR's last byte and what follows it).
+  uint32_t copyHead = 0;
+  uint32_t copyLast = 0;
   uint32_t interruptAccept = 0;  // IM2 acknowledge + handler register saves
   uint32_t serialIsr = 0;        // acceptance + library ISR body
   // The timer service along each path (bit 0: no millisecond due, bit 1:

@@ -133,7 +133,8 @@ bool Vm::State::fastForward(Tick until) {
 // runs that pass and the rest, each costing loop.pass, and touches nothing
 // but its counter until the arrival at its top where the compare fails.
 Tick Vm::State::quietUntil() const {
-  if (fault || anyPending || lib.active || lib.awaitingBegin || burn || halted || measure.loop < 0)
+  if (fault || anyPending || lib.active || lib.awaitingBegin || burn || copy.left || halted ||
+      measure.loop < 0)
     return now;
   const Loop& loop = loops[static_cast<size_t>(measure.loop)];
   if (pc < loop.top || pc >= loop.exit || measure.accepted != acceptances ||

@@ -250,17 +250,19 @@ SIMBOT_INSTRUCTION(COPY) {
   const uint32_t n = r.u16();
   const uint32_t src = r.pop() & 0xFFFF, dst = r.pop() & 0xFFFF;
   if (!access(r, src, n) || !access(r, dst, n)) return false;
-  std::memmove(r.m + dst, r.m + src, n);
-  // LDIR's bytes before the last: time that passes in steps with a
-  // boundary between them, as a long instruction's tail (an interrupt can
-  // come between two bytes on the chip).
-  if (n > 1) {
-    const uint32_t repeats = (n - 1) * costs.ldirRepeat;
-    if (r.profile) r.profile[r.opPc] += repeats;
-    burn += repeats;
-    burnPc = r.pc();
-    r.limit = 0;
-  }
+  if (n == 0) return true;
+  // The sequence up to LDIR has run (copyHead); then a byte a step at the
+  // slow boundary, each after a boundary (State::copyStep): the total is
+  // op[] + (n - 1) x ldirRepeat as the listing says, charged to the
+  // profile here. Dispatch charged op[] (or its first kMaxStepTstates, the
+  // rest in burn): take back what comes after the head.
+  const Tick start = r.clk - (costs.op[static_cast<int>(Op::COPY)] - burn);
+  burn = 0;
+  r.clk = start + costs.copyHead;
+  if (r.profile) r.profile[r.opPc] += (n - 1) * costs.ldirRepeat;
+  copy = BlockCopy{dst, src, n};
+  burnPc = r.pc();
+  r.limit = 0;
   return true;
 }
 
@@ -629,6 +631,8 @@ SIMBOT_INSTRUCTION(RETI) {
   mfp = rd16(f.msp - kInterruptFpOffset);
   halted = f.halted;
   burn = f.burn;
+  burnPc = f.burnPc;
+  copy = f.copy;
   lib = std::move(f.lib);
   const Irq irq = f.irq;
   const uint32_t expected = f.retPc;
@@ -651,6 +655,7 @@ SIMBOT_INSTRUCTION(RETI) {
     pc = target;
     halted = false;
     burn = 0;
+    copy = BlockCopy{};
     lib = LibCall{};
     divert(r.pc(), target);
   }

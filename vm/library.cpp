@@ -330,9 +330,9 @@ void Vm::State::libBegin() {
       if (fault) return;
       lib.result = w(static_cast<int32_t>(lib.text.size()));
       // Per character: the routine's own loop (builtins.def's step sequence)
-      // and the debug port's time for it (knob printf_char_tstates).
-      lib.remaining = static_cast<uint32_t>(lib.text.size()) *
-                      (costs.libStep[static_cast<int>(Lib::PRINTF)] + costs.printfChar);
+      // and the debug port's time for it (knob printf_char_tstates); each
+      // line goes to the console when its newline has gone (printfSent).
+      lib.remaining = static_cast<uint32_t>(lib.text.size()) * printfCharTstates();
       lib.active = true;
       return;
     case Lib::Count_:
@@ -345,11 +345,46 @@ void Vm::State::libFinish(bool pushResult) {
   if (pushResult) eval[sp++] = lib.result;
 }
 
-// One step of a long library call: at most kMaxStepTstates T-states.
+// printf sends its characters one after the other over the debug port,
+// each taking its loop's pass and the port's time (libBegin): character i
+// (from 0) has gone once (i + 1) x that has passed since the call
+// sequence. lib.index counts those given to the console, which stamps a
+// line with the tick its newline went.
+uint32_t Vm::State::printfCharTstates() const {
+  return costs.libStep[static_cast<int>(Lib::PRINTF)] + costs.printfChar;
+}
+
+// T-states until the next newline not yet sent has gone (a step ends
+// there, so that its line is stamped with that tick), or UINT32_MAX.
+uint32_t Vm::State::printfToLineEnd() const {
+  const size_t newline = lib.text.find('\n', lib.index);
+  const uint32_t perChar = printfCharTstates();
+  if (newline == std::string::npos || perChar == 0) return UINT32_MAX;
+  const uint32_t elapsed = static_cast<uint32_t>(lib.text.size()) * perChar - lib.remaining;
+  return static_cast<uint32_t>(newline + 1) * perChar - elapsed;
+}
+
+// Gives the console the characters sent by now.
+void Vm::State::printfSent() {
+  const uint32_t perChar = printfCharTstates();
+  const auto size = static_cast<uint32_t>(lib.text.size());
+  const uint32_t sent =
+      perChar == 0 || lib.remaining == 0 ? size : (size * perChar - lib.remaining) / perChar;
+  if (sent <= lib.index) return;
+  emitConsole(std::string_view(lib.text).substr(lib.index, sent - lib.index));
+  lib.index = sent;
+}
+
+// One step of a long library call: at most kMaxStepTstates T-states of its
+// call sequence or of a time it waits (A/D, printf), or one unit of its
+// inner loop (a byte copied, compared, set): the Z180's loop is
+// interruptible after every byte (LDIR after each, a JR NZ loop between
+// any two of its instructions), so a handler sees a copy or fill as far as
+// it has gone, not some bytes at a time.
 void Vm::State::libStep() {
   const int id = static_cast<int>(lib.id);
   const uint32_t unit = std::max<uint32_t>(1, costs.libStepLooping[id]);
-  const uint32_t perStep = std::max<uint32_t>(1, kMaxStepTstates / unit);
+  constexpr uint32_t perStep = 1;
   const uint32_t* a = lib.args;
   ++stats.instructions;
   if (lib.setup > 0) {
@@ -363,15 +398,14 @@ void Vm::State::libStep() {
   switch (lib.id) {
     case Lib::AD_RD8:
     case Lib::PRINTF: {
-      const uint32_t step = std::min(kMaxStepTstates, lib.remaining);
+      uint32_t step = std::min(kMaxStepTstates, lib.remaining);
+      if (lib.id == Lib::PRINTF) step = std::min(step, printfToLineEnd());
       now += step;
       if (profiling) profile[lib.pc] += step;
       lib.remaining -= step;
+      if (lib.id == Lib::PRINTF) printfSent();
       if (lib.remaining == 0) {
-        if (lib.id == Lib::PRINTF) {
-          emitConsole(lib.text);
-          lib.text.clear();
-        }
+        lib.text.clear();
         libFinish(true);
       }
       return;

@@ -60,7 +60,7 @@ struct LibCall {
   // that a bus access is always at a boundary that starts before the
   // horizon (the host never sees an access past the tick it ran us to).
   bool awaitingBegin = false;
-  uint32_t index = 0;      // bytes processed
+  uint32_t index = 0;      // bytes processed (printf: characters sent)
   uint32_t remaining = 0;  // T-states still to burn (A/D, printf)
   uint32_t mark = 0;       // a routine's second phase: where it began
   uint32_t result = 0;
@@ -87,6 +87,17 @@ struct Diversion {
   bool operator==(const Diversion&) const = default;
 };
 
+// A struct assignment's LDIR under way (COPY): one byte a step with an
+// instruction boundary after each, as the Z180's LDIR is interruptible
+// after every byte (it runs again with BC decremented), so a handler sees
+// the copy as far as it has gone.
+struct BlockCopy {
+  uint32_t dst = 0;
+  uint32_t src = 0;
+  uint32_t left = 0;  // bytes still to copy; 0: none under way
+  bool operator==(const BlockCopy&) const = default;
+};
+
 struct InterruptFrame {
   uint32_t retPc;
   Irq irq;
@@ -95,6 +106,8 @@ struct InterruptFrame {
   int callDepth;
   bool halted;
   uint32_t burn;
+  uint32_t burnPc;
+  BlockCopy copy;
   LibCall lib;
   bool operator==(const InterruptFrame&) const = default;
 };
@@ -271,7 +284,20 @@ struct Vm::State {
   // into a run-time routine): its effect is done, its time passes in steps
   // with an instruction boundary between them.
   uint32_t burn = 0;
-  uint32_t burnPc = 0;
+  uint32_t burnPc = 0;  // the instruction whose tail (burn) or copy runs
+  BlockCopy copy;
+  // The instruction, library call or interrupt acceptance under way at the
+  // current boundary (Vm::pc).
+  uint32_t currentPc() const { return lib.active ? lib.pc : burn || copy.left ? burnPc : pc; }
+  // The boundary's step of a copy under way: its next byte, then LDIR's
+  // time for it (cost.h copyHead, ldirRepeat, copyLast).
+  void copyStep() {
+    wr8(copy.dst, rd8(copy.src));
+    copy.dst = (copy.dst + 1) & 0xFFFF;
+    copy.src = (copy.src + 1) & 0xFFFF;
+    --copy.left;
+    now += copy.left ? costs.ldirRepeat : costs.copyLast;
+  }
   VmStats stats;
   // The dispatch copy of the code (vm.cpp "Fast path"): per code address
   // the opcode the fast path runs there, or kTrap where the slow path must
@@ -470,6 +496,9 @@ struct Vm::State {
   void libStep();
   void libFinish(bool pushResult);
   std::string formatPrintf(uint32_t instructionPc, int formatArg);
+  uint32_t printfCharTstates() const;
+  uint32_t printfToLineEnd() const;
+  void printfSent();
 
   template <bool kProfile>
   Stop run(Tick until);

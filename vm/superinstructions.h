@@ -70,9 +70,12 @@ constexpr bool endsRun(Op op) {
 // exec sets the limit to 0): only a last piece.
 constexpr bool addsBurn(Op op) { return op == Op::SHLW || op == Op::SHRW || op == Op::SHRUW; }
 // The instructions that always go to the slow boundary: never a piece.
+// COPY too: its bytes are the slow boundary's steps, and it sets its own
+// clock back from the whole figure dispatch charged to its set-up's end.
 constexpr bool needsSlowBoundary(Op op) {
   return op == Op::RETI || op == Op::HALT || op == Op::LIB || op == Op::EI || op == Op::DI ||
-         op == Op::COSTATE || op == Op::COYIELD || op == Op::COEND || op == Op::CODONE;
+         op == Op::COSTATE || op == Op::COYIELD || op == Op::COEND || op == Op::CODONE ||
+         op == Op::COPY;
 }
 
 // What a run of pieces does to the expression stack, from opcodes.def:

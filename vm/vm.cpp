@@ -56,7 +56,7 @@ void Vm::State::accept() {
   pend[i] = false;
   updatePending();
   ++stats.interrupts[i];
-  const uint32_t interruptedPc = lib.active ? lib.pc : burn ? burnPc : pc;
+  const uint32_t interruptedPc = currentPc();
   if (irq == Irq::Timer) {
     timerService(interruptedPc);
     return;
@@ -86,13 +86,14 @@ void Vm::State::accept() {
     return;
   }
   ints.push_back(InterruptFrame{pc, irq, msp, sp, static_cast<int>(calls.size()), halted, burn,
-                                std::move(lib)});
+                                burnPc, copy, std::move(lib)});
   // The frame's PC and IX, as the handler's prologue pushed them (the other
   // registers' slots keep what they held: the VM has no AF, BC, DE, HL, IY).
   wr16(msp - kReturnAddressBytes, pc);
   wr16(msp - kInterruptFpOffset, mfp);
   lib = LibCall{};
   burn = 0;
+  copy = BlockCopy{};
   resumeAtBreakpoint = false;
   msp -= kInterruptFrameBytes;
   halted = false;
@@ -533,6 +534,11 @@ boundary:
     accept();
     goto boundary;
   }
+  if (copy.left) {
+    copyStep();
+    eiShadow = false;
+    goto boundary;
+  }
   if (burn) {
     const uint32_t step = std::min(kMaxStepTstates, burn);
     now += step;
@@ -622,7 +628,7 @@ slowNext:
     r.limit = longLimit;
     longLimit = -1;
     burnTail(r);
-    if (!burn && r.clk < r.limit) DISPATCH_NEXT;
+    if (!burn && !copy.left && r.clk < r.limit) DISPATCH_NEXT;
   }
   save(r);
   goto boundary;
@@ -799,7 +805,7 @@ Tick Vm::quietUntil() const { return s_->quietUntil(); }
 bool Vm::halted() const { return s_->halted; }
 const Fault* Vm::fault() const { return s_->fault ? &*s_->fault : nullptr; }
 bool Vm::interruptsEnabled() const { return s_->iff1; }
-uint32_t Vm::pc() const { return s_->lib.active ? s_->lib.pc : s_->burn ? s_->burnPc : s_->pc; }
+uint32_t Vm::pc() const { return s_->currentPc(); }
 int Vm::line() const { return s_->image->lineAt(pc()); }
 int Vm::interruptDepth() const { return static_cast<int>(s_->ints.size()); }
 int Vm::callDepth() const { return static_cast<int>(s_->calls.size()); }

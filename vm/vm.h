@@ -14,7 +14,9 @@
 // Pending requests are taken in the Z180's fixed priority order: the PIO
 // (INT0), then PRT0 (the timer), then the ASCI (serial transmit). Long
 // library calls run as steps of <= 100 T-states with a boundary between
-// steps; a handler accepted there resumes the call when it returns. The
+// steps, their inner loops one unit (a byte) a step, and a struct
+// assignment one byte a step, as the Z180's LDIR; a handler accepted there
+// resumes the call or the copy when it returns. The
 // serial library's calls are atomic (cost.h kLibAtomic): no boundary inside
 // them, and IFF1 after them is what it was before.
 //

@@ -12,6 +12,7 @@ using simbot::config::checkTomlText;
 using simbot::config::parseHardware;
 using simbot::config::parseProfile;
 using simbot::scheduler::ControllerKnobs;
+using simbot::vm::CpuRevision;
 using simbot::vm::TimerService;
 
 namespace {
@@ -267,6 +268,26 @@ TEST(Profiles, ControllerKnobsAreTheVmsTyped) {
   EXPECT_NE(msg.find("'controller.timer_service' must be \"auto\", \"always\" or \"never\""),
             std::string::npos)
       << msg;
+}
+
+// [controller] cpu: the Z180 revision, the original Z80180 in both shipped
+// profiles (the thesis's board predates the Z8S180); "z8s180" the later
+// one; anything else is an error naming the two.
+TEST(Profiles, ControllerCpuIsTheZ180Revision) {
+  EXPECT_EQ(thesis().controller.cpu, CpuRevision::Z80180);
+  EXPECT_EQ(defaults().controller.cpu, CpuRevision::Z80180);
+  const Profile p = parseProfile(
+      edit("cpu           = { value = \"z80180\"", "cpu = { value = \"z8s180\""), "x.toml");
+  EXPECT_EQ(p.controller.cpu, CpuRevision::Z8S180);
+  const std::string msg =
+      errorOf(edit("cpu           = { value = \"z80180\"", "cpu = { value = \"z80\""));
+  EXPECT_NE(msg.find("'controller.cpu' must be \"z80180\" or \"z8s180\""), std::string::npos)
+      << msg;
+  RobotParams params = thesis().robot;
+  ControllerKnobs controller;
+  parseHardware("[controller]\ncpu = { value = \"z8s180\", source = \"our board\" }\n", "hw.toml",
+                params, controller);
+  EXPECT_EQ(controller.cpu, CpuRevision::Z8S180);
 }
 
 TEST(Hardware, ErrorsArePositioned) {

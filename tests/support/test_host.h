@@ -38,6 +38,7 @@ class TestHost : public vm::Bus {
   int eye[2] = {16, 16};
   uint8_t pioA = 0xFF;
   std::vector<std::string> consoleLines;
+  std::vector<Tick> consoleTicks;  // each line's tick
   std::vector<Access> outs;
   std::vector<Tick> sends;
   std::vector<Event> events;
@@ -75,7 +76,10 @@ class TestHost : public vm::Bus {
     schedule(sends.back() + kTicksPerChar * (next_ - 1), Irq::SerialTx);
     (void)t;
   }
-  void console(Tick, std::string_view line) override { consoleLines.emplace_back(line); }
+  void console(Tick t, std::string_view line) override {
+    consoleLines.emplace_back(line);
+    consoleTicks.push_back(t);
+  }
   void interruptAccepted(Tick t, Irq irq, uint32_t pc) override {
     events.push_back({t, irq, pc, true});
   }
