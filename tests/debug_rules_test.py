@@ -294,6 +294,50 @@ check(stop(answers[0][1]) == ("A", T0, "platform", 17) and "effect is due" in an
 check(value(answers[1][1]) == 9 and value(answers[3][1]) == 8, "cc before and after the effect")
 check(stop(answers[2][1]) == ("A", T0, "platform", 18), f"stepi over the effect: {answers[2][1]}")
 
+# ---- 6. A struct assignment an interrupt tears --------------------------------
+#
+# tests/debug/torn.dc: main() runs straight to `latest = fresh;` (line 27):
+# CALL main 18, six outport lines of DBG 68, PUSHW 22, PUSHW 22, LIB 67 =
+# 179, three stores of DBG 68, PUSHW 22, STGW 28 = 118: line 27 starts at
+# 18 + 6 * 179 + 3 * 118 = 1,446; its DBG and two PUSHWs bring the COPY to
+# 1,558. The COPY (121 T-states for 6 bytes) is LDIR's: POP, EX DE,HL,
+# LD BC,6 (9 + 3 + 9 = 21, 23 with the refresh), then a boundary after each
+# byte, 14 T-states a repeat (15 with the refresh): 1,581 (no byte yet),
+# 1,596, 1,611, 1,626, 1,641 (four bytes: x and y copied, heading not).
+# An edge requested at tick 1,612 is accepted at the next boundary, 1,626,
+# with three bytes copied: x = 0x1111, y's low byte 0x22 only. The handler
+# (acceptance 99, DBG 68, PUSHW 22, PUSHW 22, COPY 121) reaches its RETI at
+# 1,626 + 332 = 1,958 with seen = {0x1111, 0x0022, 0}: half a fix, and the
+# backtrace names line 27 as the one interrupted.
+answers = dict(enumerate(session(["tests/debug/torn.dc"], """\
+break 27
+continue
+stepi
+stepi
+stepi
+stepi
+stepi
+stepi
+stepi
+stepi
+print/x latest
+""", "--seconds", "0.01")))
+ticks = [stop(answers[k][1])[1] for k in range(1, 10)]
+check(ticks == [1446, 1514, 1536, 1558, 1581, 1596, 1611, 1626, 1641],
+      f"the copy's boundaries: {ticks}")
+check(all(stop(answers[k][1])[3] == 27 for k in range(5, 10)), "inside the COPY: line 27")
+check("{x = 0x1111, y = 0x2222, heading = 0x0}" in answers[10][1], f"4 bytes: {answers[10][1]}")
+answers = dict(enumerate(session(["tests/debug/torn.dc"], """\
+break 14
+continue
+print/x seen
+backtrace
+""", "--seconds", "0.01", "--inject", "A:edge_fore@1612t")))
+check(stop(answers[1][1]) == ("A", 1958, "edge", 14), f"the handler's RETI: {answers[1][1]}")
+check("seen (struct fix) = {x = 0x1111, y = 0x22, heading = 0x0}" in answers[2][1],
+      f"the handler saw 3 bytes: {answers[2][1]}")
+check("#1  main() at torn.dc:27 [interrupted here]" in answers[3][1], f"backtrace: {answers[3][1]}")
+
 # ---- 7. Counts and numbers the user writes ----------------------------------
 #
 # The audit's reproducers (each was signed overflow, UB, or a wrong value):

@@ -821,7 +821,12 @@ std::vector<Vm::Frame> Vm::frames() const {
   size_t k = 0;
   auto handlersAt = [&](size_t depth) {
     for (; k < ints.size() && static_cast<size_t>(ints[k].callDepth) <= depth; ++k)
-      out.push_back({ints[k].lib.active ? ints[k].lib.pc : ints[k].retPc, true});
+      // The instruction it interrupted: a library call, a long
+      // instruction's tail or a block copy under way, else the next one.
+      out.push_back({ints[k].lib.active                  ? ints[k].lib.pc
+                     : ints[k].burn || ints[k].copy.left ? ints[k].burnPc
+                                                         : ints[k].retPc,
+                     true});
   };
   for (size_t i = 0; i < calls.size(); ++i) {
     handlersAt(i);
@@ -844,7 +849,7 @@ std::vector<Vm::Activation> Vm::activations() const {
   out.reserve(outer.size() + 1);
   uint32_t fp = s.mfp;
   size_t call = s.calls.size(), handler = s.ints.size();
-  uint32_t at = s.lib.active ? s.lib.pc : s.pc;
+  uint32_t at = s.currentPc();
   bool inHandler = !s.ints.empty() && s.ints.back().callDepth == static_cast<int>(s.calls.size());
   for (size_t k = outer.size() + 1; k-- > 0;) {
     const bool framed = entered(at);
