@@ -10,57 +10,13 @@
 #include <sstream>
 #include <string>
 
-#include "compiler/compiler.h"
-#include "config/config.h"
 #include "debug/dap.h"
+#include "fuzz/tiny_run.h"
 
 using namespace simbot;
 
-namespace {
-
-constexpr const char* kProgram = R"(struct point { int x; int y; };
-struct point p;
-int data[4];
-long total;
-char name[6] = "robot";
-int *where;
-
-int twice(int n)
-{
-    int k;
-    k = n + n;
-    return k;
-}
-
-main()
-{
-    int i;
-    where = &data[1];
-    for (i = 0; ; i++) {
-        data[i & 3] = twice(i);
-        p.x = i;
-        p.y = *where;
-        total = total + i;
-    }
-}
-)";
-
-debug::Launched tinyRun() {
-  const config::Profile profile = config::loadProfile(SIMBOT_PROFILES_DIR "/default.toml");
-  compiler::Result compiled = compiler::compile(kProgram, "fuzz.dc");
-  debug::Launched run;
-  run.config.arena = config::makeArenaConfig(profile, 1);
-  run.config.robots.push_back({"A", "fuzz.dc", std::move(*compiled.image)});
-  run.config.endTick = scheduler::kTicksPerSecond / 200;
-  run.config.stopWhenAllExited = true;
-  run.programs.push_back("fuzz.dc");
-  return run;
-}
-
-}  // namespace
-
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const debug::Launched run = tinyRun();
+  static const debug::Launched run = fuzz::tinyRun();
   std::istringstream in(std::string(reinterpret_cast<const char*>(data), size));
   std::ostringstream out;
   debug::DapServer server(in, out, [](const debug::LaunchRequest& r) {

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/) with clang, ASan and UBSan into
 # build-fuzz/, and runs each for SECONDS (default 60): the compiler, the VM
-# (through a solo run), the TOML loaders, the debugger's expressions and
-# simbot dap's server, each starting from the shipped programs,
+# (through a solo run), the TOML loaders, the debugger's expressions, its
+# command line and simbot dap's server, each starting from the shipped programs,
 # configurations or debugger scripts and the saved regressions (for dap: DAP
 # sessions, well and badly formed). A crash, a leak, a timeout or undefined
 # behaviour fails the script; the input is left in build-fuzz/fuzzing/ (copy
@@ -16,7 +16,7 @@ seconds=${1:-60}
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DSIMBOT_FUZZ=ON \
   -DSIMBOT_BENCHMARKS=OFF > build-fuzz.configure.log 2>&1 || { cat build-fuzz.configure.log; exit 1; }
 cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_compiler fuzz_vm fuzz_config fuzz_inspect \
-  fuzz_dap
+  fuzz_console fuzz_dap
 work=build-fuzz/fuzzing
 mkdir -p "$work"
 shared=../shared/programs
@@ -27,7 +27,7 @@ run() {  # TARGET SEEDS...
   local dict=()
   case $target in
     config) ;;
-    inspect) dict=(-dict=fuzz/inspect.dict) ;;
+    inspect | console) dict=(-dict=fuzz/inspect.dict) ;;
     dap) dict=(-dict=fuzz/dap.dict) ;;
     *) dict=(-dict=fuzz/dynamic_c.dict) ;;
   esac
@@ -41,13 +41,14 @@ run vm programs tests/programs "$shared" & vm=$!
 wait "$compiler" || { status=1; echo "fuzz: the compiler target failed (log: $work/compiler.log)"; }
 wait "$vm" || { status=1; echo "fuzz: the vm target failed (log: $work/vm.log)"; }
 run config profiles profiles/hardware scenarios & config=$!
-# The second wave runs three targets on the two cores: each its full time.
 run inspect tests/debug & inspect=$!
-run dap & dap=$!
 wait "$config" || { status=1; echo "fuzz: the config target failed (log: $work/config.log)"; }
 wait "$inspect" || { status=1; echo "fuzz: the inspect target failed (log: $work/inspect.log)"; }
+run console tests/debug & console=$!
+run dap & dap=$!
+wait "$console" || { status=1; echo "fuzz: the console target failed (log: $work/console.log)"; }
 wait "$dap" || { status=1; echo "fuzz: the dap target failed (log: $work/dap.log)"; }
-for target in compiler vm config inspect dap; do
+for target in compiler vm config inspect console dap; do
   grep -E "stat::number_of_executed_units|stat::average_exec_per_sec" "$work/$target.log" |
     tr '\n' ' ' | sed "s/^/fuzz $target: /"
   echo
