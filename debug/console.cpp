@@ -225,10 +225,11 @@ void Console::report(Session& s, const Stop& why) {
   if (!why.note.empty() && why.kind != Stop::Kind::Event) out_ << why.note << "\n";
   if (why.kind == Stop::Kind::Step && last_.kind == Resume::Kind::StepInstruction) {
     const vm::Image& img = s.vm(s.robot()).image();
-    out_ << fmt::format("ran     {}\n", vm::disassembleAt(img, lastPc_));
+    const vm::CostTable& costs = s.vm(s.robot()).costs();
+    out_ << fmt::format("ran     {}\n", vm::disassembleAt(img, lastPc_, costs));
     out_ << fmt::format("clock   {} ({}), +{} T-states\n", s.now(), secondsText(s.now()),
                         s.now() - lastTick_);
-    out_ << fmt::format("next    {}\n", vm::disassembleAt(img, s.vm(s.robot()).pc()));
+    out_ << fmt::format("next    {}\n", vm::disassembleAt(img, s.vm(s.robot()).pc(), costs));
   }
   showLocation(s, s.robot());
   showDisplays(s);
@@ -591,7 +592,8 @@ void Console::info(Session& s, const std::string& what) {
   }
   if (what == "registers" || what == "r") {
     const std::vector<vm::Vm::Activation> acts = v.activations();
-    out_ << fmt::format("pc      0x{:04X}  {}\n", v.pc(), vm::disassembleAt(v.image(), v.pc()));
+    out_ << fmt::format("pc      0x{:04X}  {}\n", v.pc(),
+                        vm::disassembleAt(v.image(), v.pc(), v.costs()));
     out_ << fmt::format("clock   {} ({})\n", v.now(), secondsText(v.now()));
     out_ << fmt::format("IFF1    {}  (interrupts {})\n", v.interruptsEnabled() ? 1 : 0,
                         v.interruptsEnabled() ? "enabled" : "disabled");

@@ -338,6 +338,26 @@ check("seen (struct fix) = {x = 0x1111, y = 0x22, heading = 0x0}" in answers[2][
       f"the handler saw 3 bytes: {answers[2][1]}")
 check("#1  main() at torn.dc:27 [interrupted here]" in answers[3][1], f"backtrace: {answers[3][1]}")
 
+# ---- 8. The controller's CPU revision in a step ---------------------------------
+#
+# The handler's RETI, stepped: the epilogue's sequence with the default
+# profile's Z80180 (RETI 22 T-states) is 94 calibrated; a profile that
+# says "z8s180" (RETI 12) charges 10 fewer plus the one refresh cycle
+# those 10 would have stretched (2 T-states every 20; docs/cycle-model.md):
+# 83, from tick 1,958 to 2,052 and to 2,041.
+with tempfile.TemporaryDirectory() as work:
+    default = open(SOURCE + "/profiles/default.toml").read()
+    check('cpu           = { value = "z80180"' in default, "the default profile's cpu line")
+    with open(work + "/z8s180.toml", "w") as f:
+        f.write(default.replace('cpu           = { value = "z80180"',
+                                'cpu           = { value = "z8s180"'))
+    for profile, reti in (("default", 94), (work + "/z8s180.toml", 83)):
+        answers = dict(enumerate(session(["tests/debug/torn.dc"], "break 14\ncontinue\nstepi\n",
+                                         "--seconds", "0.01", "--inject", "A:edge_fore@1612t",
+                                         "--profile", profile)))
+        check(f"000f  RETI       [{reti} T-states]" in answers[2][1] and
+              f"clock   {1958 + reti} " in answers[2][1], f"RETI on {profile}: {answers[2][1]}")
+
 # ---- 7. Counts and numbers the user writes ----------------------------------
 #
 # The audit's reproducers (each was signed overflow, UB, or a wrong value):

@@ -166,13 +166,16 @@ Parts instructionParts(const Image& img, const CostTable& costs,
 }  // namespace
 
 std::string disassembleAt(const Image& img, uint32_t at) {
+  return disassembleAt(img, at, makeCostTable(calibratedKnobs()));
+}
+
+std::string disassembleAt(const Image& img, uint32_t at, const CostTable& costs) {
   if (at >= img.code.size()) return fmt::format("{:04x}  (outside the code)", at);
   const uint8_t byte = img.code[at];
   if (byte >= kOpCount) return fmt::format("{:04x}  .byte {}", at, byte);
   const Op op = static_cast<Op>(byte);
   if (at + static_cast<uint32_t>(instructionSize(op)) > img.code.size())
     return fmt::format("{:04x}  {} (truncated)", at, info(op).name);
-  const CostTable costs = makeCostTable(calibratedKnobs());
   const auto [name, operands, cost] = instructionParts(img, costs, img.returnFrames(), at);
   return fmt::format("{:04x}  {:<8} {}  [{} T-states]", at, name, operands, cost);
 }

@@ -891,6 +891,7 @@ uint16_t Vm::read16(uint16_t a) const { return s_->rd16(a); }
 uint32_t Vm::read32(uint16_t a) const { return s_->rd32(a); }
 const VmStats& Vm::stats() const { return s_->stats; }
 const Image& Vm::image() const { return *s_->image; }
+const CostTable& Vm::costs() const { return s_->costs; }
 
 void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
   State& s = *s_;

@@ -233,6 +233,7 @@ class Vm {
 
   const VmStats& stats() const;
   const Image& image() const;
+  const CostTable& costs() const;  // what it charges (its profile's revision and knobs)
 
   // Stop before executing the instruction at `codeAddress` (used for
   // program-point injection and for tests). The next run() executes it.
@@ -261,5 +262,8 @@ std::string disassemble(const Image& image);
 // The instruction at `codeAddress` as one line of that listing: address,
 // name, operands and T-states (the debugger's stepi).
 std::string disassembleAt(const Image& image, uint32_t codeAddress);
+// The same with the T-states of `costs` (a robot's own table: its CPU
+// revision).
+std::string disassembleAt(const Image& image, uint32_t codeAddress, const CostTable& costs);
 
 }  // namespace simbot::vm
