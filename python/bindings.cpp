@@ -20,6 +20,7 @@
 #include "batch/sweep.h"
 #include "compiler/compiler.h"
 #include "config/config.h"
+#include "files/files.h"
 #include "runs/play.h"
 #include "sinks/json_text.h"
 #include "sinks/trace_jsonl.h"
@@ -213,6 +214,8 @@ PYBIND11_MODULE(_simbot, m) {
       .def("header", [](const Sweep& s) { return batch::sweepHeader(s.spec); })
       .def("programs", &Sweep::programs)
       .def("row", &Sweep::row, py::arg("index"));
+  m.attr("MAX_TRACE_BYTES") = files::kMaxTraceBytes;
+  m.attr("MAX_TRACE_LINE_BYTES") = files::kMaxTraceLineBytes;
   m.def("parse_shard", &batch::parseShard, py::arg("text"));
   m.def("shard_range", &checkedShardRange, py::arg("runs"), py::arg("k"), py::arg("n"));
   m.def("silence_compile_warnings", &silenceCompileWarnings);
