@@ -21,12 +21,17 @@ Usage: outputs_test.py SIMBOT SOURCE_DIR SHARED_DIR OUTDIR [--sanitized]
 - --resume refuses a batch whose program or settings changed, naming what.
 - A sweep whose run count overflows or is too large is refused at once.
 - Worker threads that cannot be created are one line and exit 1.
+- A bench, tournament or sweep refused for bad input (a program that does
+  not compile, a missing opponent; with --resume too) leaves the earlier
+  batch's table, batch.json and summaries byte-identical.
+- bench, compare, tournament and sweep each refuse an output that is one of
+  their inputs, in one line, writing nothing.
+- `simbot sweep FILE` in a folder with no out/ makes it and writes there.
 - A trace whose second line is 1 GiB long: view and explain report
   FILE:2 in one line, read no further (peak RSS under 128 MiB; the old
   reader took 2.1 GB); the longest record simbot can write (a 1-MiB
-  program of control bytes: 6 MiB of JSON) still reads back; and memory
-  that runs out while reading a line is reported as that, FILE:LINE (not
-  as an empty trace).
+  program of control bytes: 6 MiB of JSON) still reads back; and memory that runs out while reading a line is
+  reported as that, FILE:LINE (not as an empty trace).
 """
 import os
 import shutil
@@ -314,6 +319,112 @@ if not SANITIZED:  # an address-space limit is what makes thread stacks fail
                        capture_output=True, text=True, timeout=120)
     check(one_line_error(r, "cannot start"), f"threads that cannot start ({r.returncode} "
           f"{r.stderr[-300:]!r})")
+
+# ---- batches refused for bad input leave the earlier batch's folder as it was
+def snapshot(directory):
+    return {p.name: p.read_bytes() for p in Path(directory).iterdir()}
+
+
+def refused_batches_leave_folder(kind, folder, table, refusals):
+    """Each refusal (what, args, words) exits 1 naming `words` and leaves
+    every file in `folder` byte-identical; the last ones resume (-Werror
+    makes ICEMAN's warnings errors) a table whose last row was cut short,
+    which stays cut short."""
+    for what, args, words in refusals:
+        if "--resume" in args:
+            with open(folder / table, "ab") as f:
+                f.write(b"1,2,3")  # a row cut short by a kill
+        before = snapshot(folder)
+        r = run(args)
+        check(r.returncode == 1 and words in r.stderr,
+              f"{kind}, {what}: refused ({r.returncode} {r.stderr[-300:]!r})")
+        check(snapshot(folder) == before,
+              f"{kind}, {what}: the earlier table, its settings and summaries are byte-identical")
+
+
+bad = OUT / "bad.dc"
+bad.write_text("main() { undeclared = 1; }\n")
+missing = OUT / "no-such-opponent.dc"
+done = OUT / "done-bench"
+SMALL_BENCH = ["--seeds", "2", "--seconds", "1", "--out", done]
+r = run(["bench", ICEMAN, "--family", "stationary"] + SMALL_BENCH)
+check(r.returncode == 0 and sorted(snapshot(done)) ==
+      ["batch.json", "runs.csv", "summary.json", "summary.md"], f"a small bench ({r.stderr[-300:]!r})")
+refused_batches_leave_folder("bench", done, "runs.csv", [
+    ("a program that does not compile",
+     ["bench", ICEMAN, bad, "--family", "stationary"] + SMALL_BENCH, "bad.dc:1:"),
+    ("a missing opponent", ["bench", ICEMAN, "--family", "head-to-head", "--opponent", missing]
+     + SMALL_BENCH, "no such program"),
+    ("--resume -Werror", ["bench", ICEMAN, "--family", "stationary", "--resume", "-Werror"]
+     + SMALL_BENCH, "iceman.dc:")])
+done = OUT / "done-tournament"
+SMALL_TOURNAMENT = ["--rounds", "1", "--seconds", "1", "--out", done]
+r = run(["tournament", ICEMAN, SPIRAL] + SMALL_TOURNAMENT)
+check(r.returncode == 0 and len(snapshot(done)) == 4, f"a small tournament ({r.stderr[-300:]!r})")
+refused_batches_leave_folder("tournament", done, "games.csv", [
+    ("a program that does not compile", ["tournament", ICEMAN, bad] + SMALL_TOURNAMENT,
+     "bad.dc:1:"),
+    ("a missing program", ["tournament", ICEMAN, missing] + SMALL_TOURNAMENT, "no such program"),
+    ("--resume -Werror", ["tournament", ICEMAN, SPIRAL, "--resume", "-Werror"] + SMALL_TOURNAMENT,
+     "iceman.dc:")])
+done = OUT / "done-sweep"
+done.mkdir()
+grids = {"good": f'programs = ["{ICEMAN}"]\nfamilies = ["stationary"]',
+         "bad": f'programs = ["{ICEMAN}", "{bad}"]\nfamilies = ["stationary"]',
+         "missing": f'programs = ["{ICEMAN}"]\nopponents = ["{missing}"]\n'
+                    'families = ["head-to-head"]'}
+for name, text in grids.items():
+    (OUT / f"{name}.toml").write_text(f"{text}\nseconds = 1\n[seeds]\nfirst = 1\ncount = 2\n")
+r = run(["sweep", OUT / "good.toml", "--out", done / "t.csv"])
+check(r.returncode == 0 and sorted(snapshot(done)) == ["t.csv", "t.csv.batch.json"],
+      f"a small sweep ({r.stderr[-300:]!r})")
+refused_batches_leave_folder("sweep", done, "t.csv", [
+    ("a program that does not compile", ["sweep", OUT / "bad.toml", "--out", done / "t.csv"],
+     "bad.dc:1:"),
+    ("a missing opponent", ["sweep", OUT / "missing.toml", "--out", done / "t.csv"],
+     "no such program"),
+    ("--resume -Werror", ["sweep", OUT / "good.toml", "--out", done / "t.csv", "--resume",
+                          "-Werror"], "iceman.dc:")])
+
+# ---- no batch writes onto one of its inputs (one check for all four)
+same = OUT / "same"
+same.mkdir()
+for name in ("summary.md", "runs-b.csv", "standings.md", "program.dc"):
+    shutil.copy(SPIRAL, same / name)
+sweep_same = same / "s.toml"
+sweep_same.write_text(f'programs = ["{same / "program.dc"}"]\nfamilies = ["stationary"]\n'
+                      "seconds = 1\n[seeds]\nfirst = 1\ncount = 1\n")
+for what, args, name in [
+        ("bench: a program named DIR/summary.md",
+         ["bench", same / "summary.md", "--family", "stationary", "--seeds", "1", "--out", same],
+         "summary.md"),
+        ("compare: program B is DIR/runs-b.csv",
+         ["compare", SPIRAL, same / "." / "runs-b.csv", "--family", "stationary", "--seeds", "1",
+          "--out", same], "runs-b.csv"),
+        ("tournament: a program named DIR/standings.md",
+         ["tournament", SPIRAL, same / "standings.md", "--rounds", "1", "--out", same],
+         "standings.md"),
+        ("sweep: --out onto its program", ["sweep", sweep_same, "--out", same / "program.dc"],
+         "program.dc")]:
+    r = run(args + ["--seconds", "1"] if args[0] != "sweep" else args)
+    check(one_line_error(r, "same file", name), f"{what}: refused in one line ({r.stderr!r})")
+    check((same / name).read_bytes() == SPIRAL.read_bytes(), f"{what}: the input is unchanged")
+check(sorted(p.name for p in same.iterdir()) ==
+      ["program.dc", "runs-b.csv", "s.toml", "standings.md", "summary.md"],
+      f"nothing was written beside them: {sorted(p.name for p in same.iterdir())}")
+
+# ---- `simbot sweep FILE` in a folder with no out/ yet: the folder is made first
+fresh = OUT / "fresh"
+fresh.mkdir()
+(fresh / "g.toml").write_text(f'programs = ["{SPIRAL}"]\nfamilies = ["stationary"]\n'
+                              "seconds = 1\n[seeds]\nfirst = 1\ncount = 2\n")
+r = subprocess.run([SIMBOT, "sweep", "g.toml"], cwd=fresh, capture_output=True, text=True,
+                   timeout=120)
+table = fresh / "out" / "sweep-g.csv"
+check(r.returncode == 0 and table.is_file() and len(table.read_bytes().split(b"\r\n")) == 4
+      and (fresh / "out" / "sweep-g.csv.batch.json").is_file(),
+      f"sweep FILE with no out/ folder: {r.returncode} {r.stderr[-300:]!r}")
+
 
 # ---- a trace line longer than the limit: FILE:LINE, read no further, bounded memory
 def peak_kib(args):
