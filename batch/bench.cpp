@@ -163,6 +163,13 @@ scheduler::MatchConfig baseConfig(const BenchConfig& config, const config::Profi
 
 }  // namespace
 
+uint64_t benchRunSeed(const BenchConfig& config, const std::string& program, int index) {
+  return scheduler::streamSeed(
+      config.masterSeed,
+      fmt::format("{}/{}/{}", benchLabel(config),
+                  config.seedKey.empty() ? fileName(program) : config.seedKey, index));
+}
+
 CsvRow benchHeader() {
   CsvRow header = {"program",           "run",          "seed",
                    "start_x_ft",        "start_y_ft",   "start_heading_deg",
@@ -346,41 +353,48 @@ BenchResult runBench(const BenchConfig& config, const config::Profile& profile, 
   result.config = config;
   const size_t seeds = static_cast<size_t>(config.seeds);
   result.runs.resize(config.programs.size() * seeds);
-  // Runs an earlier, interrupted batch finished (--resume).
+  // Runs an earlier, interrupted batch finished (--resume): each must be
+  // one of this bench's runs (its program, index and seed), once.
   if (io.table) {
-    for (const CsvRow& row : io.table->previous()) {
+    for (const PreviousRow& row : io.table->previous()) {
+      const std::string where = io.table->where(row.line);
       BenchRun run;
       try {
-        run = benchRunFromRow(row);
+        run = benchRunFromRow(row.fields);
       } catch (const std::exception&) {
-        throw sinks::UserError(
-            fmt::format("simbot: --resume: a malformed row in {}/runs.csv\n", io.table->dir()));
+        throw sinks::UserError(fmt::format("simbot: --resume: {}: a malformed row\n", where));
       }
       const auto p = std::find(config.programs.begin(), config.programs.end(), run.program);
       if (p == config.programs.end() || run.index < 0 || run.index >= config.seeds)
         throw sinks::UserError(
-            fmt::format("simbot: --resume: run {} of '{}' does not belong to this "
-                        "bench\n",
-                        run.index, run.program));
-      result.runs[static_cast<size_t>(p - config.programs.begin()) * seeds +
-                  static_cast<size_t>(run.index)] = std::move(run);
+            fmt::format("simbot: --resume: {}: run {} of '{}' is not one of this bench's runs\n",
+                        where, run.index, run.program));
+      if (const uint64_t seed = benchRunSeed(config, run.program, run.index); run.seed != seed)
+        throw sinks::UserError(fmt::format(
+            "simbot: --resume: {}: run {} of '{}' has seed {}, but this bench's run {} has seed "
+            "{} (a row from another batch)\n",
+            where, run.index, run.program, run.seed, run.index, seed));
+      BenchRun& slot = result.runs[static_cast<size_t>(p - config.programs.begin()) * seeds +
+                                   static_cast<size_t>(run.index)];
+      if (slot.done)
+        throw sinks::UserError(fmt::format("simbot: --resume: {}: run {} of '{}' is there twice\n",
+                                           where, run.index, run.program));
+      slot = std::move(run);
     }
+    // Inputs compiled, rows checked: only now does the folder change.
+    io.table->begin();
   }
   std::vector<size_t> todo;
   for (size_t j = 0; j < result.runs.size(); ++j)
     if (!result.runs[j].done) todo.push_back(j);
   const scheduler::Tick endTick = timebase::ticksFromSeconds(config.seconds);
-  const std::string label = benchLabel(config);
   auto job = [&](size_t k) {
     const size_t j = todo[k];
     const size_t p = j / seeds;
     BenchRun& run = result.runs[j];
     run.program = config.programs[p];
     run.index = static_cast<int>(j % seeds);
-    run.seed = scheduler::streamSeed(
-        config.masterSeed,
-        fmt::format("{}/{}/{}", label,
-                    config.seedKey.empty() ? fileName(run.program) : config.seedKey, run.index));
+    run.seed = benchRunSeed(config, run.program, run.index);
     scheduler::MatchConfig mc = bases[p];
     if (!config.family.empty()) {
       plant::SplitMix64 bits(scheduler::streamSeed(run.seed, "scenario"));

@@ -88,6 +88,9 @@ inline constexpr double kCircleSpeedFps = 0.5;
 // The family's name in outputs: the family, or "scenario NAME".
 std::string benchLabel(const BenchConfig& config);
 
+// Run `index` of `program`: streamSeed(master, "<family>/<program's file
+// name>/<index>"), the seed key in place of the file name when given.
+uint64_t benchRunSeed(const BenchConfig& config, const std::string& program, int index);
 // UserError if the configuration cannot run (a family, the counts).
 void checkBenchConfig(const BenchConfig& config);
 // runs.csv's columns, and the settings that identify a bench (batch.json).
@@ -98,8 +101,9 @@ nlohmann::json benchSettings(const BenchConfig& config, const config::Profile& p
 std::vector<std::string> benchInputs(const BenchConfig& config, const config::Profile& profile);
 
 // Runs every run not already in io.table (resume); each finished run goes
-// to the table as it completes. A run that faults or fails is recorded as
-// such; the others go on.
+// to the table as it completes. The table begins (RunTable::begin) only
+// once every program is compiled and the resumed rows are checked. A run
+// that faults or fails is recorded as such; the others go on.
 BenchResult runBench(const BenchConfig& config, const config::Profile& profile,
                      const BenchIo& io = {});
 

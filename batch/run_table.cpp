@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "files/files.h"
+#include "runs/play.h"
 #include "sinks/json_text.h"
 #include "sinks/user_error.h"
 
@@ -138,74 +139,132 @@ std::string readAll(const std::string& path) {
 
 }  // namespace
 
-RunTable::RunTable(const std::string& dir, const std::string& file, const CsvRow& header,
-                   const nlohmann::json& settings, bool resume)
-    : dir_(dir), path_((fs::path(dir) / file).string()), header_(header) {
+void makeOutputFolder(const std::string& dir) {
   std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir))
+  if (!dir.empty()) fs::create_directories(dir, ec);
+  if (ec || (!dir.empty() && !fs::is_directory(dir)))
     throw sinks::UserError(fmt::format("simbot: cannot use '{}' for the outputs: {}\n", dir,
                                        ec ? ec.message() : "not a directory"));
-  const std::string settingsPath = (fs::path(dir) / "batch.json").string();
-  if (resume) {
-    if (!fs::exists(path_))
-      throw sinks::UserError(fmt::format("simbot: --resume: no table '{}' to resume\n", path_));
-    checkResumeSettings(settingsPath, settings, fmt::format("the batch in '{}'", dir));
-    size_t number = 0;
-    // A last line cut short by a kill is left out: that run is done again.
-    for (const std::string& line : csvRecords(readAll(path_))) {
-      CsvRow row;
-      try {
-        row = parseCsvLine(line);
-      } catch (const std::invalid_argument& e) {
-        throw sinks::UserError(fmt::format("{}:{}: error: {}\n", path_, number + 1, e.what()));
-      }
-      if (number++ == 0) {
-        if (row != header)
-          throw sinks::UserError(
-              fmt::format("{}:1: error: not this batch's table (its header differs)\n", path_));
-        continue;
-      }
-      if (row.size() != header.size())
-        throw sinks::UserError(fmt::format("{}:{}: error: {} fields, the header has {}\n", path_,
-                                           number, row.size(), header.size()));
-      previous_.push_back(std::move(row));
-    }
-    // Rewrite the table with the complete rows only, then append to it.
-    std::vector<CsvRow> keep = previous_;
-    rewrite(keep);
-  } else {
-    writeFileAtomically(settingsPath, sinks::dumpJson(settings, 2) + "\n");
-    writeFileAtomically(path_, csvRecord(header));
+}
+
+void checkBatchOutputs(const std::vector<std::string>& inputs,
+                       const std::vector<std::string>& outputs) {
+  std::vector<files::Named> in, out;
+  for (const auto& path : inputs) in.push_back({path, "the input"});
+  for (const auto& path : outputs) out.push_back({path, "the output"});
+  runs::checkFiles(in, out);
+}
+
+// ---- the settings file
+
+BatchSettings::BatchSettings(std::string path, nlohmann::json settings, const std::string& version)
+    : path_(std::move(path)), settings_(std::move(settings)) {
+  settings_["simbot"] = version;
+}
+
+std::vector<std::string> BatchSettings::inputs() const {
+  std::vector<std::string> paths;
+  if (const auto contents = settings_.find("contents"); contents != settings_.end())
+    for (const auto& [path, print] : contents->items()) paths.push_back(path);
+  return paths;
+}
+
+void BatchSettings::checkResume(const std::string& what) const {
+  nlohmann::json earlier;
+  try {
+    earlier = nlohmann::json::parse(files::readInput(path_, files::kMaxConfigBytes));
+  } catch (const std::exception&) {
+    throw sinks::UserError(fmt::format("simbot: --resume: '{}' is missing or unreadable\n", path_));
   }
-  rows_.emplace(path_);
+  if (earlier != settings_)
+    throw sinks::UserError(
+        fmt::format("simbot: --resume: {} {}; run it again as it was, or choose another --out\n",
+                    what, settingsChange(earlier, settings_)));
+}
+
+void BatchSettings::remove() const {
+  std::error_code ec;
+  fs::remove(path_, ec);
+  if (ec)
+    throw sinks::UserError(fmt::format("simbot: cannot remove '{}': {}\n", path_, ec.message()));
+}
+
+void BatchSettings::write() const {
+  writeFileAtomically(path_, sinks::dumpJson(settings_, 2) + "\n");
+}
+
+// ---- the table
+
+RunTable::RunTable(TableSpec spec)
+    : spec_(std::move(spec)),
+      path_((fs::path(spec_.dir) / spec_.file).string()),
+      settings_((fs::path(spec_.dir) / "batch.json").string(), spec_.settings, spec_.version) {
+  std::vector<std::string> outputs = {path_, settings_.path()};
+  for (const auto& name : spec_.summaries) outputs.push_back((fs::path(spec_.dir) / name).string());
+  checkBatchOutputs(settings_.inputs(), outputs);
+  if (!spec_.resume) return;
+  if (!fs::exists(path_))
+    throw sinks::UserError(fmt::format("simbot: --resume: no table '{}' to resume\n", path_));
+  settings_.checkResume(fmt::format("the batch in '{}'", spec_.dir));
+  size_t number = 0;
+  // A last line cut short by a kill is left out: that run is done again.
+  for (const std::string& line : csvRecords(readAll(path_))) {
+    CsvRow row;
+    try {
+      row = parseCsvLine(line);
+    } catch (const std::invalid_argument& e) {
+      throw sinks::UserError(fmt::format("{}: error: {}\n", where(number + 1), e.what()));
+    }
+    if (number++ == 0) {
+      if (row != spec_.header)
+        throw sinks::UserError(
+            fmt::format("{}: error: not this batch's table (its header differs)\n", where(1)));
+      continue;
+    }
+    if (row.size() != spec_.header.size())
+      throw sinks::UserError(fmt::format("{}: error: {} fields, the header has {}\n", where(number),
+                                         row.size(), spec_.header.size()));
+    previous_.push_back({number, std::move(row)});
+  }
 }
 
 RunTable::~RunTable() = default;
 
-void RunTable::append(const CsvRow& row) { rows_->append(csvRecord(row)); }
+std::string RunTable::where(size_t line) const { return fmt::format("{}:{}", path_, line); }
+
+void RunTable::begin() {
+  if (rows_) return;
+  makeOutputFolder(spec_.dir);
+  if (spec_.resume) {
+    // The table with its complete rows only, then appended to.
+    std::vector<CsvRow> keep;
+    for (const auto& row : previous_) keep.push_back(row.fields);
+    rewrite(keep);
+    return;
+  }
+  // The old batch's settings and summaries describe a table that is about
+  // to go: removed first, so that nothing stale is ever beside the new one.
+  settings_.remove();
+  for (const auto& name : spec_.summaries) {
+    std::error_code ec;
+    fs::remove(fs::path(spec_.dir) / name, ec);
+  }
+  writeFileAtomically(path_, csvRecord(spec_.header));
+  settings_.write();
+  rows_.emplace(path_);
+}
+
+void RunTable::append(const CsvRow& row) {
+  if (!rows_) throw std::logic_error("RunTable::append before begin");
+  rows_->append(csvRecord(row));
+}
 
 void RunTable::rewrite(const std::vector<CsvRow>& rows) {
-  std::string text = csvRecord(header_);
+  std::string text = csvRecord(spec_.header);
   for (const auto& row : rows) text += csvRecord(row);
   rows_.reset();
   writeFileAtomically(path_, text);
   rows_.emplace(path_);
-}
-
-void checkResumeSettings(const std::string& settingsPath, const nlohmann::json& settings,
-                         const std::string& what) {
-  nlohmann::json earlier;
-  try {
-    earlier = nlohmann::json::parse(files::readInput(settingsPath, files::kMaxConfigBytes));
-  } catch (const std::exception&) {
-    throw sinks::UserError(
-        fmt::format("simbot: --resume: '{}' is missing or unreadable\n", settingsPath));
-  }
-  if (earlier != settings)
-    throw sinks::UserError(
-        fmt::format("simbot: --resume: {} {}; run it again as it was, or choose another --out\n",
-                    what, settingsChange(earlier, settings)));
 }
 
 nlohmann::json inputContents(const std::vector<std::string>& paths) {
@@ -216,6 +275,17 @@ nlohmann::json inputContents(const std::vector<std::string>& paths) {
 
 std::string settingsChange(const nlohmann::json& earlier, const nlohmann::json& now) {
   if (!earlier.is_object() || !now.is_object()) return "was written by another kind of batch";
+  // Another simbot may run the same settings differently: said first.
+  if (const auto version = now.find("simbot"); version != now.end()) {
+    const auto was = earlier.find("simbot");
+    if (was == earlier.end())
+      return fmt::format("was run by a simbot that did not record its version, not {}",
+                         version->get<std::string>());
+    if (*was != *version)
+      return fmt::format("was run by {}, not {}",
+                         was->is_string() ? was->get<std::string>() : sinks::dumpJson(*was),
+                         version->get<std::string>());
+  }
   for (const auto& [key, value] : now.items()) {
     const auto was = earlier.find(key);
     if (was == earlier.end()) return fmt::format("was run before '{}' was recorded", key);

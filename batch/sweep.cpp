@@ -11,9 +11,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <tuple>
 
 #include "batch/bench.h"
 #include "config/config.h"
+#include "runs/play.h"
 #include "sinks/user_error.h"
 
 namespace simbot::batch {
@@ -70,7 +72,11 @@ CsvRow sweepHeader(const SweepSpec& spec) {
   return header;
 }
 
-CsvRow runSweepRow(const SweepSpec& spec, const SweepRun& run) {
+namespace {
+
+// The bench a sweep row is: run 0 of the row's program, family and
+// opponent, with the row's master seed, under its grid point's profile.
+BenchConfig sweepBench(const SweepSpec& spec, const SweepRun& run) {
   BenchConfig c;
   c.programs = {config::sweepPath(spec, run.program)};
   c.family = run.family;
@@ -80,7 +86,23 @@ CsvRow runSweepRow(const SweepSpec& spec, const SweepRun& run) {
   c.masterSeed = run.seed;
   c.threads = 1;
   c.progress = false;
-  const BenchResult result = runBench(c, config::sweepProfile(spec, run.point));
+  return c;
+}
+
+// The columns a row's run alone decides: run, program, family, opponent,
+// master_seed and the grid values.
+CsvRow sweepRowKey(const SweepSpec& spec, const SweepRun& run) {
+  CsvRow row = {std::to_string(run.index), run.program, run.family, run.opponent,
+                std::to_string(run.seed)};
+  const std::vector<size_t> at = config::sweepPointValues(spec, run.point);
+  for (size_t k = 0; k < spec.grid.size(); ++k) row.push_back(spec.grid[k].second[at[k]]);
+  return row;
+}
+
+}  // namespace
+
+CsvRow runSweepRow(const SweepSpec& spec, const SweepRun& run) {
+  const BenchResult result = runBench(sweepBench(spec, run), config::sweepProfile(spec, run.point));
   // The bench's own row, through its own CSV (one header line, one row).
   const std::string csv = runsCsv(result);
   // Line ends may be LF or CRLF (RFC 4180's).
@@ -95,13 +117,24 @@ CsvRow runSweepRow(const SweepSpec& spec, const SweepRun& run) {
     throw std::logic_error("simbot: sweep: the bench gave no row for run " +
                            std::to_string(run.index));
   const CsvRow benchRow = parseCsvLine(body);
-  CsvRow row = {std::to_string(run.index), run.program, run.family, run.opponent,
-                std::to_string(run.seed)};
-  const std::vector<size_t> at = config::sweepPointValues(spec, run.point);
-  for (size_t k = 0; k < spec.grid.size(); ++k) row.push_back(spec.grid[k].second[at[k]]);
+  CsvRow row = sweepRowKey(spec, run);
   for (size_t i = 0; i < names.size() && i < benchRow.size(); ++i)
     if (keptBenchColumn(names[i])) row.push_back(benchRow[i]);
   return row;
+}
+
+std::string sweepRowMismatch(const SweepSpec& spec, const SweepRun& run, const CsvRow& row) {
+  const CsvRow header = sweepHeader(spec);
+  CsvRow expected = sweepRowKey(spec, run);
+  const BenchConfig bench = sweepBench(spec, run);
+  expected.push_back(std::to_string(benchRunSeed(bench, bench.programs[0], 0)));  // stream_seed
+  for (size_t k = 0; k < expected.size(); ++k)
+    if (k >= row.size() || row[k] != expected[k])
+      return fmt::format(
+          "run {}'s {} is '{}', but this sweep's run {} has '{}' (a row from "
+          "another batch)",
+          run.index, header[k], k < row.size() ? row[k] : "", run.index, expected[k]);
+  return "";
 }
 
 std::pair<size_t, size_t> parseShard(const std::string& text) {
@@ -123,14 +156,8 @@ std::pair<size_t, size_t> shardRange(size_t runs, size_t k, size_t n) {
   return {runs * (k - 1) / n, runs * k / n};
 }
 
-namespace {
-
-// A CSV file's records (a quoted field may hold a line break); a last
-// record without its line end is left out (cut short by a kill).
-}  // namespace
-
 SweepWriter::SweepWriter(const std::string& path, const CsvRow& header, bool writeHeader,
-                         size_t begin, size_t end, bool resume)
+                         size_t begin, size_t end, bool resume, const SweepRowCheck& check)
     : path_(path), next_(begin), end_(end) {
   const fs::path dir = fs::path(path).parent_path();
   std::error_code ec;
@@ -161,8 +188,12 @@ SweepWriter::SweepWriter(const std::string& path, const CsvRow& header, bool wri
         }
         if (row.size() != header.size() || row[0] != std::to_string(next_) || next_ >= end_)
           throw sinks::UserError(
-              fmt::format("{}: error: --resume: row {} is not run {} of this sweep (or shard)\n",
+              fmt::format("{}:{}: error: --resume: this row is not run {} of this sweep (or "
+                          "shard)\n",
                           path, r + 1, next_));
+        if (check)
+          if (const std::string wrong = check(next_, row); !wrong.empty())
+            throw sinks::UserError(fmt::format("{}:{}: error: --resume: {}\n", path, r + 1, wrong));
         kept += records[r] + "\r\n";
         ++next_;
       }
@@ -215,6 +246,54 @@ void SweepWriter::finish() {
         "simbot: sweep: {} rows are missing from '{}' (first missing: run {}); --resume "
         "continues\n",
         end_ - next_, path_, next_));
+}
+
+// ---- before the first run
+
+namespace {
+
+nlohmann::json sweepSettings(const SweepSpec& spec, const std::string& shard, bool header) {
+  std::vector<std::string> inputs = {spec.file, config::sweepProfilePath(spec)};
+  for (const auto* list : {&spec.programs, &spec.opponents})
+    for (const auto& p : *list) inputs.push_back(config::sweepPath(spec, p));
+  return {{"command", "sweep"},
+          {"shard", shard},
+          {"header", header},
+          {"contents", inputContents(inputs)}};
+}
+
+}  // namespace
+
+SweepOutput::SweepOutput(const SweepSpec& spec, const std::string& out, const std::string& shard,
+                         bool header, bool resume, const std::string& version)
+    : spec_(spec),
+      out_(out),
+      header_(header),
+      resume_(resume),
+      settings_(out + ".batch.json", sweepSettings(spec, shard, header), version) {
+  const auto [k, n] = parseShard(shard);
+  checkBatchOutputs(settings_.inputs(), {out_, settings_.path()});
+  if (resume_) settings_.checkResume(fmt::format("the sweep in '{}'", out_));
+  // Every program a run plays compiles (its warnings shown once, here).
+  for (const auto* list : {&spec_.programs, &spec_.opponents})
+    for (const auto& p : *list) runs::compileProgramFile(config::sweepPath(spec_, p));
+  runs_ = expandSweep(spec_);
+  std::tie(begin_, end_) = shardRange(runs_.size(), k, n);
+}
+
+std::unique_ptr<SweepWriter> SweepOutput::open() const {
+  makeOutputFolder(fs::path(out_).parent_path().string());
+  const SweepRowCheck check = [this](size_t index, const CsvRow& row) {
+    return sweepRowMismatch(spec_, runs_[index], row);
+  };
+  if (resume_)
+    return std::make_unique<SweepWriter>(out_, sweepHeader(spec_), header_, begin_, end_, true,
+                                         check);
+  settings_.remove();
+  auto writer =
+      std::make_unique<SweepWriter>(out_, sweepHeader(spec_), header_, begin_, end_, false);
+  settings_.write();
+  return writer;
 }
 
 }  // namespace simbot::batch

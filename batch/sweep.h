@@ -10,6 +10,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -39,6 +40,10 @@ std::vector<SweepRun> expandSweep(const SweepSpec& spec);
 CsvRow sweepHeader(const SweepSpec& spec);
 // Runs one row; deterministic from the row.
 CsvRow runSweepRow(const SweepSpec& spec, const SweepRun& run);
+// What is wrong with `row` as the table's row of `run` ("" if nothing):
+// the columns the run alone decides (run, program, family, opponent,
+// master_seed, the grid values and stream_seed), for --resume.
+std::string sweepRowMismatch(const SweepSpec& spec, const SweepRun& run, const CsvRow& row);
 
 // "K/N" (1 <= K <= N) into K and N; UserError otherwise.
 std::pair<size_t, size_t> parseShard(const std::string& text);
@@ -46,14 +51,18 @@ std::pair<size_t, size_t> parseShard(const std::string& text);
 // concatenated in order are the whole table.
 std::pair<size_t, size_t> shardRange(size_t runs, size_t k, size_t n);
 
+// What is wrong with a kept row as run `index`'s ("" if nothing).
+using SweepRowCheck = std::function<std::string(size_t index, const CsvRow& row)>;
+
 // The table of runs [begin, end), written in run-index order. Rows may
 // arrive in any order; each is written (and flushed) once every row before
 // it is. With `resume`, an existing file's complete rows are kept (checked
-// against the header and the run indices) and a row cut short is dropped.
+// against the header, the run indices and `check`, before anything is
+// written) and a row cut short is dropped.
 class SweepWriter {
  public:
   SweepWriter(const std::string& path, const CsvRow& header, bool writeHeader, size_t begin,
-              size_t end, bool resume);
+              size_t end, bool resume, const SweepRowCheck& check = {});
   ~SweepWriter();
   SweepWriter(const SweepWriter&) = delete;
   SweepWriter& operator=(const SweepWriter&) = delete;
@@ -73,6 +82,36 @@ class SweepWriter {
   size_t next_, end_;
   std::vector<std::pair<size_t, std::string>> waiting_;  // sorted by index
   mutable std::mutex mutex_;
+};
+
+// Everything a sweep (or one shard of it) does before its first run, one
+// code for the local threads (cli/sweep_command.cpp) and the Dask driver
+// (python/simbot/sweep.py), so that either resumes the other's table.
+class SweepOutput {
+ public:
+  // Checks, and writes nothing: every program and opponent compiles (its
+  // warnings printed once), no output (OUT, OUT.batch.json) is an input,
+  // and with `resume` OUT.batch.json holds these settings (the same simbot
+  // `version`, shard, header and input contents). `shard` is "K/N".
+  SweepOutput(const SweepSpec& spec, const std::string& out, const std::string& shard, bool header,
+              bool resume, const std::string& version);
+  // The shard's runs, [begin, end) of all.
+  size_t begin() const { return begin_; }
+  size_t end() const { return end_; }
+  const std::vector<SweepRun>& runs() const { return runs_; }
+  // Makes OUT's folder, then: with resume, keeps OUT's complete rows, each
+  // checked to be this sweep's run (sweepRowMismatch); without, removes the
+  // old OUT.batch.json, writes the header and then OUT.batch.json. The
+  // writer appends the rest.
+  std::unique_ptr<SweepWriter> open() const;
+
+ private:
+  SweepSpec spec_;
+  std::string out_;
+  bool header_, resume_;
+  BatchSettings settings_;
+  std::vector<SweepRun> runs_;
+  size_t begin_ = 0, end_ = 0;
 };
 
 }  // namespace simbot::batch

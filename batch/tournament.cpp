@@ -78,6 +78,11 @@ CsvRow gameRow(const TournamentGame& g, const std::vector<std::string>& programs
           std::to_string(g.reloadsB)};
 }
 
+// A row of games.csv that is not one of this tournament's games.
+struct NotThisTournament : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 // The game a row of games.csv records; sides and winner are checked against
 // the pair and round (the names must be the programs this tournament plays).
 TournamentGame gameFromRow(const CsvRow& r, const std::vector<std::string>& programs) {
@@ -86,12 +91,19 @@ TournamentGame gameFromRow(const CsvRow& r, const std::vector<std::string>& prog
   g.j = std::stoi(r.at(1));
   g.round = std::stoi(r.at(2));
   const int n = static_cast<int>(programs.size());
-  if (g.i < 0 || g.j <= g.i || g.j >= n || g.round < 0) throw std::out_of_range("pair");
+  if (g.i < 0 || g.j <= g.i || g.j >= n || g.round < 0)
+    throw NotThisTournament(
+        fmt::format("pair {}-{} is not one of this tournament's {} programs' "
+                    "pairs",
+                    g.i, g.j, n));
   g.a = g.round % 2 == 0 ? g.i : g.j;
   g.b = g.round % 2 == 0 ? g.j : g.i;
-  if (r.at(3) != programs[static_cast<size_t>(g.a)] ||
-      r.at(4) != programs[static_cast<size_t>(g.b)])
-    throw std::out_of_range("sides");
+  for (const auto& [field, side] : {std::pair{3, g.a}, std::pair{4, g.b}})
+    if (r.at(static_cast<size_t>(field)) != programs[static_cast<size_t>(side)])
+      throw NotThisTournament(fmt::format(
+          "pair {}-{} round {} has '{}' as robot {}, but this tournament plays '{}' there", g.i,
+          g.j, g.round, r.at(static_cast<size_t>(field)), field == 3 ? "A" : "B",
+          programs[static_cast<size_t>(side)]));
   g.seed = std::stoull(r.at(5));
   g.hitsA = std::stoi(r.at(6));
   g.hitsB = std::stoi(r.at(7));
@@ -159,24 +171,39 @@ TournamentResult runTournament(const TournamentConfig& config, const config::Pro
             scheduler::streamSeed(config.masterSeed, fmt::format("tournament/{}/{}/{}", i, j, k));
         result.games.push_back(g);
       }
-  // Games an earlier, interrupted tournament played (--resume).
+  // Games an earlier, interrupted tournament played (--resume): each must
+  // be one of this tournament's games (its programs and seed), once.
   if (table) {
-    for (const CsvRow& row : table->previous()) {
+    for (const PreviousRow& row : table->previous()) {
+      const std::string where = table->where(row.line);
       TournamentGame g;
       try {
-        g = gameFromRow(row, config.programs);
+        g = gameFromRow(row.fields, config.programs);
+      } catch (const NotThisTournament& e) {
+        throw sinks::UserError(fmt::format("simbot: --resume: {}: {}\n", where, e.what()));
       } catch (const std::exception&) {
-        throw sinks::UserError(
-            fmt::format("simbot: --resume: a malformed row in {}/games.csv\n", table->dir()));
+        throw sinks::UserError(fmt::format("simbot: --resume: {}: a malformed row\n", where));
       }
       const auto at = std::find_if(result.games.begin(), result.games.end(), [&](const auto& x) {
         return x.i == g.i && x.j == g.j && x.round == g.round;
       });
-      if (at == result.games.end() || at->seed != g.seed)
+      if (at == result.games.end())
+        throw sinks::UserError(fmt::format(
+            "simbot: --resume: {}: pair {}-{} round {} is not one of this tournament's games\n",
+            where, g.i, g.j, g.round));
+      if (at->seed != g.seed)
+        throw sinks::UserError(fmt::format(
+            "simbot: --resume: {}: pair {}-{} round {} has seed {}, but this tournament's has "
+            "seed {} (a row from another batch)\n",
+            where, g.i, g.j, g.round, g.seed, at->seed));
+      if (at->done)
         throw sinks::UserError(
-            "simbot: --resume: a game in games.csv does not belong to this tournament\n");
+            fmt::format("simbot: --resume: {}: pair {}-{} round {} is there twice\n", where, g.i,
+                        g.j, g.round));
       *at = g;
     }
+    // Inputs compiled, rows checked: only now does the folder change.
+    table->begin();
   }
   std::vector<size_t> todo;
   for (size_t k = 0; k < result.games.size(); ++k)

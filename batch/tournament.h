@@ -68,7 +68,9 @@ CsvRow tournamentHeader();
 nlohmann::json tournamentSettings(const TournamentConfig& config, const config::Profile& profile);
 
 // Plays every game not already in `table` (resume); each finished game goes
-// to the table as it completes. `stop` (may be null) stops the tournament.
+// to the table as it completes. The table begins (RunTable::begin) only
+// once every program is compiled and the resumed rows are checked. `stop`
+// (may be null) stops the tournament.
 TournamentResult runTournament(const TournamentConfig& config, const config::Profile& profile,
                                RunTable* table = nullptr, const std::atomic<bool>* stop = nullptr);
 // Rewrites games.csv in order and writes standings.json and standings.md

@@ -13,6 +13,7 @@
 #include "batch/compare.h"
 #include "batch/run_table.h"
 #include "batch/tournament.h"
+#include "cli/version.h"
 #include "config/config.h"
 #include "runs/play.h"
 #include "runs/scenario.h"
@@ -124,9 +125,14 @@ Subcommand addBenchCommand(CLI::App& app) {
           std::string label = batch::benchLabel(c);
           std::replace(label.begin(), label.end(), ' ', '-');
           const std::string dir = o->out.empty() ? "out/bench-" + label : o->out;
-          // The table is opened (and the location checked) before any run.
-          batch::RunTable table(dir, "runs.csv", batch::benchHeader(),
-                                batch::benchSettings(c, loaded), o->resume);
+          // Checked now; written once the programs compile (runBench).
+          batch::RunTable table({dir,
+                                 "runs.csv",
+                                 {"summary.json", "summary.md"},
+                                 batch::benchHeader(),
+                                 batch::benchSettings(c, loaded),
+                                 simbotVersion(),
+                                 o->resume});
           batch::StopOnSignals signals;
           const batch::BenchResult r = batch::runBench(c, loaded, {&table, &signals.requested()});
           batch::writeBenchOutputs(r, table);
@@ -198,7 +204,14 @@ Subcommand addCompareCommand(CLI::App& app) {
               r.profileA = pa.name;
               r.profileB = pb.name;
               batch::checkBenchConfig(a);
-              std::filesystem::create_directories(o->out);
+              const auto out = [&](const char* name) {
+                return (std::filesystem::path(o->out) / name).string();
+              };
+              std::vector<std::string> inputs = batch::benchInputs(a, pa);
+              for (const auto& path : batch::benchInputs(b, pb)) inputs.push_back(path);
+              batch::checkBatchOutputs(inputs, {out("runs-a.csv"), out("runs-b.csv")});
+              // Made now (an unusable location fails before any run); written at the end.
+              batch::makeOutputFolder(o->out);
               batch::StopOnSignals signals;
               r.a = batch::runBench(a, pa, {nullptr, &signals.requested()});
               if (!r.a.stopped) r.b = batch::runBench(b, pb, {nullptr, &signals.requested()});
@@ -207,8 +220,8 @@ Subcommand addCompareCommand(CLI::App& app) {
                                          signals.signal());
                 return 128 + signals.signal();
               }
-              batch::writeFileAtomically(o->out + "/runs-a.csv", batch::runsCsv(r.a));
-              batch::writeFileAtomically(o->out + "/runs-b.csv", batch::runsCsv(r.b));
+              batch::writeFileAtomically(out("runs-a.csv"), batch::runsCsv(r.a));
+              batch::writeFileAtomically(out("runs-b.csv"), batch::runsCsv(r.b));
               r.rows = batch::compareRuns(r.a, r.b);
               std::cout << (o->json ? sinks::dumpJson(batch::compareJson(r), 2) + "\n"
                                     : batch::compareMarkdown(r));
@@ -251,8 +264,13 @@ Subcommand addTournamentCommand(CLI::App& app) {
               const config::Profile profile = runs::loadNamedProfile(o->profile);
               if (o->secondsOption->count() > 0) o->config.seconds = o->seconds;
               batch::checkTournamentConfig(o->config);
-              batch::RunTable table(o->out, "games.csv", batch::tournamentHeader(),
-                                    batch::tournamentSettings(o->config, profile), o->resume);
+              batch::RunTable table({o->out,
+                                     "games.csv",
+                                     {"standings.json", "standings.md"},
+                                     batch::tournamentHeader(),
+                                     batch::tournamentSettings(o->config, profile),
+                                     simbotVersion(),
+                                     o->resume});
               batch::StopOnSignals signals;
               const batch::TournamentResult r =
                   batch::runTournament(o->config, profile, &table, &signals.requested());

@@ -3,7 +3,6 @@
 // reports/, sinks/); DESIGN.md's tool contract says what tests and scripts
 // rely on.
 #include <fmt/format.h>
-#include <sundials/sundials_config.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -19,6 +18,7 @@
 
 #include "batch/sweep.h"
 #include "cli/commands.h"
+#include "cli/version.h"
 #include "compiler/compiler.h"
 #include "config/config.h"
 #include "files/files.h"
@@ -27,7 +27,6 @@
 #include "runs/play.h"
 #include "runs/scenario.h"
 #include "scheduler/match.h"
-#include "simbot_version.h"
 #include "sinks/json_text.h"
 #include "sinks/trace_jsonl.h"
 #include "sinks/user_error.h"
@@ -269,9 +268,7 @@ void addWarningOptions(CLI::App* cmd) {
 
 int main(int argc, char** argv) {
   CLI::App app{"simbot: a timing-faithful simulator of the 1997 NPS Robot Wars"};
-  app.set_version_flag("--version",
-                       fmt::format("simbot {} (commit {}, {} build, SUNDIALS {})", SIMBOT_VERSION,
-                                   SIMBOT_COMMIT, SIMBOT_BUILD_TYPE, SUNDIALS_VERSION));
+  app.set_version_flag("--version", cli::simbotVersion());
   app.require_subcommand(1);
 
   std::string compileFile;

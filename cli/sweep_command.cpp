@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -18,10 +17,8 @@
 #include "batch/parallel.h"
 #include "batch/sweep.h"
 #include "cli/commands.h"
+#include "cli/version.h"
 #include "config/config.h"
-#include "files/files.h"
-#include "runs/play.h"
-#include "sinks/json_text.h"
 #include "sinks/user_error.h"
 
 namespace simbot::cli {
@@ -77,39 +74,22 @@ std::string defaultOut(const SweepOptions& o) {
 
 int runSweepCommand(SweepOptions& o) {
   if (o.out.empty()) o.out = defaultOut(o);
-  const auto [k, n] = batch::parseShard(o.shard);
-  const batch::SweepSpec spec = config::loadSweep(o.file, batch::benchFamilies());
-  // Every file the sweep reads, for the output check and --resume's
-  // fingerprint (kept beside the table, in OUT.batch.json).
-  std::vector<std::string> inputPaths = {o.file, config::sweepProfilePath(spec)};
-  for (const auto* list : {&spec.programs, &spec.opponents})
-    for (const auto& p : *list) inputPaths.push_back(config::sweepPath(spec, p));
-  std::vector<files::Named> inputs;
-  for (const auto& p : inputPaths) inputs.push_back({p, p == o.file ? "the sweep" : "an input"});
-  const std::string settingsPath = o.out + ".batch.json";
-  runs::checkFiles(inputs, {{o.out, "--out"}, {settingsPath, "its settings"}});
-  const nlohmann::json settings = {{"command", "sweep"},
-                                   {"shard", o.shard},
-                                   {"header", !o.noHeader},
-                                   {"contents", batch::inputContents(inputPaths)}};
-  if (o.resume)
-    batch::checkResumeSettings(settingsPath, settings, fmt::format("the sweep in '{}'", o.out));
+  batch::parseShard(o.shard);
   if (!o.dask.empty()) {
     if (!o.warningOptions.empty())
       throw sinks::UserError(
           "simbot: sweep: -W options apply to this process's compiles; the Dask workers compile "
           "with the default warnings (leave them out with --dask)\n");
-    // The Dask driver writes the table and keeps no fingerprints: an
-    // earlier run's are removed, so that a later --resume refuses the
-    // table rather than mix its rows with another version's.
-    std::error_code ignored;
-    std::filesystem::remove(settingsPath, ignored);
+    // The driver checks and opens the table with the same code as below
+    // (batch::SweepOutput), fingerprint and all.
     execDaskDriver(o);
   }
-  if (!o.resume) batch::writeFileAtomically(settingsPath, sinks::dumpJson(settings, 2) + "\n");
-  const std::vector<batch::SweepRun> runs = batch::expandSweep(spec);
-  const auto [begin, end] = batch::shardRange(runs.size(), k, n);
-  batch::SweepWriter writer(o.out, batch::sweepHeader(spec), !o.noHeader, begin, end, o.resume);
+  const batch::SweepSpec spec = config::loadSweep(o.file, batch::benchFamilies());
+  const batch::SweepOutput output(spec, o.out, o.shard, !o.noHeader, o.resume, simbotVersion());
+  const std::vector<batch::SweepRun>& runs = output.runs();
+  const size_t begin = output.begin(), end = output.end();
+  const std::unique_ptr<batch::SweepWriter> opened = output.open();
+  batch::SweepWriter& writer = *opened;
   const size_t first = writer.next();
   batch::StopOnSignals signals;
   batch::parallelFor(

@@ -14,6 +14,7 @@
 // config/, sinks/, reports/, batch/ and cli/ use it; it uses none of them.
 // Its errors carry the reason alone, for each caller's own format.
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <stdexcept>
@@ -25,6 +26,10 @@ namespace simbot::files {
 struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+// Input::readLine's line past its limit.
+struct LineTooLong : Error {
+  using Error::Error;
+};
 
 // Profiles, hardware files, scenarios and sweep files: 1 MiB (the shipped
 // default profile is 9 KB; a larger file is not a configuration).
@@ -32,6 +37,13 @@ constexpr std::uint64_t kMaxConfigBytes = std::uint64_t{1} << 20;
 // Traces read back (view, explain, Python's read_trace): 16 GiB (a 180-s
 // match with --trace-costate wrote 181 MB).
 constexpr std::uint64_t kMaxTraceBytes = std::uint64_t{16} << 30;
+// A line of a trace read back: 8 MiB. The longest record simbot writes is
+// a robot's, which carries its program's source: at most the compiler's
+// 1 MiB (compiler::kMaxSourceBytes), at most 6 MiB as JSON (a control
+// byte is written as 6 characters, \u0001), with a path of at most 4096
+// bytes (24 KiB as JSON) and some 30 numbers. A longer line is no record of
+// simbot's, and is refused without being held whole.
+constexpr std::size_t kMaxTraceLineBytes = std::size_t{8} << 20;
 
 // The whole of the regular file `path`, of at most `maxBytes`. Error: "no
 // such file", "it is a directory", "not a regular file", "N bytes is more
@@ -51,9 +63,19 @@ class Input {
   Input(const Input&) = delete;
   Input& operator=(const Input&) = delete;
   std::FILE* file() const { return file_; }
+  // The next line, without its '\n', into `line`; false at the end of the
+  // file. `whole`: it ended in '\n' (the last line of a file cut short
+  // does not). A line of more than `maxBytes` is Error "a line of more than
+  // N bytes" once that much of it is read: its rest is never held, so a
+  // 1-GB line costs no more memory than the limit. Error with the system's
+  // reason when a read fails; std::bad_alloc passes through. Not to be
+  // mixed with reads through file().
+  bool readLine(std::string& line, bool& whole, std::size_t maxBytes);
 
  private:
   std::FILE* file_ = nullptr;
+  std::string buffer_;  // read from the file, not yet returned
+  std::size_t at_ = 0;  // where in buffer_ the next line begins
 };
 
 // A file named on the command line and what it is to the run, for messages:

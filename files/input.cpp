@@ -94,4 +94,34 @@ Input::~Input() {
   if (file_) std::fclose(file_);
 }
 
+bool Input::readLine(std::string& line, bool& whole, std::size_t maxBytes) {
+  constexpr std::size_t kChunk = 65536;
+  line.clear();
+  while (true) {
+    const char* start = buffer_.data() + at_;
+    const std::size_t left = buffer_.size() - at_;
+    const void* newline = std::memchr(start, '\n', left);
+    const std::size_t take =
+        newline ? static_cast<std::size_t>(static_cast<const char*>(newline) - start) : left;
+    if (line.size() + take > maxBytes)
+      throw LineTooLong(fmt::format("a line of more than {} bytes", maxBytes));
+    line.append(start, take);
+    if (newline) {
+      at_ += take + 1;
+      whole = true;
+      return true;
+    }
+    // The buffer is used up: the next chunk.
+    buffer_.resize(kChunk);
+    at_ = 0;
+    const std::size_t n = std::fread(buffer_.data(), 1, kChunk, file_);
+    buffer_.resize(n);
+    if (n == 0) {
+      if (std::ferror(file_)) throw Error(std::strerror(errno));
+      whole = false;
+      return !line.empty();
+    }
+  }
+}
+
 }  // namespace simbot::files

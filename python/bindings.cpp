@@ -1,6 +1,6 @@
 // _simbot: the C++ side of the Python module `simbot` (python/simbot/).
 // Every entry point is the CLI's own code (runs/play.h for solo and match,
-// batch/bench.h, batch/sweep.h), so a result here is the CLI's result:
+// batch/bench.h, batch/sweep.h, cli/version.h), so a result here is the CLI's result:
 // simbot.match(A, B) is `simbot match A B --json`, parsed. JSON and CSV
 // cross as text and are parsed on the Python side. Runs release the GIL,
 // so Python threads (a Dask worker's) run them in parallel.
@@ -18,8 +18,10 @@
 
 #include "batch/bench.h"
 #include "batch/sweep.h"
+#include "cli/version.h"
 #include "compiler/compiler.h"
 #include "config/config.h"
+#include "files/files.h"
 #include "runs/play.h"
 #include "sinks/json_text.h"
 #include "sinks/trace_jsonl.h"
@@ -155,6 +157,13 @@ struct Sweep {
     py::gil_scoped_release release;
     return batch::runSweepRow(spec, runs[index]);
   }
+  // The CLI's own checks and table (batch::SweepOutput), with this
+  // build's simbot version, which the CLI's is.
+  std::unique_ptr<batch::SweepOutput> output(const std::string& out, const std::string& shard,
+                                             bool header, bool resume) const {
+    return std::make_unique<batch::SweepOutput>(spec, out, shard, header, resume,
+                                                cli::simbotVersion());
+  }
 };
 
 // batch::shardRange with its K/N checked (the CLI's come from parseShard):
@@ -212,7 +221,15 @@ PYBIND11_MODULE(_simbot, m) {
       .def("__len__", [](const Sweep& s) { return s.runs.size(); })
       .def("header", [](const Sweep& s) { return batch::sweepHeader(s.spec); })
       .def("programs", &Sweep::programs)
-      .def("row", &Sweep::row, py::arg("index"));
+      .def("row", &Sweep::row, py::arg("index"))
+      .def("output", &Sweep::output, py::arg("out"), py::arg("shard"), py::arg("header"),
+           py::arg("resume"));
+  py::class_<batch::SweepOutput>(m, "SweepOutput")
+      .def("begin", &batch::SweepOutput::begin)
+      .def("end", &batch::SweepOutput::end)
+      .def("open", &batch::SweepOutput::open);
+  m.attr("MAX_TRACE_BYTES") = files::kMaxTraceBytes;
+  m.attr("MAX_TRACE_LINE_BYTES") = files::kMaxTraceLineBytes;
   m.def("parse_shard", &batch::parseShard, py::arg("text"));
   m.def("shard_range", &checkedShardRange, py::arg("runs"), py::arg("k"), py::arg("n"));
   m.def("silence_compile_warnings", &silenceCompileWarnings);

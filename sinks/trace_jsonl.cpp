@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <new>
 #include <stdexcept>
 #include <type_traits>
 
@@ -180,21 +181,27 @@ TraceRead readTrace(const std::string& path, const std::function<void(const trac
   TraceRead read;
   std::string line;
   int number = 0;
-  bool header = false;
-  char* buffer = nullptr;
-  std::size_t capacity = 0;
-  struct Free {
-    char*& p;
-    ~Free() { std::free(p); }
-  } freeBuffer{buffer};
-  for (ssize_t n; (n = ::getline(&buffer, &capacity, in->file())) > 0;) {
+  bool header = false, whole = false;
+  while (true) {
+    try {
+      if (!in->readLine(line, whole, files::kMaxTraceLineBytes)) break;
+    } catch (const files::LineTooLong& e) {
+      throw UserError(fmt::format("{}:{}: error: {}: no record of a simbot trace is that long\n",
+                                  path, number + 1, e.what()));
+    } catch (const files::Error& e) {
+      throw UserError(
+          fmt::format("{}:{}: error: cannot read the trace: {}\n", path, number + 1, e.what()));
+    } catch (const std::bad_alloc&) {
+      throw UserError(
+          fmt::format("{}:{}: error: out of memory reading the trace\n", path, number + 1));
+    }
     ++number;
-    const bool whole = buffer[n - 1] == '\n';
-    line.assign(buffer, static_cast<std::size_t>(whole ? n - 1 : n));
     if (line.empty()) continue;
     trace::Entry e;
     try {
       e = traceEntry(json::parse(line));
+    } catch (const std::bad_alloc&) {
+      throw UserError(fmt::format("{}:{}: error: out of memory reading the trace\n", path, number));
     } catch (const std::exception& ex) {
       // A last line with no line end that does not parse: the run that
       // wrote it was killed or its disk filled. What came before is whole.
@@ -215,11 +222,13 @@ TraceRead readTrace(const std::string& path, const std::function<void(const trac
     read.ended = std::holds_alternative<trace::rec::End>(e.record);
     read.lastTick = e.t;
     ++read.records;
-    each(e);
+    try {
+      each(e);
+    } catch (const std::bad_alloc&) {
+      throw UserError(fmt::format(
+          "{}:{}: error: out of memory keeping the trace's records up to here\n", path, number));
+    }
   }
-  if (std::ferror(in->file()))
-    throw UserError(fmt::format("{}:{}: error: reading the trace: {}\n", path, number + 1,
-                                std::strerror(errno)));
   if (!header) throw UserError(fmt::format("{}:1: error: the trace is empty\n", path));
   return read;
 }

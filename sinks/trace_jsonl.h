@@ -69,9 +69,12 @@ struct TraceRead {
 };
 
 // Reads a JSONL trace file record by record (a regular file within
-// files::kMaxTraceBytes). Bad input throws UserError "FILE:LINE: error:
-// MESSAGE"; a trace cut short (a last partial line, no "end" record) is
-// read up to its last whole record, and said so by cutShortWarning.
+// files::kMaxTraceBytes, each line within files::kMaxTraceLineBytes, so
+// that memory stays bounded whatever the file holds). Bad input throws
+// UserError "FILE:LINE: error: MESSAGE" (a line too long, as soon as the
+// limit is passed; memory running out, as that); a trace cut short (a last
+// partial line, no "end" record) is read up to its last whole record, and
+// said so by cutShortWarning.
 TraceRead readTrace(const std::string& path, const std::function<void(const trace::Entry&)>& each);
 // The warning line for a trace that was cut short; empty for a whole one.
 std::string cutShortWarning(const std::string& path, const TraceRead& read);

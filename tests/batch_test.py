@@ -12,6 +12,10 @@ Usage: batch_test.py SIMBOT ICEMAN FIG92 SPIRAL TURRET OUTDIR
 - The output location is checked before the first run; a write that fails
   (a file-size limit) ends the bench with an error, not a success.
 - --resume refuses a table another batch wrote.
+- --resume refuses, in one line naming FILE:LINE and changing nothing, a
+  row of another seed (bench and tournament: pasted from the same batch
+  run with another --seed), of a program the batch does not play, or a run
+  twice; and a batch.json that another simbot version wrote, naming both.
 """
 import json
 import os
@@ -142,6 +146,63 @@ other = [arg if arg != "20" else "21" for arg in BENCH]  # 21 simulated seconds 
 r = subprocess.run(other + ["--out", str(whole), "--resume"], capture_output=True, text=True)
 check(r.returncode == 1 and "was run with seconds 20" in r.stderr and "not 21" in r.stderr,
       f"--resume with other settings is refused: {r.returncode} {r.stderr[-300:]}")
+
+# ---- --resume keeps only this batch's rows, and only under the same simbot
+def refused_resume(what, cmd, folder, table, words):
+    """--resume is refused in one line holding `words`, and changes nothing."""
+    before = {p.name: p.read_bytes() for p in folder.iterdir()}
+    r = subprocess.run(cmd + ["--out", str(folder), "--resume"], capture_output=True, text=True)
+    lines = [line for line in r.stderr.splitlines() if line.startswith("simbot:")]
+    check(r.returncode == 1 and len(lines) == 1 and all(w in lines[0] for w in words),
+          f"{what}: --resume refused in one line naming {words}: {r.returncode} {r.stderr[-400:]}")
+    check({p.name: p.read_bytes() for p in folder.iterdir()} == before,
+          f"{what}: the refused --resume changed nothing")
+
+
+SMALL = [SIMBOT, "bench", ICEMAN, FIG92, "--family", "stationary", "--seeds", "3", "--seconds",
+         "2", "--threads", "2"]
+mine, other = OUT / "paste-mine", OUT / "paste-other"
+subprocess.run(SMALL + ["--out", str(mine)], check=True, capture_output=True)
+subprocess.run(SMALL + ["--seed", "2", "--out", str(other)], check=True, capture_output=True)
+mine_rows = (mine / "runs.csv").read_bytes().split(b"\r\n")[:-1]  # header and 6 rows
+other_rows = (other / "runs.csv").read_bytes().split(b"\r\n")[:-1]
+# Row 4 of the table (ICEMAN's run 2) replaced by the bench with --seed 2's run 2, and the
+# last rows dropped as by a kill: the same program and run index, another seed.
+(mine / "runs.csv").write_bytes(b"\r\n".join(mine_rows[:3] + other_rows[3:4]) + b"\r\n")
+pasted_seed = other_rows[3].split(b",")[2].decode()
+refused_resume("bench, a row of another seed", SMALL, mine, "runs.csv",
+               [f"{mine}/runs.csv:4:", f"seed {pasted_seed}", "run 2 of"])
+# A row of a program this bench does not play.
+(mine / "runs.csv").write_bytes(b"\r\n".join(mine_rows[:3] + [
+    mine_rows[3].replace(ICEMAN.encode(), SPIRAL.encode())]) + b"\r\n")
+refused_resume("bench, a row of another program", SMALL, mine, "runs.csv",
+               [f"{mine}/runs.csv:4:", SPIRAL, "not one of this bench's runs"])
+# The same row twice.
+(mine / "runs.csv").write_bytes(b"\r\n".join(mine_rows[:4] + mine_rows[3:4]) + b"\r\n")
+refused_resume("bench, a row twice", SMALL, mine, "runs.csv",
+               [f"{mine}/runs.csv:5:", "twice"])
+
+TWO = [SIMBOT, "tournament", ICEMAN, FIG92, SPIRAL, "--rounds", "1", "--seconds", "2"]
+mine_t, other_t = OUT / "paste-mine-t", OUT / "paste-other-t"
+subprocess.run(TWO + ["--out", str(mine_t)], check=True, capture_output=True)
+subprocess.run(TWO + ["--seed", "2", "--out", str(other_t)], check=True, capture_output=True)
+games_mine = (mine_t / "games.csv").read_bytes().split(b"\r\n")[:-1]
+games_other = (other_t / "games.csv").read_bytes().split(b"\r\n")[:-1]
+(mine_t / "games.csv").write_bytes(b"\r\n".join(games_mine[:2] + games_other[2:3]) + b"\r\n")
+refused_resume("tournament, a game of another seed", TWO, mine_t, "games.csv",
+               [f"{mine_t}/games.csv:3:", f"seed {games_other[2].split(b',')[5].decode()}",
+                "pair 0-2 round 0"])
+
+# Another simbot: batch.json records `simbot --version`, and --resume names both.
+version = subprocess.run([SIMBOT, "--version"], capture_output=True, text=True).stdout.strip()
+settings = json.loads((whole / "batch.json").read_text())
+check(settings.get("simbot") == version, f"batch.json records {settings.get('simbot')!r}, "
+      f"simbot --version says {version!r}")
+older = "simbot 0.24.0 (commit 0123456789ab, RelWithDebInfo build, SUNDIALS 6.4.1)"
+settings["simbot"] = older
+(whole / "batch.json").write_text(json.dumps(settings, indent=2) + "\n")
+refused_resume("bench, another simbot", BENCH, whole, "runs.csv",
+               [f"was run by {older}, not {version}"])
 
 if failures:
     sys.exit(f"{len(failures)} check(s) failed")

@@ -21,6 +21,17 @@ Usage: outputs_test.py SIMBOT SOURCE_DIR SHARED_DIR OUTDIR [--sanitized]
 - --resume refuses a batch whose program or settings changed, naming what.
 - A sweep whose run count overflows or is too large is refused at once.
 - Worker threads that cannot be created are one line and exit 1.
+- A bench, tournament or sweep refused for bad input (a program that does
+  not compile, a missing opponent; with --resume too) leaves the earlier
+  batch's table, batch.json and summaries byte-identical.
+- bench, compare, tournament and sweep each refuse an output that is one of
+  their inputs, in one line, writing nothing.
+- `simbot sweep FILE` in a folder with no out/ makes it and writes there.
+- A trace whose second line is 1 GiB long: view and explain report
+  FILE:2 in one line, read no further (peak RSS under 128 MiB; the old
+  reader took 2.1 GB); the longest record simbot can write (a 1-MiB
+  program of control bytes: 6 MiB of JSON) still reads back; and memory that runs out while reading a line is
+  reported as that, FILE:LINE (not as an empty trace).
 """
 import os
 import shutil
@@ -308,6 +319,177 @@ if not SANITIZED:  # an address-space limit is what makes thread stacks fail
                        capture_output=True, text=True, timeout=120)
     check(one_line_error(r, "cannot start"), f"threads that cannot start ({r.returncode} "
           f"{r.stderr[-300:]!r})")
+
+# ---- batches refused for bad input leave the earlier batch's folder as it was
+def snapshot(directory):
+    return {p.name: p.read_bytes() for p in Path(directory).iterdir()}
+
+
+def refused_batches_leave_folder(kind, folder, table, refusals):
+    """Each refusal (what, args, words) exits 1 naming `words` and leaves
+    every file in `folder` byte-identical; the last ones resume (-Werror
+    makes ICEMAN's warnings errors) a table whose last row was cut short,
+    which stays cut short."""
+    for what, args, words in refusals:
+        if "--resume" in args:
+            with open(folder / table, "ab") as f:
+                f.write(b"1,2,3")  # a row cut short by a kill
+        before = snapshot(folder)
+        r = run(args)
+        check(r.returncode == 1 and words in r.stderr,
+              f"{kind}, {what}: refused ({r.returncode} {r.stderr[-300:]!r})")
+        check(snapshot(folder) == before,
+              f"{kind}, {what}: the earlier table, its settings and summaries are byte-identical")
+
+
+bad = OUT / "bad.dc"
+bad.write_text("main() { undeclared = 1; }\n")
+missing = OUT / "no-such-opponent.dc"
+done = OUT / "done-bench"
+SMALL_BENCH = ["--seeds", "2", "--seconds", "1", "--out", done]
+r = run(["bench", ICEMAN, "--family", "stationary"] + SMALL_BENCH)
+check(r.returncode == 0 and sorted(snapshot(done)) ==
+      ["batch.json", "runs.csv", "summary.json", "summary.md"], f"a small bench ({r.stderr[-300:]!r})")
+refused_batches_leave_folder("bench", done, "runs.csv", [
+    ("a program that does not compile",
+     ["bench", ICEMAN, bad, "--family", "stationary"] + SMALL_BENCH, "bad.dc:1:"),
+    ("a missing opponent", ["bench", ICEMAN, "--family", "head-to-head", "--opponent", missing]
+     + SMALL_BENCH, "no such program"),
+    ("--resume -Werror", ["bench", ICEMAN, "--family", "stationary", "--resume", "-Werror"]
+     + SMALL_BENCH, "iceman.dc:")])
+done = OUT / "done-tournament"
+SMALL_TOURNAMENT = ["--rounds", "1", "--seconds", "1", "--out", done]
+r = run(["tournament", ICEMAN, SPIRAL] + SMALL_TOURNAMENT)
+check(r.returncode == 0 and len(snapshot(done)) == 4, f"a small tournament ({r.stderr[-300:]!r})")
+refused_batches_leave_folder("tournament", done, "games.csv", [
+    ("a program that does not compile", ["tournament", ICEMAN, bad] + SMALL_TOURNAMENT,
+     "bad.dc:1:"),
+    ("a missing program", ["tournament", ICEMAN, missing] + SMALL_TOURNAMENT, "no such program"),
+    ("--resume -Werror", ["tournament", ICEMAN, SPIRAL, "--resume", "-Werror"] + SMALL_TOURNAMENT,
+     "iceman.dc:")])
+done = OUT / "done-sweep"
+done.mkdir()
+grids = {"good": f'programs = ["{ICEMAN}"]\nfamilies = ["stationary"]',
+         "bad": f'programs = ["{ICEMAN}", "{bad}"]\nfamilies = ["stationary"]',
+         "missing": f'programs = ["{ICEMAN}"]\nopponents = ["{missing}"]\n'
+                    'families = ["head-to-head"]'}
+for name, text in grids.items():
+    (OUT / f"{name}.toml").write_text(f"{text}\nseconds = 1\n[seeds]\nfirst = 1\ncount = 2\n")
+r = run(["sweep", OUT / "good.toml", "--out", done / "t.csv"])
+check(r.returncode == 0 and sorted(snapshot(done)) == ["t.csv", "t.csv.batch.json"],
+      f"a small sweep ({r.stderr[-300:]!r})")
+refused_batches_leave_folder("sweep", done, "t.csv", [
+    ("a program that does not compile", ["sweep", OUT / "bad.toml", "--out", done / "t.csv"],
+     "bad.dc:1:"),
+    ("a missing opponent", ["sweep", OUT / "missing.toml", "--out", done / "t.csv"],
+     "no such program"),
+    ("--resume -Werror", ["sweep", OUT / "good.toml", "--out", done / "t.csv", "--resume",
+                          "-Werror"], "iceman.dc:")])
+
+# ---- no batch writes onto one of its inputs (one check for all four)
+same = OUT / "same"
+same.mkdir()
+for name in ("summary.md", "runs-b.csv", "standings.md", "program.dc"):
+    shutil.copy(SPIRAL, same / name)
+sweep_same = same / "s.toml"
+sweep_same.write_text(f'programs = ["{same / "program.dc"}"]\nfamilies = ["stationary"]\n'
+                      "seconds = 1\n[seeds]\nfirst = 1\ncount = 1\n")
+for what, args, name in [
+        ("bench: a program named DIR/summary.md",
+         ["bench", same / "summary.md", "--family", "stationary", "--seeds", "1", "--out", same],
+         "summary.md"),
+        ("compare: program B is DIR/runs-b.csv",
+         ["compare", SPIRAL, same / "." / "runs-b.csv", "--family", "stationary", "--seeds", "1",
+          "--out", same], "runs-b.csv"),
+        ("tournament: a program named DIR/standings.md",
+         ["tournament", SPIRAL, same / "standings.md", "--rounds", "1", "--out", same],
+         "standings.md"),
+        ("sweep: --out onto its program", ["sweep", sweep_same, "--out", same / "program.dc"],
+         "program.dc")]:
+    r = run(args + ["--seconds", "1"] if args[0] != "sweep" else args)
+    check(one_line_error(r, "same file", name), f"{what}: refused in one line ({r.stderr!r})")
+    check((same / name).read_bytes() == SPIRAL.read_bytes(), f"{what}: the input is unchanged")
+check(sorted(p.name for p in same.iterdir()) ==
+      ["program.dc", "runs-b.csv", "s.toml", "standings.md", "summary.md"],
+      f"nothing was written beside them: {sorted(p.name for p in same.iterdir())}")
+
+# ---- `simbot sweep FILE` in a folder with no out/ yet: the folder is made first
+fresh = OUT / "fresh"
+fresh.mkdir()
+(fresh / "g.toml").write_text(f'programs = ["{SPIRAL}"]\nfamilies = ["stationary"]\n'
+                              "seconds = 1\n[seeds]\nfirst = 1\ncount = 2\n")
+r = subprocess.run([SIMBOT, "sweep", "g.toml"], cwd=fresh, capture_output=True, text=True,
+                   timeout=120)
+table = fresh / "out" / "sweep-g.csv"
+check(r.returncode == 0 and table.is_file() and len(table.read_bytes().split(b"\r\n")) == 4
+      and (fresh / "out" / "sweep-g.csv.batch.json").is_file(),
+      f"sweep FILE with no out/ folder: {r.returncode} {r.stderr[-300:]!r}")
+
+
+# ---- a trace line longer than the limit: FILE:LINE, read no further, bounded memory
+def peak_kib(args):
+    """Runs simbot in a child Python, which reports its child's peak RSS (KiB)."""
+    code = ("import resource, subprocess, sys\n"
+            "r = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
+            "sys.stderr.write(r.stderr)\n"
+            "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n"
+            "sys.exit(r.returncode)\n")
+    r = subprocess.run([sys.executable, "-c", code, SIMBOT] + [str(a) for a in args],
+                       capture_output=True, text=True, timeout=120)
+    return r, int(r.stdout.split()[-1])
+
+
+long_line = OUT / "long-line.jsonl"
+with open(long_line, "wb") as f:
+    f.write(data.split(b"\n")[0] + b"\n")  # the run record of a real trace
+    f.truncate(f.tell() + (1 << 30))  # then a 1-GiB line (sparse: it takes no disk)
+for command in (["view", long_line, "-o", OUT / "long.html"], ["explain", long_line]):
+    started = time.monotonic()
+    r, peak = peak_kib(command)
+    errors = error_lines(r.stderr)
+    check(r.returncode == 1 and len(errors) == 1 and
+          errors[0].startswith(f"{long_line}:2: error: a line of more than 8388608 bytes"),
+          f"{command[0]}: a 1-GiB line is one error naming FILE:2 ({r.stderr[-300:]!r})")
+    # The limit (8 MiB) and the program; the old reader held the whole line twice: 2.1 GB.
+    # (ASan's shadow memory and quarantine need more.)
+    bound = 512 if SANITIZED else 128
+    check(peak < bound << 10, f"{command[0]}: a 1-GiB line read in {peak} KiB, not < {bound} MiB")
+    check(time.monotonic() - started < 10, f"{command[0]}: the long line is not read through")
+    print(f"{command[0]} of a trace with a 1-GiB line: peak RSS {peak} KiB")
+
+# The limit is enough: the longest record simbot writes is a robot's, with its source, at
+# most the compiler's 1 MiB (compiler::kMaxSourceBytes); of control bytes, each written as
+# 6 characters (\u0001), it is a 6-MiB line, which view and explain read back.
+widest = OUT / "widest.dc"
+head, tail = b"main() { }\n/*", b"*/\n"
+widest.write_bytes(head + b"\x01" * ((1 << 20) - len(head) - len(tail)) + tail)
+widest_trace = OUT / "widest.jsonl"
+r = run(["solo", widest, "--seconds", "0.01", "--trace", widest_trace])
+longest = max(len(line) for line in widest_trace.read_bytes().split(b"\n"))
+check(r.returncode == 0 and 6 << 20 < longest < 8 << 20,
+      f"a 1-MiB program of control bytes: its robot record is {longest} bytes ({r.stderr[-200:]!r})")
+for command in (["view", widest_trace, "-o", OUT / "widest.html"], ["explain", widest_trace]):
+    r = run(command)
+    check(r.returncode == 0, f"{command[0]} reads the longest record ({r.stderr[-300:]!r})")
+
+# ---- memory that runs out while reading a trace is said so, FILE:LINE
+if not SANITIZED:  # ASan reserves its shadow memory: an address-space limit cannot apply
+    first = OUT / "first-line.jsonl"
+    first.write_bytes(b'"' + b"x" * (7 << 20) + b'"\n')  # 7 MiB, within the line limit
+    tiny = OUT / "tiny.jsonl"
+    run(["solo", SPIRAL, "--seconds", "0.1", "--trace", tiny])
+    limit = 16 << 10
+    while limit < (512 << 10):  # the smallest address space (KiB) a small trace reads in
+        r = subprocess.run(["bash", "-c", f"ulimit -v {limit}; exec \"$@\"", "bash", SIMBOT,
+                            "explain", str(tiny)], capture_output=True, text=True, timeout=60)
+        if r.returncode == 0:
+            break
+        limit += 4 << 10
+    r = subprocess.run(["bash", "-c", f"ulimit -v {limit}; exec \"$@\"", "bash", SIMBOT,
+                        "explain", str(first)], capture_output=True, text=True, timeout=60)
+    check(one_line_error(r, f"{first}:1: error: out of memory reading the trace"),
+          f"a 7-MiB line in {limit} KiB of address space: out of memory, said so "
+          f"({r.returncode} {r.stderr[-300:]!r})")
 
 if failures:
     sys.exit(f"{len(failures)} check(s) failed")

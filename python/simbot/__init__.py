@@ -17,7 +17,7 @@ from . import _simbot
 from ._simbot import Error
 
 __all__ = ["Error", "compile", "solo", "match", "bench", "read_trace", "trace_frame",
-           "MAX_TRACE_BYTES"]
+           "MAX_TRACE_BYTES", "MAX_TRACE_LINE_BYTES"]
 
 
 def compile(path, disasm=False):
@@ -31,9 +31,11 @@ def trace_frame(lines):
     return pandas.DataFrame.from_records([json.loads(line) for line in lines])
 
 
-# The largest trace read_trace reads, as the CLI's view and explain
-# (files/files.h, kMaxTraceBytes): 16 GiB.
-MAX_TRACE_BYTES = 16 << 30
+# The largest trace read_trace reads, and its longest line, as the CLI's
+# view and explain (files/files.h, kMaxTraceBytes and kMaxTraceLineBytes):
+# 16 GiB and 8 MiB.
+MAX_TRACE_BYTES = _simbot.MAX_TRACE_BYTES
+MAX_TRACE_LINE_BYTES = _simbot.MAX_TRACE_LINE_BYTES
 
 
 def read_trace(path):
@@ -41,7 +43,9 @@ def read_trace(path):
 
     The file must be a regular file of at most MAX_TRACE_BYTES (16 GiB);
     anything else (a directory, /dev/zero, a FIFO, which is not waited on)
-    raises simbot.Error at once, as the CLI refuses it."""
+    raises simbot.Error at once, as the CLI refuses it. A line longer than
+    MAX_TRACE_LINE_BYTES (8 MiB) raises simbot.Error naming FILE:LINE once
+    that much of it is read, as the CLI's view and explain do."""
     name = os.fspath(path)
 
     def refuse(problem):
@@ -65,9 +69,18 @@ def read_trace(path):
     except BaseException:
         os.close(fd)
         raise
-    lines, size = [], 0
+    lines, size, number = [], 0, 0
     with f:
-        for line in f:
+        while True:
+            # At most the limit and a byte: a longer line is never held whole.
+            line = f.readline(MAX_TRACE_LINE_BYTES + 2)
+            if not line:
+                break
+            number += 1
+            if len(line.rstrip(b"\n")) > MAX_TRACE_LINE_BYTES:
+                raise Error(f"{name}:{number}: error: a line of more than "
+                            f"{MAX_TRACE_LINE_BYTES} bytes: no record of a simbot trace is "
+                            "that long")
             size += len(line)  # a file that grows while it is read
             if size > MAX_TRACE_BYTES:
                 raise refuse(f"more than the limit of {MAX_TRACE_BYTES} bytes")

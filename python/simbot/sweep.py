@@ -4,9 +4,13 @@
 code (batch/sweep.h) and each run's row is computed by it on a worker, so a
 row is the same as the local run's; the rows come back in any order and the
 C++ SweepWriter writes them in run-index order as soon as a prefix is
-complete. Workers read the programs and profiles at the paths the sweep
-names: a cluster on several machines needs them on a shared file system,
-and the simbot package installed on every worker.
+complete. The checks before the first run, the fingerprint beside the
+table (OUT.batch.json) and --resume's checks of it and of each kept row are
+the local sweep's own (batch::SweepOutput), so a Dask sweep, killed or
+finished, resumes as a local one does, on Dask or locally. Workers read the
+programs and profiles at the paths the sweep names: a cluster on several
+machines needs them on a shared file system, and the simbot package
+installed on every worker.
 """
 import argparse
 import functools
@@ -89,29 +93,27 @@ def _one_line(e):
     return text or type(e).__name__
 
 
-def _print_warnings(sweep):
-    """Each program's compiler warnings, once (as a local sweep prints them)."""
-    for program in sweep.programs():
-        for line in _simbot.compile(program)["diagnostics"]:
-            print(line, file=sys.stderr)
-
-
 def run(path, out, dask, shard="1/1", header=True, resume=False, progress=True):
     """Runs the sweep (or its shard) on the Dask cluster at `dask` into `out`.
     With progress, a line on stderr each time another tenth of the runs is
     done."""
     from dask.distributed import as_completed
-    path = os.path.abspath(path)
-    sweep = _sweep(path)
-    k, n = _simbot.parse_shard(shard)
-    begin, end = _simbot.shard_range(len(sweep), k, n)
-    # Connected first: a cluster that cannot be reached leaves `out` as it was.
+    sweep = _simbot.Sweep(path)
+    # Connected first: a cluster that cannot be reached leaves `out` as it
+    # was, and is the one line said.
     client, cluster = _client(dask)
     try:
-        writer = _simbot.SweepWriter(out, sweep.header(), header, begin, end, resume)
+        # The CLI's own checks, fingerprint and table (batch::SweepOutput),
+        # with the sweep file named as given, as a local sweep names it:
+        # either resumes the other's table. Each program's compiler warnings
+        # are printed once, here, and nothing is written before every check
+        # has passed.
+        output = sweep.output(out, shard, header, resume)
+        begin, end = output.begin(), output.end()
+        writer = output.open()
         todo = list(range(writer.next(), end))
-        if progress:
-            _print_warnings(sweep)
+        # The workers' path does not depend on their working directory.
+        path = os.path.abspath(path)
         start, done, shown = time.monotonic(), 0, 0
         # By reference to simbot.sweep._row (run as __main__, _row would be
         # pickled by value with this module's globals).

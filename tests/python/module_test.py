@@ -154,6 +154,16 @@ check("not a regular file" in message, f"read_trace(FIFO): {message}")
 raises(simbot.Error, "read_trace(directory)", lambda: simbot.read_trace(work))
 raises(simbot.Error, "read_trace(missing)", lambda: simbot.read_trace(os.path.join(work, "no")))
 check(simbot.MAX_TRACE_BYTES == 16 << 30, "read_trace's stated limit is 16 GiB")
+# A line past MAX_TRACE_LINE_BYTES (8 MiB, as view and explain) is an error
+# naming FILE:LINE: here a 64-MiB second line (sparse), after a real record.
+check(simbot.MAX_TRACE_LINE_BYTES == 8 << 20, "read_trace's line limit is 8 MiB")
+long_trace = os.path.join(work, "long-line.jsonl")
+with open(trace_file, "rb") as f, open(long_trace, "wb") as out:
+    out.write(f.readline())
+    out.truncate(out.tell() + (64 << 20))
+message = raises(simbot.Error, "read_trace(a 64-MiB line)", lambda: simbot.read_trace(long_trace))
+check(message.startswith(f"{long_trace}:2: error: a line of more than 8388608 bytes"),
+      f"read_trace(a 64-MiB line): {message}")
 # A bench whose threads cannot all be created is simbot.Error, not an
 # abort of Python: a child process with its address space limited so that
 # 400 thread stacks cannot fit.

@@ -11,7 +11,14 @@ usage: sweep_test.py SIMBOT ICEMAN TURRET WORKDIR [--no-dask] (PYTHONPATH: build
 Through --dask, a program's compiler warning is printed once, with
 progress lines and a last line; a refused address (tcp://127.0.0.1:9) is
 one line, `simbot: --dask: ...`, in well under the 10-s connect timeout,
-and leaves --out as it was.
+and leaves --out as it was. A Dask sweep keeps the local one's fingerprint:
+killed with SIGKILL once it has written rows and resumed with --resume on
+Dask, it gives the uninterrupted table byte for byte (and --resume of the
+finished table changes nothing).
+
+--resume refuses, in one line naming FILE:LINE and changing nothing, a row
+pasted from the same sweep with another first seed, and a fingerprint that
+another simbot version wrote (naming both).
 
 --no-dask (the sanitizer builds, which have no Python module): everything
 but the Dask run.
@@ -19,8 +26,10 @@ but the Dask run.
 import csv
 import os
 import shutil
+import signal
 import subprocess
 import sys
+import time
 
 failures = []
 
@@ -114,10 +123,54 @@ if __name__ == "__main__":
             check(any(line.startswith("sweep: 4/4 done in ") for line in lines)
                   and lines[-1].startswith("simbot: 4 runs (runs 0 to 4 of 4) on Dask"),
                   f"dask: progress and a last line: {lines}")
+            # Dask sweeps resume as local ones do: a 30-s grid (80 runs of
+            # some 20 ms each) killed with SIGKILL once its table has rows,
+            # then --resume on Dask, gives the uninterrupted table; so does
+            # --resume of a finished one, which runs nothing.
+            long_file = os.path.join(work, "long.toml")
+            with open(long_file, "w", encoding="utf-8") as f:
+                f.write(f'programs = ["{iceman}", "{turret}"]\n'
+                        'families = ["stationary", "circle"]\nseconds = 30.0\n'
+                        '[seeds]\nfirst = 1\ncount = 10\n[grid]\n'
+                        '"eyes.noise_sigma" = [0.0, 20.0]\n')
+            long_whole = os.path.join(work, "long-local.csv")
+            sweep(cli, long_file, "--out", long_whole, "--threads", "2")
+            killed = os.path.join(work, "long-killed.csv")
+            for stale in (killed, killed + ".batch.json"):
+                if os.path.exists(stale):
+                    os.remove(stale)
+            proc = subprocess.Popen([cli, "sweep", long_file, "--out", killed, "--dask",
+                                     cluster.scheduler_address], stderr=subprocess.DEVNULL)
+            deadline = time.monotonic() + 60
+            while time.monotonic() < deadline and proc.poll() is None:
+                if os.path.exists(killed) and read(killed).count(b"\n") >= 4:
+                    break
+                time.sleep(0.002)
+            proc.send_signal(signal.SIGKILL)
+            proc.wait()
+            kept = read(killed).count(b"\n") - 1
+            print(f"dask: SIGKILL with {kept} of 80 rows in the table")
+            check(proc.returncode == -signal.SIGKILL and 3 <= kept < 80,
+                  f"dask, SIGKILL: status {proc.returncode}, {kept} of 80 rows kept")
+            check(os.path.exists(killed + ".batch.json"), "dask: the fingerprint is kept")
+            r = subprocess.run([cli, "sweep", long_file, "--out", killed, "--resume", "--dask",
+                                cluster.scheduler_address], capture_output=True, text=True,
+                               timeout=120)
+            check(r.returncode == 0 and r.stderr.splitlines()[-1].startswith(
+                f"simbot: 80 runs (runs 0 to 80 of 80) on Dask"),
+                f"dask --resume after SIGKILL: status {r.returncode}, {r.stderr[-300:]}")
+            check(read(killed) == read(long_whole),
+                  "dask killed and resumed: the table differs from the uninterrupted one")
+            check(read(killed + ".batch.json") == read(long_whole + ".batch.json"),
+                  "dask and local sweeps keep the same fingerprint")
+            r = subprocess.run([cli, "sweep", long_file, "--out", killed, "--resume", "--dask",
+                                cluster.scheduler_address], capture_output=True, text=True,
+                               timeout=120)
+            check(r.returncode == 0 and read(killed) == read(long_whole),
+                  f"dask --resume of a finished sweep: {r.returncode} {r.stderr[-300:]}")
         finally:
             cluster.close()
         # A refused address: one line, at once (Dask alone retries for 30 s).
-        import time
         refused = os.path.join(work, "refused.csv")
         with open(refused, "w", encoding="utf-8") as f:
             f.write("an earlier table\n")
@@ -154,6 +207,47 @@ if __name__ == "__main__":
         f.write(b"\n".join(lines[:18]) + b"\n" + lines[18][:25])
     sweep(cli, sweep_file, "--out", cut, "--resume", "--threads", "2")
     check(read(cut) == table, "resume: table differs")
+
+    # --resume keeps only this sweep's rows: row 4 (run 3) replaced by run 3
+    # of the same sweep with first seed 100 (master seed 103, not 4) is
+    # refused in one line naming the row, and nothing changes.
+    other_file = os.path.join(work, "other.toml")
+    with open(sweep_file, encoding="utf-8") as f:
+        other_text = f.read().replace("first = 1", "first = 100")
+    with open(other_file, "w", encoding="utf-8") as f:
+        f.write(other_text)
+    other = os.path.join(work, "other.csv")
+    sweep(cli, other_file, "--out", other, "--threads", "2")
+    pasted = os.path.join(work, "pasted.csv")
+    shutil.copy(local + ".batch.json", pasted + ".batch.json")
+    mine, theirs = table.split(b"\r\n"), read(other).split(b"\r\n")
+    with open(pasted, "wb") as f:
+        f.write(b"\r\n".join(mine[:4] + theirs[4:5] + mine[5:8]) + b"\r\n")
+    before = read(pasted)
+
+    def refused_resume(what, *words):
+        r = subprocess.run([cli, "sweep", sweep_file, "--out", pasted, "--resume"],
+                           capture_output=True, text=True)
+        # Not the compiler's warnings (each with its source line and caret).
+        lines = [line for line in r.stderr.splitlines()
+                 if line.startswith("simbot:") or ": error: " in line]
+        check(r.returncode == 1 and len(lines) == 1 and all(w in lines[0] for w in words),
+              f"{what}: status {r.returncode}, {r.stderr.strip()[-500:]}")
+        check(read(pasted) == before, f"{what}: the table changed")
+
+    refused_resume("a pasted row of another master seed", f"{pasted}:5: error: --resume:",
+                   "run 3's master_seed is '103'", "has '4'")
+    # Another simbot version began it: both named.
+    import json
+    with open(pasted + ".batch.json", encoding="utf-8") as f:
+        fingerprint = json.load(f)
+    version = subprocess.run([cli, "--version"], capture_output=True, text=True).stdout.strip()
+    check(fingerprint.get("simbot") == version, f"the fingerprint records {fingerprint.get('simbot')}")
+    fingerprint["simbot"] = "simbot 0.1.0 (commit 0123456789ab, Debug build, SUNDIALS 6.4.1)"
+    with open(pasted + ".batch.json", "w", encoding="utf-8") as f:
+        json.dump(fingerprint, f)
+    refused_resume("another simbot's sweep",
+                   f"was run by {fingerprint['simbot']}, not {version}")
 
     # A sweep naming a key the profile does not have is an error, exit 1.
     bad = os.path.join(work, "bad.toml")
