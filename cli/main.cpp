@@ -3,7 +3,6 @@
 // reports/, sinks/); DESIGN.md's tool contract says what tests and scripts
 // rely on.
 #include <fmt/format.h>
-#include <sundials/sundials_config.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -269,9 +268,9 @@ void addWarningOptions(CLI::App* cmd) {
 
 int main(int argc, char** argv) {
   CLI::App app{"simbot: a timing-faithful simulator of the 1997 NPS Robot Wars"};
-  app.set_version_flag("--version",
-                       fmt::format("simbot {} (commit {}, {} build, SUNDIALS {})", SIMBOT_VERSION,
-                                   SIMBOT_COMMIT, SIMBOT_BUILD_TYPE, SUNDIALS_VERSION));
+  app.set_version_flag(
+      "--version", fmt::format("simbot {} (commit {}, {} build, SUNDIALS {})", SIMBOT_VERSION,
+                               SIMBOT_COMMIT, SIMBOT_BUILD_TYPE, simbot::plant::sundialsVersion()));
   app.require_subcommand(1);
 
   std::string compileFile;
