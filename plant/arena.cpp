@@ -15,7 +15,7 @@
 // (arena_impl.h, Motion). Only the centres' x and y have none: one ARKODE
 // ERKStep instance (Dormand-Prince 5(4), the pair's last stage reused as
 // the next step's first) integrates them, 2 values a robot. A one-step
-// method restarts for free at an input (ERKStepReset keeps its planned
+// method restarts for free at an input (ARKODE's reset keeps its planned
 // step), where CVODE's multistep method started again at order 1 with a
 // tiny step. Balls in flight are closed forms too (straight line at the
 // muzzle speed, z = h - g t^2 / 2) that live only in the root functions.
@@ -28,7 +28,7 @@
 // Events. Every discrete change (edge detector entering or leaving the wire's
 // range, contact starting or ending, reflex end, ball hit or miss, centre
 // leaving the field) is the zero of a root function; ARKODE locates it
-// (ARK_ROOT_RETURN) at t, and it happens at tick T = ceil(t * 9,216,000)
+// (a root return) at t, and it happens at tick T = ceil(t * 9,216,000)
 // (time.cpp), or the tick before when the crossing is on it (crossedTick).
 // At T we evaluate every root function again on the state at T and compare
 // with the discrete flags: a function ARKODE reported takes its new side
@@ -41,10 +41,10 @@
 //
 // The events at T are a prediction (DESIGN.md "co-simulation"): advance()
 // returns them and keeps the post-event state aside; they are applied (and
-// ARKODE reset with ERKStepReset, as at every discontinuity in sundials'
-// examples) when the scheduler proceeds, or discarded if an input at an
-// earlier tick changes the plant. Hence an input can reset at any tick
-// between the last reset and now().
+// ARKODE reset, as at every discontinuity in SUNDIALS' examples) when the
+// scheduler proceeds, or discarded if an input at an earlier tick changes
+// the plant. Hence an input can reset at any tick between the last reset
+// and now().
 //
 // Stepping is independent of how the caller chops time. advance(stop) does
 // not stop ARKODE at `stop`: it takes whole internal steps until ARKODE has
@@ -57,14 +57,14 @@
 // its stop, and a later advance() whose stop reaches the root's tick
 // reports it there, with the same events, exactly as a single long
 // advance() would have. A reset drops a held root (it lies past the
-// input's tick). Between resets the sequence of ERKStepEvolve calls is
+// input's tick). Between resets the sequence of calls to ARKODE is
 // therefore the same whatever the stops were, and so are the steps, the
 // step bounds (set from the state at each step's end), the segments, the
 // roots and every query; tout, the only argument that is not a state of
 // the plant, matters only to the first step's guess and is a fixed
 // horizon past the integrator's own time.
 //
-// Dense output. ARKODE runs in ARK_ONE_STEP mode; after every internal step
+// Dense output. ARKODE runs in its one-step mode; after every internal step
 // we keep the quintic Hermite polynomial of x and y matching their values,
 // slopes and curvatures at both ends of the step (arena_integrator.cpp), so
 // a query at any tick since the last reset evaluates it and the closed
@@ -387,15 +387,12 @@ int Arena::hits(int robot) const {
 }
 
 IntegratorStats Arena::stats() const {
-  Impl& m = *impl_;
-  // ARKODE's counters run on over resets (ERKStepReset keeps them); the
-  // dense output's own right-hand sides are counted with them.
+  const Impl& m = *impl_;
+  // ARKODE's counters run on over resets (a reset keeps them); the dense
+  // output's own right-hand sides are counted with them.
   IntegratorStats s = m.acc;
-  long v = 0;
-  ERKStepGetNumSteps(m.mem.get(), &v);
-  s.steps = v;
-  ERKStepGetNumRhsEvals(m.mem.get(), &v);
-  s.rhs_evals = v + m.ownRhs;
+  s.steps = m.ode.steps();
+  s.rhs_evals = m.ode.rhsEvals() + m.ownRhs;
   return s;
 }
 

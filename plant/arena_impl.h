@@ -3,7 +3,7 @@
 // The arena's implementation is split by job (the design is in arena.cpp's
 // header comment): arena.cpp is the protocol with the scheduler (the public
 // Arena methods: inputs, advance/retreat, queries), arena_integrator.cpp the
-// CVODE set-up, right-hand side, re-initialisation, dense output and the
+// ARKODE set-up, right-hand side, re-initialisation, dense output and the
 // stepping loop, arena_roots.cpp the root functions and the geometry they
 // evaluate on a state, arena_events.cpp the event rules applied at an
 // event's tick. This header holds the state all of them share and the
@@ -41,8 +41,8 @@ static_assert(kMaxBalls >= 2 * 2 * kMaxBallsPerGun, "the ball table must hold ev
 constexpr int kMaxRoots = 2 * 7 + 1 + kMaxBalls * 5;
 constexpr int kRing = 16;
 static_assert(kRing > kMaxRefereeLimit, "the referee must see one event more than its limit");
-// ERKStepEvolve's tout in ARK_ONE_STEP mode only bounds the first step's
-// guess after creation; a fixed horizon keeps it independent of the caller.
+// ARKODE's tout in its one-step mode only bounds the first step's guess
+// after creation; a fixed horizon keeps it independent of the caller.
 constexpr double kFirstStepHorizon = 1.0;  // s
 constexpr double kNoStopTime = 1e12;       // s, far beyond any match
 // A crossing this close after a tick (in ticks) is taken as on the tick.
@@ -196,11 +196,9 @@ struct Arena::Impl {
   double half = 0, wireHalf = 0;
   contact::Bodies bodies;  // radii and masses for the contact solve
 
-  // ---- SUNDIALS objects, in creation order (destroyed in reverse)
-  ark::Context ctx;
-  ark::Vector yv;
-  ark::Vector dky;
-  ark::ErkMemory mem;
+  // ---- the integrator of the centres (arkode.h): its state vector holds
+  // x, y at the end of each step, its scratch vector interpolations
+  ark::Integrator ode;
 
   // ---- discrete state being integrated, and the pending prediction
   Discrete D;
@@ -230,7 +228,7 @@ struct Arena::Impl {
   std::array<std::array<double, 2>, 2> segWheel{}, segGun{};
 
   // ---- the integrator's own position (see "Stepping" in arena.cpp)
-  double tReturned = 0;          // time of ERKStepEvolve's last return: roots up to it are known
+  double tReturned = 0;          // time of ARKODE's last return: roots up to it are known
   double tStepEnd = 0;           // end of ARKODE's last internal step
   bool lastRoot = false;         // ARKODE's last return was a root
   bool rootsMuted = false;       // clearRootFlag(): every root function reads 1
@@ -299,7 +297,7 @@ struct Arena::Impl {
   // each reset, read at every step.
   double segSpeed = 0;     // pointSpeed()
   bool segRest = false;    // atRest()
-  double maxStepSet = -1;  // the value last given to ERKStepSetMaxStep
+  double maxStepSet = -1;  // the value last given to ARKODE's maximum step
 
   // ------------------------------------------------------------ geometry on a
   // full state
@@ -343,12 +341,11 @@ struct Arena::Impl {
   void sideRoots(double t0, const std::vector<double>& y);
 
   // ------------------------------------------------------------ ARKODE
-  // callbacks
-  static int rhsThunk(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
-    static_cast<Impl*>(user)->rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
-    return 0;
+  // callbacks (ark::RhsFn, ark::RootFn)
+  static void rhsThunk(double t, const double* y, double* ydot, void* user) {
+    static_cast<Impl*>(user)->rhs(t, y, ydot);
   }
-  static int rootThunk(sunrealtype t, N_Vector y, sunrealtype* g, void* user);
+  static void rootThunk(double t, const double* y, double* g, void* user);
 
   // Velocities of x, y (nx values) at t with positions xy, after the
   // active contacts' projection; `accel`, if given, their time derivative.

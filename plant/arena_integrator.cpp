@@ -13,7 +13,7 @@ namespace simbot::plant {
 
 namespace {
 
-// ERKStep's tolerances on x and y: absolute (ft) and relative. Against the
+// ARKODE's tolerances on x and y: absolute (ft) and relative. Against the
 // exact motion (closed-form heading, Boost.Math quadrature of x and y;
 // tests/plant/tolerance_test.cpp) the arcs, spins and straight runs of the
 // default profile stay within 1e-9 ft over 10 s, 1/380 of the 3.8e-7 ft a
@@ -44,9 +44,7 @@ Arena::Impl::Impl(const ArenaConfig& c)
       nR(static_cast<int>(c.robots.size())),
       n(kPerRobot * static_cast<int>(c.robots.size())),
       nx(kXY * static_cast<int>(c.robots.size())),
-      yv(kXY * static_cast<sunindextype>(c.robots.size()), ctx.get()),
-      dky(kXY * static_cast<sunindextype>(c.robots.size()), ctx.get()),
-      mem(&Impl::rhsThunk, 0.0, yv.get(), ctx.get()) {
+      ode(kXY * static_cast<int>(c.robots.size()), &Impl::rhsThunk, this) {
   if (nR < 1 || nR > 2) throw std::invalid_argument("Arena: 1 or 2 robots");
   half = cfg.field.size_ft / 2;
   wireHalf = half - cfg.field.wire_inset_ft;
@@ -99,20 +97,17 @@ Arena::Impl::Impl(const ArenaConfig& c)
   }
   D.robotContact = nR == 2 && gapOf(contact::Kind::Robot, 0, y.data()) <= 0;
 
-  void* m = mem.get();
-  ark::check(ERKStepSetUserData(m, this), "ERKStepSetUserData");
   // Dormand-Prince 5(4): the fifth-order pair with the smallest error
   // constants ARKODE ships, its last stage reused as the next step's first.
-  ark::check(ERKStepSetTableNum(m, ARKODE_DORMAND_PRINCE_7_4_5), "ERKStepSetTableNum");
-  ark::check(ERKStepSStolerances(m, kRelativeTolerance, kAbsoluteTolerance), "ERKStepSStolerances");
+  ode.useDormandPrince745();
+  ode.setTolerances(kRelativeTolerance, kAbsoluteTolerance);
   // ARKODE's root finder locates a crossing on its own interpolant, the
   // quartic Hermite it uses with a fifth-order table (one more right-hand
   // side, only in a step with a sign change); crossedTick() then decides
   // the tick from the quintic dense output below.
-  ark::check(ERKStepSetMaxNumSteps(m, 100000), "ERKStepSetMaxNumSteps");
-  // ARKODE's own messages would go to stderr: a failure is reported as the
-  // run's plant fault instead (SolverError).
-  ark::check(ERKStepSetErrFile(m, nullptr), "ERKStepSetErrFile");
+  ode.setMaxNumSteps(100000);
+  // ARKODE's own messages are silenced (arkode.cpp): a failure is reported
+  // as the run's plant fault instead (SolverError).
   reinit(0, 0.0, tmp, /*first=*/true);
 }
 
@@ -343,7 +338,7 @@ void Arena::Impl::setActive(const Discrete& d) {
 
 void Arena::Impl::setMaxStep(double h) {
   if (h == maxStepSet) return;
-  ark::check(ERKStepSetMaxStep(mem.get(), h), "ERKStepSetMaxStep");
+  ode.setMaxStep(h);
   maxStepSet = h;
 }
 
@@ -366,14 +361,14 @@ void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, b
   segSpeed = pointSpeed();
   segRest = atRest();
   setActive(D);
-  double* xy = yv.data();
+  double* xy = ode.data(ark::Buffer::State);
   centresOf(y.data(), xy);
   if (!same) {
     if (!first) {
       ++acc.reinits;
       clearRootFlag();
     }
-    ark::check(ERKStepReset(mem.get(), t0, yv.get()), "ERKStepReset");
+    ode.reset(t0);
   }
   fresh = true;
   segWheel = wheelTarget;
@@ -381,7 +376,7 @@ void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, b
   // The new segment starts with the step ARKODE reported as its next after
   // the step that holds t0 (Rec::next; a one-step method restarts for free), within half the
   // distance to the nearest feature, and with its step controller afresh:
-  // ERKStepSetInitStep clears the error history that ERKStepReset keeps.
+  // setting the initial step clears the error history that a reset keeps.
   // Both then depend on the steps up to t0 alone, never on steps taken past
   // it, which a caller that chops time otherwise may not have taken.
   const double bound = segRest ? kRestStep : 0.5 * stepBound(y.data(), 0.0);
@@ -390,15 +385,12 @@ void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, b
   if (!first) {
     const double planned = recordAt(t0).next;
     initial = planned > 0 ? std::min(planned, bound) : 0.0;
-    ark::check(ERKStepSetInitStep(mem.get(), initial), "ERKStepSetInitStep");
+    ode.setInitStep(initial);
   }
   buildRoots();
   sideRoots(t0, y);
   if (nRoots != nRootsRegistered) {
-    ark::check(ERKStepRootInit(mem.get(), nRoots, nRoots > 0 ? &Impl::rootThunk : nullptr),
-               "ERKStepRootInit");
-    if (nRoots > 0)  // (the root memory exists only now)
-      ark::check(ERKStepSetNoInactiveRootWarn(mem.get()), "ERKStepSetNoInactiveRootWarn");
+    ode.setRoots(nRoots, &Impl::rootThunk);
     nRootsRegistered = nRoots;
   }
   now = tick;
@@ -411,12 +403,13 @@ void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, b
   // this reset came before) is moved out of reach.
   const std::int64_t nl = nextLaunch();
   if (nl > tick) {
-    ark::check(ERKStepSetStopTime(mem.get(), secondsFromTick(nl)), "ERKStepSetStopTime");
+    ode.setStopTime(secondsFromTick(nl));
     launchStop = nl;
   } else if (launchStop >= 0) {
     // Without a reset (nothing that moves changed) the old one is still
-    // armed: ARKODE 6.4 has no way to clear it but one out of reach.
-    ark::check(ERKStepSetStopTime(mem.get(), kNoStopTime), "ERKStepSetStopTime");
+    // armed: it is moved out of reach, as every version allows (ARKODE
+    // 6.4 has no call that clears it).
+    ode.setStopTime(kNoStopTime);
     launchStop = -1;
   }
   recs.clear();
@@ -443,10 +436,13 @@ void Arena::Impl::clearRootFlag() {
   if (!lastRoot || tReturned >= tStepEnd) return;
   rootsMuted = true;
   double tr = 0;
-  const int flag =
-      ERKStepEvolve(mem.get(), tStepEnd + kFirstStepHorizon, dky.get(), &tr, ARK_ONE_STEP);
+  try {
+    ode.step(tStepEnd + kFirstStepHorizon, ark::Buffer::Scratch, tr);
+  } catch (...) {
+    rootsMuted = false;
+    throw;
+  }
   rootsMuted = false;
-  ark::check(flag, "ERKStepEvolve");
   lastRoot = false;
 }
 
@@ -653,37 +649,33 @@ AdvanceResult Arena::Impl::advance(std::int64_t stopTick) {
     // tout matters only to the first step's size guess (after creation);
     // a fixed horizon past the current time keeps it independent of the
     // caller.
-    const int flag =
-        ERKStepEvolve(mem.get(), tStepEnd + kFirstStepHorizon, yv.get(), &tret, ARK_ONE_STEP);
-    ark::check(flag, "ERKStepEvolve");
-    double tn = 0;
-    ERKStepGetCurrentTime(mem.get(), &tn);
+    const ark::StepEnd end = ode.step(tStepEnd + kFirstStepHorizon, ark::Buffer::State, tret);
+    const double tn = ode.currentTime();
     if (tn > tStepEnd) {
       // A new internal step: its end state (at a root return ARKODE hands
       // back the root's state; its own interpolant gives the step's end,
       // exactly, at tn).
-      const double* yn = yv.data();
+      const double* yn = ode.data(ark::Buffer::State);
       if (tret != tn) {
-        ark::check(ERKStepGetDky(mem.get(), tn, 0, dky.get()), "ERKStepGetDky");
-        yn = dky.data();
+        ode.interpolate(tn, ark::Buffer::Scratch);
+        yn = ode.data(ark::Buffer::Scratch);
       }
       recordStep(tn, yn);
       tStepEnd = tn;
       recs.back().thi = std::max(tn, tret);
       fullState(tn, yn, qtmp.data());
-      double ahead = 0;
-      ERKStepGetCurrentStep(mem.get(), &ahead);
+      const double ahead = ode.currentStep();
       recs.back().next = ahead;
       setMaxStep(segRest ? kRestStep : stepBound(qtmp.data(), ahead));
     } else if (tret > recs.back().thi) {
       recs.back().thi = tret;
     }
     tReturned = tret;
-    lastRoot = flag == ARK_ROOT_RETURN;
-    if (flag == ARK_TSTOP_RETURN) launchStop = -1;  // ARKODE disarms a reached stop time
-    if (flag != ARK_ROOT_RETURN) continue;
+    lastRoot = end == ark::StepEnd::Root;
+    if (end == ark::StepEnd::StopTime) launchStop = -1;  // ARKODE disarms a reached stop time
+    if (end != ark::StepEnd::Root) continue;
     ++acc.roots;
-    ark::check(ERKStepGetRootInfo(mem.get(), rootsFound.data()), "ERKStepGetRootInfo");
+    ode.rootsFound(rootsFound.data());
     const std::int64_t T0 = eventTickFromSeconds(tret);
     const std::int64_t k = crossedTick(T0);
     std::int64_t T = std::max(k, now);

@@ -5,7 +5,7 @@
 // field, reflex end, robot-robot contact and the balls' closed-form
 // flights. buildRoots() lists the ones the current discrete state needs;
 // ARKODE evaluates them through rootThunk; crossedTick() decides the tick of
-// a crossing CVODE reported. They only read the state: the rules that act
+// a crossing ARKODE reported. They only read the state: the rules that act
 // on a crossing are in arena_events.cpp.
 #include "plant/arena_impl.h"
 
@@ -170,24 +170,23 @@ double Arena::Impl::rootValue(const RootDesc& rd, double t, const double* y) con
   return 1.0;
 }
 
-int Arena::Impl::rootThunk(sunrealtype t, N_Vector y, sunrealtype* g, void* user) {
+void Arena::Impl::rootThunk(double t, const double* y, double* g, void* user) {
   const Impl* self = static_cast<const Impl*>(user);
   if (self->rootsMuted) {
     for (int i = 0; i < self->nRoots; ++i) g[i] = 1.0;
-    return 0;
+    return;
   }
   double* full = self->rootY.data();
-  self->fullState(t, N_VGetArrayPointer(y), full);
+  self->fullState(t, y, full);
   for (int i = 0; i < self->nRoots; ++i) g[i] = self->sidedValue(i, t, full);
-  return 0;
 }
 
 // Sided roots. A contact or edge function's sign is the discrete state
 // (touching, or the detector low, exactly when g < 0), but at the tick of
-// a crossing the rules decide by the direction CVODE reported, and there
+// a crossing the rules decide by the direction ARKODE reported, and there
 // the function can be exactly 0 (a crossing exactly on a tick) or on the
-// old side by round-off (the dense output is not CVODE's own
-// interpolation to the last bit). CVODE ignores a root function that
+// old side by round-off (the dense output is not ARKODE's own
+// interpolation to the last bit). ARKODE ignores a root function that
 // starts a segment at exactly 0, and one that starts on the wrong side
 // crosses the wrong way or not at all: a reflex backing off a wall at
 // once ended the contact only at the next event (rules_test.cpp,
@@ -196,7 +195,7 @@ int Arena::Impl::rootThunk(sunrealtype t, N_Vector y, sunrealtype* g, void* user
 // it does not, it is shifted by its start value plus as much again (at
 // least the smallest normal double). The shift is round-off sized, far
 // below the distance a robot moves in a tick; it holds for the whole
-// segment, in CVODE's root finding, crossedTick() and the event rules.
+// segment, in ARKODE's root finding, crossedTick() and the event rules.
 void Arena::Impl::sideRoots(double t0, const std::vector<double>& y) {
   for (int j = 0; j < nRoots; ++j) {
     const RootDesc& rd = roots[static_cast<std::size_t>(j)];
@@ -280,7 +279,7 @@ void Arena::Impl::buildRoots() {
 }
 
 // DESIGN.md: an event happens at the first integer tick at which its root
-// function has crossed. CVODE returns the right end of its root bracket,
+// function has crossed. ARKODE returns the right end of its root bracket,
 // a hair past the crossing, so T0 = ceil(tret) is one tick late when the
 // crossing falls exactly on tick T0 - 1 (a contact at constant speed, a
 // reflex of exactly 1.5 ft at 1.5 ft/s). Decide from dense output at the

@@ -1,82 +1,81 @@
-// plant/arkode.h -- internal: RAII owners for the SUNDIALS 6.x objects.
+// plant/arkode.h -- internal: the plant's one door to SUNDIALS ARKODE.
 //
-// ARKODE hands out raw handles that must be freed in the right order (the
-// ERKStep memory refers to the vector and the context). Each wrapper owns
-// one handle, is move-only, and frees it in its destructor; Arena::Impl
-// declares them in creation order so C++'s reverse destruction order frees
-// them correctly. A failing SUNDIALS call throws SolverError (plant.h)
-// naming the call: the run ends with a fault of the plant.
+// The arena integrates the robots' centres with ARKODE's ERKStep. Only
+// arkode.cpp names SUNDIALS (its headers, types and calls), so a new
+// SUNDIALS release changes that file alone: it is written for 6.x (from
+// 6.4) and 7.x, with version tests where their APIs differ and the names
+// that are not deprecated where both have one (plant/CMakeLists.txt finds
+// a SUNDIALS in that range). This interface speaks plain arrays of
+// doubles: one Integrator owns the context, its two vectors and the
+// ERKStep memory and frees them in the right order; after its constructor
+// it allocates nothing (ARKODE itself only when the number of root
+// functions changes). A failing call throws SolverError (plant.h) naming
+// the SUNDIALS function: the run ends with a fault of the plant.
 #pragma once
 
-#include <arkode/arkode_erkstep.h>
-#include <nvector/nvector_serial.h>
-#include <sundials/sundials_context.h>
-
-#include <stdexcept>
-#include <string>
-
-#include "plant/plant.h"
+#include <memory>
 
 namespace simbot::plant::ark {
 
-inline void check(int flag, const char* what) {
-  if (flag < 0)
-    throw SolverError(std::string("SUNDIALS: ") + what + " failed, flag " + std::to_string(flag));
-}
+// The right-hand side y' = f(t, y) and the root functions g(t, y) (one
+// value each), over arrays of the integrator's size; `user` is the pointer
+// given to the Integrator.
+using RhsFn = void (*)(double t, const double* y, double* ydot, void* user);
+using RootFn = void (*)(double t, const double* y, double* g, void* user);
 
-class Context {
+// How a step() call ended (ARK_SUCCESS, ARK_TSTOP_RETURN, ARK_ROOT_RETURN).
+enum class StepEnd { Step, StopTime, Root };
+
+// One of the integrator's two vectors: the state that reset() starts from
+// and step() returns into, and a second one for interpolation.
+enum class Buffer { State, Scratch };
+
+class Integrator {
  public:
-  Context() { check(SUNContext_Create(nullptr, &ctx_), "SUNContext_Create"); }
-  ~Context() {
-    if (ctx_) SUNContext_Free(&ctx_);
-  }
-  Context(const Context&) = delete;
-  Context& operator=(const Context&) = delete;
-  SUNContext get() const { return ctx_; }
+  // n values, starting at t = 0 from state() as it is (zeros).
+  Integrator(int n, RhsFn rhs, void* user);
+  ~Integrator();
+  Integrator(const Integrator&) = delete;
+  Integrator& operator=(const Integrator&) = delete;
+
+  double* data(Buffer b) const { return b == Buffer::State ? state_ : scratch_; }
+
+  // The method and its limits (once, after construction).
+  void useDormandPrince745();
+  void setTolerances(double relative, double absolute);
+  void setMaxNumSteps(long steps);
+
+  // A new start at t0 from data(Buffer::State); the step counters and the
+  // step controller's history go on (ERKStep's reset).
+  void reset(double t0);
+  void setInitStep(double h);  // 0: ARKODE's own estimate
+  void setMaxStep(double h);
+  // n root functions, all evaluated by g (n = 0: none).
+  void setRoots(int n, RootFn g);
+  void setStopTime(double t);
+
+  // One internal step (ARKODE's one-step mode) into `into`; tret is the time
+  // returned. tout, ahead of the current time, only guides the first
+  // step's size after creation or a reset.
+  StepEnd step(double tout, Buffer into, double& tret);
+  double currentTime() const;  // end of the last internal step
+  double currentStep() const;  // the step ARKODE plans next
+  // ARKODE's own interpolant at t (within the last step) into `into`.
+  void interpolate(double t, Buffer into);
+  // After a StepEnd::Root: for each root function, +1 or -1 where it
+  // crossed (rising, falling), 0 elsewhere.
+  void rootsFound(int* found) const;
+
+  long steps() const;     // internal steps since construction
+  long rhsEvals() const;  // calls of the right-hand side, likewise
 
  private:
-  SUNContext ctx_ = nullptr;
-};
-
-class Vector {
- public:
-  Vector(sunindextype n, SUNContext ctx) : v_(N_VNew_Serial(n, ctx)) {
-    if (!v_) throw std::runtime_error("SUNDIALS: N_VNew_Serial failed");
-    // ARKODE's clones inherit this: one pass for each linear combination
-    // (the Runge-Kutta stages) instead of one call per term.
-    if (N_VEnableFusedOps_Serial(v_, SUNTRUE) != 0) {
-      N_VDestroy(v_);
-      throw std::runtime_error("SUNDIALS: N_VEnableFusedOps_Serial failed");
-    }
-  }
-  ~Vector() {
-    if (v_) N_VDestroy(v_);
-  }
-  Vector(const Vector&) = delete;
-  Vector& operator=(const Vector&) = delete;
-  N_Vector get() const { return v_; }
-  double* data() const { return N_VGetArrayPointer(v_); }
-
- private:
-  N_Vector v_;
-};
-
-// The ERKStep integrator's memory.
-class ErkMemory {
- public:
-  ErkMemory(ARKRhsFn f, double t0, N_Vector y0, SUNContext ctx)
-      : mem_(ERKStepCreate(f, t0, y0, ctx)) {
-    if (!mem_) throw std::runtime_error("SUNDIALS: ERKStepCreate failed");
-  }
-  ~ErkMemory() {
-    if (mem_) ERKStepFree(&mem_);
-  }
-  ErkMemory(const ErkMemory&) = delete;
-  ErkMemory& operator=(const ErkMemory&) = delete;
-  void* get() const { return mem_; }
-
- private:
-  void* mem_;
+  // The SUNDIALS objects and the callbacks ARKODE calls (arkode.cpp).
+  struct Handles;
+  std::unique_ptr<Handles> h_;
+  void* mem_ = nullptr;  // the ERKStep memory, at hand for every call
+  double* state_ = nullptr;
+  double* scratch_ = nullptr;
 };
 
 }  // namespace simbot::plant::ark

@@ -42,7 +42,7 @@ inline double wrap180(double deg) {
 
 // Distance from p to the boundary of the square |x|,|y| <= hw (the wire).
 // Inside: distance to the nearest side; outside: Euclidean distance to the
-// square. Continuous everywhere, which is all CVODE's root finder needs.
+// square. Continuous everywhere, which is all ARKODE's root finder needs.
 inline double squareRingDistance(const Vec2& p, double hw) {
   const double ax = std::abs(p.x()), ay = std::abs(p.y());
   if (ax <= hw && ay <= hw) return std::min(hw - ax, hw - ay);

@@ -40,7 +40,7 @@ using timebase::kTicksPerSecond;
 // Tick of a continuous-time event found at t seconds: ceil(t * 9,216,000),
 // the ceiling of the exact real product (not of the rounded double product).
 std::int64_t eventTickFromSeconds(double t);
-// The double nearest to tick / 9,216,000 (used to hand times to CVODE).
+// The double nearest to tick / 9,216,000 (used to hand times to ARKODE).
 double secondsFromTick(std::int64_t tick);
 
 // ---------------------------------------------------------------- parameters
@@ -147,6 +147,9 @@ class SolverError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// The version of the SUNDIALS the plant was built with ("7.1.1").
+const char* sundialsVersion();
 
 // ---------------------------------------------------------------- motor frames
 struct WheelCommand {

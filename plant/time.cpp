@@ -1,4 +1,4 @@
-// plant/time.cpp -- conversions between integer ticks and CVODE's seconds.
+// plant/time.cpp -- conversions between integer ticks and ARKODE's seconds.
 //
 // DESIGN.md: an event found by the integrator at t seconds happens at tick
 // ceil(t * 9,216,000). The rounded double product t * N can sit on the wrong

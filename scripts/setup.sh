@@ -49,6 +49,38 @@ if ((${#missing[@]})); then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 [ "${1:-}" = --quickstart ] && exit 0
+# SUNDIALS 7 beside Debian 12's 6.4, for the test suite's build of the plant
+# against it (scripts/test.sh): Debian 13's libsundials-dev and the
+# libsundials-* packages it depends on, fetched from the mirror this
+# machine's apt already uses through a throwaway apt configuration and
+# unpacked into build-sundials7/prefix, never installed (the system, its
+# apt sources and its package state are left as they are). They need only
+# Debian 12's glibc and Open MPI's libmpi.so.40 (mpi-default-dev, which
+# Debian 12's libsundials-dev brings).
+sundials7=build-sundials7/prefix
+if [ ! -e "$sundials7/.unpacked" ]; then
+  . /etc/os-release
+  mirror=$(apt-get indextargets --no-release-info --format '$(REPO_URI)' \
+    "Release: $VERSION_CODENAME" "Identifier: Packages" | awk 'NR == 1')
+  [ -n "$mirror" ] || { echo "setup.sh: no apt source for $VERSION_CODENAME to take SUNDIALS 7 from" >&2; exit 1; }
+  apt_dir=$(mktemp -d)
+  trap 'rm -rf "$apt_dir"' EXIT
+  mkdir -p "$apt_dir/lists/partial" "$apt_dir/cache/archives/partial" "$apt_dir/debs"
+  echo "deb [signed-by=/usr/share/keyrings/debian-archive-keyring.gpg] $mirror trixie main" \
+    > "$apt_dir/sources.list"
+  touch "$apt_dir/status"
+  apt_opts=(-qq -o "Dir::Etc::sourcelist=$apt_dir/sources.list" -o Dir::Etc::sourceparts=-
+    -o "Dir::State::Lists=$apt_dir/lists" -o "Dir::State::status=$apt_dir/status"
+    -o "Dir::Cache=$apt_dir/cache" -o APT::Sandbox::User=root)
+  apt-get "${apt_opts[@]}" update
+  mapfile -t libs < <(apt-cache "${apt_opts[@]}" depends libsundials-dev |
+    awk '$1 == "Depends:" && $2 ~ /^libsundials-/ { print $2 }')
+  (cd "$apt_dir/debs" && apt-get "${apt_opts[@]}" download libsundials-dev "${libs[@]}")
+  rm -rf "$sundials7"
+  mkdir -p "$sundials7"
+  for deb in "$apt_dir"/debs/*.deb; do dpkg-deb -x "$deb" "$sundials7"; done
+  touch "$sundials7/.unpacked"
+fi
 # playwright-core only: it drives Debian's Chromium and downloads no browser.
 lock=tests/browser/package-lock.json
 stamp=tests/browser/node_modules/.simbot-lock

@@ -205,7 +205,7 @@ TEST(Chopping, ResultsDoNotDependOnWhereAdvanceStops) {
 // advance overshot it and was retreated) leave nothing behind: a reset
 // starts from the step planned where the input is, with the step
 // controller's error history cleared, so the run is bit-identical to one
-// that never went past the input. (ERKStepReset alone keeps the history:
+// that never went past the input. (ARKODE's reset alone keeps the history:
 // the runs then differ in the last bits, seen as a trace that changed with
 // fast-forward on.)
 TEST(Chopping, StepsPastAnInputTheArenaRetreatedFromLeaveNoTrace) {

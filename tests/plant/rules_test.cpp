@@ -92,10 +92,10 @@ TEST(ExactTicks, WallContactAndReflexEnd) {
 // as is, and with a referee that turns a robot at its first reflex (at the
 // contact's tick, by 45 degrees about its centre, which stays where it
 // was; the robot then backs off at 45 degrees to the wall). For k = 6 the
-// function is exactly 0.0 at the contact's tick: CVODE ignores a root
-// function that starts a segment at exactly 0, and the end was found 0.19
-// s late, at the next event, until the function was sided
-// (arena_roots.cpp); with the turn, the contact was decided again from
+// function is exactly 0.0 at the contact's tick: the root finder (CVODE's
+// then, ARKODE's now) ignores a root function that starts a segment at
+// exactly 0, and the end was found 0.19 s late, at the next event, until
+// the function was sided (arena_roots.cpp); with the turn, the contact was decided again from
 // that 0 and ended at the tick it began, until a turn left contacts
 // standing (arena_events.cpp).
 TEST(ExactTicks, WallContactEndsTheTickAfterItBegins) {

@@ -5,7 +5,7 @@
 // of x and y (lag_arc_oracle.h); and edge-wire crossings, whose tick must
 // be the ceiling of the oracle's crossing time.
 //
-// The bounds are those docs/plant.md states for ERKStep at rtol = atol =
+// The bounds are those docs/plant.md states for ARKODE at rtol = atol =
 // 1e-9 with the quintic dense output: position within 1e-9 ft (1/380 of
 // the 3.8e-7 ft a point at the top speed of 3.5 ft/s moves in a tick);
 // the heading is a closed form, within 1e-12 rad (round-off of the

@@ -1,0 +1,216 @@
+// plant/arkode.cpp -- the adapter to SUNDIALS ARKODE (arkode.h): the one
+// file that includes SUNDIALS' headers and calls it.
+//
+// Versions 6.4 to 7.x. Where they differ:
+// - 7.0 made SUNContext_Create take a SUNComm (SUN_COMM_NULL without a
+//   communicator; 6.x took a void*, null) and removed ERKStepSetErrFile:
+//   errors go to the handlers on the context's stack, warnings to its
+//   logger.
+// - 7.1 gave the calls that every ARKODE stepper shares ARKODE-level names
+//   (ARKodeEvolve for ERKStepEvolve, ...) and deprecated ERKStep's;
+//   ERKStepCreate and ERKStepSetTableNum stay ERKStep's own.
+// - 7.2 did the same for the count of right-hand sides
+//   (ARKodeGetNumRhsEvals).
+// The calls, their order and their arguments are the same in every
+// version: the numbers come from ARKODE alone.
+#include <arkode/arkode.h>
+#include <arkode/arkode_erkstep.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_config.h>
+#include <sundials/sundials_context.h>
+#if SUNDIALS_VERSION_MAJOR >= 7
+#include <sundials/sundials_logger.h>
+#endif
+
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+
+#include "plant/arkode.h"
+#include "plant/plant.h"
+
+#if SUNDIALS_VERSION_MAJOR < 6 || (SUNDIALS_VERSION_MAJOR == 6 && SUNDIALS_VERSION_MINOR < 4) || \
+    SUNDIALS_VERSION_MAJOR > 7
+#error "plant/arkode.cpp is written for SUNDIALS 6.4 to 7.x (plant/CMakeLists.txt)"
+#endif
+static_assert(std::is_same_v<sunrealtype, double>, "the plant needs SUNDIALS built for double");
+
+// A call ERKStep shares with the other steppers: by its ARKODE-level name
+// from 7.1 on, by ERKStep's before.
+#if SUNDIALS_VERSION_MAJOR > 7 || (SUNDIALS_VERSION_MAJOR == 7 && SUNDIALS_VERSION_MINOR >= 1)
+#define SIMBOT_ARK(fn) ARKode##fn
+#else
+#define SIMBOT_ARK(fn) ERKStep##fn
+#endif
+#define SIMBOT_ARK_QUOTE(x) #x
+#define SIMBOT_ARK_NAME(x) SIMBOT_ARK_QUOTE(x)
+// Makes the shared call `fn` and throws SolverError naming it if it fails.
+#define SIMBOT_ARK_CALL(fn, ...) check(SIMBOT_ARK(fn)(__VA_ARGS__), SIMBOT_ARK_NAME(SIMBOT_ARK(fn)))
+
+namespace simbot::plant {
+
+const char* sundialsVersion() { return SUNDIALS_VERSION; }
+
+namespace ark {
+
+namespace {
+
+void check(int flag, const char* what) {
+  if (flag < 0)
+    throw SolverError(std::string("SUNDIALS: ") + what + " failed, flag " + std::to_string(flag));
+}
+
+N_Vector newVector(int n, SUNContext ctx) {
+  N_Vector v = N_VNew_Serial(static_cast<sunindextype>(n), ctx);
+  if (!v) throw std::runtime_error("SUNDIALS: N_VNew_Serial failed");
+  // ARKODE's clones inherit this: one pass for each linear combination
+  // (the Runge-Kutta stages) instead of one call per term.
+  if (N_VEnableFusedOps_Serial(v, SUNTRUE) != 0) {
+    N_VDestroy(v);
+    throw std::runtime_error("SUNDIALS: N_VEnableFusedOps_Serial failed");
+  }
+  return v;
+}
+
+}  // namespace
+
+// Freed in the reverse order of creation: the ERKStep memory refers to the
+// vectors' context.
+struct Integrator::Handles {
+  SUNContext ctx = nullptr;
+  N_Vector state = nullptr;
+  N_Vector scratch = nullptr;
+  void* mem = nullptr;
+  RhsFn rhs = nullptr;
+  RootFn root = nullptr;
+  void* user = nullptr;
+
+  Handles() = default;
+  Handles(const Handles&) = delete;
+  Handles& operator=(const Handles&) = delete;
+  ~Handles() {
+    if (mem) SIMBOT_ARK(Free)(&mem);
+    if (scratch) N_VDestroy(scratch);
+    if (state) N_VDestroy(state);
+    if (ctx) SUNContext_Free(&ctx);
+  }
+
+  N_Vector vector(Buffer b) const { return b == Buffer::State ? state : scratch; }
+
+  static int rhsThunk(sunrealtype t, N_Vector y, N_Vector ydot, void* self) {
+    const Handles* h = static_cast<const Handles*>(self);
+    h->rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot), h->user);
+    return 0;
+  }
+  static int rootThunk(sunrealtype t, N_Vector y, sunrealtype* g, void* self) {
+    const Handles* h = static_cast<const Handles*>(self);
+    h->root(t, N_VGetArrayPointer(y), g, h->user);
+    return 0;
+  }
+};
+
+Integrator::Integrator(int n, RhsFn rhs, void* user) : h_(std::make_unique<Handles>()) {
+  Handles& h = *h_;
+  h.rhs = rhs;
+  h.user = user;
+#if SUNDIALS_VERSION_MAJOR >= 7
+  check(SUNContext_Create(SUN_COMM_NULL, &h.ctx), "SUNContext_Create");
+  // No error handler: a failure reaches the plant as its call's flag (a
+  // SolverError, the run's plant fault), not as a line on stderr.
+  check(SUNContext_ClearErrHandlers(h.ctx), "SUNContext_ClearErrHandlers");
+#if SUNDIALS_LOGGING_LEVEL >= 2  // SUN_LOGLEVEL_WARNING
+  // A build that logs warnings prints them to stdout, simbot's JSON and
+  // trace output, unless told otherwise (6.x sent them to the error file,
+  // which was none).
+  SUNLogger logger = nullptr;
+  check(SUNContext_GetLogger(h.ctx, &logger), "SUNContext_GetLogger");
+  check(SUNLogger_SetWarningFilename(logger, "/dev/null"), "SUNLogger_SetWarningFilename");
+#endif
+#else
+  check(SUNContext_Create(nullptr, &h.ctx), "SUNContext_Create");
+#endif
+  h.state = newVector(n, h.ctx);
+  h.scratch = newVector(n, h.ctx);
+  h.mem = ERKStepCreate(&Handles::rhsThunk, 0.0, h.state, h.ctx);
+  if (!h.mem) throw std::runtime_error("SUNDIALS: ERKStepCreate failed");
+  mem_ = h.mem;
+  state_ = N_VGetArrayPointer(h.state);
+  scratch_ = N_VGetArrayPointer(h.scratch);
+  SIMBOT_ARK_CALL(SetUserData, mem_, h_.get());
+#if SUNDIALS_VERSION_MAJOR < 7
+  // ARKODE's own messages would go to stderr.
+  check(ERKStepSetErrFile(mem_, nullptr), "ERKStepSetErrFile");
+#endif
+}
+
+Integrator::~Integrator() = default;
+
+void Integrator::useDormandPrince745() {
+  check(ERKStepSetTableNum(mem_, ARKODE_DORMAND_PRINCE_7_4_5), "ERKStepSetTableNum");
+}
+
+void Integrator::setTolerances(double relative, double absolute) {
+  SIMBOT_ARK_CALL(SStolerances, mem_, relative, absolute);
+}
+
+void Integrator::setMaxNumSteps(long steps) { SIMBOT_ARK_CALL(SetMaxNumSteps, mem_, steps); }
+
+void Integrator::reset(double t0) { SIMBOT_ARK_CALL(Reset, mem_, t0, h_->state); }
+
+void Integrator::setInitStep(double h) { SIMBOT_ARK_CALL(SetInitStep, mem_, h); }
+
+void Integrator::setMaxStep(double h) { SIMBOT_ARK_CALL(SetMaxStep, mem_, h); }
+
+void Integrator::setRoots(int n, RootFn g) {
+  h_->root = g;
+  SIMBOT_ARK_CALL(RootInit, mem_, n, n > 0 ? &Handles::rootThunk : nullptr);
+  // (the root memory exists only now)
+  if (n > 0) SIMBOT_ARK_CALL(SetNoInactiveRootWarn, mem_);
+}
+
+void Integrator::setStopTime(double t) { SIMBOT_ARK_CALL(SetStopTime, mem_, t); }
+
+StepEnd Integrator::step(double tout, Buffer into, double& tret) {
+  const int flag = SIMBOT_ARK(Evolve)(mem_, tout, h_->vector(into), &tret, ARK_ONE_STEP);
+  check(flag, SIMBOT_ARK_NAME(SIMBOT_ARK(Evolve)));
+  if (flag == ARK_ROOT_RETURN) return StepEnd::Root;
+  if (flag == ARK_TSTOP_RETURN) return StepEnd::StopTime;
+  return StepEnd::Step;
+}
+
+double Integrator::currentTime() const {
+  double t = 0;
+  SIMBOT_ARK_CALL(GetCurrentTime, mem_, &t);
+  return t;
+}
+
+double Integrator::currentStep() const {
+  double h = 0;
+  SIMBOT_ARK_CALL(GetCurrentStep, mem_, &h);
+  return h;
+}
+
+void Integrator::interpolate(double t, Buffer into) {
+  SIMBOT_ARK_CALL(GetDky, mem_, t, 0, h_->vector(into));
+}
+
+void Integrator::rootsFound(int* found) const { SIMBOT_ARK_CALL(GetRootInfo, mem_, found); }
+
+long Integrator::steps() const {
+  long n = 0;
+  SIMBOT_ARK_CALL(GetNumSteps, mem_, &n);
+  return n;
+}
+
+long Integrator::rhsEvals() const {
+  long n = 0;
+#if SUNDIALS_VERSION_MAJOR > 7 || (SUNDIALS_VERSION_MAJOR == 7 && SUNDIALS_VERSION_MINOR >= 2)
+  check(ARKodeGetNumRhsEvals(mem_, 0, &n), "ARKodeGetNumRhsEvals");  // ERKStep's one partition
+#else
+  check(ERKStepGetNumRhsEvals(mem_, &n), "ERKStepGetNumRhsEvals");
+#endif
+  return n;
+}
+
+}  // namespace ark
+}  // namespace simbot::plant
