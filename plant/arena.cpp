@@ -102,9 +102,8 @@ std::int64_t Arena::lastReinitTick() const { return impl_->segTick; }
 
 bool Arena::setWheels(int robot, const MotorFrame& frame, std::int64_t tick) {
   Impl& m = *impl_;
-  const Journal::Entry entry(
-      m.journal.get(),
-      {.kind = Journal::Kind::SetWheels, .robot = robot, .tick = tick, .frame = frame});
+  const Journal::Entry entry =
+      m.enter({.kind = Journal::Kind::SetWheels, .robot = robot, .tick = tick, .frame = frame});
   m.checkRobot(robot);
   m.checkInputTick(tick);
   const bool committedAtTick = m.pending && tick == m.pendingTick;
@@ -131,11 +130,11 @@ bool Arena::setWheels(int robot, const MotorFrame& frame, std::int64_t tick) {
 
 bool Arena::setDrive(int robot, double leftFps, double rightFps, std::int64_t tick) {
   Impl& m = *impl_;
-  const Journal::Entry entry(m.journal.get(), {.kind = Journal::Kind::SetDrive,
-                                               .robot = robot,
-                                               .tick = tick,
-                                               .left = leftFps,
-                                               .right = rightFps});
+  const Journal::Entry entry = m.enter({.kind = Journal::Kind::SetDrive,
+                                        .robot = robot,
+                                        .tick = tick,
+                                        .left = leftFps,
+                                        .right = rightFps});
   m.checkRobot(robot);
   m.checkInputTick(tick);
   const bool committedAtTick = m.pending && tick == m.pendingTick;
@@ -160,13 +159,13 @@ bool Arena::setDrive(int robot, double leftFps, double rightFps, std::int64_t ti
 EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, RandomBits* gunLuck,
                           RandomBits* muzzle, RandomBits* dispersion) {
   Impl& m = *impl_;
-  const Journal::Entry entry(m.journal.get(), {.kind = Journal::Kind::SetPortB,
-                                               .robot = robot,
-                                               .tick = tick,
-                                               .value = value,
-                                               .gunLuck = gunLuck != nullptr,
-                                               .muzzle = muzzle != nullptr,
-                                               .dispersion = dispersion != nullptr});
+  const Journal::Entry entry = m.enter({.kind = Journal::Kind::SetPortB,
+                                        .robot = robot,
+                                        .tick = tick,
+                                        .value = value,
+                                        .gunLuck = gunLuck != nullptr,
+                                        .muzzle = muzzle != nullptr,
+                                        .dispersion = dispersion != nullptr});
   Journal::Recorder gunLuckRecorder(m.journal.get(), gunLuck, 0);
   Journal::Recorder muzzleRecorder(m.journal.get(), muzzle, 1);
   Journal::Recorder dispersionRecorder(m.journal.get(), dispersion, 2);
@@ -239,9 +238,8 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
 
 EventList Arena::triggerReflex(int robot, Bumper side, std::int64_t tick) {
   Impl& m = *impl_;
-  const Journal::Entry entry(
-      m.journal.get(),
-      {.kind = Journal::Kind::TriggerReflex, .robot = robot, .tick = tick, .side = side});
+  const Journal::Entry entry =
+      m.enter({.kind = Journal::Kind::TriggerReflex, .robot = robot, .tick = tick, .side = side});
   EventList ev;
   m.checkRobot(robot);
   m.rewindTo(tick);
@@ -252,8 +250,8 @@ EventList Arena::triggerReflex(int robot, Bumper side, std::int64_t tick) {
 
 EventList Arena::edgeHandlerEntered(int robot, std::int64_t tick) {
   Impl& m = *impl_;
-  const Journal::Entry entry(
-      m.journal.get(), {.kind = Journal::Kind::EdgeHandlerEntered, .robot = robot, .tick = tick});
+  const Journal::Entry entry =
+      m.enter({.kind = Journal::Kind::EdgeHandlerEntered, .robot = robot, .tick = tick});
   EventList ev;
   m.checkRobot(robot);
   m.checkInputTick(tick);
@@ -291,12 +289,11 @@ EventList Arena::edgeHandlerEntered(int robot, std::int64_t tick) {
 }
 
 AdvanceResult Arena::advance(std::int64_t stopTick) {
-  const Journal::Entry entry(impl_->journal.get(),
-                             {.kind = Journal::Kind::Advance, .tick = stopTick});
+  const Journal::Entry entry = impl_->enter({.kind = Journal::Kind::Advance, .tick = stopTick});
   return impl_->advance(stopTick);
 }
 void Arena::retreat(std::int64_t tick) {
-  const Journal::Entry entry(impl_->journal.get(), {.kind = Journal::Kind::Retreat, .tick = tick});
+  const Journal::Entry entry = impl_->enter({.kind = Journal::Kind::Retreat, .tick = tick});
   impl_->retreat(tick);
 }
 
@@ -391,8 +388,8 @@ IntegratorStats Arena::stats() const {
   // ARKODE's counters run on over resets (a reset keeps them); the dense
   // output's own right-hand sides are counted with them.
   IntegratorStats s = m.acc;
-  s.steps = m.ode.steps();
-  s.rhs_evals = m.ode.rhsEvals() + m.ownRhs;
+  s.steps = m.ode.steps() + m.stepsOffset;
+  s.rhs_evals = m.ode.rhsEvals() + m.rhsEvalsOffset + m.ownRhs;
   return s;
 }
 

@@ -183,23 +183,12 @@ struct Motion {
   }
 };
 
-}  // namespace arena_detail
-
-using namespace arena_detail;
-
-struct Arena::Impl {
-  // ---- configuration
-  ArenaConfig cfg;
-  int nR = 0;
-  int n = 0;   // full state size (kPerRobot a robot)
-  int nx = 0;  // integrated state size (kXY a robot)
-  double half = 0, wireHalf = 0;
-  contact::Bodies bodies;  // radii and masses for the contact solve
-
-  // ---- the integrator of the centres (arkode.h): its state vector holds
-  // x, y at the end of each step, its scratch vector interpolations
-  ark::Integrator ode;
-
+// Everything of an arena that changes as it runs, but the integrator itself
+// (whose state SUNDIALS keeps private): a value, copied whole with
+// `= default`, so that a member added later is copied too. A Checkpoint
+// holds one, taken where ARKODE has just been reset and has not stepped
+// (arena_journal.h): there this and the reset's arguments are the arena.
+struct ArenaState {
   // ---- discrete state being integrated, and the pending prediction
   Discrete D;
   std::array<std::array<double, 2>, 2> wheelTarget{};
@@ -248,8 +237,6 @@ struct Arena::Impl {
   std::int64_t firedTick = -1;
   std::array<RootDesc, kMaxRoots> fired{};
   int nFired = 0;
-  void noteFired(std::int64_t tick, const int* found);
-  bool firedAt(std::int64_t tick, const RootDesc& rd) const;
   int nRoots = 0;
   int nRootsRegistered = -1;
   std::array<double, kMaxRoots> rootShift{};
@@ -271,13 +258,70 @@ struct Arena::Impl {
   // Slope and curvature of x, y at the end of ARKODE's last step.
   std::vector<double> endY, endF, endA;
 
-  // ---- the calls that changed the arena, when it keeps them (a copy
-  // makes them again: arena_journal.h)
-  std::shared_ptr<Journal> journal;  // shared with Arena::Mark
-
   // ---- statistics
   IntegratorStats acc{};
   long ownRhs = 0;  // right-hand sides evaluated for the dense output
+
+  // Both fixed for a segment (they read its motion and balls): set at
+  // each reset, read at every step.
+  double segSpeed = 0;     // pointSpeed()
+  bool segRest = false;    // atRest()
+  double maxStepSet = -1;  // the value last given to ARKODE's maximum step
+};
+
+// An arena's state where it can be rebuilt without replaying what came
+// before: ARKODE freshly reset at segT0 from the segment's start (segY),
+// with the reset's initial step (recs.front().next), maximum step, root
+// functions and stop time all read from `state`. `steps` and `rhsEvals`
+// are ARKODE's counters then (a new integrator's start from 0).
+struct Checkpoint {
+  ArenaState state;
+  long steps = 0, rhsEvals = 0;
+};
+
+}  // namespace arena_detail
+
+using namespace arena_detail;
+
+struct Arena::Impl : ArenaState {
+  // ---- configuration
+  ArenaConfig cfg;
+  int nR = 0;
+  int n = 0;   // full state size (kPerRobot a robot)
+  int nx = 0;  // integrated state size (kXY a robot)
+  double half = 0, wireHalf = 0;
+  contact::Bodies bodies;  // radii and masses for the contact solve
+
+  // ---- the integrator of the centres (arkode.h): its state vector holds
+  // x, y at the end of each step, its scratch vector interpolations
+  ark::Integrator ode;
+
+  // The arena's step counts less ARKODE's (a restored arena's integrator
+  // is new; stats() adds these): 0 unless restored from a checkpoint.
+  long stepsOffset = 0, rhsEvalsOffset = 0;
+  // ARKODE 6.4 keeps a root's flag across a reset that clearRootFlag()
+  // could not clear (the root was at its step's end): a checkpoint is not
+  // taken then, as a new integrator would not have it.
+  bool rootFlagCarried = false;
+  // Resets made (reinit(), `same` or not), and the count at the last
+  // checkpoint: one checkpoint a reset is enough.
+  std::uint64_t reinitSerial = 0, checkpointSerial = 0;
+
+  void noteFired(std::int64_t tick, const int* found);
+  bool firedAt(std::int64_t tick, const RootDesc& rd) const;
+
+  // ---- the calls that changed the arena since its last checkpoint, when
+  // it keeps them (a copy restores the checkpoint and makes them again:
+  // arena_journal.h)
+  std::shared_ptr<Journal> journal;              // shared with Arena::Mark
+  std::shared_ptr<const ArenaConfig> sharedCfg;  // cfg, for the journals
+  // Opens a public call's journal entry; first, if ARKODE has just been
+  // reset (and has stepped before, as a new integrator will have: see
+  // restore()), starts a new journal from a checkpoint of this state.
+  Journal::Entry enter(const Journal::Call& call);
+  // Makes this new arena (constructed from the same configuration) the one
+  // checkpoint `cp` was taken of.
+  void restore(const Checkpoint& cp);
 
   // ---- scratch
   std::vector<double> tmp;
@@ -293,11 +337,6 @@ struct Arena::Impl {
   double pointSpeed() const;
   double stepBound(const double* y, double ahead) const;
   bool atRest() const;
-  // Both fixed for a segment (they read its motion and balls): set at
-  // each reset, read at every step.
-  double segSpeed = 0;     // pointSpeed()
-  bool segRest = false;    // atRest()
-  double maxStepSet = -1;  // the value last given to ARKODE's maximum step
 
   // ------------------------------------------------------------ geometry on a
   // full state

@@ -364,12 +364,16 @@ void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, b
   double* xy = ode.data(ark::Buffer::State);
   centresOf(y.data(), xy);
   if (!same) {
+    const bool steppedSinceReset = !fresh;
     if (!first) {
       ++acc.reinits;
       clearRootFlag();
     }
+    // The flag of a root at ARKODE's last return outlives the reset.
+    rootFlagCarried = lastRoot || (!steppedSinceReset && rootFlagCarried);
     ode.reset(t0);
   }
+  ++reinitSerial;
   fresh = true;
   segWheel = wheelTarget;
   segGun = gunTarget;

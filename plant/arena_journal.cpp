@@ -88,10 +88,50 @@ void Journal::replay(Arena& arena, std::size_t callCount, std::size_t drawCount)
 }  // namespace arena_detail
 
 void Arena::keepJournal() {
-  if (impl_->journal) return;
-  if (impl_->now != 0 || impl_->segTick != 0)
+  Impl& m = *impl_;
+  if (m.journal) return;
+  if (m.now != 0 || m.segTick != 0)
     throw std::logic_error("an arena keeps its journal from its first call");
-  impl_->journal = std::make_shared<arena_detail::Journal>(impl_->cfg);
+  m.sharedCfg = std::make_shared<const ArenaConfig>(m.cfg);
+  m.journal = std::make_shared<arena_detail::Journal>(m.sharedCfg, nullptr);
+}
+
+Journal::Entry Arena::Impl::enter(const Journal::Call& call) {
+  // Only while ARKODE has just been reset; and not before its first step
+  // (its first step's growth limit is another than after a reset: restore()
+  // gives a new integrator one step) nor with a root's flag carried over.
+  if (journal && fresh && reinitSerial != checkpointSerial && !rootFlagCarried &&
+      ode.steps() + stepsOffset > 0) {
+    auto cp = std::make_shared<const Checkpoint>(Checkpoint{static_cast<const ArenaState&>(*this),
+                                                            ode.steps() + stepsOffset,
+                                                            ode.rhsEvals() + rhsEvalsOffset});
+    journal = std::make_shared<Journal>(sharedCfg, std::move(cp));
+    checkpointSerial = reinitSerial;
+  }
+  return Journal::Entry(journal.get(), call);
+}
+
+// A new integrator differs from one that has been reset in one way that
+// matters: ARKODE bounds the growth of the first step it ever takes by
+// another factor (etamx1) than a later one's after a reset. So the new one
+// takes one step first (from the configuration's start; whatever it
+// computes is overwritten), then gets the checkpoint's reset: its start
+// (segY's centres at segT0), initial step, maximum step, root functions
+// and stop time, as reinit() gave them to the original.
+void Arena::Impl::restore(const Checkpoint& cp) {
+  double tr = 0;
+  ode.step(kFirstStepHorizon, ark::Buffer::Scratch, tr);
+  static_cast<ArenaState&>(*this) = cp.state;
+  centresOf(segY.data(), ode.data(ark::Buffer::State));
+  ode.reset(segT0);
+  ode.setInitStep(recs.front().next);
+  ode.setMaxStep(maxStepSet);
+  if (nRootsRegistered >= 0) ode.setRoots(nRootsRegistered, &Impl::rootThunk);
+  if (launchStop >= 0) ode.setStopTime(secondsFromTick(launchStop));
+  stepsOffset = cp.steps - ode.steps();
+  rhsEvalsOffset = cp.rhsEvals - ode.rhsEvals();
+  rootFlagCarried = false;
+  checkpointSerial = reinitSerial;
 }
 
 Arena::Mark Arena::mark() const {
@@ -100,19 +140,22 @@ Arena::Mark Arena::mark() const {
   return Mark{journal, journal->calls.size(), journal->draws.size()};
 }
 
+// The arena a mark names: the checkpoint its journal starts from restored
+// (or a new arena), and the journal's calls up to the mark made again, into
+// a journal of its own that starts from the same checkpoint.
 Arena::Arena(const Mark& mark) {
-  impl_ = std::make_unique<Impl>(mark.journal->initial);
-  keepJournal();
+  if (!mark.journal) throw std::logic_error("an arena is made from a mark of an arena");
+  impl_ = std::make_unique<Impl>(*mark.journal->initial);
+  impl_->sharedCfg = mark.journal->initial;
+  if (mark.journal->base) impl_->restore(*mark.journal->base);
+  impl_->journal = std::make_shared<arena_detail::Journal>(impl_->sharedCfg, mark.journal->base);
   mark.journal->replay(*this, mark.calls, mark.draws);
 }
 
-Arena::Arena(const Arena& other) {
-  const arena_detail::Journal* journal = other.impl_->journal.get();
-  if (!journal) throw std::logic_error("an arena is copied only when it keeps its journal");
-  impl_ = std::make_unique<Impl>(journal->initial);
-  keepJournal();
-  journal->replay(*this);
-}
+Arena::Arena(const Arena& other)
+    : Arena(other.impl_->journal
+                ? other.mark()
+                : throw std::logic_error("an arena is copied only when it keeps its journal")) {}
 
 Arena& Arena::operator=(const Arena& other) {
   if (this != &other) {

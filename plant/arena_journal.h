@@ -1,17 +1,25 @@
-// plant/arena_journal.h -- internal: the calls that changed an arena, kept
-// so that a copy of it can be made by making them again (Arena's copy
-// constructor, arena_journal.cpp). SUNDIALS keeps its integrator's state
-// private, and an arena's state depends on nothing but its configuration,
-// the calls that changed it and the random words they drew (arena.cpp,
-// "Stepping": not on queries, nor on how the caller chops time).
+// plant/arena_journal.h -- internal: the calls that changed an arena since
+// its last checkpoint, kept so that a copy of it can be made by restoring
+// the checkpoint and making them again (Arena's copy constructor,
+// arena_journal.cpp). SUNDIALS keeps its integrator's state private, but
+// where the arena has just reset ARKODE and not stepped since, the
+// arena's own state (ArenaState, arena_impl.h) and the reset's arguments
+// are all there is: a checkpoint. Between checkpoints an arena's state
+// depends on nothing but the calls that changed it and the random words
+// they drew (arena.cpp, "Stepping": not on queries, nor on how the caller
+// chops time). A journal lasts from one checkpoint to the next; marks keep
+// theirs alive, so memory follows the marks, not the run's length.
 #pragma once
 #include <cstdint>
 #include <exception>
+#include <memory>
 #include <vector>
 
 #include "plant/plant.h"
 
 namespace simbot::plant::arena_detail {
+
+struct Checkpoint;  // arena_impl.h
 
 struct Journal {
   enum class Kind : std::uint8_t {
@@ -40,8 +48,10 @@ struct Journal {
     std::uint64_t bits;
   };
 
-  explicit Journal(const ArenaConfig& config) : initial(config) {}
-  ArenaConfig initial;  // the configuration the arena was made with
+  Journal(std::shared_ptr<const ArenaConfig> config, std::shared_ptr<const Checkpoint> from)
+      : initial(std::move(config)), base(std::move(from)) {}
+  std::shared_ptr<const ArenaConfig> initial;  // the configuration the arena was made with
+  std::shared_ptr<const Checkpoint> base;      // where the calls start (null: construction)
   std::vector<Call> calls;
   std::vector<Draw> draws;
 
