@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cstdlib>
 
 namespace simbot::debug {
 
@@ -126,7 +127,28 @@ void Session::forward() {
 
 void Session::takeSnapshot() {
   const int64_t key = run_->now() / kSnapshotInterval;
-  if (!snapshots_.count(key)) snapshots_.emplace(key, run_->snapshot());
+  if (snapshots_.count(key)) return;
+  snapshots_.emplace(key, run_->snapshot());
+  // Where the session is: this snapshot's place when running on, the
+  // last stop's while a search replays an earlier window.
+  thinSnapshots(scan_ ? lastStop_ / kSnapshotInterval : key);
+}
+
+// The snapshots kept, so that memory stays bounded however long a session
+// runs: every one within kDenseSnapshots intervals of `present` (where
+// stepping and searching back happen), then one in 2, 4, 8, ... as the
+// distance doubles (a goto far away replays at most half the distance),
+// and the first. About 16 + 8 log2(n / 16) of n intervals: 88 for an hour.
+void Session::thinSnapshots(int64_t present) {
+  for (auto it = snapshots_.begin(); it != snapshots_.end();) {
+    const int64_t key = it->first, distance = std::abs(key - present);
+    int64_t spacing = 1;
+    while (kDenseSnapshots * spacing < distance) spacing *= 2;
+    if (key == 0 || key % spacing == 0)
+      ++it;
+    else
+      it = snapshots_.erase(it);
+  }
 }
 
 // The latest snapshot whose held robot has not passed `target` (has not

@@ -10,10 +10,11 @@
 // that stops the held robot where a command says. Going back, the session
 // restores the latest snapshot before the target (MatchRun::Snapshot, one
 // every kSnapshotInterval of the held robot's time, taken as the run
-// first passes it) and runs forward to the target's tick: a state reached
-// backwards is the state reached forwards. Commands that look back for a
-// place (reverse-step, reverse-continue) first replay the snapshots'
-// windows recording where the robot was, then go to the place found.
+// first passes it, fewer far from where the session is) and runs forward
+// to the target's tick: a state reached backwards is the state reached
+// forwards. Commands that look back for a place (reverse-step,
+// reverse-continue) first replay the snapshots' windows recording where
+// the robot was, then go to the place found.
 //
 // A Controller (the terminal's command interpreter, the DAP server) is
 // asked what to do at every stop; the session's accessors serve it there.
@@ -44,6 +45,9 @@ struct Error : std::runtime_error {
 // Snapshots are taken this often (the held robot's time); a reverse command
 // replays at most a few such windows. 0.5 s: 360 in a 180-s match.
 inline constexpr Tick kSnapshotInterval = timebase::kTicksPerSecond / 2;
+// Every snapshot within this many intervals (8 s) of where the session is
+// is kept; farther away they thin out (Session::thinSnapshots).
+inline constexpr int64_t kDenseSnapshots = 16;
 
 // What breakpoints and watchpoints share: one numbering, a condition, an
 // ignore count, an enable switch and a hit count (gdb's condition,
@@ -196,6 +200,9 @@ class Session final : private scheduler::DebugHook {
   int robotCount() const { return static_cast<int>(config_.robots.size()); }
   std::string robotName(int robot) const;
   const std::string& program(int robot) const;
+  // Snapshots kept now (Session::thinSnapshots): bounded, however long
+  // the session.
+  std::size_t snapshotsKept() const { return snapshots_.size(); }
   Tick now() const;        // the held robot's clock
   Tick matchTick() const;  // where the match is: its end once it is over
   // The tick this stop is at: every robot stands at its first instruction
@@ -317,6 +324,7 @@ class Session final : private scheduler::DebugHook {
 
   void forward();
   void takeSnapshot();
+  void thinSnapshots(int64_t present);
   void restoreBefore(Tick target, bool inclusive);
   void applyBreakpoints();
   void startMode(const Resume& how, const Stop& arrival = {});

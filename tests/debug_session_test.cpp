@@ -167,6 +167,43 @@ TEST(DebugSession, BackwardsReachesTheStateForwardsReached) {
   EXPECT_EQ(script.done(), 7u);
 }
 
+// Snapshots thin out with distance (Session::thinSnapshots): at 600 s the
+// held robot has passed 1,201 half-second marks (keys 0..1200), and kept
+// are key 0, every key within 16 of 1200 (1184..1200: 17), then 8 in each
+// band where the spacing doubles: (16, 32] in 2s, (32, 64] in 4s,
+// (64, 128] in 8s, (128, 256] in 16s, (256, 512] in 32s, (512, 1024] in
+// 64s (192..640), and in (1024, 1200] the multiples of 128 (0 and 128):
+// 17 + 6 * 8 + 2 = 67 snapshots, not 1,201. Going back to 10 s still lands
+// where going forwards did.
+TEST(DebugSession, SnapshotsThinOutWithDistanceFromThePresent) {
+  Place at10s;
+  NoBus bus;
+  Script script({
+      [](debug::Session&, const debug::Stop&) {
+        return Script::resume(K::Goto, 10 * timebase::kTicksPerSecond);
+      },
+      [&](debug::Session& s, const debug::Stop&) {
+        at10s = placeOf(s, bus);
+        return Script::resume(K::Goto, 600 * timebase::kTicksPerSecond);
+      },
+      [&](debug::Session& s, const debug::Stop&) {
+        EXPECT_EQ(s.snapshotsKept(), 67u);
+        return Script::resume(K::Goto, 10 * timebase::kTicksPerSecond);
+      },
+      [&](debug::Session& s, const debug::Stop&) {
+        expectSamePlace(s, at10s);
+        return Script::resume(K::Quit);
+      },
+  });
+  runs::RunOptions o;
+  o.seconds = 601;
+  debug::Session session(
+      runs::buildConfig({kShared + "/programs/iceman.dc"}, o, runs::ScenarioUse::Solo),
+      {"iceman.dc"});
+  session.run(script);
+  EXPECT_EQ(script.done(), 4u);
+}
+
 // tests/debug/inspect.dc's delay loop `for (count = 0; count < 30000;
 // count++);` (line 55). From the listing (simbot compile --disasm): the
 // line starts with DBG 68, PUSHW 22, STGW 28, so the loop's top (LDGW)
