@@ -87,9 +87,7 @@ Node* Parser::conditional() {
   Pos pos = cur().pos;
   advance();
   DepthGuard guard(*this);
-  value(c);
-  if (!isScalar(c->type)) fail(c->pos, "condition must have scalar type");
-  checkCondition(c);
+  c = condition(c);
   Node* a = expr();
   expect(":");
   Node* b = conditional();

@@ -67,11 +67,7 @@ Node* Parser::statement() {
   if (t.is("if")) {
     advance();
     Node* n = newNode(NodeKind::If, pos);
-    expect("(");
-    n->cond = value(expr());
-    checkCondition(n->cond);
-    if (!isScalar(n->cond->type)) fail(n->cond->pos, "condition must have scalar type");
-    expect(")");
+    n->cond = parenCondition();
     n->then = statement();
     if (accept("else")) n->els = statement();
     return n;
@@ -135,11 +131,7 @@ Node* Parser::statement() {
       Node* e = exprStatement();
       n->init = e;
     }
-    if (!is(";")) {
-      n->cond = value(expr());
-      checkCondition(n->cond);
-      if (!isScalar(n->cond->type)) fail(n->cond->pos, "condition must have scalar type");
-    }
+    if (!is(";")) n->cond = condition(expr());
     expectSemi("in 'for'");
     if (!is(")")) {
       Node* e = expr();
@@ -160,11 +152,7 @@ Node* Parser::statement() {
   if (t.is("while")) {
     advance();
     Node* n = newNode(NodeKind::While, pos);
-    expect("(");
-    n->cond = value(expr());
-    checkCondition(n->cond);
-    if (!isScalar(n->cond->type)) fail(n->cond->pos, "condition must have scalar type");
-    expect(")");
+    n->cond = parenCondition();
     ++loopDepth_;
     ++breakDepth_;
     n->then = statement();
@@ -185,11 +173,7 @@ Node* Parser::statement() {
       fail(cur().kind == TokKind::Eof ? after(prevPos_) : cur().pos,
            "expected 'while' in do/while loop");
     advance();
-    expect("(");
-    n->cond = value(expr());
-    checkCondition(n->cond);
-    if (!isScalar(n->cond->type)) fail(n->cond->pos, "condition must have scalar type");
-    expect(")");
+    n->cond = parenCondition();
     expectSemi("after do/while statement");
     return n;
   }
@@ -252,6 +236,14 @@ Node* Parser::statement() {
   if (t.is("else")) fail(pos, "'else' without a previous 'if'");
   if (isDeclStart(t)) fail(pos, "declaration is not allowed here");
   return exprStatement();
+}
+
+// "(" expr ")" tested for truth: if, while, do-while and waitfor.
+Node* Parser::parenCondition(bool warnAssignment) {
+  expect("(");
+  Node* c = condition(expr(), warnAssignment);
+  expect(")");
+  return c;
 }
 
 // expr-stmt = expr ";"
@@ -459,10 +451,9 @@ Node* Parser::waitforStatement() {
   advance();
   Node* n = newNode(NodeKind::Waitfor, pos);
   n->costate = costates_.back();
-  expect("(");
-  n->cond = value(expr());
-  if (!isScalar(n->cond->type)) fail(n->cond->pos, "condition must have scalar type");
-  expect(")");
+  // Dynamic C's waitfor has never warned about an assignment: the
+  // expression is often a call with effects, "waitfor(c = getc())".
+  n->cond = parenCondition(false);
   expectSemi("after 'waitfor'");
   return n;
 }

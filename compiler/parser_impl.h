@@ -191,13 +191,17 @@ class Parser {
   [[noreturn]] void undeclared(Pos pos, const std::string& name, const std::string& message);
 
   // ---- warnings ----
-  void checkCondition(const Node* cond);
   void checkTypeLimits(NodeKind k, const Node* l, const Node* r, Pos pos);
 
   // ---- statements ----
   Node* statement();
   Node* compoundStatement(bool newScope);
   Node* exprStatement();
+  // An expression tested for truth (if, for, while, do-while, waitfor,
+  // ?:), and the "(" expr ")" of all but for and ?:. waitfor does not warn
+  // about an assignment (parse_stmt.cpp says why).
+  Node* condition(Node* e, bool warnAssignment = true);
+  Node* parenCondition(bool warnAssignment = true);
 
   // ---- expressions ----
   Node* expr();

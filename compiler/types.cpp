@@ -3,6 +3,7 @@
 // them and to spell them in symbols and messages; then the type rules of
 // expressions the parser builds every typed node through (conversions,
 // folding, operand checks, pointer arithmetic, assignment).
+#include <optional>
 #include <string>
 
 #include "compiler/ast.h"
@@ -315,6 +316,33 @@ Node* Parser::binary(NodeKind k, Node* l, Node* r, Pos pos, Type* ty) {
   return n;
 }
 
+namespace {
+
+// A comparison of two constants of the same (already converted) type,
+// float or integer, as the robot's code compares them; none for an
+// operator that is not a comparison.
+template <class T>
+std::optional<bool> compareConstants(NodeKind k, T a, T b) {
+  switch (k) {
+    case NodeKind::Eq:
+      return a == b;
+    case NodeKind::Ne:
+      return a != b;
+    case NodeKind::Lt:
+      return a < b;
+    case NodeKind::Le:
+      return a <= b;
+    case NodeKind::Gt:
+      return a > b;
+    case NodeKind::Ge:
+      return a >= b;
+    default:
+      return std::nullopt;
+  }
+}
+
+}  // namespace
+
 // Constant folding, in the operands' (already converted) type.
 Node* Parser::fold(NodeKind k, Node* l, Node* r, Pos pos, Type* ty) {
   if (!isConst(l) || !isConst(r)) return nullptr;
@@ -323,6 +351,7 @@ Node* Parser::fold(NodeKind k, Node* l, Node* r, Pos pos, Type* ty) {
   if (l->kind == NodeKind::FNum || r->kind == NodeKind::FNum) {
     if (l->kind != NodeKind::FNum || r->kind != NodeKind::FNum) return nullptr;
     float a = l->fval, b = r->fval;
+    if (const auto c = compareConstants(k, a, b)) return num(*c, tyInt(), pos);
     switch (k) {
       case NodeKind::Add:
         return fnum(static_cast<float>(a + b), pos);
@@ -333,23 +362,12 @@ Node* Parser::fold(NodeKind k, Node* l, Node* r, Pos pos, Type* ty) {
       case NodeKind::Div:
         if (b == 0) fail(pos, "division by zero in constant expression");
         return fnum(static_cast<float>(a / b), pos);
-      case NodeKind::Eq:
-        return num(a == b, tyInt(), pos);
-      case NodeKind::Ne:
-        return num(a != b, tyInt(), pos);
-      case NodeKind::Lt:
-        return num(a < b, tyInt(), pos);
-      case NodeKind::Le:
-        return num(a <= b, tyInt(), pos);
-      case NodeKind::Gt:
-        return num(a > b, tyInt(), pos);
-      case NodeKind::Ge:
-        return num(a >= b, tyInt(), pos);
       default:
         return nullptr;
     }
   }
   int64_t a = l->ival, b = r->ival;
+  if (const auto c = compareConstants(k, a, b)) return num(*c, tyInt(), pos);
   switch (k) {
     case NodeKind::Add:
       return num(a + b, ty, pos);
@@ -374,18 +392,6 @@ Node* Parser::fold(NodeKind k, Node* l, Node* r, Pos pos, Type* ty) {
       return num(shiftLeft(a, b, arithOf(ty)), ty, pos);
     case NodeKind::Shr:
       return num(shiftRight(a, b, arithOf(ty)), ty, pos);
-    case NodeKind::Eq:
-      return num(a == b, tyInt(), pos);
-    case NodeKind::Ne:
-      return num(a != b, tyInt(), pos);
-    case NodeKind::Lt:
-      return num(a < b, tyInt(), pos);
-    case NodeKind::Le:
-      return num(a <= b, tyInt(), pos);
-    case NodeKind::Gt:
-      return num(a > b, tyInt(), pos);
-    case NodeKind::Ge:
-      return num(a >= b, tyInt(), pos);
     default:
       return nullptr;
   }
@@ -452,14 +458,18 @@ Node* Parser::newSub(Node* l, Node* r, Pos pos) {
   badOperands(NodeKind::Sub, l, r, pos);
 }
 
-// Comparisons leave int 0/1; pointers compare unsigned.
-// "if (x = 5)": an assignment as a whole condition, unless parenthesised
-// as gcc's -Wparentheses accepts ("if ((c = next()))").
-void Parser::checkCondition(const Node* cond) {
-  if ((cond->kind == NodeKind::Assign || cond->kind == NodeKind::OpAssign) && !cond->parenthesized)
-    diags_.warn(cond->pos, "parentheses",
+// An expression tested for truth: a scalar value. With `warnAssignment`,
+// "if (x = 5)", an assignment as the whole condition, is warned about
+// unless parenthesised as gcc's -Wparentheses accepts ("if ((c = next()))").
+Node* Parser::condition(Node* e, bool warnAssignment) {
+  value(e);
+  if (warnAssignment && (e->kind == NodeKind::Assign || e->kind == NodeKind::OpAssign) &&
+      !e->parenthesized)
+    diags_.warn(e->pos, "parentheses",
                 "assignment used as a condition; write '==' to compare, or put the assignment "
                 "in parentheses");
+  if (!isScalar(e->type)) fail(e->pos, "condition must have scalar type");
+  return e;
 }
 
 // A comparison of an integer expression with a constant outside the range
@@ -532,6 +542,7 @@ void Parser::checkTypeLimits(NodeKind k, const Node* l, const Node* r, Pos pos) 
                           verdict ? "true" : "false", typeName(e->type), lo, hi));
 }
 
+// Comparisons leave int 0/1; pointers compare unsigned.
 Node* Parser::compare(NodeKind k, Node* l, Node* r, Pos pos) {
   value(l);
   value(r);

@@ -32,6 +32,9 @@ namespace simbot::reports::explain {
 
 using trace::Tick;
 
+// The robots' names in a report: robot 0 is A, 1 is B.
+inline constexpr const char* kRobotNames[] = {"A", "B"};
+
 // A shot: one ball_launch and how its flight ended.
 struct Shot {
   int robot = 0;
@@ -208,6 +211,7 @@ struct TextLine {
   std::string text;
   std::optional<Tick> t;
 };
+// The report in words (explain_text.cpp) and as JSON (explain_json.cpp).
 std::vector<TextLine> textLines(const Report& report);
 std::string text(const Report& report);
 std::string markdown(const Report& report);

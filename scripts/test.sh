@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sets everything up and runs the whole test suite: the layout check
-# (clang-format), the normal build with warnings as errors, the plant
+# (clang-format, no source file over 1,000 lines), the normal build with warnings as errors, the plant
 # built against SUNDIALS 7 and its tests, the same suite
 # built with AddressSanitizer and UndefinedBehaviorSanitizer, the threaded
 # bench and tournament built with ThreadSanitizer, and a short campaign
@@ -28,6 +28,8 @@ mapfile -t sources < <(find compiler vm board plant scheduler config trace sinks
   debug inspect files stats timebase python \
   -path tests/browser/node_modules -prune -o \( -name '*.cpp' -o -name '*.h' \) -print | sort)
 clang-format --dry-run --Werror "${sources[@]}"
+# No source file over 1,000 lines (each one over is named with its count).
+./scripts/line_limit.sh
 # SUNDIALS is the plant's adapter's alone (docs/plant.md): no other file
 # includes its headers.
 sundials_users=$(grep -lE '#include <(arkode|cvode|cvodes|ida|idas|kinsol|nvector|sundials|sunmatrix|sunlinsol|sunnonlinsol)/' \

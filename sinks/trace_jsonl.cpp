@@ -10,7 +10,6 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "scheduler/match.h"
 #include "sinks/json_text.h"
 #include "sinks/user_error.h"
 #include "timebase/tick.h"

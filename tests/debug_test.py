@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """simbot debug --batch: the scripted session of issue 26 gives the
-transcript in tests/debug/iceman.transcript, and the README's "Debugging"
-section shows that same transcript (so it stays true).
+transcript in tests/debug/iceman.transcript, and the debugger's manual
+(docs/debugging.md) shows that same transcript (so it stays true).
 
 Usage: debug_test.py SIMBOT SOURCE_DIR [--update]
 
 Run from SOURCE_DIR (the programs are named ../shared/programs/..., as the
-README's command names them). Besides the exact transcript, the session's
+manual's command names them). Besides the exact transcript, the session's
 claims are checked on their own:
   - the first stop is the edge handler INT1 at its first entry; stepping
     back lands in the delay loop it interrupted (platform(), line 220) and
@@ -16,7 +16,7 @@ claims are checked on their own:
   - each watchpoint stop on buf was written by a line that copies a motor
     string into buf, and its new value is one of the strings that program
     copies there.
---update rewrites the transcript and the README block from this run.
+--update rewrites the transcript and the manual's block from this run.
 """
 import os
 import re
@@ -27,7 +27,7 @@ SIMBOT, SOURCE = sys.argv[1], sys.argv[2]
 UPDATE = "--update" in sys.argv[3:]
 SCRIPT = "tests/debug/iceman.gdb"
 EXPECTED = os.path.join(SOURCE, "tests/debug/iceman.transcript")
-README = os.path.join(SOURCE, "README.md")
+MANUAL = os.path.join(SOURCE, "docs/debugging.md")
 COMMAND = ["debug", "../shared/programs/iceman.dc", "../shared/programs/fig92.dc",
            "--seed", "3", "--batch", SCRIPT]
 BEGIN, END = "<!-- debug transcript: tests/debug_test.py -->", "<!-- end of debug transcript -->"
@@ -68,24 +68,24 @@ for line, old, new in writes:
     check(new in copied, f"new value {new!r} is not a string ICEMAN copies into buf")
     check(not old.startswith(f'"{new}"'), f"watchpoint stopped without a change: {new}")
 
-# The transcript, and the README's copy of it.
+# The transcript, and the manual's copy of it.
 if UPDATE:
     with open(EXPECTED, "w") as f:
         f.write(out)
 expected = open(EXPECTED).read()
 check(out == expected, "the transcript differs from tests/debug/iceman.transcript:\n" + out)
-readme = open(README).read()
+manual = open(MANUAL).read()
 block = "```text\n$ simbot " + " ".join(COMMAND) + "\n" + expected + "```\n"
 pattern = re.compile(re.escape(BEGIN) + r"\n.*?" + re.escape(END), re.S)
 if UPDATE:
-    readme = pattern.sub(lambda m: BEGIN + "\n" + block + END, readme)
-    with open(README, "w") as f:
-        f.write(readme)
-match = pattern.search(readme)
-check(match is not None, "README has no debug transcript block")
+    manual = pattern.sub(lambda m: BEGIN + "\n" + block + END, manual)
+    with open(MANUAL, "w") as f:
+        f.write(manual)
+match = pattern.search(manual)
+check(match is not None, "docs/debugging.md has no debug transcript block")
 if match:
     check(match.group(0) == BEGIN + "\n" + block + END,
-          "README's debug transcript is not this run's (run with --update)")
+          "docs/debugging.md's debug transcript is not this run's (run with --update)")
 
 for f in failures:
     print("FAIL:", f)

@@ -9,6 +9,7 @@
 #include "config/config.h"
 #include "plant/plant.h"
 #include "scheduler/match.h"
+#include "support/programs.h"
 #include "support/test_host.h"
 #include "support/traced.h"
 
@@ -17,7 +18,7 @@ using namespace simbot;
 namespace {
 
 // Arms port A as ICEMAN does; the handler records where the loop was.
-const char* kDelay = R"(#INT_VEC PIOA_VEC edge
+const std::string kDelay = R"(#INT_VEC PIOA_VEC edge
 int z, seen, hits;
 interrupt reti edge()
 {
@@ -26,13 +27,8 @@ interrupt reti edge()
 }
 main()
 {
-    outport(PIOCA, 0xff);
-    outport(PIOCA, 0xff);
-    outport(PIOCA, PIOA_VEC);
-    outport(PIOCA, 0x97);
-    outport(PIOCA, 0xfc);
-    outport(PIOCA, 0x87);
-    for (z = 0; z < 20000; z++)
+)" + std::string(testkit::kArmPortA) +
+                           R"(    for (z = 0; z < 20000; z++)
         ;
     printf("%d %d %d\n", z, seen, hits);
 }
@@ -285,7 +281,7 @@ namespace {
 
 // A one-line delay loop, as ICEMAN's platform() writes it: line:N#K and
 // pass:N#K name different things on it.
-const char* kOneLine = R"(#INT_VEC PIOA_VEC edge
+const std::string kOneLine = R"(#INT_VEC PIOA_VEC edge
 int z, seen, hits;
 interrupt reti edge()
 {
@@ -294,13 +290,8 @@ interrupt reti edge()
 }
 main()
 {
-    outport(PIOCA, 0xff);
-    outport(PIOCA, 0xff);
-    outport(PIOCA, PIOA_VEC);
-    outport(PIOCA, 0x97);
-    outport(PIOCA, 0xfc);
-    outport(PIOCA, 0x87);
-    for (z = 0; z < 700; z++);
+)" + std::string(testkit::kArmPortA) +
+                             R"(    for (z = 0; z < 700; z++);
     printf("%d %d %d\n", z, seen, hits);
 }
 )";

@@ -15,6 +15,7 @@
 #include "compiler/compiler.h"
 #include "config/config.h"
 #include "plant/plant.h"
+#include "support/programs.h"
 #include "support/records.h"
 #include "support/traced.h"
 #include "vm/bytecode.h"
@@ -506,7 +507,7 @@ class KeepSink final : public trace::Sink {
 // most of the time, so that each request waits for an EI and is accepted
 // in the middle of a round; six edges are injected 1.2 s apart.
 TEST(Match, RefereeTurnsAtTheTickOfTheCountedHandlerEntry) {
-  const char* kEdgy = R"(#INT_VEC PIOA_VEC edge
+  const std::string kEdgy = R"(#INT_VEC PIOA_VEC edge
 int z, hits;
 interrupt reti edge()
 {
@@ -514,13 +515,8 @@ interrupt reti edge()
 }
 main()
 {
-    outport(PIOCA, 0xff);
-    outport(PIOCA, 0xff);
-    outport(PIOCA, PIOA_VEC);
-    outport(PIOCA, 0x97);
-    outport(PIOCA, 0xfc);
-    outport(PIOCA, 0x87);
-    while (1) {
+)" + std::string(testkit::kArmPortA) +
+                            R"(    while (1) {
         DI();
         for (z = 0; z < 37; z++)
             ;

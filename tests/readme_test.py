@@ -15,6 +15,8 @@ The Quickstart block is the exception: `.ci/run` runs `scripts/test.sh` and
 (GTKWave) runs under Xvfb and passes when it is still showing the file
 after a few seconds; anything else must exit with status 0. A block
 that already ran (the README shows some of the manual's) runs once.
+The README's layout table must list every top-level folder of the
+checkout, and only those.
 """
 import os
 import re
@@ -41,6 +43,16 @@ def blocks(readme_text):
             pending = ""
         out.append([line for line in lines if line.strip()])
     return out
+
+
+def layout_mismatch(readme_text, source):
+    """Folders the README's layout table leaves out, and rows for folders that are not there."""
+    table = readme_text.split("\n## Layout\n", 1)[-1]
+    listed = set(re.findall(r"^\| `([^`/]+)/` \|", table, re.M))
+    # What .gitignore keeps out of the checkout: build folders and out/.
+    folders = {d for d in os.listdir(source) if os.path.isdir(os.path.join(source, d))
+               and not d.startswith((".", "build")) and d != "out"}
+    return sorted(folders - listed), sorted(listed - folders)
 
 
 def sandbox(source, simbot, work):
@@ -87,6 +99,9 @@ def main():
     source = os.path.dirname(os.path.abspath(readme))
     cwd = sandbox(source, simbot, os.path.abspath(work))
     failures, ran = [], 0
+    missing, extra = layout_mismatch(open(readme, encoding="utf-8").read(), source)
+    if missing or extra:
+        failures.append(f"README's layout table: folders not listed {missing}, rows for no folder {extra}")
     seen = set()
     every = [b for page in pages for b in blocks(open(page, encoding="utf-8").read())]
     for block in every:

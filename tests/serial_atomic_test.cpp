@@ -10,6 +10,7 @@
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "support/assembler.h"
+#include "support/programs.h"
 #include "support/test_host.h"
 #include "support/traced.h"
 
@@ -26,7 +27,7 @@ namespace {
 uint32_t libCallCost(const vm::CostTable& t, vm::Lib l) { return t.libCall[static_cast<int>(l)]; }
 
 // Arms port A as ICEMAN does, then sends one frame; the edge handler counts.
-const char* kSendWithEdge = R"(#INT_VEC PIOA_VEC edge
+const std::string kSendWithEdge = R"(#INT_VEC PIOA_VEC edge
 char buf[9];
 char cc;
 int z, hits;
@@ -37,13 +38,8 @@ interrupt reti edge()
 main()
 {
     ser_init_z1(0, 9600/1200);
-    outport(PIOCA, 0xff);
-    outport(PIOCA, 0xff);
-    outport(PIOCA, PIOA_VEC);
-    outport(PIOCA, 0x97);
-    outport(PIOCA, 0xfc);
-    outport(PIOCA, 0x87);
-    strcpy(buf, "4fgr4rgr");
+)" + std::string(testkit::kArmPortA) +
+                                  R"(    strcpy(buf, "4fgr4rgr");
     cc = sizeof(buf);
     ser_send_z1(buf, &cc);
     for (z = 0; z < 2000; z++);

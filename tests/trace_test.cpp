@@ -13,6 +13,7 @@
 #include "plant/plant.h"
 #include "scheduler/match.h"
 #include "sinks/trace_jsonl.h"
+#include "support/programs.h"
 #include "support/records.h"
 #include "support/test_host.h"
 
@@ -112,7 +113,7 @@ TEST(Trace, SamplesSayWhichLineTheProgramIsAt) {
 // 1,843,200 + 5,040,000 = 6,883,200, and samples 15 and 16 (6,912,000 and
 // 7,372,800) are back in main's loop, which has 30,000 x 252 - 1,843,200
 // ticks of its own left.
-const char* kHandler =
+const std::string kHandler =
     "#INT_VEC PIOA_VEC edge\n"
     "int z, w;\n"
     "interrupt reti edge()\n"
@@ -120,13 +121,8 @@ const char* kHandler =
     "    for (w = 0; w < 20000; w++);\n"
     "}\n"
     "main()\n"
-    "{\n"
-    "    outport(PIOCA, 0xff);\n"
-    "    outport(PIOCA, 0xff);\n"
-    "    outport(PIOCA, PIOA_VEC);\n"
-    "    outport(PIOCA, 0x97);\n"
-    "    outport(PIOCA, 0xfc);\n"
-    "    outport(PIOCA, 0x87);\n"
+    "{\n" +
+    std::string(testkit::kArmPortA) +
     "    for (z = 0; z < 30000; z++);\n"
     "}\n";
 
@@ -242,7 +238,7 @@ TEST(Trace, SendsSayWhereTheyCameFrom) {
 // handler edge() on line 12 calls go(), which sends on line 8; the
 // handler's own send on line 13 has no caller (nothing called edge()) and
 // overwrites go()'s.
-const char* kHandlerSends =
+const std::string kHandlerSends =
     "#INT_VEC PIOA_VEC edge\n"
     "char buf[9];\n"
     "char cc;\n"
@@ -263,13 +259,8 @@ const char* kHandlerSends =
     "}\n"
     "main()\n"
     "{\n"
-    "    ser_init_z1(0, 9600/1200);\n"
-    "    outport(PIOCA, 0xff);\n"
-    "    outport(PIOCA, 0xff);\n"
-    "    outport(PIOCA, PIOA_VEC);\n"
-    "    outport(PIOCA, 0x97);\n"
-    "    outport(PIOCA, 0xfc);\n"
-    "    outport(PIOCA, 0x87);\n"
+    "    ser_init_z1(0, 9600/1200);\n" +
+    std::string(testkit::kArmPortA) +
     "    strcpy(buf, \"cfgrcfgr\");\n"
     "    wait();\n"
     "}\n";

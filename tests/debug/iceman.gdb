@@ -1,5 +1,5 @@
 # simbot debug --batch: ICEMAN vs Figure 9.2, seed 3 (tests/debug_test.py
-# checks the transcript against iceman.transcript; README "Debugging"
+# checks the transcript against iceman.transcript; docs/debugging.md
 # shows it). The edge handler's first entry interrupts platform()'s delay
 # loop; stepping back lands on the instruction it interrupted, stepping on
 # enters the handler again with the same values.
