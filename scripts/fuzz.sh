@@ -10,13 +10,31 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
-# Debug (-O0), and only the four targets: with UBSan, clang's optimiser
-# spends 420-475 s on vm/vm.cpp alone at -O1 or -O2 (41 s at -O0); the
-# campaigns are short, so build time outweighs executions per second.
+# Debug (-O0), and only the targets: with UBSan, clang's optimiser spends
+# 420-475 s on vm/vm.cpp alone at -O1 or -O2 (41 s at -O0); the campaigns
+# are short, so build time outweighs executions per second.
+#
+# This build is also the suite's build against SUNDIALS 7 (Debian 13's,
+# which scripts/setup.sh unpacks into build-sundials7/prefix; the other
+# builds use Debian 12's 6.4): plant/arkode.cpp's 7.x branches compiled
+# with warnings as errors (so no deprecated call), the plant's tests run
+# on it under ASan and UBSan, and the targets fuzz a plant built on it.
+# Without that prefix (setup.sh not run) it builds against the system's.
+sundials=()
+if [ -e build-sundials7/prefix/.unpacked ]; then
+  sundials=("-DCMAKE_PREFIX_PATH=$PWD/build-sundials7/prefix/usr")
+fi
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DSIMBOT_FUZZ=ON \
-  -DSIMBOT_BENCHMARKS=OFF > build-fuzz.configure.log 2>&1 || { cat build-fuzz.configure.log; exit 1; }
+  -DSIMBOT_BENCHMARKS=OFF -DSIMBOT_WERROR=ON "${sundials[@]}" > build-fuzz.configure.log 2>&1 ||
+  { cat build-fuzz.configure.log; exit 1; }
 cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_compiler fuzz_vm fuzz_config fuzz_inspect \
-  fuzz_console fuzz_dap
+  fuzz_console fuzz_dap plant_test
+if [ ${#sundials[@]} -gt 0 ]; then
+  grep -q '^-- SUNDIALS 7\.' build-fuzz.configure.log ||
+    { grep SUNDIALS build-fuzz.configure.log; echo "fuzz: build-fuzz did not find SUNDIALS 7"; exit 1; }
+fi
+ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-fuzz -R '^plant_test$' --output-on-failure \
+  --no-tests=error
 work=build-fuzz/fuzzing
 mkdir -p "$work"
 shared=../shared/programs

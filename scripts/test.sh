@@ -45,21 +45,6 @@ phase "set-up and layout check"
 phase "normal build"
 ctest --test-dir build --output-on-failure --parallel "$jobs" --timeout 900
 phase "normal tests"
-# The plant against SUNDIALS 7 (Debian 13's, unpacked by setup.sh beside
-# Debian 12's 6.4): plant/arkode.cpp's other branches, compiled with
-# warnings as errors (so with no deprecated call), and the plant's tests
-# on it. Only what plant_test needs is built, unoptimised and without
-# debug information (a third less compiling than at -O2 -g1: 189 s of
-# CPU instead of 284; the tests take 4 s instead of 2).
-cmake -S . -B build-sundials7 -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-g0 \
-  -DSIMBOT_WERROR=ON -DSIMBOT_CLI_ONLY=OFF -DSIMBOT_BENCHMARKS=OFF \
-  "-DCMAKE_PREFIX_PATH=$PWD/build-sundials7/prefix/usr" > build-sundials7.configure.log 2>&1 ||
-  { cat build-sundials7.configure.log; exit 1; }
-grep -q '^-- SUNDIALS 7\.' build-sundials7.configure.log ||
-  { grep SUNDIALS build-sundials7.configure.log; echo "test.sh: build-sundials7 did not find SUNDIALS 7"; exit 1; }
-cmake --build build-sundials7 --parallel "$jobs" --target plant_test
-ctest --test-dir build-sundials7 -R '^plant_test$' --output-on-failure --no-tests=error
-phase "plant against SUNDIALS 7"
 # The sanitizer builds keep line tables only (-g1): their reports still give
 # FILE:LINE, and compiling takes less time (ThreadSanitizer at -O1 -g1: 14 s
 # for reports/explain.cpp where -O2 -g takes 22).
@@ -98,7 +83,7 @@ TSAN_OPTIONS=halt_on_error=1 \
   ctest --test-dir build-tsan -R '^(Bench|Tournament)\.' --output-on-failure --parallel "$jobs"
 phase "ThreadSanitizer build and tests"
 ./scripts/fuzz.sh 20
-phase "fuzzing build and campaigns"
+phase "fuzzing build (against SUNDIALS 7), the plant's tests on it, campaigns"
 echo "test.sh: time per stage"
 printf '  %s\n' "${stages[@]}"
 echo "  $SECONDS s wall, $(cpu) s CPU in all"
