@@ -28,7 +28,14 @@ namespace simbot::timebase {
 // (callers put the option, or FILE:LINE:COL, in front).
 class TimeError : public std::invalid_argument {
  public:
-  using std::invalid_argument::invalid_argument;
+  // NotATime: not in the grammar at all (a caller with other forms, such
+  // as --inject's line:N#K, says so instead).
+  enum class Kind { NotATime, BetweenTicks, RunLength };
+  TimeError(Kind kind, const std::string& message) : std::invalid_argument(message), kind_(kind) {}
+  Kind kind() const { return kind_; }
+
+ private:
+  Kind kind_;
 };
 
 // What a number written without a unit is, where it is written.
@@ -52,6 +59,21 @@ inline constexpr std::array<Unit, 4> kUnits = {{{"ms", kTicksPerSecond, -3},
                                                 {"t", 1, 0}}};
 
 inline std::string quoted(std::string_view text) { return "'" + std::string(text) + "'"; }
+
+// The shortest decimal that reads back as `seconds`, as %g writes it
+// (0.0001, 1e-05, 2e+06): what the user most likely wrote.
+struct Shortest {
+  char text[40];
+  std::size_t size;
+  std::string_view view() const { return {text, size}; }
+};
+inline Shortest shortest(double seconds) {
+  Shortest s{};
+  const auto end =
+      std::to_chars(s.text, s.text + sizeof s.text, seconds, std::chars_format::general);
+  s.size = static_cast<std::size_t>(end.ptr - s.text);
+  return s;
+}
 }  // namespace written
 
 // The tick `text` names (see above). TimeError if it is no time, more
@@ -75,14 +97,16 @@ inline Tick parseTime(std::string_view text, BareNumber bare) {
                                                       : "";
   const auto ticks = timebase::ticksFromDecimal(digits, ticksPerUnit, scale);
   if (!ticks || (!unit && bare == BareNumber::Refused))
-    throw TimeError(written::quoted(text) +
-                    " is not a time (write 12.5s, 800ms, 300us or 115200000t, at most 1e11 s" +
-                    bareMeans + ")");
+    throw TimeError(TimeError::Kind::NotATime,
+                    written::quoted(text) +
+                        " is not a time (write 12.5s, 800ms, 300us or 115200000t, at most 1e11 s" +
+                        bareMeans + ")");
   if (!ticks->exact) {
     const Tick below = ticks->roundedUp ? ticks->ticks - 1 : ticks->ticks;
-    throw TimeError(written::quoted(text) +
-                    " is not a whole number of ticks of the 9.216 MHz clock: the nearest are " +
-                    std::to_string(below) + "t and " + std::to_string(below + 1) + "t");
+    throw TimeError(TimeError::Kind::BetweenTicks,
+                    written::quoted(text) +
+                        " is not a whole number of ticks of the 9.216 MHz clock: the nearest are " +
+                        std::to_string(below) + "t and " + std::to_string(below + 1) + "t");
   }
   return ticks->ticks;
 }
@@ -92,10 +116,7 @@ inline Tick parseTime(std::string_view text, BareNumber bare) {
 // 0.04299999999999999656...), read by parseTime. TimeError for a negative,
 // NaN or infinite number too.
 inline Tick parseSeconds(double seconds) {
-  char text[40];
-  const auto written = std::to_chars(text, text + sizeof text, seconds);
-  return parseTime(std::string_view(text, static_cast<std::size_t>(written.ptr - text)),
-                   BareNumber::Seconds);
+  return parseTime(written::shortest(seconds).view(), BareNumber::Seconds);
 }
 
 // The longest run any command plays: 1e6 s (11.6 days) of simulated time,
@@ -109,9 +130,10 @@ inline constexpr Tick kMaxRunTicks = static_cast<Tick>(kMaxRunSeconds) * kTicksP
 // more than 0 and at most kMaxRunTicks.
 inline Tick checkRunLength(Tick ticks, std::string_view text) {
   if (ticks <= 0 || ticks > kMaxRunTicks)
-    throw TimeError(written::quoted(text) +
-                    " is not a run's length: more than 0 s and at most 1e6 s (" +
-                    std::to_string(kMaxRunTicks) + "t)");
+    throw TimeError(TimeError::Kind::RunLength,
+                    written::quoted(text) +
+                        " is not a run's length: more than 0 s and at most 1e6 s (" +
+                        std::to_string(kMaxRunTicks) + "t)");
   return ticks;
 }
 
@@ -119,6 +141,13 @@ inline Tick checkRunLength(Tick ticks, std::string_view text) {
 // seconds, then checkRunLength.
 inline Tick parseRunLength(std::string_view text) {
   return checkRunLength(parseTime(text, BareNumber::Seconds), text);
+}
+
+// A run's length given as a number of seconds (a batch's configuration):
+// parseSeconds, then checkRunLength.
+inline Tick runLengthFromSeconds(double seconds) {
+  const auto decimal = written::shortest(seconds);
+  return checkRunLength(parseTime(decimal.view(), BareNumber::Seconds), decimal.view());
 }
 
 }  // namespace simbot::timebase
