@@ -16,7 +16,7 @@
 #include "scheduler/match.h"
 #include "sinks/json_text.h"
 #include "sinks/user_error.h"
-#include "timebase/tick.h"
+#include "timebase/written.h"
 
 namespace simbot::batch {
 
@@ -312,6 +312,27 @@ std::string faultLine(const scheduler::MatchResult& r) {
 
 }  // namespace
 
+BenchConfig benchConfig(const runs::RunOptions& o,
+                        const std::optional<config::Scenario>& scenario) {
+  BenchConfig c;
+  c.scenario = scenario;
+  c.family = o.family;
+  c.seeds = o.seeds.value_or(0);
+  std::optional<timebase::Tick> length = o.length;
+  if (!length && scenario) length = scenario->length;
+  if (length) c.seconds = timebase::secondsFromTicks(*length);  // a whole number of ticks: exact
+  c.masterSeed = runs::preferCommandLine(
+      o.seed.has_value(), scenario ? scenario->seed : std::nullopt, o.seed.value_or(c.masterSeed));
+  c.threads = o.threads.value_or(0);
+  c.opponent = o.opponent;
+  if (o.seenThreshold) c.thresholds.seen = *o.seenThreshold;
+  if (o.aimMaxDiff) c.thresholds.aimMaxDiff = *o.aimMaxDiff;
+  if (o.aimMinSum) c.thresholds.aimMinSum = *o.aimMinSum;
+  c.median =
+      o.median == "midpoint" ? stats::QuantileRule::Midpoint : stats::QuantileRule::FirstBelow;
+  return c;
+}
+
 void checkBenchConfig(const BenchConfig& config) {
   const auto& families = benchFamilies();
   if (config.family.empty() && !config.scenario)
@@ -321,9 +342,11 @@ void checkBenchConfig(const BenchConfig& config) {
     throw sinks::UserError(fmt::format(
         "simbot: unknown family '{}' (stationary, circle, head-to-head, edge)\n", config.family));
   if (config.seeds <= 0) throw sinks::UserError("simbot: --seeds must be positive\n");
-  if (!(config.seconds > 0) || config.seconds > 1e6)
-    throw sinks::UserError(
-        fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", config.seconds));
+  try {  // read by the one grammar already, except from a caller that set it
+    timebase::runLengthFromSeconds(config.seconds);
+  } catch (const timebase::TimeError& e) {
+    throw sinks::UserError(fmt::format("simbot: --seconds: {}\n", e.what()));
+  }
   if (config.family == "head-to-head" && config.opponent.empty())
     throw sinks::UserError("simbot: the head-to-head family needs --opponent FILE\n");
   if (config.programs.empty()) throw sinks::UserError("simbot: bench needs at least one program\n");

@@ -18,6 +18,7 @@
 #include "batch/run_table.h"
 #include "config/config.h"
 #include "plant/plant.h"
+#include "runs/play.h"
 #include "runs/scenario.h"
 #include "stats/stats.h"
 
@@ -91,6 +92,13 @@ std::string benchLabel(const BenchConfig& config);
 // Run `index` of `program`: streamSeed(master, "<family>/<program's file
 // name>/<index>"), the seed key in place of the file name when given.
 uint64_t benchRunSeed(const BenchConfig& config, const std::string& program, int index);
+// A bench's configuration from the run options of `simbot bench`,
+// `simbot compare` and simbot.bench() (runs/run_options.def): --family,
+// --seeds, --seconds (else BenchConfig's 60 s), --seed, --threads,
+// --opponent, the thresholds, --median; with `scenario`, its seconds and
+// seed where the options give none. The programs are the caller's.
+BenchConfig benchConfig(const runs::RunOptions& o,
+                        const std::optional<config::Scenario>& scenario = std::nullopt);
 // UserError if the configuration cannot run (a family, the counts).
 void checkBenchConfig(const BenchConfig& config);
 // runs.csv's columns, and the settings that identify a bench (batch.json).

@@ -14,7 +14,7 @@
 #include "scheduler/match.h"
 #include "sinks/json_text.h"
 #include "sinks/user_error.h"
-#include "timebase/tick.h"
+#include "timebase/written.h"
 
 namespace simbot::batch {
 
@@ -139,9 +139,11 @@ void checkTournamentConfig(const TournamentConfig& config) {
   if (config.programs.size() < 2)
     throw sinks::UserError("simbot: a tournament needs two programs\n");
   if (config.rounds <= 0) throw sinks::UserError("simbot: --rounds must be positive\n");
-  if (config.seconds && (!(*config.seconds > 0) || *config.seconds > 1e6))
-    throw sinks::UserError(
-        fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", *config.seconds));
+  try {  // read by the one grammar already, except from a caller that set it
+    if (config.seconds) timebase::runLengthFromSeconds(*config.seconds);
+  } catch (const timebase::TimeError& e) {
+    throw sinks::UserError(fmt::format("simbot: --seconds: {}\n", e.what()));
+  }
 }
 
 double roundSeconds(const TournamentConfig& config, const config::Profile& profile) {

@@ -1,4 +1,5 @@
-// The bench and tournament subcommands, kept out of main.cpp. Private to
+// The subcommands kept out of main.cpp, and the run options every command
+// takes from one table (runs/run_options.def). Private to
 // cli/ (namespace simbot::cli, the simbot executable), the top of the
 // parts: it uses batch/, runs/, reports/ and sinks/; nothing uses it.
 #pragma once
@@ -22,19 +23,20 @@ int guarded(const std::function<int()>& body);
 // A seed: a decimal integer from 0 to 2^64 - 1 (not wrapped, not signed).
 CLI::Validator seedValidator();
 
+// The options of runs/run_options.def that `command` (runs::kSolo,
+// kBench, ...) offers, into `o` (cli/options.cpp).
+void addRunOptions(CLI::App* cmd, runs::RunOptions& o, unsigned command);
+
 Subcommand addBenchCommand(CLI::App& app);
 // simbot compare (batch/compare.cpp): the same seeded runs for two programs
 // or two profiles, and a test of each metric.
 Subcommand addCompareCommand(CLI::App& app);
-// --seen-threshold, --aim-max-diff, --aim-min-sum (bench and compare).
-void addThresholdOptions(CLI::App& cmd, batch::MetricThresholds& thresholds);
 Subcommand addTournamentCommand(CLI::App& app);
 Subcommand addExplainCommand(CLI::App& app);  // cli/explain_command.cpp
 Subcommand addSweepCommand(CLI::App& app);    // cli/sweep_command.cpp
 // simbot debug (cli/debug_command.cpp): commands from --batch FILE, the
-// terminal or stdin; `robot` the one held first ("A" or "B").
-int debugCommand(const std::vector<std::string>& programs, const runs::RunOptions& o,
-                 const std::string& batch, const std::string& robot);
+// terminal or stdin; --robot the one held first ("A" or "B").
+int debugCommand(const std::vector<std::string>& programs, const runs::RunOptions& o);
 // simbot dap (cli/dap_command.cpp): the debugger over the Debug Adapter
 // Protocol on stdin and stdout.
 int dapCommand();

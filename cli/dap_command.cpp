@@ -60,7 +60,7 @@ debug::Launched launch(const debug::LaunchRequest& r) {
     if (ec) throw debug::Error(fmt::format("cwd '{}': {}", r.cwd, ec.message()));
   }
   runs::RunOptions o;
-  o.seconds = r.seconds;
+  o.length = r.length;
   o.seed = r.seed;
   o.profile = r.profile;
   o.scenario = r.scenario;

@@ -17,8 +17,9 @@
 
 namespace simbot::cli {
 
-int debugCommand(const std::vector<std::string>& programs, const runs::RunOptions& o,
-                 const std::string& batch, const std::string& robot) {
+int debugCommand(const std::vector<std::string>& programs, const runs::RunOptions& o) {
+  const std::string& batch = o.batch;
+  const std::string& robot = o.robot;
   std::vector<files::Named> inputs;
   scheduler::MatchConfig config = runs::buildConfig(
       programs, o, programs.size() == 1 ? runs::ScenarioUse::Solo : runs::ScenarioUse::Match,

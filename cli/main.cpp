@@ -129,7 +129,8 @@ int matchCommand(const std::string& a, const std::string& b, const runs::RunOpti
 }
 
 // Cycles per source line and per function of a solo run, largest first.
-int profileCommand(const std::string& program, runs::RunOptions o, int top) {
+int profileCommand(const std::string& program, runs::RunOptions o) {
+  const int top = o.top;
   o.trace.clear();
   scheduler::MatchConfig config = runs::buildConfig({program}, o, runs::ScenarioUse::Profile);
   config.stopWhenAllExited = true;
@@ -232,29 +233,6 @@ int profileCommand(const std::string& program, runs::RunOptions o, int top) {
   return status;
 }
 
-// A run option on the command line: a flag for a bool, a repeatable option
-// for a list, a seed checked as seeds are.
-void addRunOption(CLI::App* cmd, const char* flag, bool& value, const char* help) {
-  cmd->add_flag(flag, value, help);
-}
-void addRunOption(CLI::App* cmd, const char* flag, std::optional<uint64_t>& value,
-                  const char* help) {
-  cmd->add_option(flag, value, help)->check(cli::seedValidator());
-}
-template <class T>
-void addRunOption(CLI::App* cmd, const char* flag, T& value, const char* help) {
-  cmd->add_option(flag, value, help);
-}
-
-// The run options (runs/run_options.def) that `command` offers.
-void addRunOptions(CLI::App* cmd, runs::RunOptions& o, unsigned command) {
-  using enum runs::RunOptionUse;
-#define RUN_OPTION(member, Type, flag, keyword, where, help) \
-  if ((where)&command) addRunOption(cmd, flag, o.member, help);
-#include "runs/run_options.def"
-#undef RUN_OPTION
-}
-
 // -W words come through CLI11 as extras (it has no multi-letter
 // single-dash options); main() checks them.
 void addWarningOptions(CLI::App* cmd) {
@@ -282,7 +260,7 @@ int main(int argc, char** argv) {
   std::string soloProgram;
   auto* solo = app.add_subcommand("solo", "run one robot alone in the arena");
   solo->add_option("FILE", soloProgram, "program (.dc)")->required();
-  addRunOptions(solo, soloOptions, runs::kSolo);
+  cli::addRunOptions(solo, soloOptions, runs::kSolo);
   addWarningOptions(solo);
 
   runs::RunOptions matchOptions;
@@ -290,20 +268,17 @@ int main(int argc, char** argv) {
   auto* match = app.add_subcommand("match", "play a match between two programs");
   match->add_option("A", programA, "robot A's program")->required();
   match->add_option("B", programB, "robot B's program")->required();
-  addRunOptions(match, matchOptions, runs::kMatch);
+  cli::addRunOptions(match, matchOptions, runs::kMatch);
   addWarningOptions(match);
 
   runs::RunOptions profileOptions;
-  profileOptions.defaultSeconds = 60;
+  profileOptions.defaultLength = 60 * timebase::kTicksPerSecond;
   std::string profileProgram;
-  int profileTop = 20;
   auto* profile =
       app.add_subcommand("profile", "cycles and time per source line and function of a solo run");
   profile->add_option("FILE", profileProgram, "program (.dc)")->required();
-  addRunOptions(profile, profileOptions, runs::kProfile);
+  cli::addRunOptions(profile, profileOptions, runs::kProfile);
   addWarningOptions(profile);
-  profile->add_option("--top", profileTop, "source lines to list (default 20)")
-      ->check(CLI::Range(1, 1'000'000));
 
   std::string viewTrace, viewOut;
   auto* view = app.add_subcommand("view", "write the replay page (HTML) of a recorded trace");
@@ -313,7 +288,6 @@ int main(int argc, char** argv) {
 
   runs::RunOptions debugOptions;
   std::vector<std::string> debugPrograms;
-  std::string debugBatch, debugRobot = "A";
   auto* debugCmd = app.add_subcommand(
       "debug",
       "stop a robot and look at it: breakpoints, stepping both ways in simulated time, any "
@@ -321,11 +295,7 @@ int main(int argc, char** argv) {
   debugCmd->add_option("PROGRAMS", debugPrograms, "robot A's program, and B's for a match")
       ->required()
       ->expected(1, 2);
-  addRunOptions(debugCmd, debugOptions, runs::kDebug);
-  debugCmd->add_option("--batch", debugBatch,
-                       "read the commands from this file, echoing each (a transcript)");
-  debugCmd->add_option("--robot", debugRobot, "the robot held at the start: A (default) or B")
-      ->check(CLI::IsMember({"A", "B"}));
+  cli::addRunOptions(debugCmd, debugOptions, runs::kDebug);
   addWarningOptions(debugCmd);
   auto* dapCmd = app.add_subcommand(
       "dap",
@@ -370,8 +340,8 @@ int main(int argc, char** argv) {
     if (*compile) return compileCommand(compileFile, disasm, compile->remaining());
     if (*solo) return soloCommand(soloProgram, soloOptions);
     if (*match) return matchCommand(programA, programB, matchOptions);
-    if (*profile) return profileCommand(profileProgram, profileOptions, profileTop);
-    if (*debugCmd) return cli::debugCommand(debugPrograms, debugOptions, debugBatch, debugRobot);
+    if (*profile) return profileCommand(profileProgram, profileOptions);
+    if (*debugCmd) return cli::debugCommand(debugPrograms, debugOptions);
     if (*dapCmd) return cli::dapCommand();
     if (*view) return viewCommand(viewTrace, viewOut);
     if (*bench.app) return bench.run();

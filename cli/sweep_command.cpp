@@ -28,9 +28,8 @@ namespace fs = std::filesystem;
 namespace {
 
 struct SweepOptions {
-  std::string file, out, shard = "1/1", dask;
-  int threads = 0;
-  bool noHeader = false, resume = false;
+  std::string file;
+  runs::RunOptions run;  // --out, --threads, --shard, --no-header, --resume, --dask
   std::vector<std::string> warningOptions;  // -Wno-NAME, -Werror (main() applies them)
 };
 
@@ -54,9 +53,9 @@ std::string defaultOut(const SweepOptions& o) {
   if (const char* old = std::getenv("PYTHONPATH"); old && *old) path += std::string(":") + old;
   setenv("PYTHONPATH", path.c_str(), 1);
   std::vector<std::string> args = {SIMBOT_PYTHON, "-m",      "simbot.sweep", o.file,   "--out",
-                                   o.out,         "--shard", o.shard,        "--dask", o.dask};
-  if (o.noHeader) args.push_back("--no-header");
-  if (o.resume) args.push_back("--resume");
+                                   o.run.out,     "--shard", o.run.shard,    "--dask", o.run.dask};
+  if (o.run.noHeader) args.push_back("--no-header");
+  if (o.run.resume) args.push_back("--resume");
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -73,9 +72,9 @@ std::string defaultOut(const SweepOptions& o) {
 }
 
 int runSweepCommand(SweepOptions& o) {
-  if (o.out.empty()) o.out = defaultOut(o);
-  batch::parseShard(o.shard);
-  if (!o.dask.empty()) {
+  if (o.run.out.empty()) o.run.out = defaultOut(o);
+  batch::parseShard(o.run.shard);
+  if (!o.run.dask.empty()) {
     if (!o.warningOptions.empty())
       throw sinks::UserError(
           "simbot: sweep: -W options apply to this process's compiles; the Dask workers compile "
@@ -85,7 +84,8 @@ int runSweepCommand(SweepOptions& o) {
     execDaskDriver(o);
   }
   const batch::SweepSpec spec = config::loadSweep(o.file, batch::benchFamilies());
-  const batch::SweepOutput output(spec, o.out, o.shard, !o.noHeader, o.resume, simbotVersion());
+  const batch::SweepOutput output(spec, o.run.out, o.run.shard, !o.run.noHeader, o.run.resume,
+                                  simbotVersion());
   const std::vector<batch::SweepRun>& runs = output.runs();
   const size_t begin = output.begin(), end = output.end();
   const std::unique_ptr<batch::SweepWriter> opened = output.open();
@@ -93,7 +93,7 @@ int runSweepCommand(SweepOptions& o) {
   const size_t first = writer.next();
   batch::StopOnSignals signals;
   batch::parallelFor(
-      end - first, o.threads,
+      end - first, o.run.threads.value_or(0),
       [&](size_t i) {
         if (signals.requested()) return;
         writer.put(first + i, batch::runSweepRow(spec, runs[first + i]));
@@ -102,12 +102,12 @@ int runSweepCommand(SweepOptions& o) {
   if (signals.requested()) {
     std::cerr << fmt::format(
         "simbot: sweep stopped by signal {}; {} holds runs {} to {}; --resume continues\n",
-        signals.signal(), o.out, begin, writer.next());
+        signals.signal(), o.run.out, begin, writer.next());
     return 128 + signals.signal();
   }
   writer.finish();
   std::cerr << fmt::format("simbot: {} runs (runs {} to {} of {}); wrote {}\n", end - begin, begin,
-                           end, runs.size(), o.out);
+                           end, runs.size(), o.run.out);
   return 0;
 }
 
@@ -118,19 +118,7 @@ Subcommand addSweepCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "sweep", "bench runs over a grid of programs, families, seeds and profile values");
   cmd->add_option("SWEEP", o->file, "sweep file (TOML)")->required();
-  cmd->add_option("--out", o->out, "the table to write (CSV; default out/sweep-NAME.csv)");
-  cmd->add_option("--threads", o->threads, "worker threads (default: all cores)")
-      ->check(CLI::Range(1, 1024));
-  cmd->add_option("--shard", o->shard,
-                  "run only part K of N (K/N): a contiguous block of the runs, so the parts "
-                  "concatenated in order are the whole table");
-  cmd->add_flag("--no-header", o->noHeader,
-                "leave out the header line (for shards after the first)");
-  cmd->add_flag("--resume", o->resume,
-                "keep the complete rows of an existing table and run the rest");
-  cmd->add_option("--dask", o->dask,
-                  "run on a Dask cluster through the Python module: tcp://HOST:PORT, or "
-                  "local:N for a local cluster of N worker processes");
+  addRunOptions(cmd, o->run, runs::kSweep);
   return {cmd, [o, cmd] {
             o->warningOptions = cmd->remaining();
             return guarded([&] { return runSweepCommand(*o); });

@@ -7,8 +7,8 @@
 // and robot parameters, the scheduler's injections, and each robot's VM
 // knobs (timer service, fast-forward). It includes their headers, never
 // the other way round (plant/, vm/ and scheduler/ do not include config/);
-// runs/ and batch/ apply what it reads to a run. Durations in text are read by
-// timebase/tick.h's one parser (ticksFromDecimal), not here.
+// runs/ and batch/ apply what it reads to a run. Times written in these
+// files are read by timebase/written.h's one grammar, not here.
 //
 // Every error in a file is a ConfigError whose what() is "FILE:LINE:COL:
 // error: MESSAGE"; a file that is not there is "simbot: no ... 'PATH'"
@@ -97,11 +97,11 @@ struct SourcePos {
 // One leg of a beacon's path, as the scenario file states it.
 struct PathLeg {
   enum class Kind : uint8_t { Forward, Arc, Spin, Wait } kind = Kind::Wait;
-  double forwardFt = 0;  // Forward: signed distance (negative: backwards)
-  double radiusFt = 0;   // Arc: radius of the centre's path
-  double turnDeg = 0;    // Arc, Spin: signed turn, + clockwise (to the right)
-  double speedFps = 0;   // Forward, Arc: centre speed; Spin: wheel speed
-  double waitS = 0;      // Wait
+  double forwardFt = 0;      // Forward: signed distance (negative: backwards)
+  double radiusFt = 0;       // Arc: radius of the centre's path
+  double turnDeg = 0;        // Arc, Spin: signed turn, + clockwise (to the right)
+  double speedFps = 0;       // Forward, Arc: centre speed; Spin: wheel speed
+  scheduler::Tick wait = 0;  // Wait: its length
   SourcePos pos;
 };
 
@@ -118,8 +118,8 @@ struct ScenarioRobot {
 
 struct Scenario {
   std::string file;
-  std::optional<std::string> profile;  // a profile name, or a resolved path
-  std::optional<double> seconds;
+  std::optional<std::string> profile;     // a profile name, or a resolved path
+  std::optional<scheduler::Tick> length;  // `seconds`: the run's length
   std::optional<uint64_t> seed;
   ScenarioRobot a, b;
   enum class Opponent : uint8_t { None, Program, Beacon } opponent = Opponent::None;
@@ -182,8 +182,9 @@ Profile sweepProfile(const SweepSpec& spec, size_t point);
 std::string sweepPath(const SweepSpec& spec, const std::string& path);
 
 // ---------------------------------------------------------------- injections
-// Parses ROBOT:SOURCE@WHEN (WHEN: 12.5s, 800ms, 115200000t, line:N#K,
-// pass:N#K) for a run of `robotCount` robots.
+// Parses ROBOT:SOURCE@WHEN (WHEN: a time in timebase/written.h's grammar
+// with its unit, 12.5s, 800ms, 300us or 115200000t, a whole number of
+// ticks; or line:N#K, pass:N#K) for a run of `robotCount` robots.
 // Throws std::invalid_argument with a message naming what is wrong.
 scheduler::Injection parseInjection(const std::string& text, int robotCount);
 

@@ -7,27 +7,25 @@
 #include <string>
 
 #include "config/config.h"
-#include "timebase/tick.h"
+#include "timebase/written.h"
 
 namespace simbot::config {
 
-using timebase::kTicksPerSecond;
-
 namespace {
 
-// A non-negative decimal number of `unit`s as an exact tick count, read by
-// the one parser of durations (timebase::ticksFromDecimal): "12.5s" is
-// exactly 115,200,000 ticks, "1e-3s" 9,216; an injection is at a tick, so a
-// time between two ticks is refused rather than rounded.
-scheduler::Tick parseDuration(const std::string& digits, int64_t ticksPerUnit,
-                              const std::string& whole) {
-  const auto ticks = timebase::ticksFromDecimal(digits, ticksPerUnit);
-  if (!ticks)
-    throw std::invalid_argument("'" + whole +
-                                "': WHEN must be a time (12.5s, 800ms), a tick (115200000t) "
-                                "or a program point (line:N#K, pass:N#K)");
-  if (!ticks->exact) throw std::invalid_argument("'" + whole + "' is not a whole number of ticks");
-  return ticks->ticks;
+// WHEN as a time, in timebase/written.h's grammar ("12.5s" is exactly
+// 115,200,000 ticks, "300us" is between two ticks and refused); a number
+// alone is no time here.
+scheduler::Tick parseWhen(const std::string& when, const std::string& whole) {
+  try {
+    return timebase::parseTime(when, timebase::BareNumber::Refused);
+  } catch (const timebase::TimeError& e) {
+    if (e.kind() == timebase::TimeError::Kind::NotATime)
+      throw std::invalid_argument("'" + whole +
+                                  "': WHEN must be a time (12.5s, 800ms, 300us, 115200000t) or "
+                                  "a program point (line:N#K, pass:N#K)");
+    throw std::invalid_argument("'" + whole + "': " + e.what());
+  }
 }
 
 int parsePositive(const std::string& s, const std::string& whole, const char* what) {
@@ -75,14 +73,8 @@ scheduler::Injection parseInjection(const std::string& text, int robotCount) {
     in.pass = pass;
     in.line = parsePositive(when.substr(5, hash - 5), text, "the line N");
     in.count = parsePositive(when.substr(hash + 1), text, "the execution count K");
-  } else if (when.size() > 2 && when.compare(when.size() - 2, 2, "ms") == 0) {
-    in.tick = parseDuration(when.substr(0, when.size() - 2), kTicksPerSecond / 1000, text);
-  } else if (!when.empty() && when.back() == 's') {
-    in.tick = parseDuration(when.substr(0, when.size() - 1), kTicksPerSecond, text);
-  } else if (!when.empty() && when.back() == 't') {
-    in.tick = parseDuration(when.substr(0, when.size() - 1), 1, text);
   } else {
-    parseDuration("", 1, text);  // throws the WHEN message
+    in.tick = parseWhen(when, text);
   }
   return in;
 }

@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "timebase/written.h"
+
 namespace simbot::config::keys {
 
 using plant::Hardware;
@@ -161,7 +163,12 @@ const std::vector<KeyDef>& keyTable() {
       {"referee", "window", Kind::Time, {0.1, 3600}, false, D(p.referee.window_s)},
       {"referee", "putback", Kind::Length, {0, 10}, false, D(p.referee.putback_ft)},
       {"referee", "turn", Kind::Angle, {-360, 360}, false, D(p.referee.turn_deg)},
-      {"match", "round_length", Kind::Time, {1, 1e6}, false, D(p.round_length_s)},
+      {"match",
+       "round_length",
+       Kind::Time,
+       {1, timebase::kMaxRunSeconds},
+       false,
+       D(p.round_length_s)},
       // At least the serial port's last two characters (2.1 ms): the port
       // is reset at the reload (scheduler kMinReloadDelay).
       {"match", "reload_delay", Kind::Time, {0.01, 3600}, false, D(p.reload_delay_s)},

@@ -20,6 +20,7 @@
 
 #include "config/config.h"
 #include "config/text.h"
+#include "timebase/written.h"
 
 namespace simbot::config {
 
@@ -172,7 +173,11 @@ class Walker {
     if (const toml::node* w = t->get("wait_s")) {
       if (speed) fail(*speed, fmt::format("'{}': a wait has no speed_fps", name));
       leg.kind = PathLeg::Kind::Wait;
-      leg.waitS = positive(*w, name + ".wait_s", 1e6);
+      leg.wait = timeValue(*w, file_, name + ".wait_s", false);
+      // A leg shorter than a tick is refused where the path is driven
+      // (runs/driveLegs), with the other legs; longer than any run is pointless.
+      if (leg.wait > timebase::kMaxRunTicks)
+        fail(*w, fmt::format("'{}.wait_s' is longer than the longest run (1e6 s)", name));
       return leg;
     }
     if (!speed) fail(n, fmt::format("'{}' has no 'speed_fps'", name));
@@ -212,10 +217,7 @@ class Walker {
         s.profile = v;
       }
     }
-    if (const toml::node* n = root.get("seconds")) {
-      s.seconds = positive(*n, "seconds", 1e300);
-      if (*s.seconds > 1e6) fail(*n, "'seconds' must be at most 1e6");
-    }
+    if (const toml::node* n = root.get("seconds")) s.length = timeValue(*n, file_, "seconds", true);
     if (const toml::node* n = root.get("seed")) {
       const auto seed = seedValue(*n);
       if (!seed)

@@ -11,6 +11,7 @@
 
 #include "config/config.h"
 #include "config/text.h"
+#include "timebase/tick.h"
 
 namespace simbot::config {
 
@@ -193,12 +194,10 @@ SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& fam
     for (const auto& p : *list)
       if (!fs::is_regular_file(sweepPath(spec, p), ec))
         throw ConfigError(fmt::format("simbot: {}: no such program '{}'", path, p));
-  if (const toml::node* s = doc.get("seconds")) {
-    const auto v = s->value<double>();
-    if (!v || !(*v > 0) || *v > 1e6)
-      failAt(path, s->source(), "'seconds' must be a number in (0, 1e6]");
-    spec.seconds = *v;
-  }
+  // Written as a time; kept in seconds for the bench it configures (a
+  // whole number of ticks, so the bench's tick is this one).
+  if (const toml::node* s = doc.get("seconds"))
+    spec.seconds = timebase::secondsFromTicks(timeValue(*s, path, "seconds", true));
   if (const toml::node* p = doc.get("profile")) {
     if (!p->is_string()) failAt(path, p->source(), "'profile' is a string");
     spec.profile = *p->value<std::string>();

@@ -10,6 +10,7 @@
 #include <cstdio>
 
 #include "files/files.h"
+#include "timebase/written.h"
 
 namespace simbot::config {
 
@@ -44,6 +45,31 @@ std::optional<std::uint64_t> seedValue(const toml::node& node) {
 void failAt(const std::string& file, const toml::source_region& where, const std::string& message) {
   throw ConfigError(file, static_cast<int>(where.begin.line), static_cast<int>(where.begin.column),
                     message);
+}
+
+scheduler::Tick timeValue(const toml::node& node, const std::string& file, const std::string& name,
+                          bool runLength) {
+  std::string written;  // as the user wrote it, for the messages
+  scheduler::Tick ticks = 0;
+  try {
+    if (const auto* s = node.as_string()) {
+      written = s->get();
+      ticks = timebase::parseTime(written, timebase::BareNumber::Seconds);
+    } else if (const auto* i = node.as_integer()) {
+      written = std::to_string(i->get());
+      ticks = timebase::parseTime(written, timebase::BareNumber::Seconds);
+    } else if (const auto* f = node.as_floating_point()) {
+      written = fmt::format("{}", f->get());
+      ticks = timebase::parseSeconds(f->get());
+    } else {
+      failAt(file, node.source(),
+             fmt::format("'{}' must be a time: a number of seconds, or a string such as \"800ms\"",
+                         name));
+    }
+    return runLength ? timebase::checkRunLength(ticks, written) : ticks;
+  } catch (const timebase::TimeError& e) {
+    failAt(file, node.source(), fmt::format("'{}': {}", name, e.what()));
+  }
 }
 
 toml::table parseToml(std::string_view text, const std::string& file) {

@@ -26,6 +26,13 @@ std::string readFile(const std::string& path);
 // up to 2^64 - 1); nothing for anything else.
 std::optional<std::uint64_t> seedValue(const toml::node& node);
 
+// A time in a file: a number of seconds, or a string in
+// timebase/written.h's grammar ("800ms", "9216t"); a whole number of ticks
+// either way, checked against the one run-length limit when `runLength`.
+// ConfigError "FILE:LINE:COL: error: 'NAME': ..." at the value otherwise.
+scheduler::Tick timeValue(const toml::node& node, const std::string& file, const std::string& name,
+                          bool runLength);
+
 // checkTomlText, then toml++'s parse; its parse errors are ConfigErrors at
 // their place.
 toml::table parseToml(std::string_view text, const std::string& file);

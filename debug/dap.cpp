@@ -228,10 +228,7 @@ struct DapServer::Impl {
     if (const std::string p = text(args, "profile"); !p.empty()) r.profile = p;
     if (const std::string robot = text(args, "robot"); !robot.empty()) r.robot = robot;
     r.cwd = text(args, "cwd");
-    if (const std::optional<double> seconds = numberArgument(args, "seconds")) {
-      if (!(*seconds > 0)) throw Error("'seconds' must be a positive number");
-      r.seconds = *seconds;
-    }
+    r.length = runLengthArgument(args, "seconds");
     r.seed = unsignedArgument(args, "seed");
     r.stopOnEntry = boolArgument(args, "stopOnEntry").value_or(false);
     return r;

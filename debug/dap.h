@@ -41,9 +41,9 @@ inline constexpr int kDapFrameStride = 1 << 16;
 
 // The `launch` request's arguments, as `simbot debug` takes them.
 struct LaunchRequest {
-  std::string program;   // robot A's file
-  std::string opponent;  // B's; empty: a solo run
-  std::optional<double> seconds;
+  std::string program;         // robot A's file
+  std::string opponent;        // B's; empty: a solo run
+  std::optional<Tick> length;  // `seconds`, in timebase/written.h's grammar
   std::optional<uint64_t> seed;
   std::optional<std::string> profile;
   std::string scenario;

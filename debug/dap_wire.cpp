@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "debug/session.h"
+#include "timebase/written.h"
 
 namespace simbot::debug {
 
@@ -571,11 +572,17 @@ std::optional<uint64_t> unsignedArgument(const json& args, const char* key) {
   return v->get<uint64_t>();
 }
 
-std::optional<double> numberArgument(const json& args, const char* key) {
+std::optional<timebase::Tick> runLengthArgument(const json& args, const char* key) {
   const json* v = member(args, key);
   if (!v) return std::nullopt;
-  if (!v->is_number()) throw Error(fmt::format("'{}' must be a number", key));
-  return v->get<double>();
+  try {
+    if (v->is_string()) return timebase::parseRunLength(v->get<std::string>());
+    // A number is seconds, as JSON wrote it (its shortest decimal).
+    if (v->is_number()) return timebase::runLengthFromSeconds(v->get<double>());
+  } catch (const timebase::TimeError& e) {
+    throw Error(fmt::format("'{}': {}", key, e.what()));
+  }
+  throw Error(fmt::format("'{}' must be a number of seconds or a time such as \"800ms\"", key));
 }
 
 std::optional<bool> boolArgument(const json& args, const char* key) {

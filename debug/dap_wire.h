@@ -21,6 +21,8 @@
 #include <string_view>
 #include <thread>
 
+#include "timebase/tick.h"
+
 namespace simbot::debug {
 
 // A message body's largest size: 4 MB. The largest request a client sends
@@ -129,7 +131,10 @@ std::optional<std::string> stringArgument(const nlohmann::json& args, const char
 std::optional<int64_t> integerArgument(const nlohmann::json& args, const char* key, int64_t min,
                                        int64_t max);
 std::optional<uint64_t> unsignedArgument(const nlohmann::json& args, const char* key);
-std::optional<double> numberArgument(const nlohmann::json& args, const char* key);
+// A run's length: a number of seconds or a string in timebase/written.h's
+// grammar ("800ms", "9216t"), a whole number of ticks within the one
+// run-length limit.
+std::optional<timebase::Tick> runLengthArgument(const nlohmann::json& args, const char* key);
 std::optional<bool> boolArgument(const nlohmann::json& args, const char* key);
 // An object or an array: a pointer into `args` (null when absent or null).
 const nlohmann::json* objectArgument(const nlohmann::json& args, const char* key);

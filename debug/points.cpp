@@ -305,12 +305,7 @@ const Breakpoint& Session::breakAt(const std::string& location, bool temporary) 
   const bool named = where.find(':') != std::string::npos;
   const int robot = robotOf(where);
   if (!named && where.rfind("tick ", 0) == 0) {
-    const std::string count = where.substr(5);
-    Tick tick = 0;
-    const auto [end, error] = std::from_chars(count.data(), count.data() + count.size(), tick);
-    if (count.empty() || error != std::errc() || end != count.data() + count.size() || tick < 0)
-      throw Error(fmt::format("'{}' is not a tick count", count));
-    return breakAtTick(tick, temporary);
+    return breakAtTick(parseTime(where.substr(5)), temporary);  // a number alone: ticks
   }
   if (!named && looksLikeTime(where)) return breakAtTick(parseTime(where), temporary);
   int line = 0;

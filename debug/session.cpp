@@ -6,8 +6,9 @@
 
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <cstdlib>
+
+#include "timebase/written.h"
 
 namespace simbot::debug {
 
@@ -624,7 +625,9 @@ std::vector<std::string> Session::takeNotices() { return std::exchange(notices_,
 // ---- times ------------------------------------------------------------------
 
 bool looksLikeTime(const std::string& word) {
-  return !word.empty() && std::isdigit(static_cast<unsigned char>(word[0])) && word.back() == 's';
+  // A line is digits alone; a time ends in its unit (s, ms, us, t).
+  return !word.empty() && (std::isdigit(static_cast<unsigned char>(word[0])) || word[0] == '.') &&
+         (word.back() == 's' || word.back() == 't');
 }
 
 std::string secondsText(Tick t) { return fmt::format("{:.6f} s", timebase::secondsFromTicks(t)); }
@@ -635,39 +638,11 @@ std::string fileName(const std::string& path) {
 }
 
 Tick parseTime(const std::string& text) {
-  std::string digits = text;
-  std::string exponent;
-  auto ends = [&](const char* unit) {
-    const std::string u = unit;
-    return digits.size() > u.size() && digits.compare(digits.size() - u.size(), u.size(), u) == 0;
-  };
-  bool seconds = true;
-  if (ends("ms")) {
-    digits.resize(digits.size() - 2);
-    exponent = "e-3";
-  } else if (ends("us")) {
-    digits.resize(digits.size() - 2);
-    exponent = "e-6";
-  } else if (ends("s")) {
-    digits.resize(digits.size() - 1);
-  } else {
-    seconds = false;
+  try {
+    return timebase::parseTime(text, timebase::BareNumber::Ticks);
+  } catch (const timebase::TimeError& e) {
+    throw Error(e.what());
   }
-  if (!seconds) {
-    Tick ticks = 0;
-    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), ticks);
-    if (error != std::errc() || end != digits.data() + digits.size() || ticks < 0 || digits.empty())
-      throw Error(
-          fmt::format("'{}' is not a time (write 12.5s, 20ms, 300us or a tick count)", text));
-    return ticks;
-  }
-  // A decimal with an exponent already (1e-3s) takes no unit exponent.
-  if (!exponent.empty() && digits.find_first_of("eE") != std::string::npos)
-    throw Error(fmt::format("'{}' is not a time", text));
-  const auto ticks = timebase::ticksFromDecimal(digits + exponent, timebase::kTicksPerSecond);
-  if (!ticks || digits.empty() || digits[0] == '-')
-    throw Error(fmt::format("'{}' is not a time (write 12.5s, 20ms, 300us or a tick count)", text));
-  return ticks->ticks;
 }
 
 }  // namespace simbot::debug

@@ -383,10 +383,11 @@ class Session final : private scheduler::DebugHook {
   std::vector<std::string> notices_;
 };
 
-// "12.5s", "20ms", "123456" (ticks), "1e-3s": a time the user wrote.
-// Error if it is none.
+// "12.5s", "20ms", "300us", "9216t", "123456" (ticks): a time the user
+// wrote, in timebase/written.h's grammar, a number alone ticks. Error if it
+// is none, or not a whole number of ticks (naming the two nearest).
 Tick parseTime(const std::string& text);
-// Whether a word is written as a time with a unit (12.5s, 20ms), not a line.
+// Whether a word is written as a time with a unit (12.5s, 20ms, 9216t), not a line.
 bool looksLikeTime(const std::string& word);
 // "1.500000 s", as stops and breakpoints show a tick's time.
 std::string secondsText(Tick t);

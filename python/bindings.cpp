@@ -4,6 +4,7 @@
 // simbot.match(A, B) is `simbot match A B --json`, parsed. JSON and CSV
 // cross as text and are parsed on the Python side. Runs release the GIL,
 // so Python threads (a Dask worker's) run them in parallel.
+#include <fmt/format.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -26,6 +27,7 @@
 #include "sinks/json_text.h"
 #include "sinks/trace_jsonl.h"
 #include "sinks/user_error.h"
+#include "timebase/tick.h"
 #include "vm/vm.h"
 
 namespace py = pybind11;
@@ -55,10 +57,28 @@ py::dict compileProgram(const std::string& path, bool disasm) {
 }
 
 // A run option from its Python keyword (runs/run_options.def): None
-// leaves it unset, as an option not given on the command line.
+// leaves it unset, as an option not given on the command line; a value is
+// checked as the command line checks it, and refused naming the option.
 template <class T>
-void setRunOption(T& member, py::handle value) {
-  if (!value.is_none()) member = value.cast<T>();
+void setRunOption(T& member, py::handle value, const char* flag, const runs::OptionCheck& check) {
+  if (value.is_none()) return;
+  member = value.cast<T>();
+  if constexpr (std::is_integral_v<T> || std::is_same_v<T, std::optional<int>>) {
+    if (const std::string problem = runs::checkOption(check, py::str(value).cast<std::string>());
+        !problem.empty())
+      throw sinks::UserError(fmt::format("simbot: {}: {}\n", flag, problem));
+  }
+}
+// A run's length: a number of seconds (its shortest decimal, as Python
+// prints it) or a string in the grammar of a written time ("300ms").
+void setRunOption(std::optional<timebase::Tick>& member, py::handle value, const char*,
+                  const runs::OptionCheck&) {
+  if (value.is_none()) return;
+  if (py::isinstance<py::bool_>(value) ||
+      !(py::isinstance<py::str>(value) || py::isinstance<py::int_>(value) ||
+        py::isinstance<py::float_>(value)))
+    throw py::type_error("seconds: a number of seconds or a time such as \"800ms\"");
+  member = runs::parseLengthOption(py::str(value).cast<std::string>());
 }
 
 // How Python passes a run option: a value (None: not given), a list, or
@@ -70,16 +90,45 @@ constexpr const char* runOptionKind() {
   return "value";
 }
 
-// The Python keywords of the run options and their kinds, in their order:
-// the package builds simbot.solo's and simbot.match's signatures from them.
-std::vector<std::pair<std::string, std::string>> runOptionKeywords() {
-  using enum runs::RunOptionUse;
+// The Python keywords of the run options that `use` (runs::kPython:
+// simbot.solo and simbot.match; runs::kPythonBench: simbot.bench) takes,
+// and their kinds, in their order: the package builds the functions'
+// signatures from them.
+std::vector<std::pair<std::string, std::string>> runOptionKeywords(unsigned use) {
   std::vector<std::pair<std::string, std::string>> keywords;
-#define RUN_OPTION(member, Type, flag, keyword, where, help) \
-  if ((where)&runs::kPython) keywords.emplace_back(keyword, runOptionKind<Type>());
+#define RUN_OPTION(member, Type, initial, flag, keyword, where, check, help) \
+  if ((where)&use) keywords.emplace_back(keyword, runOptionKind<Type>());
+  {
+    using enum runs::RunOptionUse;
 #include "runs/run_options.def"
+  }
 #undef RUN_OPTION
   return keywords;
+}
+
+// The run options `use` takes, from Python keywords; TypeError for a
+// keyword that is none of them.
+runs::RunOptions runOptionsFrom(const py::kwargs& options, unsigned use) {
+  runs::RunOptions o;
+  size_t used = 0;
+  using runs::anything, runs::range, runs::oneOf;
+#define RUN_OPTION(member, Type, initial, flag, keyword, where, check, help) \
+  if (((where)&use) && options.contains(keyword)) {                          \
+    setRunOption(o.member, options[keyword], flag, check);                   \
+    ++used;                                                                  \
+  }
+  {
+    using enum runs::RunOptionUse;
+#include "runs/run_options.def"
+  }
+#undef RUN_OPTION
+  if (used != options.size())
+    for (const auto known = runOptionKeywords(use); const auto& [key, value] : options) {
+      const auto name = key.cast<std::string>();
+      if (std::none_of(known.begin(), known.end(), [&](const auto& k) { return k.first == name; }))
+        throw py::type_error("unexpected keyword argument '" + name + "'");
+    }
+  return o;
 }
 
 // solo (one program) or match (two) with the run options as keywords: the
@@ -87,22 +136,7 @@ std::vector<std::pair<std::string, std::string>> runOptionKeywords() {
 // warnings.
 py::tuple playRun(const std::vector<std::string>& programs, bool keepTrace,
                   const py::kwargs& options) {
-  using enum runs::RunOptionUse;
-  runs::RunOptions o;
-  size_t used = 0;
-#define RUN_OPTION(member, Type, flag, keyword, where, help)  \
-  if (((where)&runs::kPython) && options.contains(keyword)) { \
-    setRunOption(o.member, options[keyword]);                 \
-    ++used;                                                   \
-  }
-#include "runs/run_options.def"
-#undef RUN_OPTION
-  if (used != options.size())
-    for (const auto known = runOptionKeywords(); const auto& [key, value] : options) {
-      const auto name = key.cast<std::string>();
-      if (std::none_of(known.begin(), known.end(), [&](const auto& k) { return k.first == name; }))
-        throw py::type_error("unexpected keyword argument '" + name + "'");
-    }
+  runs::RunOptions o = runOptionsFrom(options, runs::kPython);
   sinks::JsonlLines lines;
   if (keepTrace) o.sinks.push_back(&lines);
   const bool solo = programs.size() == 1;
@@ -117,20 +151,15 @@ py::tuple playRun(const std::vector<std::string>& programs, bool keepTrace,
   return py::make_tuple(json, lines.lines, warnings);
 }
 
-py::tuple benchRuns(const std::vector<std::string>& programs, const std::string& family, int seeds,
-                    double seconds, uint64_t seed, const std::string& profile,
-                    const std::string& opponent, int threads) {
+// simbot bench's runs with its options as keywords (family, seeds,
+// seconds, seed, profile, opponent, threads): summary.json and runs.csv.
+py::tuple benchRuns(const std::vector<std::string>& programs, const py::kwargs& options) {
+  const runs::RunOptions o = runOptionsFrom(options, runs::kPythonBench);
   py::gil_scoped_release release;
-  batch::BenchConfig c;
+  batch::BenchConfig c = batch::benchConfig(o);
   c.programs = programs;
-  c.family = family;
-  c.seeds = seeds;
-  c.seconds = seconds;
-  c.masterSeed = seed;
-  c.opponent = opponent;
-  c.threads = threads;
   c.progress = false;
-  const config::Profile loaded = runs::loadNamedProfile(profile);
+  const config::Profile loaded = runs::loadNamedProfile(o.profile.value_or("default"));
   const batch::BenchResult r = batch::runBench(c, loaded);
   py::gil_scoped_acquire acquire;
   return py::make_tuple(sinks::dumpJson(batch::summaryJson(r), 2), batch::runsCsv(r));
@@ -212,10 +241,9 @@ PYBIND11_MODULE(_simbot, m) {
   });
   m.def("compile", &compileProgram, py::arg("path"), py::arg("disasm") = false);
   m.def("play", &playRun, py::arg("programs"), py::arg("keep_trace"));
-  m.def("run_options", &runOptionKeywords);
-  m.def("bench", &benchRuns, py::arg("programs"), py::arg("family"), py::arg("seeds"),
-        py::arg("seconds"), py::arg("seed"), py::arg("profile"), py::arg("opponent"),
-        py::arg("threads"));
+  m.def("run_options", [] { return runOptionKeywords(runs::kPython); });
+  m.def("bench_options", [] { return runOptionKeywords(runs::kPythonBench); });
+  m.def("bench", &benchRuns, py::arg("programs"));
   py::class_<Sweep>(m, "Sweep")
       .def(py::init<const std::string&>(), py::arg("path"))
       .def("__len__", [](const Sweep& s) { return s.runs.size(); })

@@ -111,12 +111,12 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
       preferCommandLine(o.profile.has_value(), scenario ? scenario->profile : std::nullopt,
                         o.profile.value_or("default")));
   // Without --seconds or a scenario's, a run lasts its default: the
-  // profile's round.
-  const double seconds = preferCommandLine(
-      o.seconds.has_value(), scenario ? scenario->seconds : std::nullopt,
-      o.seconds.value_or(o.defaultSeconds > 0 ? o.defaultSeconds : profile.round_length_s));
-  if (!(seconds > 0) || seconds > 1e6)
-    throw sinks::UserError(fmt::format("simbot: --seconds must be in (0, 1e6], got {}\n", seconds));
+  // profile's round. Each was checked against the one run-length limit
+  // where it was read (timebase/written.h; the profile's keys table).
+  const timebase::Tick length = preferCommandLine(
+      o.length.has_value(), scenario ? scenario->length : std::nullopt,
+      o.length.value_or(o.defaultLength > 0 ? o.defaultLength
+                                            : timebase::ticksFromSeconds(profile.round_length_s)));
   scheduler::MatchConfig config;
   config.arena = config::makeArenaConfig(profile, static_cast<int>(programs.size()));
   config.profileName = profile.name;
@@ -154,11 +154,7 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
       throw sinks::UserError(fmt::format("simbot: --inject {}\n", e.what()));
     }
   }
-  config.endTick = timebase::ticksFromSeconds(seconds);
-  if (config.endTick < 1)
-    throw sinks::UserError(fmt::format(
-        "simbot: --seconds {} is less than one tick of the 9.216 MHz clock (1.085e-07 s)\n",
-        seconds));
+  config.endTick = length;
   config.seed = preferCommandLine(o.seed.has_value(), scenario ? scenario->seed : std::nullopt,
                                   o.seed.value_or(1));
   config.reloadOnFault = o.reloadOnFault;

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "compiler/compiler.h"
@@ -20,6 +21,7 @@
 #include "files/files.h"
 #include "runs/scenario.h"
 #include "scheduler/match.h"
+#include "timebase/tick.h"
 #include "trace/trace.h"
 #include "vm/image.h"
 
@@ -41,16 +43,46 @@ vm::Image compileProgramText(const std::string& source, const std::string& name)
 // A profile by name (profiles/NAME.toml) or by path.
 config::Profile loadNamedProfile(const std::string& nameOrPath);
 
-// Where a run option is offered (runs/run_options.def).
-enum RunOptionUse : unsigned { kSolo = 1, kMatch = 2, kProfile = 4, kPython = 8, kDebug = 16 };
+// Where a run option is offered (runs/run_options.def): the commands, and
+// the Python module's simbot.solo and simbot.match (kPython) and
+// simbot.bench (kPythonBench).
+enum RunOptionUse : unsigned {
+  kSolo = 1 << 0,
+  kMatch = 1 << 1,
+  kProfile = 1 << 2,
+  kPython = 1 << 3,
+  kDebug = 1 << 4,
+  kBench = 1 << 5,
+  kCompare = 1 << 6,
+  kTournament = 1 << 7,
+  kSweep = 1 << 8,
+  kPythonBench = 1 << 9,
+};
+
+// What a run option's value must be beyond its type: anything, an integer
+// in [lo, hi], or one of the words of "A|B".
+struct OptionCheck {
+  std::int64_t lo = 0, hi = -1;  // a range when lo <= hi
+  std::string_view words;
+};
+constexpr OptionCheck anything() { return {}; }
+constexpr OptionCheck range(std::int64_t lo, std::int64_t hi) { return {lo, hi, {}}; }
+constexpr OptionCheck oneOf(std::string_view words) { return {0, -1, words}; }
+// "" if `text` passes `check`, else why not: one line, the option's name
+// left to the caller.
+std::string checkOption(const OptionCheck& check, const std::string& text);
+// The run's length from `--seconds TEXT` (or the Python keyword): the
+// grammar of a written time (timebase/written.h), a number alone in
+// seconds, within the one run-length limit; UserError naming --seconds.
+timebase::Tick parseLengthOption(const std::string& text);
 
 struct RunOptions {
-#define RUN_OPTION(member, Type, flag, keyword, where, help) Type member{};
+#define RUN_OPTION(member, Type, initial, flag, keyword, where, check, help) Type member{initial};
 #include "runs/run_options.def"
 #undef RUN_OPTION
   // A run's length when neither the option nor a scenario gives one (0:
   // the profile's round_length; simbot profile: 60 s).
-  double defaultSeconds = 0;
+  timebase::Tick defaultLength = 0;
   // More sinks for the trace's records (the Python module's in-memory
   // trace); each counts as a trace for --watch and --trace-costate.
   std::vector<trace::Sink*> sinks;

@@ -50,13 +50,15 @@ std::vector<scheduler::DriveLeg> driveLegs(const std::string& sourceName,
         right = -sign * leg.speedFps;
         seconds = radians(std::fabs(leg.turnDeg)) * half / leg.speedFps;
         break;
-      case PathLeg::Kind::Wait:
-        seconds = leg.waitS;
+      case PathLeg::Kind::Wait:  // written as a time: a whole number of ticks
+        seconds = timebase::secondsFromTicks(leg.wait);
         break;
     }
     // The range first: ticksFromSeconds refuses NaN and huge values.
-    const scheduler::Tick ticks =
-        seconds >= 0 && seconds <= 1e8 ? timebase::ticksFromSeconds(seconds) : 0;
+    const scheduler::Tick ticks = leg.kind == PathLeg::Kind::Wait ? leg.wait
+                                  : seconds >= 0 && seconds <= 1e8
+                                      ? timebase::ticksFromSeconds(seconds)
+                                      : 0;
     if (ticks < 1)
       throw config::ConfigError(
           sourceName, leg.pos.line, leg.pos.column,

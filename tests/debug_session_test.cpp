@@ -90,7 +90,7 @@ void expectSamePlace(debug::Session& s, const Place& p) {
 
 scheduler::MatchConfig icemanVsFig92() {
   runs::RunOptions o;
-  o.seconds = 30;
+  o.length = 30 * timebase::kTicksPerSecond;
   o.profile = "default";
   o.seed = 3;
   return runs::buildConfig({kShared + "/programs/iceman.dc", kShared + "/programs/fig92.dc"}, o,
@@ -216,7 +216,7 @@ TEST(DebugSession, SnapshotsThinOutWithDistanceFromThePresent) {
 // pass's top past 233), where the counter reads k up to 194 and k + 1 after.
 TEST(DebugSession, DelayLoopCounterFollowsFromTheListing) {
   runs::RunOptions o;
-  o.seconds = 2;
+  o.length = 2 * timebase::kTicksPerSecond;
   const scheduler::MatchConfig config =
       runs::buildConfig({kSource + "/tests/debug/inspect.dc"}, o, runs::ScenarioUse::Solo);
   timebase::Tick top = 0;
@@ -268,7 +268,7 @@ TEST(DebugSession, DelayLoopCounterFollowsFromTheListing) {
 // (by hand: step + 2n at each level).
 TEST(DebugSession, PrintReadsAnyLvalueOfAnyFrame) {
   runs::RunOptions o;
-  o.seconds = 1;
+  o.length = 1 * timebase::kTicksPerSecond;
   const scheduler::MatchConfig config =
       runs::buildConfig({kSource + "/tests/debug/inspect.dc"}, o, runs::ScenarioUse::Solo);
   Script script({

@@ -296,8 +296,9 @@ r = run(["sweep", many, "--out", OUT / "many.csv"], timeout=20)
 check(r.returncode == 1 and "6000000 runs" in r.stderr, f"6e6 runs are refused ({r.stderr!r})")
 
 # ---- runs that would say nothing, or too much
+# 1e-12 s is 0.000009216 ticks: between ticks 0 and 1 (timebase/written.h).
 r = run(["solo", SPIRAL, "--seconds", "1e-12"])
-check(one_line_error(r, "less than one tick"), f"--seconds 1e-12 is refused ({r.stderr!r})")
+check(one_line_error(r, "the nearest are 0t and 1t"), f"--seconds 1e-12 is refused ({r.stderr!r})")
 storm = OUT / "storm.dc"
 storm.write_text("f() { f(); }\nmain() { f(); }\n")
 quick = OUT / "quick-reload.toml"  # a reload 0.01 s after each fault

@@ -55,7 +55,7 @@ path = [
 repeat = true
 )");
   EXPECT_EQ(*s.profile, "thesis-1997");
-  EXPECT_EQ(*s.seconds, 45);
+  EXPECT_EQ(*s.length, 414'720'000);  // 45 s * 9,216,000
   EXPECT_EQ(*s.seed, 7u);
   ASSERT_TRUE(s.a.start);
   EXPECT_EQ(s.a.start->x_ft, 1.5);
@@ -71,6 +71,21 @@ repeat = true
   EXPECT_EQ(s.path[1].turnDeg, -90);
   EXPECT_EQ(s.path[3].pos.line, 15);
   EXPECT_TRUE(s.repeatPath);
+}
+
+// A scenario's times are written as every time is (timebase/written.h): a
+// number of seconds, or a string with a unit s, ms, us or t.
+TEST(Scenario, TimesInTheOneGrammar) {
+  EXPECT_EQ(parse("seconds = \"500ms\"\n").length, 4'608'000);  // 500 * 9,216
+  EXPECT_EQ(parse("seconds = \"9216t\"\n").length, 9'216);
+  EXPECT_EQ(parse("seconds = \"125us\"\n").length, 1'152);  // 125 * 9.216
+  EXPECT_EQ(parse("seconds = 0.043\n").length, 396'288);    // 43 * 9,216
+  const auto legs = [](const char* wait) {
+    return parse(std::string("[B]\nbeacon = true\npath = [{ wait_s = ") + wait + " }]\n").path;
+  };
+  EXPECT_EQ(legs("0.5")[0].wait, 4'608'000);
+  EXPECT_EQ(legs("\"2ms\"")[0].wait, 18'432);  // 2 * 9,216
+  EXPECT_EQ(legs("\"1t\"")[0].wait, 1);
 }
 
 struct Bad {
@@ -91,9 +106,29 @@ TEST(Scenario, EveryMistakeNamesItsLine) {
       {"speed = 3\n",
        "s.toml:1:1: error: unknown key 'speed' in the scenario (expected one of: profile, seconds, "
        "seed, A, B)"},
-      {"\nseconds = -1\n", "s.toml:2:11: error: 'seconds' must be greater than 0, got -1"},
-      {"seconds = \"ten\"\n", "s.toml:1:11: error: 'seconds' must be a number"},
-      {"seconds = 2e6\n", "s.toml:1:11: error: 'seconds' must be at most 1e6"},
+      // Times in timebase/written.h's grammar: a number of seconds, or a
+      // string with its unit; a whole number of ticks (300 us is 2,764.8).
+      {"\nseconds = -1\n",
+       "s.toml:2:11: error: 'seconds': '-1' is not a time (write 12.5s, 800ms, 300us or "
+       "115200000t, at most 1e11 s; a number alone is seconds)"},
+      {"seconds = \"ten\"\n",
+       "s.toml:1:11: error: 'seconds': 'ten' is not a time (write 12.5s, 800ms, 300us or "
+       "115200000t, at most 1e11 s; a number alone is seconds)"},
+      {"seconds = true\n",
+       "s.toml:1:11: error: 'seconds' must be a time: a number of seconds, or a string such as "
+       "\"800ms\""},
+      {"seconds = 2e6\n",
+       "s.toml:1:11: error: 'seconds': '2000000' is not a run's length: more than 0 s and at "
+       "most 1e6 s (9216000000000t)"},
+      {"seconds = 0\n",
+       "s.toml:1:11: error: 'seconds': '0' is not a run's length: more than 0 s and at most 1e6 "
+       "s (9216000000000t)"},
+      {"seconds = \"300us\"\n",
+       "s.toml:1:11: error: 'seconds': '300us' is not a whole number of ticks of the 9.216 MHz "
+       "clock: the nearest are 2764t and 2765t"},
+      {"seconds = 0.0001\n",  // 921.6 ticks
+       "s.toml:1:11: error: 'seconds': '0.0001' is not a whole number of ticks of the 9.216 MHz "
+       "clock: the nearest are 921t and 922t"},
       {"seed = -3\n",
        "s.toml:1:8: error: 'seed' must be an integer from 0 to 2^63 - 1, or a "
        "string of digits"},
@@ -128,8 +163,17 @@ TEST(Scenario, EveryMistakeNamesItsLine) {
        "s.toml:4:3: error: 'edge_side@1s': SOURCE must be edge_fore, edge_aft, bumper_front or "
        "bumper_back"},
       {"[A]\ninject = [\"edge_fore@soon\"]\n",
-       "s.toml:2:11: error: 'edge_fore@soon': WHEN must be a time (12.5s, 800ms), a tick "
-       "(115200000t) or a program point (line:N#K, pass:N#K)"},
+       "s.toml:2:11: error: 'edge_fore@soon': WHEN must be a time (12.5s, 800ms, 300us, "
+       "115200000t) or a program point (line:N#K, pass:N#K)"},
+      {"[A]\ninject = [\"edge_fore@12.5\"]\n",  // a number alone is no time here
+       "s.toml:2:11: error: 'edge_fore@12.5': WHEN must be a time (12.5s, 800ms, 300us, "
+       "115200000t) or a program point (line:N#K, pass:N#K)"},
+      {"[A]\ninject = [\"edge_fore@300us\"]\n",
+       "s.toml:2:11: error: 'edge_fore@300us': '300us' is not a whole number of ticks of the "
+       "9.216 MHz clock: the nearest are 2764t and 2765t"},
+      {"[B]\nbeacon = true\npath = [{ wait_s = 1e-9 }]\n",  // 0.009216 ticks
+       "s.toml:3:20: error: 'B.path[0].wait_s': '1e-09' is not a whole number of ticks of the "
+       "9.216 MHz clock: the nearest are 0t and 1t"},
       {"[B]\nprogram = \"nope.dc\"\n",
        ("s.toml:2:11: error: 'B.program': no file '" + kSource + "/nope.dc'")},
       {"[B]\nprogram = \"programs/spiral.dc\"\nbeacon = true\n",
@@ -228,8 +272,8 @@ TEST(Scenario, WhatDoesNotFitTheRunNamesItsLine) {
                        runs::ScenarioUse::Bench),
             "s.toml:2:9: error: a bench family places the robots and picks B; leave out --family "
             "to run this scenario's own poses and opponent");
-  EXPECT_EQ(applyError("[B]\nbeacon = true\npath = [{ wait_s = 1e-9 }]\n", runs::ScenarioUse::Solo),
-            "s.toml:3:9: error: this leg lasts 1e-09 s, which is not between one tick and 1e8 s");
+  EXPECT_EQ(applyError("[B]\nbeacon = true\npath = [{ wait_s = 0 }]\n", runs::ScenarioUse::Solo),
+            "s.toml:3:9: error: this leg lasts 0 s, which is not between one tick and 1e8 s");
   // The same B set-up is fine for a match when it names no program.
   EXPECT_EQ(applyError("[B]\nstart = { x_ft = 0, y_ft = 3, heading_deg = 0 }\n",
                        runs::ScenarioUse::Match, 2),

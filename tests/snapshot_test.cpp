@@ -28,7 +28,7 @@ const std::string kSource = SIMBOT_SOURCE_DIR;
 scheduler::MatchConfig configFor(const std::vector<std::string>& programs, double seconds,
                                  bool reload) {
   runs::RunOptions o;
-  o.seconds = seconds;
+  o.length = timebase::ticksFromSeconds(seconds);
   o.profile = "default";
   o.seed = 3;
   o.reloadOnFault = reload;

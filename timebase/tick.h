@@ -1,4 +1,5 @@
-// timebase/tick.h -- the whole interface of simbot's time base.
+// timebase/tick.h -- simbot's time base (with timebase/written.h, the
+// grammar of a time a user writes and the limit on a run's length).
 //
 // One definition of time (DESIGN.md "Time and determinism"): ticks of the
 // 9.216 MHz clock (one Z180 T-state) in a signed 64-bit integer, the one
@@ -26,20 +27,26 @@ inline constexpr Tick kTicksPerSecond = 9'216'000;
 // room to add to it (1e11 s is about 9.2e17 ticks; INT64_MAX is 9.2e18).
 inline constexpr double kMaxSeconds = 1e11;
 
-// A number of units of `ticksPerUnit` ticks written as a decimal ("12.5",
-// "0.043", "1e-3", "25E+2"; digits, an optional point and fraction, an
-// optional exponent; no sign), as ticks: the decimal is taken as written,
-// multiplied exactly and rounded to the nearest tick, halves away from zero.
-// `exact` says whether it was a whole number of ticks. The one parser of
-// durations: ticksFromSeconds and every time a user writes in text come
-// through it. nullopt if the text is not such a number, is more than
-// kMaxSeconds' worth of ticks or has more than 18 significant digits, or if
-// a unit is not between one tick and one second.
+// A number of units of `ticksPerUnit` * 10^`scale` ticks written as a
+// decimal ("12.5", "0.043", "1e-3", "25E+2"; digits, an optional point and
+// fraction, an optional exponent; no sign), as ticks: the decimal is taken
+// as written, multiplied exactly and rounded to the nearest tick, halves
+// away from zero (`scale` -6 with a second's ticks is a microsecond,
+// 9.216 ticks). `exact` says whether it was a whole number of ticks, and
+// `roundedUp` whether `ticks` is above the value (so the two ticks nearest
+// a value that is not whole are ticks - 1 and ticks, or ticks and ticks +
+// 1). The one parser of durations: ticksFromSeconds and the grammar of a
+// written time (timebase/written.h) come through it. nullopt if the text
+// is not such a number, is more than kMaxSeconds' worth of ticks or has
+// more than 18 significant digits, or if a unit is not between one tick
+// and one second.
 struct DecimalTicks {
   Tick ticks;
   bool exact;
+  bool roundedUp = false;
 };
-inline std::optional<DecimalTicks> ticksFromDecimal(std::string_view text, Tick ticksPerUnit) {
+inline std::optional<DecimalTicks> ticksFromDecimal(std::string_view text, Tick ticksPerUnit,
+                                                    int scale = 0) {
   // text == mantissa * 10^exponent exactly, mantissa < 10^18. A fraction's
   // trailing zeros are not significant ("0.5000" is 5e-1).
   std::int64_t mantissa = 0;
@@ -80,6 +87,7 @@ inline std::optional<DecimalTicks> ticksFromDecimal(std::string_view text, Tick 
       return std::nullopt;
     exponent += negative ? -written : written;
   }
+  exponent += scale;
   if (mantissa == 0) return DecimalTicks{0, true};
   // mantissa * ticksPerUnit < 10^18 * 2^24 < 2^84: exact in 128 bits (a
   // GCC/Clang extension); a run never needs more than kMaxTicks.
@@ -87,22 +95,23 @@ inline std::optional<DecimalTicks> ticksFromDecimal(std::string_view text, Tick 
   constexpr auto kMaxTicks = static_cast<Wide>(kMaxSeconds) * kTicksPerSecond;
   if (ticksPerUnit <= 0 || ticksPerUnit > kTicksPerSecond) return std::nullopt;
   Wide ticks = static_cast<Wide>(mantissa) * static_cast<Wide>(ticksPerUnit);
-  bool exact = true;
+  bool exact = true, roundedUp = false;
   if (exponent >= 0) {
     for (int k = 0; k < exponent; ++k)
       if ((ticks *= 10) > kMaxTicks) return std::nullopt;
   } else if (exponent < -26) {
-    return DecimalTicks{0, false};  // ticks < 10^25 / 10^27: under a hundredth of a tick
+    return DecimalTicks{0, false, false};  // ticks < 10^25 / 10^27: under a hundredth of a tick
   } else {
     Wide divisor = 1;
     for (int k = 0; k < -exponent; ++k) divisor *= 10;
     const Wide remainder = ticks % divisor;
     ticks /= divisor;
     exact = remainder == 0;
-    if (2 * remainder >= divisor) ++ticks;  // halves away from zero
+    roundedUp = 2 * remainder >= divisor;  // halves away from zero
+    if (roundedUp) ++ticks;
   }
   if (ticks > kMaxTicks) return std::nullopt;
-  return DecimalTicks{static_cast<Tick>(ticks), exact};
+  return DecimalTicks{static_cast<Tick>(ticks), exact, roundedUp};
 }
 
 // The tick nearest to `seconds`, read as the decimal the user wrote: the

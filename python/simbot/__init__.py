@@ -91,8 +91,9 @@ def read_trace(path):
 
 # The run options, as runs/run_options.def defines them for the command
 # line too: [(keyword, kind)], kind "value" (None: not given), "list" or
-# "flag". solo's and match's signatures are made from them.
+# "flag". solo's, match's and bench's signatures are made from them.
 _RUN_OPTIONS = _simbot.run_options()
+_BENCH_OPTIONS = _simbot.bench_options()
 _DEFAULTS = {"value": None, "list": (), "flag": False}
 
 
@@ -104,12 +105,14 @@ def _option(kind, value):
     return os.fspath(value) if isinstance(value, os.PathLike) else value
 
 
-def _signature(*leading):
+def _signature(options, leading, required=(), trailing=()):
     P = inspect.Parameter
     return inspect.Signature(
         [P(name, P.POSITIONAL_OR_KEYWORD) for name in leading]
-        + [P(k, P.POSITIONAL_OR_KEYWORD, default=_DEFAULTS[kind]) for k, kind in _RUN_OPTIONS]
-        + [P("keep_trace", P.POSITIONAL_OR_KEYWORD, default=False)])
+        + [P(k, P.POSITIONAL_OR_KEYWORD) for k, _ in options if k in required]
+        + [P(k, P.POSITIONAL_OR_KEYWORD, default=_DEFAULTS[kind])
+           for k, kind in options if k not in required]
+        + [P(name, P.POSITIONAL_OR_KEYWORD, default=False) for name in trailing])
 
 
 def _play(function, programs, args, kwargs):
@@ -143,8 +146,8 @@ def match(*args, **kwargs):
     return _play(match, [given["a"], given["b"]], args, kwargs)
 
 
-solo.__signature__ = _signature("program")
-match.__signature__ = _signature("a", "b")
+solo.__signature__ = _signature(_RUN_OPTIONS, ["program"], trailing=["keep_trace"])
+match.__signature__ = _signature(_RUN_OPTIONS, ["a", "b"], trailing=["keep_trace"])
 
 
 def _number(text):
@@ -158,14 +161,21 @@ def _number(text):
     return text
 
 
-def bench(programs, family, seeds, seconds=60.0, seed=1, profile="default", opponent="",
-          threads=0):
+def bench(*args, **kwargs):
     """`simbot bench`: {"summary": summary.json's dict, "runs": runs.csv's
-    rows as dicts (numbers as numbers, empty fields as None)}."""
-    if isinstance(programs, str):
+    rows as dicts (numbers as numbers, empty fields as None)}. The keywords
+    are the command line's options (seconds is a number of seconds or a
+    time such as "800ms"; None: the command's default)."""
+    given = bench.__signature__.bind(*args, **kwargs).arguments
+    programs = given.pop("programs")
+    if isinstance(programs, (str, os.PathLike)):
         programs = [programs]
-    summary, runs = _simbot.bench([str(p) for p in programs], family, seeds, float(seconds),
-                                  seed, profile, str(opponent), threads)
+    kinds = dict(_BENCH_OPTIONS)
+    options = {k: _option(kinds[k], v) for k, v in given.items()}
+    summary, runs = _simbot.bench([os.fspath(p) for p in programs], **options)
     rows = [{k: _number(v) for k, v in row.items()}
             for row in csv.DictReader(io.StringIO(runs, newline=""))]
     return {"summary": json.loads(summary), "runs": rows}
+
+
+bench.__signature__ = _signature(_BENCH_OPTIONS, ["programs"], required=["family", "seeds"])

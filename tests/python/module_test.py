@@ -101,7 +101,31 @@ try:
     simbot.match(iceman, fig92, seconds=-1)
     check(False, "match: --seconds -1 accepted")
 except simbot.Error as e:
-    check("--seconds must be in" in str(e), f"match: error message {e}")
+    check("--seconds: '-1' is not a time" in str(e), f"match: error message {e}")
+
+# seconds is written as --seconds is (timebase/written.h): a number of
+# seconds or a time with its unit, a whole number of ticks. 300 us is
+# 2,764.8 ticks; 0.0001 s is 921.6; 500 ms is 4,608,000 ticks.
+for bad, ticks in (("300us", "2764t and 2765t"), (0.0001, "921t and 922t")):
+    try:
+        simbot.solo(iceman, seconds=bad)
+        check(False, f"solo: seconds={bad!r} accepted")
+    except simbot.Error as e:
+        check(f"the nearest are {ticks}" in str(e), f"solo: seconds={bad!r}: {e}")
+got = simbot.solo(iceman, seconds="500ms")
+check(got["cycles"] == 4_608_000 and not got["exited"], f"solo: seconds='500ms' ran {got['cycles']} T-states")
+check(without_wall(got) == without_wall(json.loads(run_cli("solo", iceman, "--seconds", "500ms",
+                                                           "--json"))),
+      "solo: seconds='500ms' differs from --seconds 500ms")
+# bench's keywords are the command line's bench options, from the same table.
+helped = run_cli("bench", "--help")
+for name in list(inspect.signature(simbot.bench).parameters)[1:]:
+    check(" --" + name.replace("_", "-") + " " in helped, f"bench: keyword {name} is no CLI option")
+try:
+    simbot.bench(iceman, "stationary", 0)
+    check(False, "bench: seeds=0 accepted")
+except simbot.Error as e:
+    check("--seeds: '0' is not an integer from 1 to 1000000" in str(e), f"bench: seeds=0: {e}")
 
 # The module checks its arguments and cannot be crashed (issue 25): each
 # case below answers with an exception, never a signal.
