@@ -196,7 +196,7 @@ TEST(DebugSession, SnapshotsThinOutWithDistanceFromThePresent) {
       },
   });
   runs::RunOptions o;
-  o.seconds = 601;
+  o.length = 601 * timebase::kTicksPerSecond;
   debug::Session session(
       runs::buildConfig({kShared + "/programs/iceman.dc"}, o, runs::ScenarioUse::Solo),
       {"iceman.dc"});
