@@ -140,6 +140,8 @@ TEST(BoardReset, IsTheControllersResetAndCarriesTheRestOn) {
   // Let the port drain: a reset needs it idle (the scheduler's reload delay).
   while (!run.board.serial.idle()) run.host.runUntil(run.board.cpu.now() + 9600);
   ASSERT_TRUE(run.board.pio.interruptEnabled());  // ICEMAN armed port A
+  // The last eye values read, as a host that traces them keeps them.
+  run.board.lastAdValue = {41, 30};
   const Board before(run.board, run.host);
   const Tick t = run.board.cpu.now();
 
@@ -148,7 +150,6 @@ TEST(BoardReset, IsTheControllersResetAndCarriesTheRestOn) {
   EXPECT_FALSE(run.board.pio.interruptEnabled());
   EXPECT_EQ(run.board.enb485, -1);
   // The reloaded program has read no eye yet (its first reading is traced).
-  EXPECT_NE(before.lastAdValue[0], -1);
   EXPECT_EQ(run.board.lastAdValue, (std::array<int, 2>{-1, -1}));
   // The lines at the pins, the streams and the counters go on.
   EXPECT_EQ(run.board.edgeLines, before.edgeLines);
