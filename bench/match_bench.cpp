@@ -15,9 +15,15 @@
 // (integration, plant inputs, eye readings, including those a VM's A/D read
 // makes), sched_s (the rest: round loop, queue, bookkeeping), which add up
 // to the match's time (not counting compiling the programs).
+// BM_Snapshots: what a debugger's snapshot of that match costs (one every
+// half second of 180 s, all kept, as simbot debug keeps them): the heap
+// bytes each snapshot holds (glibc's mallinfo2, in use after less before
+// each MatchRun::snapshot call), and the wall time of taking them.
 #include <benchmark/benchmark.h>
+#include <malloc.h>
 
 #include <stdexcept>
+#include <vector>
 
 #include "compiler/compiler.h"
 #include "config/config.h"
@@ -88,6 +94,39 @@ BENCHMARK_CAPTURE(BM_IcemanVsFig92, thesis_noff, "thesis-1997", false)
     ->Unit(benchmark::kSecond)
     ->UseRealTime()
     ->Iterations(1);
+
+void BM_Snapshots(benchmark::State& state) {
+  const std::string a = SIMBOT_SHARED_DIR "/programs/iceman.dc";
+  const std::string b = SIMBOT_SHARED_DIR "/programs/fig92.dc";
+  scheduler::MatchConfig config;
+  config.arena = config::makeArenaConfig(
+      config::loadProfile(std::string(SIMBOT_SOURCE_DIR "/profiles/default.toml")), 2);
+  config.robots = {{"A", a, compileFile(a)}, {"B", b, compileFile(b)}};
+  config.endTick = 180 * scheduler::kTicksPerSecond;
+  config.snapshots = true;
+  constexpr scheduler::Tick kInterval = scheduler::kTicksPerSecond / 2;
+  double bytes = 0, count = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    scheduler::MatchRun run(config);
+    std::vector<scheduler::MatchRun::Snapshot> kept;
+    kept.reserve(512);
+    bytes = 0;
+    for (scheduler::Tick t = 0; run.runUntil(t); t += kInterval) {
+      const size_t before = mallinfo2().uordblks;
+      state.ResumeTiming();
+      kept.push_back(run.snapshot());
+      state.PauseTiming();
+      bytes += static_cast<double>(mallinfo2().uordblks) - static_cast<double>(before);
+    }
+    count = static_cast<double>(kept.size());
+    state.ResumeTiming();
+  }
+  state.counters["snapshots"] = count;
+  state.counters["bytes_per_snapshot"] = bytes / count;
+}
+
+BENCHMARK(BM_Snapshots)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 
 }  // namespace
 

@@ -20,11 +20,45 @@ class CpuMemory final : public Memory {
 
 }  // namespace
 
-Board::Board(const vm::Image& image, vm::Bus& bus, const vm::CostTable& costs,
-             const StreamSeeds& seeds, bool randomMemoryFill)
-    : Devices(seeds, randomMemoryFill), cpu(image, bus, costs) {
+vm::CostTable costsFor(const vm::CostTable& match, const Settings& settings) {
+  vm::CostTable table = match;
+  if (settings.cpu != match.knobs.cpu) {
+    vm::CostKnobs knobs = match.knobs;
+    knobs.cpu = settings.cpu;
+    table = vm::makeCostTable(knobs);
+  }
+  table.knobs.timerService = settings.timerService;
+  table.knobs.fastForward = match.knobs.fastForward && settings.fastForward;
+  return table;
+}
+
+Board::Board(const vm::Image& image, vm::Bus& bus, const vm::CostTable& matchCosts,
+             const StreamSeeds& seeds, const Settings& boardSettings)
+    : Devices(seeds, boardSettings), cpu(image, bus, costsFor(matchCosts, boardSettings)) {
   fillMemory();
 }
+
+PortWrite Board::out(uint16_t port, uint8_t value) {
+  switch (port) {
+    case vm::kPortPIOCA:
+      pio.control(value);
+      return PortWrite::Done;
+    case vm::kPortPIODA:
+      pio.writeData(value);
+      return PortWrite::Done;
+    case vm::kPortPIODB:
+      return PortWrite::PortB;
+    case vm::kPortENB485: {
+      const bool changed = value != enb485;
+      enb485 = value;
+      return changed ? PortWrite::Enb485 : PortWrite::Done;
+    }
+    default:
+      return PortWrite::Done;  // PIOCB set-up and unknown ports have no effect here
+  }
+}
+
+uint8_t Board::in(uint16_t port) const { return port == vm::kPortPIODA ? pio.read() : 0xFF; }
 
 void Board::reset(Tick t) {
   if (!serial.idle()) throw std::logic_error("a reset with bytes still in the serial port");
@@ -35,10 +69,13 @@ void Board::reset(Tick t) {
   // The reset PIO sees the lines as they are; unarmed, it raises nothing.
   if (pio.setInputs(edgeLines)) throw std::logic_error("an unarmed PIO raised an interrupt");
   enb485 = -1;
+  // The reloaded program has read nothing: its first reading of each eye is
+  // traced even if the faulted program's last was the same.
+  lastAdValue = {-1, -1};
 }
 
 void Board::fillMemory() {
-  if (randomMemory) cpu.fillMemory([this] { return memoryFill.next(); });
+  if (settings.randomMemory) cpu.fillMemory([this] { return memoryFill.next(); });
 }
 
 std::optional<OverwrittenSend> Board::serialSend(Tick t, uint16_t buf, uint16_t ccAddress) {

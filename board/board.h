@@ -5,16 +5,21 @@
 // frames, pending requests, PRT0), its ASCI channel 1 with Dynamic C's
 // serial library (SerialPort), the PIO's port A (Pio) and the lines at its
 // pins, the RS-485 enable, the random streams of the robot's devices and
-// the run's counters. The constant parts, the program image and the
-// robot's specification, are not in it (as MuJoCo keeps mjModel apart from
-// mjData); the motor controller's receiver and the physics are the
-// plant's. The host (the scheduler) implements the VM's bus: it turns the
-// board's accesses into plant inputs, queued events and trace records.
+// the run's counters. The constant parts, the program (image, cost table,
+// decode tables: vm/program.h, shared by every copy) and the robot's
+// specification, are not copied with it (as MuJoCo keeps mjModel apart
+// from mjData); the motor controller's receiver and the physics are the
+// plant's. The board decodes its own I/O ports (out, in), owns its
+// settings (Settings: the profile's [controller]) and its reset. The host
+// (the scheduler) implements the VM's bus: it turns what the board hands
+// on (port B, ENB485, the serial library's bytes) into plant inputs,
+// queued events and trace records.
 //
-// A Board is a value apart from that bus: Board(other, bus) is a copy of
-// all of it that talks to `bus`, restore() takes a copy back, and a copy
-// goes on byte for byte as the original would. reset() is the controller's
-// reset (a reload).
+// A Board is a value apart from that bus: its copy and assignment are the
+// compiler's (= default: a member added later is copied with the rest); a
+// copy talks to no bus until attach(), an assigned board keeps its own, and
+// a copy goes on byte for byte as the original would. reset() is the
+// controller's reset (a reload).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -22,6 +27,7 @@
 
 #include "board/pio.h"
 #include "board/serial_port.h"
+#include "board/settings.h"
 #include "plant/plant.h"
 #include "vm/vm.h"
 
@@ -36,15 +42,22 @@ struct StreamSeeds {
   uint64_t dispersion;  // the ball's azimuth and elevation, two draws per launching stroke
 };
 
+// What a write to an I/O port leaves to the host.
+enum class PortWrite : uint8_t {
+  Done,    // the board's own (the PIO's control and data), or no device
+  PortB,   // the PIO's port B: the plant's guns, solenoids, disc shooter
+  Enb485,  // ENB485 changed (Devices::enb485)
+};
+
 // Everything on the board but the Z180: a plain value.
 struct Devices {
-  explicit Devices(const StreamSeeds& seeds, bool randomMemoryFill)
+  Devices(const StreamSeeds& seeds, const Settings& boardSettings)
       : memoryFill(seeds.memoryFill),
         eyeNoise(seeds.eyeNoise),
         gunLuck(seeds.gunLuck),
         muzzle(seeds.muzzle),
         dispersion(seeds.dispersion),
-        randomMemory(randomMemoryFill) {}
+        settings(boardSettings) {}
   bool operator==(const Devices&) const = default;
 
   SerialPort serial;
@@ -55,7 +68,7 @@ struct Devices {
   uint8_t edgeLines = 0xFF;
   int enb485 = -1;  // never written
   plant::SplitMix64 memoryFill, eyeNoise, gunLuck, muzzle, dispersion;
-  bool randomMemory;
+  Settings settings;
   // Over the whole run: ad_rd8 calls per eye and the last value each
   // returned, interrupts accepted per source (vm::Irq).
   std::array<int64_t, 2> adReads{};
@@ -65,26 +78,30 @@ struct Devices {
 
 class Board : public Devices {
  public:
-  // Powered on at tick 0; `randomMemory` fills RAM from its stream.
-  Board(const vm::Image& image, vm::Bus& bus, const vm::CostTable& costs, const StreamSeeds& seeds,
-        bool randomMemory);
-  Board(const Board& other, vm::Bus& bus) : Devices(other), cpu(other.cpu, bus) {}
-  Board(const Board&) = delete;
-  Board& operator=(const Board&) = delete;
-  // This board takes `snapshot`'s state; its VM keeps talking to its bus.
-  void restore(const Board& snapshot) {
-    static_cast<Devices&>(*this) = snapshot;
-    cpu.restore(snapshot.cpu);
-  }
+  // Powered on at tick 0, running `image` under the match's cost table
+  // with this board's settings (costsFor), talking to `bus`.
+  Board(const vm::Image& image, vm::Bus& bus, const vm::CostTable& matchCosts,
+        const StreamSeeds& seeds, const Settings& settings);
+  Board(const Board&) = default;
+  Board& operator=(const Board&) = default;
+  // A copy that talks to `bus`.
+  Board(const Board& other, vm::Bus& bus) : Board(other) { attach(bus); }
+  void attach(vm::Bus& bus) { cpu.attach(bus); }
   // The controller's reset at t: the Z180 as powered on at t (its RAM
   // filled from the next bytes of its stream, as a power cycle leaves new
   // garbage), the serial port and library idle, the PIO unarmed (it raises
-  // nothing until the program arms it again), ENB485 unknown. The lines at
-  // the pins, the streams and the counters go on. The port must be idle.
+  // nothing until the program arms it again), ENB485 unknown, no eye read
+  // yet by the new program. The lines at the pins, the streams and the
+  // counters go on. The port must be idle.
   void reset(Tick t);
   bool operator==(const Board& other) const {
     return cpu == other.cpu && Devices::operator==(other);
   }
+
+  // The I/O ports as the board decodes them (vm/bytecode.h kPort*): a
+  // write, and what it leaves to the host; a read (0xFF: no device).
+  PortWrite out(uint16_t port, uint8_t value);
+  uint8_t in(uint16_t port) const;
 
   // The serial library: ser_send_z1 returned at t (the send it overwrote,
   // if any), its transmit interrupt service ran at t, the TSR finished a

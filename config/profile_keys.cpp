@@ -124,7 +124,7 @@ const std::vector<KeyDef>& keyTable() {
        {0, 1},
        true,
        D(p.robot.misfire_probability)},
-      {"controller", "random_memory", Kind::Bool, {0, 0}, true, B(p.robot.random_memory)},
+      {"controller", "random_memory", Kind::Bool, {0, 0}, true, B(p.controller.randomMemory)},
       {"controller",
        "timer_service",
        Kind::Choice,

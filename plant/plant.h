@@ -100,8 +100,6 @@ struct RobotParams {
   // later, this match), or misfires (launches nothing; the ball stays
   // chambered for the next stroke). DESIGN.md: an option.
   double jam_probability = 0, misfire_probability = 0;
-  // controller
-  bool random_memory = false;  // power-on RAM from a seeded stream, not zeros
 };
 
 struct FieldParams {

@@ -107,45 +107,80 @@ plant::ArenaConfig arenaConfigFor(const MatchConfig& config) {
 
 // ---- match ------------------------------------------------------------------
 
-namespace {
+MatchState::MatchState(const MatchConfig& config)
+    : config_(config),
+      arenaConfig_(std::make_shared<const plant::ArenaConfig>(arenaConfigFor(config))),
+      coin_(streamSeed(config.seed, "coin")),
+      fired_(config.injections.size()),
+      injectionAddress_(config.injections.size()),
+      clock_(config.timeParts) {}
 
-// The plant of a copy (each return a prvalue: the member is made in place).
-plant::Arena arenaFor(const plant::Arena& other, const plant::Arena::Mark* mark,
-                      const plant::ArenaConfig& config, bool fresh) {
-  if (mark) return plant::Arena(*mark);
-  if (fresh) return plant::Arena(config);
-  return plant::Arena(other);
+Match::Match(const MatchConfig& config) : MatchState(config), arena_(*arenaConfig_) {
+  if (config.snapshots) arena_.keepJournal();
+  for (trace::Sink* sink : config.sinks) trace_.attach(sink);
+  if (config.robots.empty() || config.robots.size() > 2)
+    throw std::invalid_argument("a match needs one or two robots");
+  const vm::CostTable costs = vm::makeCostTable(config.knobs);
+  for (size_t i = 0; i < config.robots.size(); ++i)
+    robots_.emplace_back(
+        std::make_unique<Robot>(*this, static_cast<int>(i), config.robots[i], costs, config.seed));
+  if (config.reloadOnFault && config.reloadDelay < kMinReloadDelay)
+    throw std::invalid_argument(
+        fmt::format("a reload must wait at least {} ticks (the serial port's two characters)",
+                    kMinReloadDelay));
+  resolveWatches();
+  link();
+  queue_.schedule(config.endTick, EventClass::EndOfRound, {QueuedEvent::Kind::EndOfRound, 0, 0});
+  for (size_t i = 0; i < config.robots.size(); ++i) {
+    for (const DriveLeg& leg : config.robots[i].path)
+      if (leg.duration <= 0) throw std::invalid_argument("a path leg must last at least a tick");
+    if (!config.robots[i].path.empty())
+      queue_.schedule(0, EventClass::MotorLatch,
+                      {QueuedEvent::Kind::DriveLeg, static_cast<int>(i), 0});
+  }
+  for (size_t k = 0; k < config.injections.size(); ++k) {
+    const Injection& in = config.injections[k];
+    if (in.robot < 0 || in.robot >= static_cast<int>(robots_.size()))
+      throw std::invalid_argument("injection for a robot that is not in this run: " + in.text);
+    Robot& r = *robots_[static_cast<size_t>(in.robot)];
+    if (in.line > 0) {
+      const auto& lines = r.spec.image.lines;
+      const auto at = std::find(lines.begin(), lines.end(), in.line);
+      if (at == lines.end())
+        throw std::invalid_argument(
+            fmt::format("{}: line {} of {} has no code", in.text, in.line, r.spec.program));
+      const std::optional<uint32_t> head = r.spec.image.loopHead(in.line);
+      if (in.pass && !head)
+        throw std::invalid_argument(fmt::format(
+            "{}: line {} of {} holds no whole loop (pass:N#K counts the passes of a loop "
+            "written on one line; line:N#K counts entries into a line)",
+            in.text, in.line, r.spec.program));
+      if (!in.pass && head)
+        warnings_.push_back(fmt::format(
+            "--inject {}: line {} of {} holds a whole loop; line:N#K counts entries into "
+            "the line (runs of its first instruction, once before each run of the loop), "
+            "not passes of the loop; for pass {} of the loop write pass:{}#{}",
+            in.text, in.line, r.spec.program, in.count, in.line, in.count));
+      const auto address = in.pass ? *head : static_cast<uint32_t>(at - lines.begin());
+      r.lineInjections[address].push_back(static_cast<int>(k));
+      injectionAddress_[k] = address;
+      r.vm().setBreakpoint(address);
+    } else {
+      queue_.schedule(in.tick, EventClass::Injection,
+                      {QueuedEvent::Kind::Inject, in.robot, static_cast<int>(k)});
+    }
+  }
 }
 
-}  // namespace
+Match::Match(const Match& other) : MatchView(), MatchState(other), arena_(other.arena_) { link(); }
 
-Match::Match(const Match& other) : Match(other, nullptr, false) {}
-Match::Match(const Match& other, const plant::Arena::Mark* mark)
-    : Match(other, mark, mark == nullptr) {}
+Match::Match(const MatchState& state, const plant::Arena::Mark& mark)
+    : MatchView(), MatchState(state), arena_(mark) {
+  link();
+}
 
-Match::Match(const Match& other, const plant::Arena::Mark* mark, bool freshArena)
-    : config_(other.config_),
-      costs_(other.costs_),
-      arenaConfig_(other.arenaConfig_),
-      arena_(arenaFor(other.arena_, mark, other.arenaConfig_, freshArena)),
-      trace_(other.trace_),
-      coin_(other.coin_),
-      queue_(other.queue_),
-      inputs_(other.inputs_),
-      warnings_(other.warnings_),
-      fired_(other.fired_),
-      injectionAddress_(other.injectionAddress_),
-      betweenRounds_(other.betweenRounds_),
-      begun_(other.begun_),
-      over_(other.over_),
-      roundStart_(other.roundStart_),
-      result_(other.result_),
-      nextSample_(other.nextSample_),
-      rounds_(other.rounds_),
-      subRounds_(other.subRounds_),
-      clock_(other.clock_) {
-  if (freshArena) arena_.keepJournal();
-  for (const auto& r : other.robots_) robots_.push_back(std::make_unique<Robot>(*r, *this));
+void Match::link() {
+  for (auto& r : robots_) r->attach(*this);
   orderRobots();
 }
 
@@ -166,7 +201,7 @@ plant::Pose Match::pose(int robot, Tick t) const {
   return arena_.pose(robot, std::clamp(t, arena_.lastReinitTick(), arena_.now()));
 }
 
-Tick Match::earliestClock() const {
+Tick MatchState::earliestClock() const {
   Tick t = INT64_MAX;
   for (const auto& r : robots_)
     if (!r->vm().fault()) t = std::min(t, r->now());
@@ -235,7 +270,7 @@ void Match::emit(Tick t, trace::Record record) {
 
 // The run's set-up: the first records of every trace.
 void Match::emitSetup() {
-  const plant::FieldParams& f = arenaConfig_.field;
+  const plant::FieldParams& f = arenaConfig_->field;
   emit(0,
        trace::rec::Run{"simbot-trace/1", static_cast<int64_t>(config_.seed), config_.profileName,
                        static_cast<int64_t>(robots_.size()), config_.endTick, kTicksPerSecond,
@@ -244,7 +279,7 @@ void Match::emitSetup() {
                        f.divider_thickness_ft, f.divider_height_ft, f.gravity_fps2},
        {});
   for (const auto& r : robots_) {
-    const plant::RobotSetup& setup = arenaConfig_.robots[static_cast<size_t>(r->index)];
+    const plant::RobotSetup& setup = arenaConfig_->robots[static_cast<size_t>(r->index)];
     const plant::RobotParams& p = setup.params;
     std::string source;
     for (const auto& line : r->spec.image.sourceLines) source += line + "\n";
@@ -770,24 +805,28 @@ MatchRun::Snapshot::Snapshot() = default;
 MatchRun::Snapshot::Snapshot(Snapshot&&) noexcept = default;
 MatchRun::Snapshot& MatchRun::Snapshot::operator=(Snapshot&&) noexcept = default;
 MatchRun::Snapshot::~Snapshot() = default;
-Tick MatchRun::Snapshot::now() const { return match_->roundStart(); }
-Tick MatchRun::Snapshot::robotClock(int robot) const { return match_->robotClock(robot); }
+Tick MatchRun::Snapshot::now() const { return state_->roundStart(); }
+Tick MatchRun::Snapshot::robotClock(int robot) const {
+  return state_->robots_[static_cast<size_t>(robot)]->now();
+}
+bool MatchRun::Snapshot::robotFaulted(int robot) const {
+  return state_->robots_[static_cast<size_t>(robot)]->vm().fault() != nullptr;
+}
 
+// What changes and the plant's mark: no plant is built until a restore.
 MatchRun::Snapshot MatchRun::snapshot() const {
   Snapshot s;
   s.mark_ = match_->arena().mark();
-  s.match_ = std::make_unique<detail::Match>(*match_, nullptr);
+  s.state_ = std::make_unique<detail::MatchState>(match_->state());
+  // Its robots belong to no match until a restore links them.
+  for (auto& r : s.state_->robots_) r->match = nullptr;
   return s;
 }
 
 void MatchRun::restore(const Snapshot& snapshot) {
-  match_ = std::make_unique<detail::Match>(*snapshot.match_, &snapshot.mark_);
+  match_ = std::make_unique<detail::Match>(*snapshot.state_, snapshot.mark_);
   // The held robot's boundary at the snapshot is the first it looks at.
   if (match_->debugger()) match_->robot(match_->debugRobot()).debugLook = true;
-}
-
-bool MatchRun::Snapshot::robotFaulted(int robot) const {
-  return match_->vm(robot).fault() != nullptr;
 }
 
 std::string_view debugEventName(DebugEvent e) {

@@ -50,6 +50,7 @@
 #include <utility>
 #include <vector>
 
+#include "board/settings.h"
 #include "plant/plant.h"
 #include "timebase/tick.h"
 #include "trace/trace.h"
@@ -69,17 +70,9 @@ struct DriveLeg {
   double leftFps = 0, rightFps = 0;
 };
 
-// A robot's controller settings that reach its VM (the profile's
-// [controller] timer_service, fast_forward and cpu; config/ reads them).
-struct ControllerKnobs {
-  vm::TimerService timerService = vm::TimerService::Auto;
-  // Delay loops run in one exact step; with MatchConfig::knobs.fastForward
-  // off no robot's do.
-  bool fastForward = true;
-  // The Z180 revision on its board: the figures of the instructions that
-  // differ between them (vm/z180.def).
-  vm::CpuRevision cpu = vm::CpuRevision::Z80180;
-};
+// A robot's controller settings (the profile's [controller]; config/ reads
+// them): its board's own.
+using ControllerKnobs = board::Settings;
 
 struct RobotSpec {
   RobotSpec() = default;
@@ -322,7 +315,8 @@ MatchResult runMatch(const MatchConfig& config);
 
 namespace detail {
 class Match;
-}
+struct MatchState;
+}  // namespace detail
 
 // A match that stops between rounds and is a value: a copy (a snapshot)
 // holds everything of it, both boards, the scheduler's queue, the plant,
@@ -349,10 +343,11 @@ class MatchRun {
   // injections) stay.
   void setDebugBreakpoints(int robot, const std::vector<uint32_t>& addresses);
 
-  // A snapshot that costs a copy of both boards and the scheduler's state
-  // but not of the plant (a mark in its journal: Arena::Mark); restoring
-  // it replays the plant. The snapshot stays valid whatever this run does
-  // later, restores included.
+  // A snapshot holds only what changes: both boards (not their programs,
+  // which every copy shares) and the scheduler's state, and of the plant a
+  // mark in its journal (Arena::Mark), nothing built; restoring it replays
+  // the plant. The snapshot stays valid whatever this run does later,
+  // restores included.
   class Snapshot {
    public:
     Snapshot(Snapshot&&) noexcept;
@@ -365,7 +360,7 @@ class MatchRun {
    private:
     friend class MatchRun;
     Snapshot();
-    std::unique_ptr<detail::Match> match_;
+    std::unique_ptr<detail::MatchState> state_;
     plant::Arena::Mark mark_;
   };
   Snapshot snapshot() const;

@@ -71,11 +71,12 @@ plant::ArenaConfig arenaConfigFor(const MatchConfig& config);
 class Robot : public vm::Bus {
  public:
   Robot(Match& match, int index, const RobotSpec& spec, const vm::CostTable& costs, uint64_t seed);
-  // A copy of `other` in the match `match` (a snapshot of other's match):
-  // its board talks to the copy.
-  Robot(const Robot& other, Match& match);
-  Robot(const Robot&) = delete;
+  // A robot is a value: its copy is the compiler's, so that a member added
+  // later is copied with the rest. A copy belongs to no match and its board
+  // talks to no bus until the match that holds it attaches it.
+  Robot(const Robot&) = default;
   Robot& operator=(const Robot&) = delete;
+  void attach(Match& match);
 
   // The robot's clock (match ticks) and its program's VM.
   Tick now() const { return board.cpu.now(); }
@@ -179,7 +180,7 @@ class Robot : public vm::Bus {
 
   const RobotSpec& spec;
   int index;
-  Match& match;
+  Match* match;  // the match that holds it (attach)
   // Its clock is the match's; a reload resets it.
   board::Board board;
   plant::MotorReceiver receiver;
@@ -202,78 +203,72 @@ class Robot : public vm::Bus {
   std::map<uint16_t, CoState> costates;
 };
 
-class Match : public MatchView {
+// An owning pointer that copies what it owns: a class holding one copies
+// with = default, and what it owns keeps its address (a robot is its VM's
+// bus).
+template <class T>
+class Owned {
  public:
-  explicit Match(const MatchConfig& config)
-      : config_(config),
-        costs_(vm::makeCostTable(config.knobs)),
-        arenaConfig_(arenaConfigFor(config)),
-        arena_(arenaConfig_),
-        coin_(streamSeed(config.seed, "coin")),
-        clock_(config.timeParts) {
-    if (config.snapshots) arena_.keepJournal();
-    for (trace::Sink* sink : config.sinks) trace_.attach(sink);
-    if (config.robots.empty() || config.robots.size() > 2)
-      throw std::invalid_argument("a match needs one or two robots");
-    for (size_t i = 0; i < config.robots.size(); ++i)
-      robots_.push_back(std::make_unique<Robot>(*this, static_cast<int>(i), config.robots[i],
-                                                costs_, config.seed));
-    if (config.reloadOnFault && config.reloadDelay < kMinReloadDelay)
-      throw std::invalid_argument(
-          fmt::format("a reload must wait at least {} ticks (the serial port's two characters)",
-                      kMinReloadDelay));
-    resolveWatches();
-    orderRobots();
-    queue_.schedule(config.endTick, EventClass::EndOfRound, {QueuedEvent::Kind::EndOfRound, 0, 0});
-    for (size_t i = 0; i < config.robots.size(); ++i) {
-      for (const DriveLeg& leg : config.robots[i].path)
-        if (leg.duration <= 0) throw std::invalid_argument("a path leg must last at least a tick");
-      if (!config.robots[i].path.empty())
-        queue_.schedule(0, EventClass::MotorLatch,
-                        {QueuedEvent::Kind::DriveLeg, static_cast<int>(i), 0});
-    }
-    for (size_t k = 0; k < config.injections.size(); ++k) {
-      const Injection& in = config.injections[k];
-      if (in.robot < 0 || in.robot >= static_cast<int>(robots_.size()))
-        throw std::invalid_argument("injection for a robot that is not in this run: " + in.text);
-      Robot& r = *robots_[static_cast<size_t>(in.robot)];
-      if (in.line > 0) {
-        const auto& lines = r.spec.image.lines;
-        const auto at = std::find(lines.begin(), lines.end(), in.line);
-        if (at == lines.end())
-          throw std::invalid_argument(
-              fmt::format("{}: line {} of {} has no code", in.text, in.line, r.spec.program));
-        const std::optional<uint32_t> head = r.spec.image.loopHead(in.line);
-        if (in.pass && !head)
-          throw std::invalid_argument(fmt::format(
-              "{}: line {} of {} holds no whole loop (pass:N#K counts the passes of a loop "
-              "written on one line; line:N#K counts entries into a line)",
-              in.text, in.line, r.spec.program));
-        if (!in.pass && head)
-          warnings_.push_back(fmt::format(
-              "--inject {}: line {} of {} holds a whole loop; line:N#K counts entries into "
-              "the line (runs of its first instruction, once before each run of the loop), "
-              "not passes of the loop; for pass {} of the loop write pass:{}#{}",
-              in.text, in.line, r.spec.program, in.count, in.line, in.count));
-        const auto address = in.pass ? *head : static_cast<uint32_t>(at - lines.begin());
-        r.lineInjections[address].push_back(static_cast<int>(k));
-        injectionAddress_[k] = address;
-        r.vm().setBreakpoint(address);
-      } else {
-        queue_.schedule(in.tick, EventClass::Injection,
-                        {QueuedEvent::Kind::Inject, in.robot, static_cast<int>(k)});
-      }
-    }
+  explicit Owned(std::unique_ptr<T> p) : p_(std::move(p)) {}
+  Owned(const Owned& other) : p_(std::make_unique<T>(*other.p_)) {}
+  Owned(Owned&&) noexcept = default;
+  Owned& operator=(const Owned& other) {
+    p_ = std::make_unique<T>(*other.p_);
+    return *this;
   }
+  Owned& operator=(Owned&&) noexcept = default;
+  ~Owned() = default;
+  T* get() const { return p_.get(); }
+  T* operator->() const { return p_.get(); }
+  T& operator*() const { return *p_; }
 
-  // A snapshot: every part of `other`, its robots' boards talking to this
-  // match's robots, its plant copied by replay (MatchConfig::snapshots).
+ private:
+  std::unique_ptr<T> p_;
+};
+
+// All of a match but its plant and the links between its parts (each
+// robot's match, its VM's bus): a value whose copy is the compiler's, so
+// that a member added later is in every copy and snapshot (the copy test:
+// snapshot_test.cpp). A snapshot (MatchRun::Snapshot) is one of these and
+// the plant's journal mark.
+struct MatchState {
+  explicit MatchState(const MatchConfig& config);
+
+  Tick earliestClock() const;
+  Tick roundStart() const { return over_ ? result_.endTick : earliestClock(); }
+
+  const MatchConfig& config_;
+  // config_.arena with this seed's variation: constant, shared by the copies.
+  std::shared_ptr<const plant::ArenaConfig> arenaConfig_;
+  trace::Tracer trace_;
+  plant::SplitMix64 coin_;
+  EventQueue<QueuedEvent> queue_;
+  std::vector<Owned<Robot>> robots_;
+  std::vector<PlantInput> inputs_;
+  std::vector<std::string> warnings_;
+  std::vector<bool> fired_;
+  std::vector<uint32_t> injectionAddress_;
+  bool betweenRounds_ = false;
+  // The run so far: runUntil stops between rounds and goes on later.
+  bool begun_ = false, over_ = false;
+  Tick roundStart_ = 0;  // the tick the current round began at
+  MatchResult result_;
+  Tick nextSample_ = 0;
+  uint64_t rounds_ = 0;
+  uint64_t subRounds_ = 0;  // sub-rounds after the first of each round
+  PartClock clock_;
+};
+
+class Match : public MatchView, private MatchState {
+ public:
+  explicit Match(const MatchConfig& config);
+  // A copy: the state (the compiler's copy), the plant copied by replay
+  // (MatchConfig::snapshots), and the links made again.
   Match(const Match& other);
-  // The same with the plant made from `mark` (Arena::Mark), or, with none,
-  // a fresh plant that stands for a mark kept beside this copy
-  // (MatchRun::Snapshot).
-  Match(const Match& other, const plant::Arena::Mark* mark);
+  // The match a snapshot holds: its state and the plant made from its mark.
+  Match(const MatchState& state, const plant::Arena::Mark& mark);
   Match& operator=(const Match&) = delete;
+  const MatchState& state() const { return *this; }
 
   // The whole run (runUntil and end).
   MatchResult run();
@@ -282,7 +277,7 @@ class Match : public MatchView {
   bool runUntil(Tick pause);
   // Runs to the end; the result.
   MatchResult end();
-  Tick roundStart() const { return over_ ? result_.endTick : earliestClock(); }
+  using MatchState::roundStart;
   // The round loop, until the run is over or the next round would start at
   // or after `pause`.
   void rounds(Tick pause);
@@ -334,13 +329,10 @@ class Match : public MatchView {
   }
   std::string describe(Tick t) const override;
   plant::Pose pose(int robot, Tick t) const override;
-  const plant::RobotParams& robotParams(int robot) const {
-    return arenaConfig_.robots[static_cast<size_t>(robot)].params;
-  }
 
  private:
-  Match(const Match& other, const plant::Arena::Mark* mark, bool freshArena);
-  Tick earliestClock() const;
+  // Each robot's match and its VM's bus, and the order they run in.
+  void link();
   // The earliest tick at which a robot that has not faulted can act:
   // the least of their Vm::quietUntil (match ticks).
   Tick earliestAction() const;
@@ -362,35 +354,15 @@ class Match : public MatchView {
   void sampleUpTo(Tick t);
   void finish(MatchResult& result);
 
-  const MatchConfig& config_;
-  vm::CostTable costs_;
-  plant::ArenaConfig arenaConfig_;  // config_.arena with this seed's variation
   plant::Arena arena_;
-  trace::Tracer trace_;
-  plant::SplitMix64 coin_;
-  EventQueue<QueuedEvent> queue_;
-  std::vector<std::unique_ptr<Robot>> robots_;
   // The order robots run in a round: the one a debugger holds first.
   std::vector<Robot*> runOrder_;
   void orderRobots();
-  std::vector<PlantInput> inputs_;
-  std::vector<std::string> warnings_;
-  std::vector<bool> fired_ = std::vector<bool>(config_.injections.size());
-  std::vector<uint32_t> injectionAddress_ = std::vector<uint32_t>(config_.injections.size());
   int hitsAt(const Injection& in, uint32_t address) const {
     const auto& hits = robots_[static_cast<size_t>(in.robot)]->lineHits;
     const auto it = hits.find(address);
     return it == hits.end() ? 0 : it->second;
   }
-  bool betweenRounds_ = false;
-  // The run so far: runUntil stops between rounds and goes on later.
-  bool begun_ = false, over_ = false;
-  Tick roundStart_ = 0;  // the tick the current round began at
-  MatchResult result_;
-  Tick nextSample_ = 0;
-  uint64_t rounds_ = 0;
-  uint64_t subRounds_ = 0;  // sub-rounds after the first of each round
-  PartClock clock_;
 };
 
 }  // namespace simbot::scheduler::detail

@@ -14,66 +14,27 @@
 
 namespace simbot::scheduler::detail {
 
-namespace {
-
-// The match's cost table with this robot's controller's settings (profile
-// [controller]): its timer service, fast-forward unless it turns it off,
-// and its CPU revision (whose figures make a table of their own).
-vm::CostTable robotCosts(const vm::CostTable& costs, const ControllerKnobs& controller) {
-  vm::CostTable table = costs;
-  if (controller.cpu != costs.knobs.cpu) {
-    vm::CostKnobs knobs = costs.knobs;
-    knobs.cpu = controller.cpu;
-    table = vm::makeCostTable(knobs);
-  }
-  table.knobs.timerService = controller.timerService;
-  table.knobs.fastForward = costs.knobs.fastForward && controller.fastForward;
-  return table;
-}
-
-}  // namespace
-
 Robot::Robot(Match& m, int i, const RobotSpec& s, const vm::CostTable& costs, uint64_t seed)
     : spec(s),
       index(i),
-      match(m),
-      board(s.image, *this, robotCosts(costs, s.controller),
+      match(&m),
+      board(s.image, *this, costs,
             board::StreamSeeds{
                 streamSeed(seed, "memory-fill-" + s.name), streamSeed(seed, "eye-noise-" + s.name),
                 streamSeed(seed, "gun-" + s.name), streamSeed(seed, "muzzle-" + s.name),
                 streamSeed(seed, "dispersion-" + s.name)},
-            m.robotParams(i).random_memory),
+            s.controller),
       mainReturn(s.image.entry + static_cast<uint32_t>(vm::instructionSize(vm::Op::CALL))) {
   result.name = s.name;
   result.program = s.program;
   board.cpu.setBreakpoint(mainReturn);
-  if (match.profiling()) board.cpu.enableProfile();
+  if (m.profiling()) board.cpu.enableProfile();
 }
 
-Robot::Robot(const Robot& other, Match& m)
-    : reloadPending(other.reloadPending),
-      faultSeen(other.faultSeen),
-      debugLook(other.debugLook),
-      debugBreakpoints(other.debugBreakpoints),
-      lineInjections(other.lineInjections),
-      lineHits(other.lineHits),
-      watches(other.watches),
-      tickStart(other.tickStart),
-      snapshots(other.snapshots),
-      nextSnapshot(other.nextSnapshot),
-      spec(other.spec),
-      index(other.index),
-      match(m),
-      board(other.board, *this),
-      receiver(other.receiver),
-      serialEventAt(other.serialEventAt),
-      serialIsrAccepted(other.serialIsrAccepted),
-      serialIsrWatch(other.serialIsrWatch),
-      lastSend(other.lastSend),
-      sendBefore(other.sendBefore),
-      result(other.result),
-      mainReturn(other.mainReturn),
-      costates(other.costates) {}
+void Robot::attach(Match& m) {
+  match = &m;
+  board.attach(*this);
+}
 
 void Robot::reload(Tick t) {
   reloadPending = false;
@@ -89,22 +50,19 @@ void Robot::reload(Tick t) {
   // reloaded program's frames).
   receiver.clear();
   serialEventAt = -1;
-  // The reloaded program has read nothing: its first reading of each eye is
-  // an ad_read record even if the faulted program's last was the same.
-  board.lastAdValue = {-1, -1};
   // Samples up to t were taken from the faulted program: the reloaded one's start at
   // the next sample tick.
   snapshots.clear();
-  const Tick interval = match.sampleInterval();
+  const Tick interval = match->sampleInterval();
   nextSnapshot = (t / interval + 1) * interval;
-  if (match.tracing()) match.emit(t, trace::rec::Reload{index, result.reloads});
-  if (match.observer()) match.observer()->onReload(index, t);
+  if (match->tracing()) match->emit(t, trace::rec::Reload{index, result.reloads});
+  if (match->observer()) match->observer()->onReload(index, t);
 }
 
 void Robot::runTo(Tick horizon) {
-  DebugHook* hook = match.debugger();
-  if (hook && index == match.debugRobot()) return debugRunTo(horizon);
-  const bool tracing = match.tracing();
+  DebugHook* hook = match->debugger();
+  if (hook && index == match->debugRobot()) return debugRunTo(horizon);
+  const bool tracing = match->tracing();
   for (;;) {
     if (tracing) takeSnapshots();
     if (now() >= horizon) return;
@@ -113,7 +71,7 @@ void Robot::runTo(Tick horizon) {
     if (watched && board.cpu.effectPending()) {
       board.cpu.settle();
       if (board.cpu.fault()) return noteFault();
-      hook->otherBoundary(match, index);
+      hook->otherBoundary(*match, index);
       continue;
     }
     Tick until = tracing ? std::min(horizon, nextSnapshot) : horizon;
@@ -122,9 +80,9 @@ void Robot::runTo(Tick horizon) {
     if (stop == vm::Stop::Fault) return noteFault();
     if (stop == vm::Stop::Breakpoint) {
       noteBreakpoint();
-      if (hook) hook->otherBreakpoint(match, index);
+      if (hook) hook->otherBreakpoint(*match, index);
     }
-    if (watched) hook->otherBoundary(match, index);
+    if (watched) hook->otherBoundary(*match, index);
   }
 }
 
@@ -137,10 +95,10 @@ void Robot::noteFault() {
   FaultInfo info{f->message, timebase::secondsFromTicks(at), f->line, depth, calls};
   if (!result.fault) result.fault = info;
   result.faults.push_back(info);
-  if (match.tracing())
-    match.emit(at, trace::rec::Fault{index, f->message, f->line, depth, std::move(calls)});
-  if (match.observer()) match.observer()->onHalt(index, at);
-  match.faulted(index, at);
+  if (match->tracing())
+    match->emit(at, trace::rec::Fault{index, f->message, f->line, depth, std::move(calls)});
+  if (match->observer()) match->observer()->onHalt(index, at);
+  match->faulted(index, at);
   debugEvent(at, DebugEvent::Fault);
 }
 
@@ -148,13 +106,13 @@ void Robot::noteBreakpoint() {
   if (board.cpu.pc() == mainReturn) {
     result.exited = true;
     result.exitTick = now();
-    if (match.tracing()) match.emit(now(), trace::rec::Exit{index});
-    if (match.observer()) match.observer()->onHalt(index, now());
+    if (match->tracing()) match->emit(now(), trace::rec::Exit{index});
+    if (match->observer()) match->observer()->onHalt(index, now());
   }
   if (auto it = lineInjections.find(board.cpu.pc()); it != lineInjections.end()) {
     const int hit = ++lineHits[board.cpu.pc()];
     for (int k : it->second)
-      if (match.injection(k).count == hit) inject(now(), match.injection(k));
+      if (match->injection(k).count == hit) inject(now(), match->injection(k));
   }
 }
 
@@ -163,8 +121,8 @@ void Robot::noteBreakpoint() {
 // the debugger's tick or the next instruction when stepping. A halted VM
 // (main returned) is never stepped: its clock runs on without boundaries.
 void Robot::debugRunTo(Tick horizon) {
-  DebugHook& hook = *match.debugger();
-  const bool tracing = match.tracing();
+  DebugHook& hook = *match->debugger();
+  const bool tracing = match->tracing();
   for (;;) {
     if (tracing) takeSnapshots();
     if (now() >= horizon || board.cpu.fault()) return;
@@ -204,16 +162,16 @@ void Robot::look(DebugHook& hook) {
     board.cpu.settle();
     if (board.cpu.fault()) noteFault();
   }
-  match.bringOthersTo(index, hook.othersTo(now()));
-  hook.boundary(match);
+  match->bringOthersTo(index, hook.othersTo(now()));
+  hook.boundary(*match);
 }
 
 void Robot::debugEvent(Tick t, DebugEvent e) {
-  DebugHook* hook = match.debugger();
+  DebugHook* hook = match->debugger();
   if (!hook || !hook->event(index, t, e)) return;
-  Robot& held = match.debugged();
+  Robot& held = match->debugged();
   // Inside the held robot's own run: it stops at its next boundary.
-  if (&held == this && e != DebugEvent::Fault && !match.betweenRounds())
+  if (&held == this && e != DebugEvent::Fault && !match->betweenRounds())
     board.cpu.stopAtNextBoundary();
   else
     held.debugLook = true;
@@ -226,7 +184,7 @@ void Robot::takeSnapshots() {
     snapshots.push_back(Snapshot{nextSnapshot, board.cpu.line(),
                                  spec.image.functionAt(board.cpu.pc()),
                                  board.cpu.interruptDepth() > 0, watchedValues()});
-    nextSnapshot += match.sampleInterval();
+    nextSnapshot += match->sampleInterval();
   }
 }
 

@@ -17,32 +17,23 @@
 
 namespace simbot::scheduler::detail {
 
+// The board decodes its ports; port B and ENB485 are the host's to carry on.
 void Robot::out(Tick t, uint16_t port, uint8_t value) {
-  switch (port) {
-    case vm::kPortPIOCA:
-      board.pio.control(value);
-      return;
-    case vm::kPortPIODA:
-      board.pio.writeData(value);
-      return;
-    case vm::kPortPIODB:
-      match.inputs().push_back(
+  switch (board.out(port, value)) {
+    case board::PortWrite::PortB:
+      match->inputs().push_back(
           {t, index, PlantInput::Kind::PortB, value, plant::Bumper::Front, tracedWatch(t)});
-      if (match.tracing()) match.emit(t, trace::rec::PortB{index, value});
+      if (match->tracing()) match->emit(t, trace::rec::PortB{index, value});
       return;
-    case vm::kPortENB485:
-      if (match.tracing() && value != board.enb485) match.emit(t, trace::rec::Rs485{index, value});
-      board.enb485 = value;
+    case board::PortWrite::Enb485:
+      if (match->tracing()) match->emit(t, trace::rec::Rs485{index, value});
       return;
-    default:
-      return;  // PIOCB set-up and unknown ports have no effect here
+    case board::PortWrite::Done:
+      return;
   }
 }
 
-uint8_t Robot::in(Tick, uint16_t port) {
-  if (port == vm::kPortPIODA) return board.pio.read();
-  return 0xFF;
-}
+uint8_t Robot::in(Tick, uint16_t port) { return board.in(port); }
 
 int Robot::adSample(Tick t, int channel) {
   // Only the eye asked for is computed; the noise stream advances as for both.
@@ -50,17 +41,17 @@ int Robot::adSample(Tick t, int channel) {
                                    : channel == 1 ? plant::EyeChannels::Right
                                                   : plant::EyeChannels::Both;
   const plant::EyeReadings e = [&] {
-    const PartScope plant(match.clock(), PartClock::Plant);
-    return match.arena().eyeReadings(index, t, &board.eyeNoise, asked);
+    const PartScope plant(match->clock(), PartClock::Plant);
+    return match->arena().eyeReadings(index, t, &board.eyeNoise, asked);
   }();
   const int value = channel == 0 ? e.left : channel == 1 ? e.right : 0;
-  if (match.observer()) match.observer()->onEyeRead(index, t, channel, value);
+  if (match->observer()) match->observer()->onEyeRead(index, t, channel, value);
   if (channel == 0 || channel == 1) {
     // Traced as a step when it differs: a search loop reads thousands a second.
     const auto c = static_cast<size_t>(channel);
     ++board.adReads[c];
-    if (match.tracing() && value != board.lastAdValue[c])
-      match.emit(t, trace::rec::AdRead{index, channel, value, board.adReads[c]});
+    if (match->tracing() && value != board.lastAdValue[c])
+      match->emit(t, trace::rec::AdRead{index, channel, value, board.adReads[c]});
     board.lastAdValue[c] = value;
   }
   return value;
@@ -128,8 +119,8 @@ std::pair<std::string, int> Robot::faultChain() const {
 // path stays as short as it was.
 void Robot::traceSend(Tick t, int count) {
   SendSite site = sendSite(t);
-  match.emit(t, trace::rec::SerialSend{index, count, site.line, site.function, site.callerLine,
-                                       site.callerFunction, site.calls});
+  match->emit(t, trace::rec::SerialSend{index, count, site.line, site.function, site.callerLine,
+                                        site.callerFunction, site.calls});
   sendBefore = std::exchange(lastSend, std::move(site));
 }
 
@@ -137,22 +128,22 @@ void Robot::traceOverwrite(Tick t, const board::OverwrittenSend& overwritten) {
   // The overwritten send is the latest before this one; a snapshot or
   // reload that lost it leaves its lines 0.
   const SendSite before = sendBefore.t == overwritten.sentAt ? sendBefore : SendSite{};
-  match.emit(t, trace::rec::FrameOverwritten{
-                    index, overwritten.sentAt, overwritten.count, overwritten.fetched,
-                    lastSend.line, lastSend.function, lastSend.callerLine, lastSend.callerFunction,
-                    before.line, before.function, before.callerLine, before.callerFunction});
+  match->emit(t, trace::rec::FrameOverwritten{
+                     index, overwritten.sentAt, overwritten.count, overwritten.fetched,
+                     lastSend.line, lastSend.function, lastSend.callerLine, lastSend.callerFunction,
+                     before.line, before.function, before.callerLine, before.callerFunction});
 }
 
 void Robot::serialSend(Tick t, uint16_t buf, uint16_t cc) {
   // The call's effect (the library takes buf[0], *cc counts it) happens at
   // T0, so the records made at T0 carry the values from before it
   // (docs/trace.md, "watch"); the next boundary shows it.
-  if (match.tracing() && !watches.empty() && !(tickStart && tickStart->first == t))
+  if (match->tracing() && !watches.empty() && !(tickStart && tickStart->first == t))
     tickStart.emplace(t, watchedValues());
-  if (match.tracing()) traceSend(t, board.cpu.read8(cc));  // *cc as the program set it
+  if (match->tracing()) traceSend(t, board.cpu.read8(cc));  // *cc as the program set it
   if (const auto overwritten = board.serialSend(t, buf, cc)) {
     ++result.framesOverwritten;
-    if (match.tracing()) traceOverwrite(t, *overwritten);
+    if (match->tracing()) traceOverwrite(t, *overwritten);
   }
   scheduleSerial(t);
 }
@@ -168,11 +159,11 @@ void Robot::scheduleSerial(Tick) {
   const auto done = board.serial.nextByteDone();
   if (done && *done != serialEventAt) {
     serialEventAt = *done;
-    if (match.tracing())
-      match.emit(*done - timebase::kTicksPerChar,
-                 trace::rec::SerialByte{index, board.serial.shifting()});
-    match.queue().schedule(*done, EventClass::SerialByte,
-                           {QueuedEvent::Kind::SerialByte, index, 0});
+    if (match->tracing())
+      match->emit(*done - timebase::kTicksPerChar,
+                  trace::rec::SerialByte{index, board.serial.shifting()});
+    match->queue().schedule(*done, EventClass::SerialByte,
+                            {QueuedEvent::Kind::SerialByte, index, 0});
   }
 }
 
@@ -181,20 +172,20 @@ void Robot::byteDone(Tick t) {
   serialEventAt = -1;
   const std::optional<uint8_t> byte = board.serialByteDone(t);
   if (const auto frame = byte ? receiver.receive(*byte) : std::nullopt) {
-    if (match.observer()) match.observer()->onFrame(index, t, frame->command.has_value());
+    if (match->observer()) match->observer()->onFrame(index, t, frame->command.has_value());
     if (frame->command) {
       ++result.framesLatched;
-      const PartScope plant(match.clock(), PartClock::Plant);
-      match.arena().setWheels(index, *frame->command, t);
+      const PartScope plant(match->clock(), PartClock::Plant);
+      match->arena().setWheels(index, *frame->command, t);
       debugEvent(t, DebugEvent::FrameLatched);
     } else {
       ++result.framesRejected;
     }
-    if (match.tracing()) {
+    if (match->tracing()) {
       if (frame->command)
-        match.emit(t, trace::rec::FrameLatched{index, frame->bytes});
+        match->emit(t, trace::rec::FrameLatched{index, frame->bytes});
       else
-        match.emit(t, trace::rec::FrameRejected{index, frame->bytes});
+        match->emit(t, trace::rec::FrameRejected{index, frame->bytes});
     }
   }
   scheduleSerial(t);
@@ -221,7 +212,7 @@ trace::WatchValue Robot::expressionValue(const inspect::Expression& e) const {
 // Each watched variable's value as its C type reads it (the compiler's
 // vm::Symbol::Value; resolveWatches admits scalars only).
 trace::Watch Robot::tracedWatch(Tick t) const {
-  if (!match.tracing() || watches.empty()) return {};
+  if (!match->tracing() || watches.empty()) return {};
   return tickStart && tickStart->first == t ? tickStart->second : watchedValues();
 }
 
@@ -267,22 +258,22 @@ trace::Watch Robot::watchedValues() const {
 }
 
 void Robot::updateEdgeLines(Tick t) {
-  if (board.updateEdgeLines() && match.tracing())
-    match.emit(t, trace::rec::PortA{index, board.edgeLines});
+  if (board.updateEdgeLines() && match->tracing())
+    match->emit(t, trace::rec::PortA{index, board.edgeLines});
 }
 
 void Robot::inject(Tick t, const Injection& injection) {
-  match.fired(injection);
-  if (match.tracing())
-    match.emit(t, trace::rec::Injection{index, injection.text, board.cpu.line()});
+  match->fired(injection);
+  if (match->tracing())
+    match->emit(t, trace::rec::Injection{index, injection.text, board.cpu.line()});
   switch (injection.source) {
     case InjectSource::EdgeFore:
     case InjectSource::EdgeAft: {
       const uint8_t bit = injection.source == InjectSource::EdgeFore ? 0x02 : 0x01;
       board.injectedLow |= bit;
       updateEdgeLines(t);
-      match.queue().schedule(t + kInjectedEdgePulse, EventClass::Injection,
-                             {QueuedEvent::Kind::ReleaseEdge, index, bit});
+      match->queue().schedule(t + kInjectedEdgePulse, EventClass::Injection,
+                              {QueuedEvent::Kind::ReleaseEdge, index, bit});
       return;
     }
     case InjectSource::BumperFront:
@@ -292,10 +283,10 @@ void Robot::inject(Tick t, const Injection& injection) {
                                      : plant::Bumper::Back;
       // Between rounds (a time or tick) the plant takes it at once; at a
       // program point it waits for the end of the round with port B writes.
-      if (match.betweenRounds())
-        match.applyReflex(t, index, side);
+      if (match->betweenRounds())
+        match->applyReflex(t, index, side);
       else
-        match.inputs().push_back({t, index, PlantInput::Kind::Reflex, 0, side, tracedWatch(t)});
+        match->inputs().push_back({t, index, PlantInput::Kind::Reflex, 0, side, tracedWatch(t)});
       return;
     }
   }
@@ -303,7 +294,7 @@ void Robot::inject(Tick t, const Injection& injection) {
 
 void Robot::console(Tick t, std::string_view line) {
   result.console.emplace_back(line);
-  if (match.tracing()) match.emit(t, trace::rec::Console{index, std::string(line)});
+  if (match->tracing()) match->emit(t, trace::rec::Console{index, std::string(line)});
 }
 
 // The #INT_VEC handler the PIO's vector selects.
@@ -315,15 +306,15 @@ std::string Robot::handlerName() const {
 
 void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
   ++board.interruptCounts[static_cast<size_t>(irq)];
-  if (match.observer()) match.observer()->onInterruptAccepted(index, t, irq);
+  if (match->observer()) match->observer()->onInterruptAccepted(index, t, irq);
   if (irq == vm::Irq::Pio) {
     board.pio.accepted();
     debugEvent(t, DebugEvent::EdgeAccepted);
-    match.inputs().push_back(
+    match->inputs().push_back(
         {t, index, PlantInput::Kind::EdgeHandler, 0, plant::Bumper::Front, tracedWatch(t)});
   }
   // The BIOS timer service (1,024 a second) is counted, not traced.
-  if (!match.tracing() || irq == vm::Irq::Timer) return;
+  if (!match->tracing() || irq == vm::Irq::Timer) return;
   if (irq == vm::Irq::SerialTx) {
     // Traced as one span when it returns, with the values it found.
     serialIsrAccepted = t;
@@ -331,28 +322,28 @@ void Robot::interruptAccepted(Tick t, vm::Irq irq, uint32_t pc) {
     return;
   }
   const vm::Symbol* fn = spec.image.functionAt(pc);
-  match.emit(t, trace::rec::InterruptAccepted{index, std::string(vm::irqName(irq)),
-                                              spec.image.lineAt(pc), fn ? fn->name : "",
-                                              irq == vm::Irq::Pio ? handlerName() : ""});
+  match->emit(t, trace::rec::InterruptAccepted{index, std::string(vm::irqName(irq)),
+                                               spec.image.lineAt(pc), fn ? fn->name : "",
+                                               irq == vm::Irq::Pio ? handlerName() : ""});
 }
 
 void Robot::interruptReturned(Tick t, vm::Irq irq) {
   if (irq == vm::Irq::SerialTx) {
-    if (match.tracing())
-      match.emit(serialIsrAccepted, trace::rec::SerialIsr{index, t}, std::move(serialIsrWatch));
+    if (match->tracing())
+      match->emit(serialIsrAccepted, trace::rec::SerialIsr{index, t}, std::move(serialIsrWatch));
     return;
   }
   if (irq != vm::Irq::Pio) return;
-  if (match.tracing())
-    match.emit(t, trace::rec::InterruptReturned{index, std::string(vm::irqName(irq))});
+  if (match->tracing())
+    match->emit(t, trace::rec::InterruptReturned{index, std::string(vm::irqName(irq))});
   board.pioReturned();
 }
 
 void Robot::iffChanged(Tick t, bool iff1) {
-  if (match.tracing()) match.emit(t, trace::rec::Iff1{index, iff1});
+  if (match->tracing()) match->emit(t, trace::rec::Iff1{index, iff1});
 }
 
-bool Robot::wantCostateEvents() const { return match.tracingCostates(); }
+bool Robot::wantCostateEvents() const { return match->tracingCostates(); }
 
 // Only a change of state is recorded (trace/records.def, docs/trace.md).
 // A costatement rests between passes either waiting at the line it gave way
@@ -401,7 +392,7 @@ void Robot::costate(Tick t, uint16_t coData, CostateEvent e, int line) {
       break;
     }
   static constexpr const char* kEvent[] = {"enter", "yield", "end"};
-  match.emit(t, trace::rec::Costate{index, name, kEvent[static_cast<int>(e)], line});
+  match->emit(t, trace::rec::Costate{index, name, kEvent[static_cast<int>(e)], line});
 }
 
 }  // namespace simbot::scheduler::detail

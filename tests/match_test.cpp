@@ -261,7 +261,7 @@ TEST(Match, RandomPowerOnMemoryLeavesInitialisedDataAlone) {
       "}\n";
   auto run = [&](bool random, uint64_t seed) {
     auto c = matchConfig({{"A", "mem.dc", compileSource(kProgram)}}, 1);
-    c.arena.robots[0].params.random_memory = random;
+    c.robots[0].controller.randomMemory = random;
     c.stopWhenAllExited = true;
     c.seed = seed;
     const auto r = scheduler::runMatch(c);
@@ -445,7 +445,7 @@ TEST(Match, CostateHunterLatchesFramesWithRandomPowerOnMemory) {
   for (const uint64_t seed : {1u, 2u, 3u}) {
     SCOPED_TRACE(seed);
     auto c = matchConfig({{"A", hunter, compileFile(hunter)}}, 5);
-    c.arena.robots[0].params.random_memory = true;
+    c.robots[0].controller.randomMemory = true;
     c.seed = seed;
     const auto r = scheduler::runMatch(c);
     const auto& a = r.robots[0];

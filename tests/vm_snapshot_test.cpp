@@ -6,6 +6,7 @@
 // on the BIOS timer (PRT0's interrupt, TICK_TIMER).
 #include <gtest/gtest.h>
 
+#include <stdexcept>
 #include <string>
 
 #include "support/test_host.h"
@@ -81,6 +82,44 @@ TEST(VmSnapshot, ACopyGoesOnAsTheOriginalAndARestoreReplaysIt) {
     EXPECT_TRUE(copy == v);
     expectSameRun(host, firstRun);
   }
+}
+
+// The program (image, cost table, decode tables) is the VM's constant
+// half: every copy shares it, and a copy holds only the machine's state. A
+// breakpoint a copy sets is its own (its dispatch is copied then, not
+// before); a copy runs only once attached to a bus.
+TEST(VmSnapshot, ACopySharesTheProgramAndKeepsItsBreakpointsToItself) {
+  const vm::Image image = testkit::compileFileOrDie(SIMBOT_SHARED_DIR "/programs/iceman.dc");
+  TestHost host;
+  vm::Vm v(image, host, costs());
+  host.runUntil(v, kSecond / 2);
+  const vm::Vm unattached(v);
+  EXPECT_TRUE(unattached.sharesProgram(v));
+  EXPECT_TRUE(unattached == v);
+  vm::Vm idle(unattached);
+  EXPECT_THROW(idle.run(v.now() + 1), std::logic_error);
+  // Another VM of the same image decodes it again: the same machine, not
+  // the same program.
+  TestHost otherHost;
+  const vm::Vm other(image, otherHost, costs());
+  EXPECT_FALSE(other.sharesProgram(v));
+
+  // ICEMAN's main calls read() before its search: a breakpoint there.
+  uint32_t read = 0;
+  for (const vm::Symbol& s : image.symbols)
+    if (s.kind == vm::Symbol::Kind::Function && s.name == "read") read = s.address;
+  ASSERT_GT(read, 0u);
+  TestHost copyHost = host;
+  vm::Vm copy(v, copyHost);
+  copy.setBreakpoint(read);
+  EXPECT_TRUE(copy.sharesProgram(v));
+  ASSERT_EQ(copyHost.runUntil(copy, 30 * kSecond), vm::Stop::Breakpoint);
+  EXPECT_EQ(copy.pc(), read);
+  EXPECT_NE(host.runUntil(v, copy.now()), vm::Stop::Breakpoint);
+  // The original ran the same instructions up to there, and on past it.
+  host.runUntil(v, copy.now() + kSecond);
+  EXPECT_GT(v.now(), copy.now());
+  EXPECT_EQ(v.fault(), nullptr);
 }
 
 TEST(VmReset, IsTheMachineOfAVmPoweredOnThenWithTheCountersCarriedOn) {

@@ -29,7 +29,7 @@ namespace simbot::vm {
 [[gnu::always_inline]] inline void Vm::State::save(const Regs& r) {
   now = r.clk;
   pc = static_cast<uint32_t>(r.ip);
-  sp = r.esp;
+  eval.sp = r.esp;
   stats.instructions = r.count;
 }
 
@@ -52,7 +52,7 @@ namespace simbot::vm {
 // taken): charge the difference from the not-taken figure.
 template <Op O>
 [[gnu::always_inline]] inline void Vm::State::branch(Regs& r, unsigned path) {
-  r.charge(costs.branchDelta[static_cast<int>(O)][path]);
+  r.charge(costs().branchDelta[static_cast<int>(O)][path]);
 }
 
 // A 16-bit comparison as the Z180 code does it: the result, and the path
@@ -102,7 +102,7 @@ template <Op O, class Shift>
   if (n == 0) {
     branch<O>(r, 1u);
   } else if (n > 1) {
-    const uint32_t more = (n - 1) * costs.loopPass[static_cast<int>(O)];
+    const uint32_t more = (n - 1) * costs().loopPass[static_cast<int>(O)];
     if (r.profile) r.profile[r.opPc] += more;
     burn += more;
     burnPc = r.pc();
@@ -256,10 +256,10 @@ SIMBOT_INSTRUCTION(COPY) {
   // op[] + (n - 1) x ldirRepeat as the listing says, charged to the
   // profile here. Dispatch charged op[] (or its first kMaxStepTstates, the
   // rest in burn): take back what comes after the head.
-  const Tick start = r.clk - (costs.op[static_cast<int>(Op::COPY)] - burn);
+  const Tick start = r.clk - (costs().op[static_cast<int>(Op::COPY)] - burn);
   burn = 0;
-  r.clk = start + costs.copyHead;
-  if (r.profile) r.profile[r.opPc] += (n - 1) * costs.ldirRepeat;
+  r.clk = start + costs().copyHead;
+  if (r.profile) r.profile[r.opPc] += (n - 1) * costs().ldirRepeat;
   copy = BlockCopy{dst, src, n};
   burnPc = r.pc();
   r.limit = 0;
@@ -562,7 +562,7 @@ SIMBOT_INSTRUCTION(CALL) { return callTo(r, r.u16()); }
 SIMBOT_INSTRUCTION(CALLI) {
   const uint32_t target = r.pop() & 0xFFFF;
   const uint32_t argc = r.code[r.opPc + 1];
-  const Image::Entry* entry = image->entryAt(target);
+  const Image::Entry* entry = image().entryAt(target);
   if (!entry || entry->params != argc) return badCallThrough(r, target, argc);
   return callTo(r, target);
 }
@@ -584,11 +584,11 @@ SIMBOT_INSTRUCTION(RET) {
     return fail(r, "return with no caller");
   const CallFrame call = calls.back();
   calls.pop_back();
-  const int32_t frame = returnFrame[r.opPc];
+  const int32_t frame = program->returnFrame[r.opPc];
   const uint32_t fp = mfp;
   uint32_t readAt = msp;
   if (frame >= 0) {
-    r.charge(static_cast<int32_t>(costs.autoFrameRet));  // LD SP,IX; POP IX
+    r.charge(static_cast<int32_t>(costs().autoFrameRet));  // LD SP,IX; POP IX
     const uint32_t savedFp = (fp + static_cast<uint32_t>(frame)) & 0xFFFF;
     mfp = r.rd16(savedFp);
     readAt = (savedFp + kSavedFpBytes) & 0xFFFF;
@@ -615,7 +615,7 @@ SIMBOT_INSTRUCTION(RETI) {
     return false;
   }
   InterruptFrame& f = ints.back();
-  if (f.evalSp != sp && !diverted) {
+  if (f.evalSp != eval.sp && !diverted) {
     raiseFault("internal error: stack imbalance at RETI", r.pc());
     return false;
   }
@@ -639,8 +639,8 @@ SIMBOT_INSTRUCTION(RETI) {
   ints.pop_back();
   bus->interruptReturned(now, irq);
   // The epilogue's EI: IFF1 is set when the RETI after it ends.
-  if (costs.knobs.epilogueEi && !iff1) bus->iffChanged(now, true);
-  if (costs.knobs.epilogueEi) iff1 = iff2 = true;
+  if (costs().knobs.epilogueEi && !iff1) bus->iffChanged(now, true);
+  if (costs().knobs.epilogueEi) iff1 = iff2 = true;
   if (target != expected) {
     // A smashed frame: the robot goes where it leads, and what it was
     // doing at the interrupted point (a library call, a HALT) is dropped.
@@ -672,7 +672,7 @@ SIMBOT_INSTRUCTION(LIB) {
   save(r);
   const int id = r.code[r.opPc + 1];
   const int argc = r.code[r.opPc + 2];
-  if (id >= kLibCount || argc > kMaxLibArgs || argc > sp)
+  if (id >= kLibCount || argc > kMaxLibArgs || argc > eval.sp)
     raiseFault("invalid library call", r.pc());
   else
     libCall(static_cast<Lib>(id), argc, r.pc());
@@ -698,8 +698,8 @@ SIMBOT_INSTRUCTION(COSTATE) {
   if (!checkAccess(cd, kCoDataSize, r.pc())) return false;
   const uint8_t state = rd8(cd + kCoState);
   if (state & kCoStopped) {
-    now += costs.costateStoppedDelta;
-    if (r.profile) r.profile[r.opPc] += static_cast<uint64_t>(int64_t{costs.costateStoppedDelta});
+    now += costs().costateStoppedDelta;
+    if (r.profile) r.profile[r.opPc] += static_cast<uint64_t>(int64_t{costs().costateStoppedDelta});
     pc = end;
     return false;
   }
@@ -709,7 +709,7 @@ SIMBOT_INSTRUCTION(COSTATE) {
     // JR Z taken over JP (HL): the documented 84 T-states of a fresh entry.
     // (save(r) above copied the clock out of the registers: the delta goes
     // to `now`, which the boundary after this instruction runs on.)
-    const int32_t d = costs.branchDelta[static_cast<int>(Op::COSTATE)][2];
+    const int32_t d = costs().branchDelta[static_cast<int>(Op::COSTATE)][2];
     now += d;
     if (r.profile) r.profile[r.opPc] += static_cast<uint64_t>(int64_t{d});
   } else {
@@ -717,7 +717,7 @@ SIMBOT_INSTRUCTION(COSTATE) {
       raiseFault("costatement's resume address is corrupted (CoData checksum)", r.pc());
       return false;
     }
-    if (!std::binary_search(image->resumePoints.begin(), image->resumePoints.end(),
+    if (!std::binary_search(image().resumePoints.begin(), image().resumePoints.end(),
                             static_cast<uint16_t>(resume))) {
       raiseFault(fmt::format("costatement resumes at 0x{:04x}, not a yield point", resume), r.pc());
       return false;

@@ -172,16 +172,16 @@ void Vm::State::libCall(Lib id, int argc, uint32_t instructionPc) {
   lib.id = id;
   lib.pc = instructionPc;
   lib.argc = argc;
-  for (int k = argc - 1; k >= 0; --k) lib.args[k] = eval[--sp];
+  for (int k = argc - 1; k >= 0; --k) lib.args[k] = eval.pop();
   lib.index = 0;
   lib.remaining = 0;
   lib.result = 0;
-  uint32_t callCost = costs.libCall[static_cast<int>(id)];
+  uint32_t callCost = costs().libCall[static_cast<int>(id)];
   // abs: JP P is taken (the negation skipped) when the argument is not
   // negative (builtins.def); every other routine costs the same either way.
   if (id == Lib::ABS && asInt16(lib.args[0]) >= 0)
     callCost = static_cast<uint32_t>(static_cast<int32_t>(callCost) +
-                                     costs.libTakenDelta[static_cast<int>(id)]);
+                                     costs().libTakenDelta[static_cast<int>(id)]);
   // An atomic call (the serial library's DI ... restore idiom) runs its
   // whole sequence with no boundary inside; its effect happens at the next
   // boundary, before any interrupt can be accepted there.
@@ -204,15 +204,15 @@ void Vm::State::libBegin() {
     case Lib::AD_RD8:
       // Sampled at the start of the conversion, which then takes its time.
       lib.result = w(bus->adSample(now, static_cast<int>(asInt16(a[0]))));
-      lib.remaining = costs.adConversion;
+      lib.remaining = costs().adConversion;
       lib.active = lib.remaining > 0;
-      if (!lib.active) eval[sp++] = lib.result;
+      if (!lib.active) eval.push(lib.result);
       return;
     case Lib::OUTPORT:
       bus->out(now, static_cast<uint16_t>(a[0]), static_cast<uint8_t>(a[1]));
       return;
     case Lib::INPORT:
-      eval[sp++] = bus->in(now, static_cast<uint16_t>(a[0]));
+      eval.push(bus->in(now, static_cast<uint16_t>(a[0])));
       return;
     case Lib::SER_INIT_Z1:
       // The routine restores the caller's interrupt state (JP PO; EI): IFF1
@@ -234,11 +234,11 @@ void Vm::State::libBegin() {
       return;
     case Lib::ABS: {
       int16_t v = asInt16(a[0]);
-      eval[sp++] = w(v < 0 ? -v : v);
+      eval.push(w(v < 0 ? -v : v));
       return;
     }
     case Lib::FABS:
-      eval[sp++] = a[0] & 0x7FFFFFFFu;
+      eval.push(a[0] & 0x7FFFFFFFu);
       return;
     case Lib::SQRT:
     case Lib::SIN:
@@ -254,18 +254,18 @@ void Vm::State::libBegin() {
     case Lib::ATAN2:
     case Lib::POW:
     case Lib::FMOD:
-      eval[sp++] = std::bit_cast<uint32_t>(
-          mathLib(id, std::bit_cast<float>(a[0]), std::bit_cast<float>(a[1])));
+      eval.push(std::bit_cast<uint32_t>(
+          mathLib(id, std::bit_cast<float>(a[0]), std::bit_cast<float>(a[1]))));
       return;
     case Lib::DELAYMS:
     case Lib::DELAYSEC:
     case Lib::DELAYTICKS: {
       // DelayTicks' interval is an unsigned int; the others' a long.
-      const uint32_t timer = id == Lib::DELAYMS    ? image->timer.ms
-                             : id == Lib::DELAYSEC ? image->timer.sec
-                                                   : image->timer.tick;
+      const uint32_t timer = id == Lib::DELAYMS    ? image().timer.ms
+                             : id == Lib::DELAYSEC ? image().timer.sec
+                                                   : image().timer.tick;
       const auto interval = static_cast<int32_t>(id == Lib::DELAYTICKS ? a[1] & 0xFFFF : a[1]);
-      eval[sp++] = delayDone(a[0] & 0xFFFF, interval, timer, instructionPc) ? 1u : 0u;
+      eval.push(delayDone(a[0] & 0xFFFF, interval, timer, instructionPc) ? 1u : 0u);
       return;
     }
     case Lib::COBEGIN:
@@ -291,10 +291,10 @@ void Vm::State::libBegin() {
           wr8(cd + kCoState, state & ~kCoStopped);
           return;
         case Lib::ISCODONE:
-          eval[sp++] = (state & (kCoStopped | kCoInit)) == (kCoStopped | kCoInit) ? 1u : 0u;
+          eval.push((state & (kCoStopped | kCoInit)) == (kCoStopped | kCoInit) ? 1u : 0u);
           return;
         default:
-          eval[sp++] = (state & kCoStopped) ? 0u : 1u;
+          eval.push((state & kCoStopped) ? 0u : 1u);
           return;
       }
     }
@@ -342,7 +342,7 @@ void Vm::State::libBegin() {
 
 void Vm::State::libFinish(bool pushResult) {
   lib.active = false;
-  if (pushResult) eval[sp++] = lib.result;
+  if (pushResult) eval.push(lib.result);
 }
 
 // printf sends its characters one after the other over the debug port,
@@ -351,7 +351,7 @@ void Vm::State::libFinish(bool pushResult) {
 // sequence. lib.index counts those given to the console, which stamps a
 // line with the tick its newline went.
 uint32_t Vm::State::printfCharTstates() const {
-  return costs.libStep[static_cast<int>(Lib::PRINTF)] + costs.printfChar;
+  return costs().libStep[static_cast<int>(Lib::PRINTF)] + costs().printfChar;
 }
 
 // T-states until the next newline not yet sent has gone (a step ends
@@ -383,7 +383,7 @@ void Vm::State::printfSent() {
 // it has gone, not some bytes at a time.
 void Vm::State::libStep() {
   const int id = static_cast<int>(lib.id);
-  const uint32_t unit = std::max<uint32_t>(1, costs.libStepLooping[id]);
+  const uint32_t unit = std::max<uint32_t>(1, costs().libStepLooping[id]);
   constexpr uint32_t perStep = 1;
   const uint32_t* a = lib.args;
   ++stats.instructions;
@@ -553,7 +553,7 @@ void Vm::State::libStep() {
     ++done;
   }
   // Every unit loops back (its branch taken) but the routine's last.
-  const uint32_t last = costs.libStep[id];
+  const uint32_t last = costs().libStep[id];
   const uint32_t cost = done * unit - (finished && done > 0 ? unit - last : 0);
   now += cost;
   if (profiling) profile[lib.pc] += cost;

@@ -1,7 +1,9 @@
 // The VM's internal state, shared by its parts: the dispatch loop and
 // interrupt acceptance (vm.cpp), the library routines (library.cpp) and the
-// fast-forward of delay loops (fast_forward.cpp). Not part of the VM's
-// interface (vm.h): nothing outside vm/ includes it.
+// fast-forward of delay loops (fast_forward.cpp). It is the machine's state
+// only; what is decoded from the image is the Program (program.h), which
+// it shares. Not part of the VM's interface (vm.h): nothing outside vm/
+// includes it.
 #pragma once
 #include <fmt/format.h>
 
@@ -16,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "vm/program.h"
 #include "vm/superinstructions.h"
 #include "vm/vm.h"
 
@@ -110,6 +113,40 @@ struct InterruptFrame {
   BlockCopy copy;
   LibCall lib;
   bool operator==(const InterruptFrame&) const = default;
+};
+
+// The expression stack. A VM that runs holds all kEvalSlots slots (the
+// fast path pushes through a pointer, checking the guard only at its
+// boundaries); a copy holds only the slots in use, [0, sp) (nothing reads a
+// slot at or above sp before writing it), and a VM takes the full size
+// again before it runs (ready()).
+class EvalStack {
+ public:
+  EvalStack() : slots_(kEvalSlots, 0) {}
+  EvalStack(const EvalStack& other)
+      : sp(other.sp), slots_(other.slots_.begin(), other.slots_.begin() + other.sp) {}
+  EvalStack& operator=(const EvalStack& other) {
+    if (this != &other) {
+      sp = other.sp;
+      slots_.assign(other.slots_.begin(), other.slots_.begin() + other.sp);
+    }
+    return *this;
+  }
+  bool operator==(const EvalStack& other) const {
+    return sp == other.sp && std::equal(slots_.begin(), slots_.begin() + sp, other.slots_.begin());
+  }
+  void ready() {
+    if (slots_.size() < static_cast<size_t>(kEvalSlots)) slots_.resize(kEvalSlots, 0);
+  }
+  uint32_t* data() { return slots_.data(); }
+  uint32_t operator[](int i) const { return slots_[static_cast<size_t>(i)]; }
+  void push(uint32_t v) { slots_[static_cast<size_t>(sp++)] = v; }
+  uint32_t pop() { return slots_[static_cast<size_t>(--sp)]; }
+
+  int sp = 0;  // the next free slot
+
+ private:
+  std::vector<uint32_t> slots_;
 };
 
 [[gnu::always_inline]] inline float asFloat(uint32_t bits) { return std::bit_cast<float>(bits); }
@@ -248,16 +285,24 @@ struct Regs {
 };
 
 struct Vm::State {
-  State(const Image& img, Bus& b, const CostTable& c) : image(&img), bus(&b), costs(c) {}
+  State(std::shared_ptr<const Program> p, Bus* b)
+      : program(std::move(p)), dispatch(program->plain), bus(b) {}
 
-  // Pointers, not references, so that a State is a value: a copy of a VM
-  // is a copy of its State pointed at the copy's bus.
-  const Image* image;
+  // The constant half, shared by every copy; and the dispatch the loop
+  // runs: the program's, or this VM's with its breakpoints (shared by its
+  // copies until they change: Vm::setBreakpoint).
+  std::shared_ptr<const Program> program;
+  std::shared_ptr<const Dispatch> dispatch;
+  const CostTable& costs() const { return program->costs; }
+  const Image& image() const { return *program->image; }
+  static constexpr uint8_t kTrap = Program::kTrap;
+  // The bus it talks to and the VM that holds it: not part of its value
+  // (Vm's copy and assignment set them).
   Bus* bus;
-  CostTable costs;
+  Vm* self = nullptr;
+
   std::vector<uint8_t> mem = std::vector<uint8_t>(kMemorySize, 0);
-  std::vector<uint32_t> eval = std::vector<uint32_t>(kEvalSlots, 0);
-  int sp = 0;  // eval stack: next free slot
+  EvalStack eval;
   std::vector<CallFrame> calls;
   std::vector<InterruptFrame> ints;
   uint32_t pc = 0;
@@ -277,7 +322,6 @@ struct Vm::State {
   std::array<bool, kIrqCount> pend{};
   std::array<uint8_t, kIrqCount> vec{};
   bool anyPending = false;
-  std::array<int32_t, 256> handlerFor{};
   std::optional<Fault> fault;
   LibCall lib;
   // T-states still to run of an opcode longer than kMaxStepTstates (a CALL
@@ -296,58 +340,12 @@ struct Vm::State {
     copy.dst = (copy.dst + 1) & 0xFFFF;
     copy.src = (copy.src + 1) & 0xFFFF;
     --copy.left;
-    now += copy.left ? costs.ldirRepeat : costs.copyLast;
+    now += copy.left ? costs().ldirRepeat : costs().copyLast;
   }
   VmStats stats;
-  // The dispatch copy of the code (vm.cpp "Fast path"): per code address
-  // the opcode the fast path runs there, or kTrap where the slow path must
-  // look first (an invalid opcode, an instruction that runs past the end of
-  // the code or jumps outside it, a fast-forward loop top, a breakpoint),
-  // kCodePad kTrap bytes past the end.
-  // `padded` is the code with kCodePad zero bytes after it, for operands.
-  static constexpr uint8_t kTrap = kOpCount;
-  static constexpr uint32_t kCodePad = 8;
-  std::vector<uint8_t> dispatch;
-  std::vector<uint8_t> baseDispatch;  // without breakpoints
-  std::vector<uint8_t> padded;
-  void decode();
-  // `dispatch` as run<kProfile> reads it: per code address the handler's
-  // label, the opcode's cost and size (0 for kTrap) and the opcode, built
-  // at the first run of each (the labels are known only inside run()).
-  struct Fast {
-    const void* label;
-    uint32_t cost;
-    uint8_t op;
-    bool operator==(const Fast&) const = default;
-  };
-  std::array<std::vector<Fast>, 2> fast;
-  std::array<const void* const*, 2> fastLabels{};
-  // The superinstructions' labels (superinstructions.def), set by
-  // run<false>: its entry for a superinstruction's first piece jumps there.
-  const void* const* superLabels = nullptr;
-  // The superinstruction whose pieces start at `address` (each where the
-  // one before leads, all ordinary and none a trap in `dispatch`), or -1.
-  int superinstructionAt(uint32_t address) const;
-  // Per superinstruction, the most ticks its inner boundaries can lie after
-  // its first piece's dispatch (every piece at its slowest path), under
-  // this VM's cost table: when they all lie before the limit, nothing can
-  // happen at them (vm.cpp State::superinstruction).
-  std::array<uint32_t, kSuperCount> superSpan{};
-  // Per superinstruction and piece k, what the pieces after k cost on their
-  // not-taken paths ([0]: all but the first).
-  std::array<std::array<uint32_t, kMaxPieces>, kSuperCount> superAfter{};
-  void setSuperSpans();
   // A piece k of an unchecked run faulted: take back the time and count
   // charged in advance for the pieces after it.
   void unwindSuperinstruction(int kind, int k);
-  // The handler that starts an instruction longer than kMaxStepTstates on
-  // the fast path.
-  std::array<const void*, 2> longLabels{};
-  void setFast(int k, uint32_t address);
-  // A REL16 instruction's target, from its start (in the padded code).
-  int64_t relTargetAt(uint32_t address) const;
-  std::vector<uint8_t> breakpoints;  // one flag per code byte
-  bool anyBreakpoint = false;
   bool resumeAtBreakpoint = false;
   bool profiling = false;
   std::vector<uint64_t> profile;
@@ -361,46 +359,31 @@ struct Vm::State {
   uint32_t biosTicks = 0;
   uint8_t biosMsFraction = 0;
   bool costateEvents = false;
-  // ---- fast-forward of delay loops ----
-  struct Loop {
-    uint32_t top, exit, counter;
-    uint32_t limit;
-    bool wide;       // a long counter
-    bool isSigned;   // LTW, LEW, LTL, LEL
-    bool inclusive;  // <=
-    // A breakpoint inside turns fast-forward off (kept by setBreakpoint, so
-    // that no arrival scans the loop's bytes).
-    bool breakpointInside = false;
-    // The cost of a pass in the constant-cost regime, once measured (0
-    // until then): every pass there costs the same.
-    Tick pass = 0;
-    bool operator==(const Loop&) const = default;
-  };
-  std::vector<Loop> loops;
-  std::vector<int16_t> loopAtTop;  // per code byte: index into loops, or -1
+  // ---- fast-forward of delay loops (Program::loops) ----
+  // Per loop, the cost of a pass in the constant-cost regime, once
+  // measured (0 until then): every pass there costs the same.
+  std::vector<Tick> loopPass = std::vector<Tick>(program->loops.size(), 0);
   // The pass being measured: from one arrival at a loop's top to the next.
-  static constexpr uint32_t kMaxLoopBytes = 32;
   struct Measure {
     int loop = -1;
     Tick start = 0;
     uint32_t counter = 0;
     uint64_t instructions = 0;
     uint64_t accepted = 0;
-    std::array<uint64_t, kMaxLoopBytes> profile{};
+    std::array<uint64_t, Program::kMaxLoopBytes> profile{};
     bool operator==(const Measure&) const = default;
   } measure;
   uint64_t acceptances = 0;  // interrupts accepted so far (a pass with one is no measure)
-  void findLoops();
   bool fastForward(Tick until);
   Tick quietUntil() const;
   std::string consoleLine;
-  Vm* self = nullptr;
   // The machine at power-on at tick `start` (the constructor's and a
-  // reset's): image, bus and costs as they are.
+  // reset's): memory as the image initialises it, the program at its entry.
   void powerOn(Tick start);
-  // Points a copied State at its VM and that VM's bus.
-  void attach(Vm* vm, Bus& to);
-  void reserveStacks();
+  // Room to run: the expression stack's full size and the stacks' deepest
+  // nesting, so that no push on the hot path allocates (a copy holds what
+  // is in use only).
+  void ready();
   // The run's counters (stats, profile, interrupt service cycles): they
   // carry on over a reset.
   void copyCounters(const State& from);
@@ -410,12 +393,12 @@ struct Vm::State {
   void raiseFault(std::string message, uint32_t atPc) {
     if (fault) return;
     if (diverted) {
-      const Symbol* f = image->functionAt(diverted->at);
+      const Symbol* f = image().functionAt(diverted->at);
       message += fmt::format(" (after the return at 0x{:04X}{} went to 0x{:04X}, off its call)",
                              diverted->at, f ? fmt::format(" in '{}'", f->name) : std::string(),
                              diverted->target);
     }
-    fault = Fault{std::move(message), now, image->lineAt(atPc), atPc};
+    fault = Fault{std::move(message), now, image().lineAt(atPc), atPc};
   }
   // Checks a pointer access of `size` bytes; false (and a fault) if invalid.
   bool checkAccess(uint32_t address, uint32_t size, uint32_t atPc) {
@@ -473,7 +456,7 @@ struct Vm::State {
   void timerService(uint32_t interruptedPc);
   // ---- costatements ----
   void costateEvent(uint32_t coData, Bus::CostateEvent kind, uint32_t atPc) {
-    if (costateEvents) bus->costate(now, static_cast<uint16_t>(coData), kind, image->lineAt(atPc));
+    if (costateEvents) bus->costate(now, static_cast<uint16_t>(coData), kind, image().lineAt(atPc));
   }
   // CoData's ChkSum: the XOR of the resume address's three bytes.
   static uint8_t coChecksum(uint32_t resume, uint8_t cbr) {
@@ -524,10 +507,7 @@ struct Vm::State {
   void divert(uint32_t at, uint32_t target);
   // Where a smashed return address may lead: instruction starts, but not
   // the reset address.
-  std::vector<uint8_t> instructionStart;
   std::string returnTargetProblem(uint32_t target) const;
-  // Per RET, the auto frame it releases, or -1 (Image::returnFrames).
-  std::vector<int32_t> returnFrame;
   bool callTo(Regs& r, uint32_t target);
   bool access(const Regs& r, uint32_t address, uint32_t bytes);
   template <Op O>

@@ -33,6 +33,7 @@
 #include <cstdio>
 #include <cstring>
 #include <optional>
+#include <stdexcept>
 
 namespace simbot::vm {
 
@@ -64,13 +65,13 @@ void Vm::State::accept() {
   if (irq == Irq::SerialTx) {
     // The serial library's own ISR: short and atomic, leaves IFF1 set.
     bus->interruptAccepted(now, irq, interruptedPc);
-    now += costs.serialIsr;
-    serialIsrCycles += costs.serialIsr;
+    now += costs().serialIsr;
+    serialIsrCycles += costs().serialIsr;
     bus->serialTxService(now, *self);
     bus->interruptReturned(now, irq);
     return;
   }
-  const int32_t handler = handlerFor[vec[i]];
+  const int32_t handler = program->handlerFor[vec[i]];
   if (handler < 0) {
     raiseFault(fmt::format("{} interrupt through vector 0x{:02x}, which no #INT_VEC binds",
                            irqName(irq), vec[i]),
@@ -85,7 +86,7 @@ void Vm::State::accept() {
     raiseFault("stack overflow (interrupt frame)", interruptedPc);
     return;
   }
-  ints.push_back(InterruptFrame{pc, irq, msp, sp, static_cast<int>(calls.size()), halted, burn,
+  ints.push_back(InterruptFrame{pc, irq, msp, eval.sp, static_cast<int>(calls.size()), halted, burn,
                                 burnPc, copy, std::move(lib)});
   // The frame's PC and IX, as the handler's prologue pushed them (the other
   // registers' slots keep what they held: the VM has no AF, BC, DE, HL, IY).
@@ -100,8 +101,8 @@ void Vm::State::accept() {
   iff1 = iff2 = false;
   bus->interruptAccepted(now, irq, interruptedPc);
   bus->iffChanged(now, false);
-  now += costs.interruptAccept;
-  if (profiling) profile[handler] += costs.interruptAccept;
+  now += costs().interruptAccept;
+  if (profiling) profile[handler] += costs().interruptAccept;
   pc = static_cast<uint32_t>(handler);
 }
 
@@ -110,7 +111,7 @@ void Vm::State::accept() {
 // IFF1 set as it was at acceptance.
 void Vm::State::timerService(uint32_t interruptedPc) {
   bus->interruptAccepted(now, Irq::Timer, interruptedPc);
-  const TimerBlock& tb = image->timer;
+  const TimerBlock& tb = image().timer;
   const uint32_t ticks = (tb.used() ? rd32(tb.tick) : biosTicks) + 1;
   const uint32_t fraction = (tb.used() ? rd8(tb.msFraction) : biosMsFraction) + kMsFractionStep;
   const bool msDue = fraction >= kMsFractionOne;
@@ -125,7 +126,7 @@ void Vm::State::timerService(uint32_t interruptedPc) {
     biosTicks = ticks;
     biosMsFraction = newFraction;
   }
-  const uint32_t cost = costs.timerIsr[(msDue ? 0u : 1u) | (secDue ? 0u : 2u)];
+  const uint32_t cost = costs().timerIsr[(msDue ? 0u : 1u) | (secDue ? 0u : 2u)];
   now += cost;
   timerIsrCycles += cost;
   bus->interruptReturned(now, Irq::Timer);
@@ -174,12 +175,12 @@ bool Vm::State::badCallThrough(const Regs& r, uint32_t target, uint32_t argc) {
   std::string message;
   if (target == 0) {
     message = "call through a null function pointer";
-  } else if (const Image::Entry* entry = image->entryAt(target)) {
-    const Symbol* f = image->functionAt(target);
+  } else if (const Image::Entry* entry = image().entryAt(target)) {
+    const Symbol* f = image().functionAt(target);
     message = fmt::format("call through a pointer to '{}' with {} argument{}; it takes {}",
                           f ? f->name : "?", argc, argc == 1 ? "" : "s", entry->params);
   } else {
-    const Symbol* f = image->functionAt(target);
+    const Symbol* f = image().functionAt(target);
     message = fmt::format(
         "call through a pointer to 0x{:04X}, which is not the start of a function", target);
     if (f && target < f->address + f->size) message += fmt::format(" (it is inside '{}')", f->name);
@@ -192,10 +193,11 @@ bool Vm::State::badCallThrough(const Regs& r, uint32_t target, uint32_t argc) {
 // first byte, where the chip would simply run on, except the reset address
 // (the chip would start its BIOS again, which simbot does not model).
 std::string Vm::State::returnTargetProblem(uint32_t target) const {
+  const std::vector<uint8_t>& instructionStart = program->instructionStart;
   if (target >= instructionStart.size()) return "outside the code";
-  if (target == image->entry) return "the reset address";
+  if (target == image().entry) return "the reset address";
   if (!instructionStart[target]) {
-    const Symbol* f = image->functionAt(target);
+    const Symbol* f = image().functionAt(target);
     return f ? fmt::format("inside an instruction of '{}'", f->name)
              : std::string("inside an instruction");
   }
@@ -215,8 +217,8 @@ void Vm::State::divert(uint32_t at, uint32_t target) {
 // the function, where the word was read and what the call had saved.
 bool Vm::State::divertedReturn(Regs& r, const CallFrame& call, uint32_t target, uint32_t readAt,
                                int32_t frame, uint32_t fp) {
-  const Symbol* callee = image->functionAt(r.pc());
-  const Symbol* caller = image->functionAt(call.retPc);
+  const Symbol* callee = image().functionAt(r.pc());
+  const Symbol* caller = image().functionAt(call.retPc);
   const std::string name = callee ? fmt::format("'{}'", callee->name) : std::string("a function");
   // IX was not the frame's (a saved IX that a callee restored had been
   // overwritten): the saved IX and return address were read elsewhere.
@@ -260,77 +262,6 @@ bool Vm::State::divertedReturn(Regs& r, const CallFrame& call, uint32_t target, 
   return false;
 }
 
-int64_t Vm::State::relTargetAt(uint32_t address) const {
-  return int64_t{address} + 3 + static_cast<int16_t>(le16(&padded[address + 1]));
-}
-
-void Vm::State::decode() {
-  const auto& code = image->code;
-  const auto size = static_cast<uint32_t>(code.size());
-  padded = code;
-  padded.resize(size + kCodePad, 0);
-  returnFrame = image->returnFrames();
-  // The code is instructions end to end (the compiler puts no data in it).
-  instructionStart.assign(size, 0);
-  for (uint32_t a = 0; a < size;) {
-    instructionStart[a] = 1;
-    a += code[a] < kOpCount ? static_cast<uint32_t>(instructionSize(static_cast<Op>(code[a]))) : 1;
-  }
-  baseDispatch.assign(size + kCodePad, kTrap);
-  for (uint32_t a = 0; a < size; ++a) {
-    const uint8_t b = code[a];
-    if (b >= kOpCount) continue;
-    const Op op = static_cast<Op>(b);
-    if (a + static_cast<uint32_t>(instructionSize(op)) > size) continue;
-    if ((op == Op::JMP || op == Op::JZ || op == Op::JNZ) &&
-        (relTargetAt(a) < 0 || relTargetAt(a) >= size))
-      continue;
-    if (op == Op::CALL && static_cast<uint32_t>(padded[a + 1] | (padded[a + 2] << 8)) >= size)
-      continue;
-    baseDispatch[a] = b;
-  }
-  if (costs.knobs.fastForward)
-    for (const Loop& loop : loops) baseDispatch[loop.top] = kTrap;
-  dispatch = baseDispatch;
-  setSuperSpans();
-}
-
-int Vm::State::superinstructionAt(uint32_t address) const {
-  const auto end = static_cast<uint32_t>(dispatch.size());
-  for (int i = 0; i < kSuperCount; ++i) {
-    const SuperShape& shape = kSuperShapes[i];
-    uint32_t a = address;
-    int k = 0;
-    for (; k < shape.n; ++k) {
-      const auto o = static_cast<uint8_t>(shape.pieces[k]);
-      // The first piece is dispatched as usual: it must be an ordinary one.
-      if (a >= end || dispatch[a] != o || (k == 0 && costs.op[o] > kMaxStepTstates)) break;
-      // decode() made a JMP or CALL out of the code a trap: its target is in it.
-      if (shape.pieces[k] == Op::JMP)
-        a = static_cast<uint32_t>(relTargetAt(a));
-      else if (shape.pieces[k] == Op::CALL)
-        a = le16(&padded[a + 1]);
-      else
-        a += static_cast<uint32_t>(instructionSize(shape.pieces[k]));
-    }
-    if (k == shape.n) return i;
-  }
-  return -1;
-}
-
-void Vm::State::setFast(int k, uint32_t address) {
-  const uint8_t o = dispatch[address];
-  const bool trap = o == kTrap;
-  const bool isLong = !trap && costs.op[o] > kMaxStepTstates;
-  const void* label = isLong ? longLabels[k] : fastLabels[k][o];
-  if (k == 0 && superLabels && !trap && !isLong) {
-    const int s = superinstructionAt(address);
-    if (s >= 0) label = superLabels[s];
-  }
-  const uint32_t cost = trap ? 0u : isLong ? kMaxStepTstates : costs.op[o];
-  fast[k][address] = Fast{label, cost, o};
-}
-
 // One instruction's handler: past the instruction, then its effect.
 template <Op O>
 [[gnu::always_inline]] inline bool Vm::State::step(Regs& r) {
@@ -338,26 +269,8 @@ template <Op O>
   return exec<O>(r);
 }
 
-void Vm::State::setSuperSpans() {
-  auto slowest = [&](Op op) {
-    const auto o = static_cast<int>(op);
-    return std::max(0, *std::max_element(costs.branchDelta[o].begin(), costs.branchDelta[o].end()));
-  };
-  for (int i = 0; i < kSuperCount; ++i) {
-    const SuperShape& shape = kSuperShapes[i];
-    uint32_t span = static_cast<uint32_t>(slowest(shape.pieces[0]));
-    for (int k = 1; k < shape.n; ++k)
-      span += costs.op[static_cast<int>(shape.pieces[k])] +
-              static_cast<uint32_t>(slowest(shape.pieces[k]));
-    superSpan[i] = span;
-    superAfter[i] = {};
-    for (int k = shape.n - 2; k >= 0; --k)
-      superAfter[i][k] = superAfter[i][k + 1] + costs.op[static_cast<int>(shape.pieces[k + 1])];
-  }
-}
-
 void Vm::State::unwindSuperinstruction(int kind, int k) {
-  const uint32_t later = superAfter[kind][k];
+  const uint32_t later = program->superAfter[kind][k];
   now -= later;
   if (fault) fault->tick -= later;
   stats.instructions -= static_cast<uint64_t>(kSuperShapes[kind].n - 1 - k);
@@ -385,7 +298,7 @@ template <Op O>
   }
   r.opPc = r.ip;
   ++r.count;
-  const uint32_t cost = costs.op[static_cast<int>(O)];
+  const uint32_t cost = costs().op[static_cast<int>(O)];
   if (cost <= kMaxStepTstates) {
     r.clk += cost;
     return step<O>(r);
@@ -431,7 +344,7 @@ template <int kKind, Op First, Op... Rest, size_t... kPieces>
   for (int k = 0; k < kReach.below; ++k) window[k] = base[k];
   r.e = window;
   r.esp = kReach.below;
-  r.clk += superAfter[kKind][0];
+  r.clk += program->superAfter[kKind][0];
   r.count += sizeof...(Rest);
   const bool ran = uncheckedPiece<kKind, 0, First>(r) &&
                    (uncheckedPiece<kKind, static_cast<int>(kPieces) + 1, Rest>(r) && ...);
@@ -439,7 +352,7 @@ template <int kKind, Op First, Op... Rest, size_t... kPieces>
     for (int k = 0; k < kReach.below + kReach.net; ++k) base[k] = window[k];
   } else {  // a fault: as it stands, with the depth it saved
     for (int k = 0; k < kReach.below + kReach.above; ++k) base[k] = window[k];
-    sp = entry - kReach.below + r.esp;
+    eval.sp = entry - kReach.below + r.esp;
   }
   r.e = stack;
   r.esp = entry - kReach.below + r.esp;
@@ -455,9 +368,9 @@ template <int kKind, Op First, Op... Rest, size_t... kPieces>
 template <int kKind, Op First, Op... Rest>
 [[gnu::always_inline]] inline bool Vm::State::superinstruction(Regs& r) {
   constexpr StackReach kReach = stackReach({First, Rest...});
-  if (__builtin_expect(
-          r.clk + superSpan[kKind] < r.limit && r.esp <= kEvalSlots - kEvalHeadroom - kReach.above,
-          1))
+  if (__builtin_expect(r.clk + program->superSpan[kKind] < r.limit &&
+                           r.esp <= kEvalSlots - kEvalHeadroom - kReach.above,
+                       1))
     return unchecked<kKind, First, Rest...>(r, std::make_index_sequence<sizeof...(Rest)>{});
   return step<First>(r) && (piece<Rest>(r) && ...);
 }
@@ -476,22 +389,20 @@ Stop Vm::State::run(Tick until) {
 #include "vm/superinstructions.def"
 #undef SUPER
   };
-  constexpr int kRun = kProfile ? 1 : 0;
-  if (fast[kRun].empty()) {
-    fastLabels[kRun] = kLabels;
-    longLabels[kRun] = &&L_Long_;
-    // The profiling run never fuses: its profile is per instruction.
-    if (!kProfile) superLabels = kSuperLabels;
-    fast[kRun].resize(dispatch.size());
-    for (uint32_t a = 0; a < dispatch.size(); ++a) setFast(kRun, a);
-  }
-  const Fast* const fd = fast[kRun].data();
-  const uint8_t* const code = padded.data();
-  const auto codeSize = static_cast<uint32_t>(image->code.size());
+  const Program& prog = *program;
+  const Fast* const fd =
+      dispatch->fast(kProfile ? 1 : 0, prog,
+                     // The profiling run never fuses: its profile is per
+                     // instruction.
+                     Labels{kLabels, &&L_Long_, kProfile ? nullptr : kSuperLabels});
+  const uint8_t* const code = prog.padded.data();
+  const auto codeSize = static_cast<uint32_t>(prog.image->code.size());
   const int16_t* const loopTop =
-      costs.knobs.fastForward && !loopAtTop.empty() ? loopAtTop.data() : nullptr;
-  Regs r{now, 0,           stats.instructions, pc,   pc,
-         sp,  eval.data(), mem.data(),         code, kProfile ? profile.data() : nullptr};
+      prog.costs.knobs.fastForward && !prog.loopAtTop.empty() ? prog.loopAtTop.data() : nullptr;
+  const uint8_t* const ops = dispatch->ops().data();
+  ready();
+  Regs r{now,     0,           stats.instructions, pc,   pc,
+         eval.sp, eval.data(), mem.data(),         code, kProfile ? profile.data() : nullptr};
   Tick longLimit = -1;  // L_Long_: the limit its instruction's tail runs to
   uint8_t op = 0;
   hostStop = false;
@@ -515,7 +426,7 @@ Stop Vm::State::run(Tick until) {
 
 boundary:
   if (fault) return Stop::Fault;
-  if (sp > kEvalSlots - kEvalGuard) {
+  if (eval.sp > kEvalSlots - kEvalGuard) {
     raiseFault("expression stack overflow (too many arguments or values pending)", pc);
     goto boundary;
   }
@@ -565,7 +476,7 @@ boundary:
     raiseFault(fmt::format("jump outside the program (0x{:04x})", pc), pc);
     goto boundary;
   }
-  if (anyBreakpoint && breakpoints[pc] && !resumeAtBreakpoint) {
+  if (dispatch->anyBreakpoint() && dispatch->breakpointAt(pc) && !resumeAtBreakpoint) {
     resumeAtBreakpoint = true;
     return Stop::Breakpoint;
   }
@@ -576,34 +487,33 @@ boundary:
     raiseFault(fmt::format("invalid opcode {}", op), pc);
     goto boundary;
   }
-  if (diverted && sp < slotsTaken(static_cast<Op>(op), code + pc)) {
+  if (diverted && eval.sp < slotsTaken(static_cast<Op>(op), code + pc)) {
     raiseFault("expression stack underflow", pc);
     goto boundary;
   }
-  if (costs.op[op] <= kMaxStepTstates) {
-    now += costs.op[op];
+  if (costs().op[op] <= kMaxStepTstates) {
+    now += costs().op[op];
   } else {
     now += kMaxStepTstates;
-    burn = costs.op[op] - kMaxStepTstates;
+    burn = costs().op[op] - kMaxStepTstates;
     burnPc = pc;
   }
-  if constexpr (kProfile) profile[pc] += costs.op[op];
+  if constexpr (kProfile) profile[pc] += costs().op[op];
   ++stats.instructions;
   eiShadow = false;
   // The boundary after this instruction is slow too when anything rare is
   // due there (see "Fast path").
-  r = Regs{now,
-           dispatch[pc] == kTrap || burn || (anyPending && iff1) || diverted
-               ? 0
-               : std::min(until, nextTimer),
-           stats.instructions,
-           pc,
-           pc,
-           sp,
-           eval.data(),
-           mem.data(),
-           code,
-           kProfile ? profile.data() : nullptr};
+  r = Regs{
+      now,
+      ops[pc] == kTrap || burn || (anyPending && iff1) || diverted ? 0 : std::min(until, nextTimer),
+      stats.instructions,
+      pc,
+      pc,
+      eval.sp,
+      eval.data(),
+      mem.data(),
+      code,
+      kProfile ? profile.data() : nullptr};
   goto* kLabels[op];
 
   // One handler per opcode, and one per superinstruction.
@@ -635,7 +545,7 @@ slowNext:
 
 L_Long_ : {
   op = fd[r.opPc].op;
-  const uint32_t rest = costs.op[op] - kMaxStepTstates;
+  const uint32_t rest = costs().op[op] - kMaxStepTstates;
   if constexpr (kProfile) profile[r.opPc] += rest;
   burn = rest;
   burnPc = r.pc();
@@ -657,41 +567,48 @@ L_Trap_ : {  // the slow boundary looks first (see "Fast path")
 // ---- public interface ---------------------------------------------------
 
 Vm::Vm(const Image& image, Bus& bus, const CostTable& costs, Tick start)
-    : s_(std::make_unique<State>(image, bus, costs)) {
+    : s_(std::make_unique<State>(std::make_shared<const Program>(image, costs), &bus)) {
   s_->self = this;
+  s_->costateEvents = bus.wantCostateEvents();
   s_->powerOn(start);
 }
 
 void Vm::State::powerOn(Tick start) {
-  std::copy(image->data.begin(), image->data.end(), mem.begin() + kDataBase);
-  stackLimit = kDataBase + static_cast<uint32_t>(image->data.size());
-  pc = image->entry;
+  std::copy(image().data.begin(), image().data.end(), mem.begin() + kDataBase);
+  stackLimit = kDataBase + static_cast<uint32_t>(image().data.size());
+  pc = image().entry;
   now = start;
-  handlerFor.fill(-1);
-  for (const auto& v : image->vectors) handlerFor[v.vector] = v.handler;
-  reserveStacks();
-  const TimerService service = costs.knobs.timerService;
-  if (service == TimerService::Always || (service == TimerService::Auto && image->timer.used()))
+  const TimerService service = costs().knobs.timerService;
+  if (service == TimerService::Always || (service == TimerService::Auto && image().timer.used()))
     nextTimer = start + kPrtTicks;
-  costateEvents = bus->wantCostateEvents();
-  findLoops();
-  decode();
 }
 
-Vm::Vm(const Vm& other, Bus& bus) : s_(std::make_unique<State>(*other.s_)) {
-  s_->attach(this, bus);
+Vm::Vm(const Vm& other) : s_(std::make_unique<State>(*other.s_)) {
+  s_->bus = nullptr;
+  s_->self = this;
 }
 
-void Vm::State::attach(Vm* vm, Bus& to) {
-  self = vm;
-  bus = &to;
-  costateEvents = to.wantCostateEvents();
-  // A copied vector keeps its size, not its room.
-  reserveStacks();
+Vm::Vm(const Vm& other, Bus& bus) : Vm(other) { attach(bus); }
+
+Vm& Vm::operator=(const Vm& other) {
+  if (this != &other) {
+    Bus* const bus = s_->bus;
+    *s_ = *other.s_;
+    s_->bus = bus;
+    s_->self = this;
+    if (bus) s_->costateEvents = bus->wantCostateEvents();
+  }
+  return *this;
 }
 
-// Room for the deepest nesting, so that no push on the hot path allocates.
-void Vm::State::reserveStacks() {
+void Vm::attach(Bus& bus) {
+  s_->bus = &bus;
+  s_->costateEvents = bus.wantCostateEvents();
+}
+
+void Vm::State::ready() {
+  if (!bus) throw std::logic_error("a copied VM runs only once attached to a bus (Vm::attach)");
+  eval.ready();
   calls.reserve(kMemorySize / kReturnAddressBytes);
   ints.reserve(kMaxInterruptNesting);
 }
@@ -705,41 +622,37 @@ void Vm::State::copyCounters(const State& from) {
 
 Vm::~Vm() = default;
 
-void Vm::restore(const Vm& snapshot) {
-  Bus& bus = *s_->bus;
-  *s_ = *snapshot.s_;
-  s_->attach(this, bus);
-}
+void Vm::restore(const Vm& snapshot) { *this = snapshot; }
 
 void Vm::reset(Tick t) {
   const State& old = *s_;
-  auto fresh = std::make_unique<State>(*old.image, *old.bus, old.costs);
-  fresh->self = this;
-  fresh->powerOn(t);
-  fresh->profiling = old.profiling;
-  fresh->copyCounters(old);
-  const std::vector<uint8_t> breakpoints = old.breakpoints;
-  s_ = std::move(fresh);
-  for (uint32_t a = 0; a < breakpoints.size(); ++a)
-    if (breakpoints[a]) setBreakpoint(a);
+  State fresh(old.program, old.bus);
+  // The breakpoints stay, and the bus's wishes.
+  fresh.dispatch = old.dispatch;
+  fresh.self = this;
+  fresh.costateEvents = old.costateEvents;
+  fresh.powerOn(t);
+  fresh.profiling = old.profiling;
+  fresh.copyCounters(old);
+  *s_ = std::move(fresh);
 }
 
 namespace {
 
 // A copy of `mine` for comparing with `other`: what is not the machine's
-// state taken from `other`. The bus it talks to, and the caches a run
-// builds from the image, the breakpoints and run()'s labels (the fast
-// path's tables, built at the first run of each kind: a VM that has not
-// run yet is the same machine as one that has run nothing).
+// state taken from `other`. The bus it talks to, and the program when it
+// is the same image decoded for the same costs by another VM (with the
+// same breakpoints, the same dispatch).
 Vm::State comparable(const Vm::State& mine, const Vm::State& other) {
   Vm::State copy = mine;
   copy.bus = other.bus;
   copy.self = other.self;
   copy.costateEvents = other.costateEvents;
-  copy.fast = other.fast;
-  copy.fastLabels = other.fastLabels;
-  copy.superLabels = other.superLabels;
-  copy.longLabels = other.longLabels;
+  if (copy.program->image == other.program->image && copy.program->costs == other.program->costs)
+    copy.program = other.program;
+  if (copy.program == other.program &&
+      copy.dispatch->breakpoints() == other.dispatch->breakpoints())
+    copy.dispatch = other.dispatch;
   return copy;
 }
 
@@ -760,14 +673,16 @@ bool Vm::sameProgramState(const Vm& other) const {
   State mine = comparable(*s_, *other.s_);
   mine.copyCounters(*other.s_);
   mine.measure = other.s_->measure;
-  mine.loops = other.s_->loops;
+  mine.loopPass = other.s_->loopPass;
   mine.resumeAtBreakpoint = other.s_->resumeAtBreakpoint;
   return mine == *other.s_;
 }
 
+bool Vm::sharesProgram(const Vm& other) const { return s_->program == other.s_->program; }
+
 void Vm::fillMemory(const std::function<uint64_t()>& next) {
   State& s = *s_;
-  const auto& init = s.image->initialised;
+  const auto& init = s.image().initialised;
   uint64_t bits = 0;
   int left = 0;
   for (uint32_t a = kDataBase; a < kMemorySize; ++a) {
@@ -806,7 +721,7 @@ bool Vm::halted() const { return s_->halted; }
 const Fault* Vm::fault() const { return s_->fault ? &*s_->fault : nullptr; }
 bool Vm::interruptsEnabled() const { return s_->iff1; }
 uint32_t Vm::pc() const { return s_->currentPc(); }
-int Vm::line() const { return s_->image->lineAt(pc()); }
+int Vm::line() const { return s_->image().lineAt(pc()); }
 int Vm::interruptDepth() const { return static_cast<int>(s_->ints.size()); }
 int Vm::callDepth() const { return static_cast<int>(s_->calls.size()); }
 uint32_t Vm::libraryCallPc() const { return s_->lib.pc; }
@@ -837,7 +752,7 @@ std::vector<Vm::Frame> Vm::frames() const {
 }
 std::vector<Vm::Activation> Vm::activations() const {
   const State& s = *s_;
-  const Image& img = *s.image;
+  const Image& img = s.image();
   // A function has a frame once its first instruction, an ENTER, has run.
   auto entered = [&](uint32_t at) {
     const Symbol* f = img.functionAt(at);
@@ -869,56 +784,49 @@ std::vector<Vm::Activation> Vm::activations() const {
   }
   return out;
 }
-int Vm::evalDepth() const { return s_->sp; }
+int Vm::evalDepth() const { return s_->eval.sp; }
 bool Vm::inLibraryCall() const { return s_->lib.active; }
 bool Vm::effectPending() const { return s_->lib.awaitingBegin && !s_->fault; }
 
 void Vm::settle() {
   State& s = *s_;
   if (!effectPending()) return;
+  s.ready();
   // What run() does at the boundary before the effect (the timer's tick
   // was taken when run() stopped here).
   if (s.now >= s.nextTimer) s.timerTick();
   s.libBegin();
 }
 uint32_t Vm::evalSlot(int fromTop) const {
-  const int i = s_->sp - 1 - fromTop;
-  return i >= 0 && i < kEvalSlots ? s_->eval[static_cast<size_t>(i)] : 0;
+  const int i = s_->eval.sp - 1 - fromTop;
+  return i >= 0 && i < kEvalSlots ? s_->eval[i] : 0;
 }
 uint8_t Vm::read8(uint16_t a) const { return s_->rd8(a); }
 void Vm::write8(uint16_t a, uint8_t v) { s_->wr8(a, v); }
 uint16_t Vm::read16(uint16_t a) const { return s_->rd16(a); }
 uint32_t Vm::read32(uint16_t a) const { return s_->rd32(a); }
 const VmStats& Vm::stats() const { return s_->stats; }
-const Image& Vm::image() const { return *s_->image; }
-const CostTable& Vm::costs() const { return s_->costs; }
+const Image& Vm::image() const { return s_->image(); }
+const CostTable& Vm::costs() const { return s_->costs(); }
 
 void Vm::setBreakpoint(uint32_t codeAddress, bool enabled) {
   State& s = *s_;
-  if (s.breakpoints.empty()) s.breakpoints.assign(s.image->code.size() + 1, 0);
-  if (codeAddress < s.breakpoints.size()) {
-    s.breakpoints[codeAddress] = enabled ? 1 : 0;
-    s.dispatch[codeAddress] = enabled ? State::kTrap : s.baseDispatch[codeAddress];
-    // A superinstruction's pieces may lie anywhere (a JMP's or CALL's
-    // target): decode every entry again.
-    for (int k = 0; k < 2; ++k)
-      for (uint32_t a = 0; a < s.fast[k].size(); ++a) s.setFast(k, a);
-  }
-  s.anyBreakpoint =
-      std::any_of(s.breakpoints.begin(), s.breakpoints.end(), [](uint8_t b) { return b != 0; });
-  for (State::Loop& loop : s.loops)
-    loop.breakpointInside =
-        std::any_of(s.breakpoints.begin() + loop.top, s.breakpoints.begin() + loop.exit,
-                    [](uint8_t b) { return b != 0; });
+  if (codeAddress > s.image().code.size() || s.dispatch->breakpointAt(codeAddress) == enabled)
+    return;
+  // A superinstruction's pieces may lie anywhere (a JMP's or CALL's
+  // target): the new dispatch decodes every entry again.
+  s.dispatch = s.dispatch->withBreakpoint(*s.program, codeAddress, enabled);
 }
 
 int Vm::superinstructionAt(uint32_t codeAddress) const {
-  return codeAddress < s_->dispatch.size() ? s_->superinstructionAt(codeAddress) : -1;
+  return codeAddress < s_->dispatch->ops().size()
+             ? s_->dispatch->superinstructionAt(*s_->program, codeAddress)
+             : -1;
 }
 
 void Vm::enableProfile() {
   s_->profiling = true;
-  s_->profile.assign(s_->image->code.size() + 1, 0);
+  s_->profile.assign(s_->image().code.size() + 1, 0);
 }
 const std::vector<uint64_t>& Vm::profile() const { return s_->profile; }
 uint64_t Vm::serialIsrCycles() const { return s_->serialIsrCycles; }

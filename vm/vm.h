@@ -115,17 +115,25 @@ class Vm {
   // Powered on at tick `start` of the host's clock: the program at its
   // entry, memory as the image initialises it, PRT0's first tick at
   // start + kPrtTicks.
+  // The image and the costs are decoded once (the program: code, cost
+  // table, decode tables), and shared read-only by every copy.
   Vm(const Image& image, Bus& bus, const CostTable& costs, Tick start = 0);
   ~Vm();
-  // A VM is a value apart from the bus it talks to: a copy holds all of
-  // the other's state (memory, registers, stacks, pending requests, clock,
-  // breakpoints, counters) and talks to `bus`. Copied into another VM, or
-  // restored from a copy, it goes on byte for byte as the original would.
+  // A VM is a value apart from the program it runs and the bus it talks
+  // to: a copy holds all of the other's state (memory, registers, stacks,
+  // pending requests, clock, breakpoints, counters), shares its program,
+  // and talks to no bus until attach() (it runs only then). Copied into
+  // another VM, or restored from a copy, it goes on byte for byte as the
+  // original would. A copy holds only the expression stack's slots in use.
+  Vm(const Vm& other);
+  // A copy that talks to `bus`.
   Vm(const Vm& other, Bus& bus);
-  Vm(const Vm&) = delete;
-  Vm& operator=(const Vm&) = delete;
-  // This VM takes `snapshot`'s state and keeps talking to its own bus.
+  // This VM takes `other`'s state and keeps talking to its own bus.
+  Vm& operator=(const Vm& other);
   void restore(const Vm& snapshot);
+  void attach(Bus& bus);
+  // The same program (the same decode tables, not a copy of them).
+  bool sharesProgram(const Vm& other) const;
   // The controller's reset at `t` (a reload): the machine as a VM powered
   // on at t; its breakpoints, its profile switch and its counters (stats,
   // profile, interrupt service cycles) carry on over the whole run.

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,12 @@ namespace {
 constexpr Tick kSecond = vm::kTicksPerSecond;
 
 const board::StreamSeeds kSeeds{1, 2, 3, 4, 5};
+board::Settings settingsWithRandomMemory() {
+  board::Settings s;
+  s.randomMemory = true;
+  return s;
+}
+const board::Settings kSettings = settingsWithRandomMemory();
 
 // Runs a board: its VM's bus, the receiver at the wire's far end.
 class Host : public vm::Bus {
@@ -39,13 +46,13 @@ class Host : public vm::Bus {
   int adSample(Tick, int channel) override {
     return channel == 0 ? 40 + static_cast<int>(board->eyeNoise.next() % 3) : 30;
   }
+  // The board decodes its ports (port B and ENB485 are the host's: kept
+  // here with every other write).
   void out(Tick t, uint16_t port, uint8_t value) override {
-    if (port == vm::kPortPIOCA) board->pio.control(value);
+    board->out(port, value);
     outs.emplace_back(t, value);
   }
-  uint8_t in(Tick, uint16_t port) override {
-    return port == vm::kPortPIODA ? board->pio.read() : 0xFF;
-  }
+  uint8_t in(Tick, uint16_t port) override { return board->in(port); }
   // Each changes when the next byte is done: runUntil looks again.
   void serialSend(Tick t, uint16_t buf, uint16_t cc) override {
     if (const auto o = board->serialSend(t, buf, cc)) overwritten.emplace_back(t, o->fetched);
@@ -89,7 +96,7 @@ struct Robot {
   Robot(const vm::Image& image, const Robot* from = nullptr)
       : host(from ? from->host : Host{}),
         board(from ? Board(from->board, host)
-                   : Board(image, host, testkit::calibratedCosts(), kSeeds, true)) {
+                   : Board(image, host, testkit::calibratedCosts(), kSeeds, kSettings)) {
     host.board = &board;
   }
 };
@@ -115,7 +122,7 @@ TEST(BoardSnapshot, ACopyGoesOnAsTheOriginalAndARestoreReplaysIt) {
   EXPECT_GT(run.host.frames.size(), saved.host.frames.size());
 
   const Host firstRun = run.host;
-  run.board.restore(saved.board);
+  run.board = saved.board;
   run.host = saved.host;
   run.host.board = &run.board;
   EXPECT_TRUE(run.board == saved.board);
@@ -133,6 +140,8 @@ TEST(BoardReset, IsTheControllersResetAndCarriesTheRestOn) {
   // Let the port drain: a reset needs it idle (the scheduler's reload delay).
   while (!run.board.serial.idle()) run.host.runUntil(run.board.cpu.now() + 9600);
   ASSERT_TRUE(run.board.pio.interruptEnabled());  // ICEMAN armed port A
+  // The last eye values read, as a host that traces them keeps them.
+  run.board.lastAdValue = {41, 30};
   const Board before(run.board, run.host);
   const Tick t = run.board.cpu.now();
 
@@ -140,6 +149,8 @@ TEST(BoardReset, IsTheControllersResetAndCarriesTheRestOn) {
   EXPECT_EQ(run.board.serial, board::SerialPort{});
   EXPECT_FALSE(run.board.pio.interruptEnabled());
   EXPECT_EQ(run.board.enb485, -1);
+  // The reloaded program has read no eye yet (its first reading is traced).
+  EXPECT_EQ(run.board.lastAdValue, (std::array<int, 2>{-1, -1}));
   // The lines at the pins, the streams and the counters go on.
   EXPECT_EQ(run.board.edgeLines, before.edgeLines);
   EXPECT_EQ(run.board.eyeNoise, before.eyeNoise);
@@ -152,6 +163,31 @@ TEST(BoardReset, IsTheControllersResetAndCarriesTheRestOn) {
   fresh.fillMemory([&] { return fill.next(); });
   EXPECT_TRUE(run.board.cpu.sameMachine(fresh));
   EXPECT_EQ(run.board.memoryFill, fill);
+}
+
+// The ports as the Tiny Giant decodes them (vm/image.h): the PIO's control
+// and data ports are the board's, port B (the guns and solenoids) and
+// ENB485 (when it changes) go on to the host, a read of no device is 0xFF.
+TEST(BoardPorts, TheBoardDecodesItsOwnPorts) {
+  const vm::Image image = testkit::compileFileOrDie(SIMBOT_SHARED_DIR "/programs/iceman.dc");
+  Robot r(image);
+  Board& b = r.board;
+  // Z80 PIO manual: 0xCF selects mode 3, the next word is the direction
+  // register (1 = input).
+  EXPECT_EQ(b.out(vm::kPortPIOCA, 0xCF), board::PortWrite::Done);
+  EXPECT_EQ(b.out(vm::kPortPIOCA, 0x03), board::PortWrite::Done);
+  EXPECT_EQ(b.pio.mode(), 3);
+  EXPECT_EQ(b.out(vm::kPortPIODA, 0xA0), board::PortWrite::Done);
+  // Bits 7-2 are outputs (the latch), 1-0 inputs (the lines, high).
+  EXPECT_EQ(b.in(vm::kPortPIODA), 0xA3);
+  EXPECT_EQ(b.out(vm::kPortPIODB, 0x12), board::PortWrite::PortB);
+  EXPECT_EQ(b.out(vm::kPortENB485, 1), board::PortWrite::Enb485);
+  EXPECT_EQ(b.out(vm::kPortENB485, 1), board::PortWrite::Done);
+  EXPECT_EQ(b.out(vm::kPortENB485, 0), board::PortWrite::Enb485);
+  EXPECT_EQ(b.enb485, 0);
+  EXPECT_EQ(b.out(0x1234, 0x55), board::PortWrite::Done);
+  EXPECT_EQ(b.in(0x1234), 0xFF);
+  EXPECT_EQ(b.in(vm::kPortPIODB), 0xFF);
 }
 
 }  // namespace
