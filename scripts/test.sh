@@ -63,7 +63,10 @@ phase "sanitizer build"
 # loops against the thesis's ten seconds (IcemanTiming.CalibratedKnobs...:
 # 95 s under ASan) and play costate_hunter against ICEMAN for 180 s
 # (Match.CostateHunter...: 92 s; costate_test covers costatements under the
-# sanitizers). The code
+# sanitizers), or copy two matches after every kind of event and run each
+# copy to the end (MatchCopy.AfterEveryKindOfEvent... and
+# MatchCopy.AfterTheTimersInterrupt...: about 200 s under ASan; the copy
+# code runs there in MatchCopy.AfterAFaultAndAReload and MatchSnapshot.*). The code
 # they run is exercised under the sanitizers by the gtest suites (Match.*,
 # Stats.*, FastForward.*, Trace.* reading JSONL back, the other Explain.*,
 # the other VmSuperinstruction.* checks: faulting pieces, the stack guard, PRT0
@@ -71,7 +74,7 @@ phase "sanitizer build"
 # and the checks themselves ran in the normal build above.
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-asan --output-on-failure --parallel "$jobs" --timeout 1800 \
-  -E '^(cli\.match\.deterministic|cli\.variation|fast_forward\.identical|Explain\.FromTheJsonlFile|batch\.kill_and_resume|browser\.viewer|stats\.oracle|VmSuperinstruction\.EveryHorizonStopsWhereTheUnfusedRunStops|VmSuperinstruction\.AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused|IcemanTiming\.CalibratedKnobsAreTheHardwareSettingNearestTenSeconds|Match\.CostateHunterPlaysIcemanAndLatchesFrames)$'
+  -E '^(cli\.match\.deterministic|cli\.variation|fast_forward\.identical|Explain\.FromTheJsonlFile|batch\.kill_and_resume|browser\.viewer|stats\.oracle|VmSuperinstruction\.EveryHorizonStopsWhereTheUnfusedRunStops|VmSuperinstruction\.AnInterruptRequestedAtAnyTickIsAcceptedWhereItIsUnfused|IcemanTiming\.CalibratedKnobsAreTheHardwareSettingNearestTenSeconds|Match\.CostateHunterPlaysIcemanAndLatchesFrames|MatchCopy\.AfterEveryKindOfEventInIcemanVsFig92|MatchCopy\.AfterTheTimersInterruptInCostateHunterVsIceman)$'
 phase "sanitizer tests"
 # ThreadSanitizer: only the suite that runs work on several threads.
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
