@@ -25,6 +25,7 @@
 #include "scheduler/match.h"
 #include "sinks/json_text.h"
 #include "sinks/trace_jsonl.h"
+#include "tests/support/seeded_match.h"
 
 using namespace simbot;
 using scheduler::Tick;
@@ -33,16 +34,6 @@ namespace {
 
 const std::string kShared = SIMBOT_SHARED_DIR;
 const std::string kSource = SIMBOT_SOURCE_DIR;
-
-scheduler::MatchConfig configFor(const std::vector<std::string>& programs, double seconds,
-                                 bool reload) {
-  runs::RunOptions o;
-  o.seconds = seconds;
-  o.profile = "default";
-  o.seed = 3;
-  o.reloadOnFault = reload;
-  return runs::buildConfig(programs, o, runs::ScenarioUse::Match);
-}
 
 // The tick of the first event of each kind.
 struct FirstEvents final : scheduler::MatchObserver {
@@ -83,7 +74,7 @@ void expectCopiesGoOn(const std::vector<std::string>& programs, double seconds, 
                       const std::vector<std::string>& kinds) {
   FirstEvents events;
   sinks::JsonlLines whole;
-  scheduler::MatchConfig plain = configFor(programs, seconds, reload);
+  scheduler::MatchConfig plain = testkit::seededMatch(programs, seconds, reload);
   plain.observer = &events;
   plain.sinks = {&whole};
   const std::string wholeResult = json(scheduler::runMatch(plain));
@@ -94,7 +85,7 @@ void expectCopiesGoOn(const std::vector<std::string>& programs, double seconds, 
   // One run, paused right after each first event in turn (every round
   // that starts at or before its tick has run), copied there twice.
   sinks::JsonlLines lines;
-  scheduler::MatchConfig c = configFor(programs, seconds, reload);
+  scheduler::MatchConfig c = testkit::seededMatch(programs, seconds, reload);
   c.snapshots = true;
   c.sinks = {&lines};
   scheduler::MatchRun run(c);

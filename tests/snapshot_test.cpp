@@ -17,6 +17,7 @@
 #include "runs/play.h"
 #include "scheduler/match.h"
 #include "sinks/trace_jsonl.h"
+#include "tests/support/seeded_match.h"
 
 using namespace simbot;
 
@@ -24,16 +25,6 @@ namespace {
 
 const std::string kShared = SIMBOT_SHARED_DIR;
 const std::string kSource = SIMBOT_SOURCE_DIR;
-
-scheduler::MatchConfig configFor(const std::vector<std::string>& programs, double seconds,
-                                 bool reload) {
-  runs::RunOptions o;
-  o.length = timebase::ticksFromSeconds(seconds);
-  o.profile = "default";
-  o.seed = 3;
-  o.reloadOnFault = reload;
-  return runs::buildConfig(programs, o, runs::ScenarioUse::Match);
-}
 
 // What a result says, without the host's wall times.
 std::string summary(const scheduler::MatchResult& r) {
@@ -49,14 +40,14 @@ std::string summary(const scheduler::MatchResult& r) {
 void expectSnapshotsContinue(const std::vector<std::string>& programs, double seconds, bool reload,
                              const std::vector<double>& at) {
   sinks::JsonlLines whole;
-  scheduler::MatchConfig plain = configFor(programs, seconds, reload);
+  scheduler::MatchConfig plain = testkit::seededMatch(programs, seconds, reload);
   plain.sinks = {&whole};
   const scheduler::MatchResult uninterrupted = scheduler::runMatch(plain);
 
   for (const double t : at) {
     SCOPED_TRACE("snapshot at " + std::to_string(t) + " s");
     sinks::JsonlLines lines;
-    scheduler::MatchConfig c = configFor(programs, seconds, reload);
+    scheduler::MatchConfig c = testkit::seededMatch(programs, seconds, reload);
     c.snapshots = true;
     c.sinks = {&lines};
     scheduler::MatchRun run(c);
