@@ -15,7 +15,6 @@ namespace {
 
 using namespace plant_test;
 
-
 // Inputs start at an odd tick, so that an exact answer is not a round number.
 constexpr std::int64_t kStart = 777'777;
 
