@@ -18,13 +18,8 @@ using vm::Stop;
 namespace {
 
 const vm::CostTable& costs() { return testkit::calibratedCosts(); }
-uint32_t cost(Op op) { return costs().op[static_cast<int>(op)]; }
-
-// A handler at label "handler" that counts into `counter` and returns.
-void countingHandler(Assembler& a, uint16_t counter) {
-  a.bind("handler").op(Op::INCGW, counter).op(Op::RETI);
-  a.image.vectors.push_back({vm::kVecPIOA, static_cast<uint16_t>(a.label("handler")), "handler"});
-}
+uint32_t cost(Op op) { return testkit::calibratedCost(op); }
+using testkit::countingHandler;
 
 // A struct assignment's LDIR repeats for every byte but the last (Zilog's
 // 14 T-states repeating, 12 for the last: z180.def): COPY of 10 bytes, on

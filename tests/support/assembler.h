@@ -74,4 +74,11 @@ class Assembler {
   std::multimap<uint32_t, std::string> fixups_;
 };
 
+// A handler at label "handler", on PIO port A's vector, that counts into
+// `counter` and returns.
+inline void countingHandler(Assembler& a, uint16_t counter) {
+  a.bind("handler").op(vm::Op::INCGW, counter).op(vm::Op::RETI);
+  a.image.vectors.push_back({vm::kVecPIOA, static_cast<uint16_t>(a.label("handler")), "handler"});
+}
+
 }  // namespace simbot::testkit

@@ -119,6 +119,8 @@ inline const vm::CostTable& calibratedCosts() {
   static const vm::CostTable table = vm::makeCostTable(vm::calibratedKnobs());
   return table;
 }
+// One opcode's T-states in that table.
+inline uint32_t calibratedCost(vm::Op op) { return calibratedCosts().op[static_cast<int>(op)]; }
 
 // Compiles a program or fails the test with the diagnostic.
 inline vm::Image compileOrDie(const std::string& source, const std::string& name = "test.dc") {
