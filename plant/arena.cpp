@@ -388,8 +388,8 @@ IntegratorStats Arena::stats() const {
   // ARKODE's counters run on over resets (a reset keeps them); the dense
   // output's own right-hand sides are counted with them.
   IntegratorStats s = m.acc;
-  s.steps = m.ode.steps() + m.stepsOffset;
-  s.rhs_evals = m.ode.rhsEvals() + m.rhsEvalsOffset + m.ownRhs;
+  s.steps = m.arenaSteps();
+  s.rhs_evals = m.arenaRhsEvals() + m.ownRhs;
   return s;
 }
 

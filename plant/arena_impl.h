@@ -299,6 +299,10 @@ struct Arena::Impl : ArenaState {
   // The arena's step counts less ARKODE's (a restored arena's integrator
   // is new; stats() adds these): 0 unless restored from a checkpoint.
   long stepsOffset = 0, rhsEvalsOffset = 0;
+  // ARKODE's steps and right-hand sides as this arena's own: over every
+  // reset, and over a restore (what stats() and checkpoints count).
+  long arenaSteps() const { return ode.steps() + stepsOffset; }
+  long arenaRhsEvals() const { return ode.rhsEvals() + rhsEvalsOffset; }
   // ARKODE 6.4 keeps a root's flag across a reset that clearRootFlag()
   // could not clear (the root was at its step's end): a checkpoint is not
   // taken then, as a new integrator would not have it.

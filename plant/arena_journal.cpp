@@ -101,10 +101,9 @@ Journal::Entry Arena::Impl::enter(const Journal::Call& call) {
   // (its first step's growth limit is another than after a reset: restore()
   // gives a new integrator one step) nor with a root's flag carried over.
   if (journal && fresh && reinitSerial != checkpointSerial && !rootFlagCarried &&
-      ode.steps() + stepsOffset > 0) {
-    auto cp = std::make_shared<const Checkpoint>(Checkpoint{static_cast<const ArenaState&>(*this),
-                                                            ode.steps() + stepsOffset,
-                                                            ode.rhsEvals() + rhsEvalsOffset});
+      arenaSteps() > 0) {
+    auto cp = std::make_shared<const Checkpoint>(
+        Checkpoint{static_cast<const ArenaState&>(*this), arenaSteps(), arenaRhsEvals()});
     journal = std::make_shared<Journal>(sharedCfg, std::move(cp));
     checkpointSerial = reinitSerial;
   }
