@@ -158,6 +158,11 @@ scheduler::MatchConfig baseConfig(const BenchConfig& config, const config::Profi
         *config.scenario,
         config.family.empty() ? runs::ScenarioUse::BenchOwn : runs::ScenarioUse::Bench, profile,
         mc);
+  runs::checkRunAgainstRules(
+      profile, mc,
+      config.scenario
+          ? std::array<std::string, 2>{config.scenario->a.hardware, config.scenario->b.hardware}
+          : std::array<std::string, 2>{});
   return mc;
 }
 
@@ -204,6 +209,7 @@ std::vector<std::string> benchInputs(const BenchConfig& c, const config::Profile
   std::vector<std::string> paths = c.programs;
   if (!c.opponent.empty()) paths.push_back(c.opponent);
   paths.push_back(profile.file);
+  if (profile.course.present) paths.push_back(profile.course.file);
   if (c.scenario) {
     paths.push_back(c.scenario->file);
     for (const auto* r : {&c.scenario->a, &c.scenario->b})

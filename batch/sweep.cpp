@@ -254,6 +254,7 @@ namespace {
 
 nlohmann::json sweepSettings(const SweepSpec& spec, const std::string& shard, bool header) {
   std::vector<std::string> inputs = {spec.file, config::sweepProfilePath(spec)};
+  if (spec.rules.present) inputs.push_back(spec.rules.file);
   for (const auto* list : {&spec.programs, &spec.opponents})
     for (const auto& p : *list) inputs.push_back(config::sweepPath(spec, p));
   return {{"command", "sweep"},

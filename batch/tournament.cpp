@@ -50,6 +50,7 @@ nlohmann::json tournamentSettings(const TournamentConfig& c, const config::Profi
           {"contents", inputContents([&] {
              std::vector<std::string> paths = c.programs;
              paths.push_back(profile.file);
+             if (profile.course.present) paths.push_back(profile.course.file);
              return paths;
            }())}};
 }

@@ -73,9 +73,11 @@ Subcommand addBenchCommand(CLI::App& app) {
           if (!run.scenario.empty()) scenario = config::loadScenario(run.scenario);
           batch::BenchConfig c = batch::benchConfig(run, scenario);
           c.programs = o->programs;
-          const config::Profile loaded = runs::loadNamedProfile(runs::preferCommandLine(
-              run.profile.has_value(), scenario ? scenario->profile : std::nullopt,
-              run.profile.value_or("default")));
+          const config::Profile loaded = runs::loadRunProfile(
+              runs::preferCommandLine(run.profile.has_value(),
+                                      scenario ? scenario->profile : std::nullopt,
+                                      run.profile.value_or("default")),
+              runs::runRules(run, scenario));
           batch::checkBenchConfig(c);
           std::string label = batch::benchLabel(c);
           std::replace(label.begin(), label.end(), ' ', '-');
@@ -142,8 +144,9 @@ Subcommand addCompareCommand(CLI::App& app) {
               a.programs = {o->programs[0]};
               b.programs = {o->programs.back()};
               batch::CompareResult r;
-              const config::Profile pa = runs::loadNamedProfile(profileA);
-              const config::Profile pb = runs::loadNamedProfile(profileB);
+              const std::string rules = run.rules.value_or("");
+              const config::Profile pa = runs::loadRunProfile(profileA, rules);
+              const config::Profile pb = runs::loadRunProfile(profileB, rules);
               r.profileA = pa.name;
               r.profileB = pb.name;
               batch::checkBenchConfig(a);
@@ -188,7 +191,7 @@ Subcommand addTournamentCommand(CLI::App& app) {
             return guarded([&] {
               const runs::RunOptions& run = o->run;
               const config::Profile profile =
-                  runs::loadNamedProfile(run.profile.value_or("default"));
+                  runs::loadRunProfile(run.profile.value_or("default"), run.rules.value_or(""));
               batch::TournamentConfig config;
               config.programs = o->programs;
               config.rounds = run.rounds;

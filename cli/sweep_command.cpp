@@ -79,11 +79,20 @@ int runSweepCommand(SweepOptions& o) {
       throw sinks::UserError(
           "simbot: sweep: -W options apply to this process's compiles; the Dask workers compile "
           "with the default warnings (leave them out with --dask)\n");
+    if (o.run.rules)
+      throw sinks::UserError(
+          "simbot: sweep: --rules is not passed to the Dask workers; write rules = \"NAME\" in "
+          "the sweep file\n");
     // The driver checks and opens the table with the same code as below
     // (batch::SweepOutput), fingerprint and all.
     execDaskDriver(o);
   }
-  const batch::SweepSpec spec = config::loadSweep(o.file, batch::benchFamilies());
+  batch::SweepSpec spec = config::loadSweep(o.file, batch::benchFamilies());
+  if (o.run.rules) {  // over the sweep file's own, checked at every point before any run
+    spec.rules = runs::loadNamedRules(*o.run.rules);
+    for (size_t point = 0; point < spec.pointProfiles.size(); ++point)
+      config::sweepProfile(spec, point);
+  }
   const batch::SweepOutput output(spec, o.run.out, o.run.shard, !o.run.noHeader, o.run.resume,
                                   simbotVersion());
   const std::vector<batch::SweepRun>& runs = output.runs();

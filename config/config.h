@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -38,6 +39,43 @@ class ConfigError : public std::runtime_error {
   ConfigError(const std::string& file, int line, int column, const std::string& message);
 };
 
+// ---------------------------------------------------------------- course rules
+// A rule set's [course] table (rules/NAME.toml, --rules; docs/rules.md):
+// how one course's competition was run. Read by loadRules, applied to a
+// profile by applyRules. The default (present = false) is no rule set: the
+// profile as it is, nothing refused, no shot judged.
+struct Course {
+  bool present = false;
+  std::string name;  // the rule set's `name`
+  std::string file;  // where it was loaded from
+  // Overrides of the profile's field and match values.
+  double field_size_ft = 16;
+  bool divider = true;
+  // The divider's geometry where the rule set gives it (NaN: the profile's).
+  double divider_x_ft = std::numeric_limits<double>::quiet_NaN();
+  double divider_south_ft = std::numeric_limits<double>::quiet_NaN();
+  double divider_north_ft = std::numeric_limits<double>::quiet_NaN();
+  double divider_thickness_ft = std::numeric_limits<double>::quiet_NaN();
+  double divider_height_ft = std::numeric_limits<double>::quiet_NaN();
+  double round_length_s = 180;
+  int gun_magazine = 15;  // the standard gun's, as issued: balls_per_gun
+  // Countermeasures allowed.
+  bool mines = false, blocks = false, decoy_lights = false, decoy_screens = false;
+  // Secondary weapons allowed (kinds), and their magazine's maximum.
+  bool secondary_disc = false;
+  int secondary_magazine = 0;
+  // The referee's counts: a hit off a floor skip is valid (the profile's
+  // projectile.count_floor_skips), a scatter shot's hit scores.
+  bool floor_skips = false;
+  bool scatter_scores = false;
+  // Detect to Engage: a shot launched while neither eye reads above this
+  // is a scatter shot (A/D readings).
+  double detect_threshold = 0;
+  // Where each key is written ("course.mines" -> line, column), so that a
+  // refusal names the rule's place.
+  std::vector<std::pair<std::string, std::pair<int, int>>> keyPlaces;
+};
+
 // ---------------------------------------------------------------- profiles
 // A profile file, checked key by key and converted to internal units (ft,
 // s, ft/s, ft/s^2, degrees, ratios, A/D readings).
@@ -53,6 +91,8 @@ struct Profile {
   // [controller] timer_service and fast_forward: the VM's, per robot
   // (scheduler::RobotSpec::controller).
   scheduler::ControllerKnobs controller;
+  // The rule set applied (applyRules); none by default.
+  Course course;
 };
 
 Profile loadProfile(const std::string& path);
@@ -81,6 +121,50 @@ void checkTomlText(std::string_view text, const std::string& sourceName);
 
 // The file of the shipped profile NAME (profiles/NAME.toml), if there is one.
 std::optional<std::string> shippedProfilePath(const std::string& name);
+
+// ---------------------------------------------------------------- rules
+// A rule set (--rules, a scenario's `rules`): rules/NAME.toml for a
+// shipped NAME, else a path. Its [course] table is checked key by key as a
+// profile's (FILE:LINE:COL: error: ...).
+Course loadRules(const std::string& path);
+Course parseRules(std::string_view text, const std::string& sourceName);
+// The file of the shipped rule set NAME (rules/NAME.toml), if there is one.
+std::optional<std::string> shippedRulesPath(const std::string& name);
+// The profile under the rules: field size, divider, round length, the
+// standard gun's magazine and floor skips replaced by the rules' values,
+// and `course` set. The result is checked as a profile is (the start
+// poses inside the smaller field, ...): ConfigError at the rule set's
+// [course].
+void applyRules(const Course& rules, Profile& profile);
+
+// What a run uses that a rule set may forbid, each with the file that put
+// it there: filled before the match (runs/rules.cpp) and checked by
+// checkRules.
+struct RunUses {
+  struct Mine {
+    std::string name;  // the obstacle's name ("" if it has none)
+    std::string file;  // the scenario or rules file that places it
+  };
+  struct Carried {
+    int robot = 0;     // 0 = A, 1 = B
+    std::string kind;  // deployables: "block", "decoy_light", "decoy_screen"; secondary: "disc"
+    int magazine = 0;  // a secondary weapon's rounds (deployables: their count)
+    std::string file;  // the hardware file
+  };
+  struct Magazine {
+    int robot = 0;
+    int balls = 0;     // the standard gun's magazine (balls_per_gun)
+    std::string file;  // the file that set it (hardware file, or the profile)
+  };
+  std::vector<Mine> mines;
+  std::vector<Carried> deployables;
+  std::vector<Carried> secondaryWeapons;
+  std::vector<Magazine> magazines;
+};
+// Refuses the first thing `uses` holds that `rules` forbid: ConfigError
+// "RULES:LINE:COL: error: course.KEY = VALUE forbids ..." at the rule's
+// place. Nothing is refused without rules (present = false).
+void checkRules(const Course& rules, const RunUses& uses);
 
 // ---------------------------------------------------------------- scenarios
 // A scenario file (--scenario FILE.toml): the set-up of a run that is not
@@ -119,6 +203,7 @@ struct ScenarioRobot {
 struct Scenario {
   std::string file;
   std::optional<std::string> profile;     // a profile name, or a resolved path
+  std::optional<std::string> rules;       // a rule set's name, or a resolved path
   std::optional<scheduler::Tick> length;  // `seconds`: the run's length
   std::optional<uint64_t> seed;
   ScenarioRobot a, b;
@@ -151,8 +236,11 @@ struct SweepSpec {
   std::string profile = "default";  // a shipped profile's name, or a file
   // [grid] "section.key" = [values]: each value's TOML text, keys in file order.
   std::vector<std::pair<std::string, std::vector<std::string>>> grid;
-  // Each grid point's profile, built once when the file is read.
+  // Each grid point's profile, built once when the file is read (without
+  // the rules: sweepProfile applies them).
   std::vector<Profile> pointProfiles;
+  // `rules = NAME|FILE`, or sweep --rules: every run's rule set.
+  Course rules;
 };
 
 // A grid has at most this many points, and a sweep at most this many runs

@@ -289,6 +289,13 @@ Profile parseProfile(std::string_view text, const std::string& sourceName) {
 
 Profile loadProfile(const std::string& path) { return parseProfile(readFile(path), path); }
 
+void keys::walkKeys(const toml::table& doc, const std::vector<const KeyDef*>& defs,
+                    const std::string& file, const std::vector<std::string>& plainStrings,
+                    Profile& p) {
+  Hardware h;
+  Checker(file).walk(doc, defs, false, plainStrings, p, h, nullptr);
+}
+
 std::optional<std::string> shippedProfilePath(const std::string& name) {
   const std::filesystem::path p = std::filesystem::path(SIMBOT_PROFILES_DIR) / (name + ".toml");
   std::error_code ec;

@@ -176,6 +176,54 @@ const std::vector<KeyDef>& keyTable() {
   return keys;
 }
 
+// A rule set's [course] (rules/*.toml; config.h Course). Bounds as the
+// profile's keys they override; the divider's geometry is optional.
+const std::vector<KeyDef>& courseTable() {
+  static const std::vector<KeyDef> keys = {
+      {"course", "field_size", Kind::Length, {1, 100}, false, D(p.course.field_size_ft)},
+      {"course", "divider", Kind::Bool, {0, 0}, false, B(p.course.divider)},
+      {"course", "divider_x", Kind::Length, {-50, 50}, false, D(p.course.divider_x_ft)},
+      {"course", "divider_south", Kind::Length, {-50, 50}, false, D(p.course.divider_south_ft)},
+      {"course", "divider_north", Kind::Length, {-50, 50}, false, D(p.course.divider_north_ft)},
+      {"course",
+       "divider_thickness",
+       Kind::Length,
+       {0, 2},
+       false,
+       D(p.course.divider_thickness_ft)},
+      {"course", "divider_height", Kind::Length, {0, 20}, false, D(p.course.divider_height_ft)},
+      {"course",
+       "round_length",
+       Kind::Time,
+       {1, timebase::kMaxRunSeconds},
+       false,
+       D(p.course.round_length_s)},
+      {"course",
+       "gun_magazine",
+       Kind::Count,
+       {0, kMaxBallsPerGun},
+       false,
+       I(p.course.gun_magazine)},
+      {"course", "mines", Kind::Bool, {0, 0}, false, B(p.course.mines)},
+      {"course", "blocks", Kind::Bool, {0, 0}, false, B(p.course.blocks)},
+      {"course", "decoy_lights", Kind::Bool, {0, 0}, false, B(p.course.decoy_lights)},
+      {"course", "decoy_screens", Kind::Bool, {0, 0}, false, B(p.course.decoy_screens)},
+      {"course", "secondary_disc", Kind::Bool, {0, 0}, false, B(p.course.secondary_disc)},
+      // Appendix A (thesis line 1103): a secondary weapon's magazine is at
+      // most fifteen rounds, under any rules that allow one.
+      {"course", "secondary_magazine", Kind::Count, {0, 15}, false, I(p.course.secondary_magazine)},
+      {"course", "floor_skips", Kind::Bool, {0, 0}, false, B(p.course.floor_skips)},
+      {"course", "scatter_scores", Kind::Bool, {0, 0}, false, B(p.course.scatter_scores)},
+      {"course",
+       "detect_threshold",
+       Kind::Reading,
+       {0, 65535},
+       false,
+       D(p.course.detect_threshold)},
+  };
+  return keys;
+}
+
 const std::vector<KeyDef>& portTable() {
   static const std::vector<KeyDef> keys = {
       {"ports", "gun1_motor", Kind::Bit, {0, 7}, true, I(h.gun_motor_bit[0])},

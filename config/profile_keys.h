@@ -8,6 +8,8 @@
 // describes the keys, so a key is added in one place.
 #pragma once
 
+#include <toml++/toml.h>
+
 #include <array>
 #include <functional>
 #include <string_view>
@@ -82,6 +84,16 @@ struct KeyDef {
 const std::vector<KeyDef>& keyTable();
 // A hardware file's [ports] keys.
 const std::vector<KeyDef>& portTable();
+// A rule set's [course] keys.
+const std::vector<KeyDef>& courseTable();
+
+// Walks a parsed document's sections against `defs` as a profile is read:
+// an unknown section or key, a wrong type, unit or range is a ConfigError
+// at its place; `plainStrings` are the top-level keys that are plain
+// strings (`name`: into p.name). Keys that are absent are left as they
+// are (the caller checks the ones it requires).
+void walkKeys(const toml::table& doc, const std::vector<const KeyDef*>& defs,
+              const std::string& file, const std::vector<std::string>& plainStrings, Profile& p);
 
 // Conversion factor to the internal unit, or NaN if the unit is not allowed.
 double unitFactor(Kind k, std::string_view u);

@@ -204,7 +204,7 @@ class Walker {
   Scenario walk(const toml::table& root) const {
     Scenario s;
     s.file = file_;
-    onlyKeys(root, "the scenario", {"profile", "seconds", "seed", "A", "B"});
+    onlyKeys(root, "the scenario", {"profile", "rules", "seconds", "seed", "A", "B"});
     if (const toml::node* n = root.get("profile")) {
       const std::string v = string(*n, "profile");
       const bool isPath = v.find('/') != std::string::npos || fs::path(v).extension() == ".toml";
@@ -215,6 +215,18 @@ class Walker {
           fail(*n, fmt::format(
                        "'profile': no profile '{}' in profiles/ (or give a path to a .toml)", v));
         s.profile = v;
+      }
+    }
+    if (const toml::node* n = root.get("rules")) {
+      const std::string v = string(*n, "rules");
+      const bool isPath = v.find('/') != std::string::npos || fs::path(v).extension() == ".toml";
+      if (isPath) {
+        s.rules = file(*n, "rules");
+      } else {
+        if (!shippedRulesPath(v))
+          fail(*n,
+               fmt::format("'rules': no rule set '{}' in rules/ (or give a path to a .toml)", v));
+        s.rules = v;
       }
     }
     if (const toml::node* n = root.get("seconds")) s.length = timeValue(*n, file_, "seconds", true);

@@ -157,8 +157,10 @@ size_t sweepPoints(const SweepSpec& spec) {
 }
 
 Profile sweepProfile(const SweepSpec& spec, size_t point) {
-  if (point < spec.pointProfiles.size()) return spec.pointProfiles[point];
-  return pointProfiles(spec).at(point);
+  Profile p =
+      point < spec.pointProfiles.size() ? spec.pointProfiles[point] : pointProfiles(spec).at(point);
+  if (spec.rules.present) applyRules(spec.rules, p);
+  return p;
 }
 
 SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& families) {
@@ -167,12 +169,12 @@ SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& fam
   toml::table doc = parseToml(readFile(path), path);
   for (auto&& [key, node] : doc) {
     static const std::vector<std::string> known = {"programs", "opponents", "families", "seeds",
-                                                   "seconds",  "profile",   "grid"};
+                                                   "seconds",  "profile",   "rules",    "grid"};
     if (std::find(known.begin(), known.end(), std::string(key.str())) == known.end())
       failAt(
           path, key.source(),
           fmt::format("unknown key '{}' (programs, opponents, families, seeds, seconds, profile, "
-                      "grid)",
+                      "rules, grid)",
                       key.str()));
   }
   spec.programs = stringArray(spec, doc, "programs", true);
@@ -201,6 +203,19 @@ SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& fam
   if (const toml::node* p = doc.get("profile")) {
     if (!p->is_string()) failAt(path, p->source(), "'profile' is a string");
     spec.profile = *p->value<std::string>();
+  }
+  if (const toml::node* r = doc.get("rules")) {
+    if (!r->is_string()) failAt(path, r->source(), "'rules' is a string");
+    const std::string name = *r->value<std::string>();
+    const std::string asFile = sweepPath(spec, name);
+    std::error_code exists;
+    if (fs::is_regular_file(asFile, exists))
+      spec.rules = loadRules(asFile);
+    else if (const auto shipped = shippedRulesPath(name))
+      spec.rules = loadRules(*shipped);
+    else
+      failAt(path, r->source(),
+             fmt::format("'rules': no rule set '{}' (a file, or one of rules/*.toml)", name));
   }
   const toml::table* seeds = doc.get_as<toml::table>("seeds");
   if (!seeds) failAt(path, doc.source(), "missing table [seeds] (first, count)");
@@ -254,6 +269,9 @@ SweepSpec loadSweep(const std::string& path, const std::vector<std::string>& fam
   // Every point's profile now: a bad value is an error before any run.
   try {
     spec.pointProfiles = pointProfiles(spec);
+    // And under the rules (a field the rules make smaller, ...).
+    if (spec.rules.present)
+      for (size_t point = 0; point < spec.pointProfiles.size(); ++point) sweepProfile(spec, point);
   } catch (const ConfigError& e) {
     const std::string what = e.what();
     if (const toml::node* g = doc.get("grid"); g && what.rfind(spec.file + ":1:1: ", 0) == 0)

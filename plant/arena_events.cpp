@@ -147,8 +147,8 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
     const bool inSlab =
         std::abs(x - cfg.field.divider_x_ft) <= cfg.field.divider_thickness_ft / 2 ||
         reported(found, RootKind::BallDivider, s) > 0;
-    if (inSlab && yy >= cfg.field.divider_south_ft && yy <= cfg.field.divider_north_ft &&
-        z <= cfg.field.divider_height_ft) {
+    if (cfg.field.divider && inSlab && yy >= cfg.field.divider_south_ft &&
+        yy <= cfg.field.divider_north_ft && z <= cfg.field.divider_height_ft) {
       e.miss = MissReason::Divider;
       ev.push(e);
       b.active = false;
@@ -290,7 +290,9 @@ void Arena::Impl::contacts(std::int64_t T, Discrete& d, std::vector<double>& y, 
   };
   for (int i = 0; i < nR; ++i) {
     RobotDisc& r = d.r[static_cast<std::size_t>(i)];
-    obstacle(i, RootKind::Divider, contact::Kind::Divider, r.dividerContact, ContactWith::Divider);
+    if (cfg.field.divider)
+      obstacle(i, RootKind::Divider, contact::Kind::Divider, r.dividerContact,
+               ContactWith::Divider);
     if (cfg.field.field_walls) {
       obstacle(i, RootKind::WallX, contact::Kind::WallX, r.wallContact[0], ContactWith::Wall);
       obstacle(i, RootKind::WallY, contact::Kind::WallY, r.wallContact[1], ContactWith::Wall);

@@ -93,7 +93,7 @@ Arena::Impl::Impl(const ArenaConfig& c)
           cfg.field.field_walls &&
           gapOf(k == 0 ? contact::Kind::WallX : contact::Kind::WallY, i, y.data()) <= 0;
     }
-    d.dividerContact = gapOf(contact::Kind::Divider, i, y.data()) <= 0;
+    d.dividerContact = cfg.field.divider && gapOf(contact::Kind::Divider, i, y.data()) <= 0;
   }
   D.robotContact = nR == 2 && gapOf(contact::Kind::Robot, 0, y.data()) <= 0;
 
@@ -143,8 +143,8 @@ double Arena::Impl::stepBound(const double* y, double ahead) const {
   if (active.count > 0) return floor;
   double d = HUGE_VAL;
   for (int i = 0; i < nR; ++i) {
-    d = std::min({d, std::abs(edgeG(y, i, 0)), std::abs(edgeG(y, i, 1)),
-                  std::abs(gapOf(contact::Kind::Divider, i, y))});
+    d = std::min({d, std::abs(edgeG(y, i, 0)), std::abs(edgeG(y, i, 1))});
+    if (cfg.field.divider) d = std::min(d, std::abs(gapOf(contact::Kind::Divider, i, y)));
     if (cfg.field.field_walls)
       d = std::min({d, std::abs(gapOf(contact::Kind::WallX, i, y)),
                     std::abs(gapOf(contact::Kind::WallY, i, y))});

@@ -258,7 +258,7 @@ void Arena::Impl::buildRoots() {
       add(RootKind::WallX, i);
       add(RootKind::WallY, i);
     }
-    add(RootKind::Divider, i);
+    if (cfg.field.divider) add(RootKind::Divider, i);
     if (D.r[static_cast<std::size_t>(i)].reflex) add(RootKind::ReflexEnd, i);
   }
   if (nR == 2) add(RootKind::RobotRobot, 0);
@@ -268,7 +268,7 @@ void Arena::Impl::buildRoots() {
     if (!ball.rolling) add(RootKind::BallFloor, b);
     if (nR == 2) add(RootKind::BallHit, b);
     add(RootKind::BallOut, b);
-    add(RootKind::BallDivider, b);
+    if (cfg.field.divider) add(RootKind::BallDivider, b);
     // Only a ball whose apex, z0 + vz^2 / 2g, clears the other robot's
     // height can come down on its top; no other ball pays for the root.
     if (nR == 2 && !ball.rolling && ball.vz > 0 &&

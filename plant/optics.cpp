@@ -75,10 +75,12 @@ std::uint64_t SplitMix64::next() {
 }
 
 bool dividerBlocks(double ax, double ay, double bx, double by, const FieldParams& field) {
+  if (!field.divider) return false;
   return geom::segmentHitsRect(geom::Vec2(ax, ay), geom::Vec2(bx, by), geom::dividerRect(field));
 }
 
 double dividerClearance(double x, double y, double radius, const FieldParams& field) {
+  if (!field.divider) return HUGE_VAL;
   const geom::Vec2 c(x, y);
   return (c - geom::closestPointOnRect(c, geom::dividerRect(field))).norm() - radius;
 }

@@ -109,6 +109,9 @@ struct FieldParams {
   bool field_walls = true;         // a body touching the field edge trips a bumper
   double divider_x_ft = 0, divider_south_ft = 0, divider_north_ft = 0;
   double divider_thickness_ft = 0, divider_height_ft = 0;
+  // A course without a divider (a rule set's course.divider = false): no
+  // contact, no ball stopped, no beacon hidden by it.
+  bool divider = true;
   std::array<Pose, 2> start{};  // A, B
   // Robots put down by hand (placeByHand): the centre uniform in a disc of
   // this radius around the start pose, the heading uniform within +- this
@@ -129,6 +132,13 @@ struct RefereeParams {
   double window_s = 10;
   double putback_ft = 1.5;  // inside the wire
   double turn_deg = 45;
+  // Detect to Engage (a rule set's [course]; thesis Appendix A): judged
+  // by the scheduler at each launch when judge_scatter. A launch is a
+  // scatter shot when neither of the shooter's eyes reads above
+  // detect_threshold; its hit counts only if scatter_scores.
+  bool judge_scatter = false;
+  double detect_threshold = 0;
+  bool scatter_scores = true;
 };
 
 // Port B bindings of one robot (bits 0..7).

@@ -159,7 +159,8 @@ py::tuple benchRuns(const std::vector<std::string>& programs, const py::kwargs& 
   batch::BenchConfig c = batch::benchConfig(o);
   c.programs = programs;
   c.progress = false;
-  const config::Profile loaded = runs::loadNamedProfile(o.profile.value_or("default"));
+  const config::Profile loaded =
+      runs::loadRunProfile(o.profile.value_or("default"), o.rules.value_or(""));
   const batch::BenchResult r = batch::runBench(c, loaded);
   py::gil_scoped_acquire acquire;
   return py::make_tuple(sinks::dumpJson(batch::summaryJson(r), 2), batch::runsCsv(r));

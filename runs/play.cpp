@@ -35,6 +35,11 @@ json consoleJson(const std::vector<std::string>& lines) {
   return out;
 }
 
+// Detect to Engage's count under the run's rules; null without rules.
+json scatterJson(const scheduler::RobotResult& rr) {
+  return rr.scatterShots ? json(*rr.scatterShots) : json(nullptr);
+}
+
 json faultsJson(const std::vector<scheduler::FaultInfo>& faults) {
   json out = json::array();
   for (const auto& f : faults) out.push_back(faultJson(f));
@@ -107,9 +112,10 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
                                    ScenarioUse use, std::vector<files::Named>* inputs) {
   std::optional<Scenario> scenario;
   if (!o.scenario.empty()) scenario = config::loadScenario(o.scenario);
-  const config::Profile profile = loadNamedProfile(
+  const config::Profile profile = loadRunProfile(
       preferCommandLine(o.profile.has_value(), scenario ? scenario->profile : std::nullopt,
-                        o.profile.value_or("default")));
+                        o.profile.value_or("default")),
+      runRules(o, scenario));
   // Without --seconds or a scenario's, a run lasts its default: the
   // profile's round. Each was checked against the one run-length limit
   // where it was read (timebase/written.h; the profile's keys table).
@@ -120,6 +126,8 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
   scheduler::MatchConfig config;
   config.arena = config::makeArenaConfig(profile, static_cast<int>(programs.size()));
   config.profileName = profile.name;
+  config.rulesName = profile.course.name;
+  config.rulesFile = profile.course.file;
   const char* names[] = {"A", "B"};
   for (size_t i = 0; i < programs.size(); ++i) {
     config.robots.push_back({names[i], programs[i], compileProgramFile(programs[i])});
@@ -146,6 +154,11 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
     setup.hardware = config::loadHardware(file, setup.params,
                                           config.robots[static_cast<size_t>(robot)].controller);
   }
+  // Each robot's hardware file: the command line's, else the scenario's.
+  std::array<std::string, 2> hardwareFiles;
+  if (scenario) hardwareFiles = {scenario->a.hardware, scenario->b.hardware};
+  for (const auto& [robot, file] : hwFiles) hardwareFiles[static_cast<size_t>(robot)] = file;
+  checkRunAgainstRules(profile, config, hardwareFiles);
   for (const auto& text : o.injections) {
     try {
       config.injections.push_back(
@@ -164,6 +177,7 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
       if (!robot.program.empty()) inputs->push_back({robot.program, "the program"});
     if (scenario) inputs->push_back({o.scenario, "the scenario"});
     inputs->push_back({profile.file, "the profile"});
+    if (profile.course.present) inputs->push_back({profile.course.file, "the rules"});
     for (const auto& [robot, file] : hwFiles) inputs->push_back({file, "the hardware file"});
     if (scenario)
       for (const auto* r : {&scenario->a, &scenario->b})
@@ -237,7 +251,8 @@ json soloJson(const Played& played) {
       {"motor_frames_rejected", a.framesRejected},
       {"motor_frames_overwritten", a.framesOverwritten},
       {"interrupts", a.interrupts},
-      {"final_pose", poseJson(a.finalPose)}};
+      {"final_pose", poseJson(a.finalPose)},
+      {"scatter_shots", scatterJson(a)}};
   return j;
 }
 
@@ -260,7 +275,8 @@ json matchJson(const Played& played) {
                       {"faults", faultsJson(rr.faults)},
                       {"reloads", rr.reloads},
                       {"final_pose", poseJson(rr.finalPose)},
-                      {"console_lines", rr.console.size()}});
+                      {"console_lines", rr.console.size()},
+                      {"scatter_shots", scatterJson(rr)}});
   json j = {{"sim_seconds", timebase::secondsFromTicks(r.endTick)},
             {"wall_seconds", wall},
             {"seed", played.seed},

@@ -9,6 +9,7 @@
 // these, so `simbot match A B --json` and simbot.match(A, B) give the same
 // JSON.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -42,6 +43,11 @@ void parseWarningOptions(const std::vector<std::string>& words, compiler::Option
 vm::Image compileProgramText(const std::string& source, const std::string& name);
 // A profile by name (profiles/NAME.toml) or by path.
 config::Profile loadNamedProfile(const std::string& nameOrPath);
+// A rule set by name (rules/NAME.toml) or by path; UserError if neither.
+config::Course loadNamedRules(const std::string& nameOrPath);
+// The profile a run plays under: loadNamedProfile, then the rules (a
+// name or path; empty: none) applied (config::applyRules).
+config::Profile loadRunProfile(const std::string& profile, const std::string& rules);
 
 // Where a run option is offered (runs/run_options.def): the commands, and
 // the Python module's simbot.solo and simbot.match (kPython) and
@@ -87,6 +93,17 @@ struct RunOptions {
   // trace); each counts as a trace for --watch and --trace-costate.
   std::vector<trace::Sink*> sinks;
 };
+
+// The rule set a run plays under: --rules if given, else the scenario's,
+// else none ("").
+std::string runRules(const RunOptions& o, const std::optional<config::Scenario>& scenario);
+
+// What a run's robots use that a rule set may forbid (config::RunUses),
+// each with the file that put it there: `hardwareFiles[i]` is robot i's
+// hardware file ("" when none). Then refused where the profile's rules
+// forbid it (config::checkRules; a ConfigError at the rule).
+void checkRunAgainstRules(const config::Profile& profile, const scheduler::MatchConfig& config,
+                          const std::array<std::string, 2>& hardwareFiles);
 
 // A run's fault lines shown (reportFaults, match's table): the first ten
 // and the last three, the others counted (a reload storm faults thousands

@@ -94,6 +94,21 @@ vm::Image compileProgramText(const std::string& source, const std::string& name)
   return imageOrThrow(compiler::compile(source, name, compileOptions()));
 }
 
+config::Course loadNamedRules(const std::string& nameOrPath) {
+  if (std::filesystem::exists(nameOrPath)) return config::loadRules(nameOrPath);
+  const auto shipped = config::shippedRulesPath(nameOrPath);
+  if (!shipped)
+    throw sinks::UserError(fmt::format(
+        "simbot: --rules: no rule set '{}' (a file, or one of rules/*.toml)\n", nameOrPath));
+  return config::loadRules(*shipped);
+}
+
+config::Profile loadRunProfile(const std::string& profile, const std::string& rules) {
+  config::Profile p = loadNamedProfile(profile);
+  if (!rules.empty()) config::applyRules(loadNamedRules(rules), p);
+  return p;
+}
+
 config::Profile loadNamedProfile(const std::string& nameOrPath) {
   if (std::filesystem::exists(nameOrPath)) return config::loadProfile(nameOrPath);
   const auto shipped = config::shippedProfilePath(nameOrPath);

@@ -278,6 +278,12 @@ void Match::emitSetup() {
                        f.field_walls, f.divider_x_ft, f.divider_south_ft, f.divider_north_ft,
                        f.divider_thickness_ft, f.divider_height_ft, f.gravity_fps2},
        {});
+  const plant::RefereeParams& referee = arenaConfig_->referee;
+  if (referee.judge_scatter)
+    emit(0,
+         trace::rec::Rules{config_.rulesName, config_.rulesFile, f.divider, f.count_floor_skips,
+                           referee.detect_threshold, referee.scatter_scores},
+         {});
   for (const auto& r : robots_) {
     const plant::RobotSetup& setup = arenaConfig_->robots[static_cast<size_t>(r->index)];
     const plant::RobotParams& p = setup.params;
@@ -501,11 +507,43 @@ void Match::handlePlantEvents(Tick t, const plant::EventList& events, const trac
       continue;
     }
     emitPlant(t, e, watch, watchRobot);
+    if (arenaConfig_->referee.judge_scatter) judgeLaunch(t, e);
     if (config_.debugger &&
         (e.kind == plant::EventKind::Contact || e.kind == plant::EventKind::BallLaunch))
       robots_[static_cast<size_t>(e.robot)]->debugEvent(
           t, e.kind == plant::EventKind::Contact ? DebugEvent::Contact : DebugEvent::Shot);
   }
+}
+
+// DESIGN.md "The wider competition": the referee's Detect to Engage. The
+// eyes are judged at the launch tick (the shot the referee sees leave the
+// muzzle; a stroke that launches nothing is no shot) by the optics model
+// without noise: where the robot points, not what its program last read
+// (docs/rules.md).
+void Match::judgeLaunch(Tick t, const plant::Event& e) {
+  if (e.kind != plant::EventKind::BallLaunch && e.kind != plant::EventKind::BallHit) return;
+  if (e.ball < 0 || static_cast<size_t>(e.ball) >= kBallSlots || e.robot < 0 || e.robot > 1)
+    throw std::logic_error("a ball slot or shooter out of range");
+  const size_t slot = static_cast<size_t>(e.ball), r = static_cast<size_t>(e.robot);
+  const plant::RefereeParams& referee = arenaConfig_->referee;
+  if (e.kind == plant::EventKind::BallHit) {
+    if (scatterBall_[slot] && !referee.scatter_scores) ++unscoredHits_[r];
+    return;
+  }
+  const plant::EyeReadings eyes = [&] {
+    const PartScope plant(clock_, PartClock::Plant);
+    return arena_.eyeReadings(e.robot, t);
+  }();
+  const double threshold = referee.detect_threshold;
+  const bool scatter = !(eyes.left > threshold || eyes.right > threshold);
+  scatterBall_[slot] = scatter;
+  if (!scatter) return;
+  ++scatterShots_[r];
+  if (trace_.on())
+    emit(t,
+         trace::rec::ScatterShot{e.robot, e.gun, e.ball, eyes.left, eyes.right, threshold,
+                                 referee.scatter_scores},
+         {});
 }
 
 // Trace samples at fixed ticks, read from dense output once the plant has
@@ -714,7 +752,9 @@ void Match::finish(MatchResult& result) {
   result.integrator = arena_.stats();
   for (auto& r : robots_) {
     RobotResult rr = r->result;
-    rr.hits = arena_.hits(r->index);
+    const size_t at = static_cast<size_t>(r->index);
+    rr.hits = arena_.hits(r->index) - unscoredHits_[at];
+    if (arenaConfig_->referee.judge_scatter) rr.scatterShots = scatterShots_[at];
     rr.shots = arena_.shots(r->index);
     // The clock at main's return, or at the end of the run: a VM's clock
     // runs on to the last round's horizon after main returns, and may stand

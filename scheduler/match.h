@@ -209,6 +209,7 @@ struct MatchConfig {
   // is built at all.
   std::vector<trace::Sink*> sinks;
   std::string profileName;                     // for the trace's run record
+  std::string rulesName, rulesFile;            // for the trace's rules record (--rules)
   Tick sampleInterval = kTicksPerSecond / 20;  // trace samples: 20 Hz
   MatchObserver* observer = nullptr;           // not owned; may be null
   // Checked once a round: when it becomes true the run throws Stopped (a
@@ -255,6 +256,9 @@ struct FaultInfo {
 struct RobotResult {
   std::string name, program;
   int hits = 0, shots = 0;
+  // Detect to Engage (the arena's referee judge_scatter): launches with
+  // neither eye above the rules' threshold. None when no rules judge them.
+  std::optional<int> scatterShots;
   int framesLatched = 0, framesRejected = 0;
   // Sends that restarted the serial library before it had fetched the last
   // byte of the previous send (its NUL): that frame can never latch.

@@ -257,6 +257,13 @@ struct MatchState {
   uint64_t rounds_ = 0;
   uint64_t subRounds_ = 0;  // sub-rounds after the first of each round
   PartClock clock_;
+  // Detect to Engage (the arena's referee judge_scatter): each robot's
+  // scatter shots, which ball slots in flight are scatter shots, and each
+  // robot's hits by scatter shots that do not score.
+  static constexpr size_t kBallSlots = 128;  // above the arena's 64
+  std::array<int, 2> scatterShots_{};
+  std::array<int, 2> unscoredHits_{};
+  std::array<bool, kBallSlots> scatterBall_{};
 };
 
 class Match : public MatchView, private MatchState {
@@ -348,6 +355,9 @@ class Match : public MatchView, private MatchState {
   trace::Record plantRecord(const plant::Event& e) const;
   // `watch` (may be null): robot `watchRobot`'s watched variables at t, for
   // its records, when it has run past t since.
+  // A launch judged by Detect to Engage (a scatter_shot record), and a
+  // hit counted or not by it.
+  void judgeLaunch(Tick t, const plant::Event& launch);
   void handlePlantEvents(Tick t, const plant::EventList& events,
                          const trace::Watch* watch = nullptr, int watchRobot = -1);
   void emitPlant(Tick t, const plant::Event& e, const trace::Watch* watch, int watchRobot);

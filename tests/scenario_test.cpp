@@ -104,8 +104,10 @@ TEST(Scenario, SeedsBeyondTomlIntegersAreStrings) {
 TEST(Scenario, EveryMistakeNamesItsLine) {
   const Bad cases[] = {
       {"speed = 3\n",
-       "s.toml:1:1: error: unknown key 'speed' in the scenario (expected one of: profile, seconds, "
-       "seed, A, B)"},
+       "s.toml:1:1: error: unknown key 'speed' in the scenario (expected one of: profile, rules, "
+       "seconds, seed, A, B)"},
+      {"rules = \"no-such\"\n",
+       "s.toml:1:9: error: 'rules': no rule set 'no-such' in rules/ (or give a path to a .toml)"},
       // Times in timebase/written.h's grammar: a number of seconds, or a
       // string with its unit; a whole number of ticks (300 us is 2,764.8).
       {"\nseconds = -1\n",

@@ -1,0 +1,32 @@
+// Course rules applied to one run (play.h): which rule set it plays
+// under, and what its robots use checked against it before the match.
+#include <fmt/format.h>
+
+#include "config/config.h"
+#include "runs/play.h"
+
+namespace simbot::runs {
+
+std::string runRules(const RunOptions& o, const std::optional<config::Scenario>& scenario) {
+  return preferCommandLine(o.rules.has_value(), scenario ? scenario->rules : std::nullopt,
+                           o.rules.value_or(""));
+}
+
+void checkRunAgainstRules(const config::Profile& profile, const scheduler::MatchConfig& config,
+                          const std::array<std::string, 2>& hardwareFiles) {
+  if (!profile.course.present) return;
+  config::RunUses uses;
+  for (size_t i = 0; i < config.arena.robots.size() && i < 2; ++i) {
+    const plant::RobotParams& params = config.arena.robots[i].params;
+    uses.magazines.push_back({static_cast<int>(i), params.balls_per_gun,
+                              hardwareFiles[i].empty() ? profile.file : hardwareFiles[i]});
+  }
+  // The other parts of issue 40 add here what they put in a run: the
+  // arena's obstacles with mine = true (uses.mines, with the scenario or
+  // rules file that places each), each robot's hardware [[deployables]]
+  // (uses.deployables: kind and count, its hardware file) and secondary
+  // weapon (uses.secondaryWeapons: kind "disc", its magazine, its file).
+  config::checkRules(profile.course, uses);
+}
+
+}  // namespace simbot::runs
