@@ -107,9 +107,12 @@ int matchCommand(const std::string& a, const std::string& b, const runs::RunOpti
     for (const auto& rr : r.robots) {
       std::cout << fmt::format(
           "{} {:<24} hits {:>2}  shots {:>2}  frames {:>5} (+{} rejected, {} frames "
-          "overwritten){}\n",
+          "overwritten){}{}\n",
           rr.name, rr.program, rr.hits, rr.shots, rr.framesLatched, rr.framesRejected,
-          rr.framesOverwritten, rr.reloads ? fmt::format("  reloads {}", rr.reloads) : "");
+          rr.framesOverwritten, rr.reloads ? fmt::format("  reloads {}", rr.reloads) : "",
+          rr.secondary ? fmt::format("  discs {} ({} hits, not scored)", rr.secondary->shots,
+                                     rr.secondary->hits)
+                       : "");
       // As many as stderr's report shows (runs::reportFaults), no more.
       const size_t n = rr.faults.size();
       for (size_t k = 0; k < n; ++k) {

@@ -12,9 +12,10 @@
 // readings; [controller]'s timer service, fast-forward and CPU revision
 // become the VM's typed knobs (Profile::controller).
 //
-// A hardware file has an optional [ports] section (port B bit numbers) and
-// may override the per-robot sections ([robot], [bumper], [eyes], [gun],
-// [controller])
+// A hardware file has an optional [ports] section (port B bit numbers), an
+// optional [secondary] section (a secondary weapon: the disc launcher,
+// all its keys but `bit` required) and may override the per-robot
+// sections ([robot], [bumper], [eyes], [gun], [controller])
 // with the same key names and the same checks; every key there is optional.
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -140,6 +141,8 @@ class Checker {
         };
         if (t.cpu)
           pick(keys::kCpuChoices, t.cpu);
+        else if (t.secondary)
+          pick(keys::kSecondaryChoices, t.secondary);
         else
           pick(keys::kChoices, t.choice);
         return;
@@ -269,6 +272,24 @@ void crossChecks(const Profile& p, const Checker& c, const toml::table& doc) {
     c.fail(where("referee"), "putback leaves no room inside the wire");
 }
 
+// A hardware file's [secondary] table, once walked: every key but `bit`
+// given, the bit given once, and a disc that flies.
+void checkSecondary(const toml::table& doc, const Checker& c, const Hardware& h) {
+  const toml::node* node = doc.get("secondary");
+  if (!node) return;
+  const toml::table& sec = *node->as_table();  // walk() checked it is a table
+  for (const KeyDef& d : keys::secondaryTable())
+    if (std::string_view(d.key) != "bit" && !sec.contains(d.key))
+      c.fail(node->source(), fmt::format("missing key '{}' in [secondary]", d.key));
+  const toml::table* ports = doc.get("ports") ? doc.get("ports")->as_table() : nullptr;
+  if (ports && ports->contains("disc_shooter") && sec.contains("bit"))
+    c.fail(sec.get("bit")->source(),
+           "the disc shooter's bit is given twice: [ports] disc_shooter and [secondary] bit");
+  if (h.secondary.stop_speed_fps >= h.secondary.launch_speed_fps)
+    c.fail(sec.get("stop_speed")->source(),
+           "secondary.stop_speed must be below secondary.launch_speed");
+}
+
 }  // namespace
 
 Profile parseProfile(std::string_view text, const std::string& sourceName) {
@@ -313,6 +334,7 @@ Hardware parseHardware(std::string_view text, const std::string& sourceName,
   Hardware h;
   std::vector<const KeyDef*> defs;
   for (const KeyDef& d : keys::portTable()) defs.push_back(&d);
+  for (const KeyDef& d : keys::secondaryTable()) defs.push_back(&d);
   for (const KeyDef& d : keys::keyTable())
     if (d.perRobot) defs.push_back(&d);
   // Field-wide keys are not per robot: name them in the error.
@@ -323,12 +345,13 @@ Hardware parseHardware(std::string_view text, const std::string& sourceName,
                fmt::format("[{}] is arena-wide and cannot be overridden per robot", d.section));
   }
   c.walk(doc, defs, false, {"name", "description"}, p, h, nullptr);
+  checkSecondary(doc, c, h);
   std::array<int, 5> bits = {h.gun_motor_bit[0], h.gun_solenoid_bit[0], h.gun_motor_bit[1],
                              h.gun_solenoid_bit[1], h.disc_shooter_bit};
   for (std::size_t i = 0; i < bits.size(); ++i)
     for (std::size_t j = i + 1; j < bits.size(); ++j)
       if (bits[i] == bits[j]) {
-        const toml::node* n = doc.get("ports");
+        const toml::node* n = doc.get("ports") ? doc.get("ports") : doc.get("secondary");
         c.fail(n ? n->source() : doc.source(),
                fmt::format("port B bit {} is bound twice", bits[i]));
       }

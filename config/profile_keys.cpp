@@ -235,6 +235,48 @@ const std::vector<KeyDef>& portTable() {
   return keys;
 }
 
+const std::vector<KeyDef>& secondaryTable() {
+  using plant::kMaxDiscsPerLauncher;
+  static const std::vector<KeyDef> keys = {
+      {"secondary",
+       "kind",
+       Kind::Choice,
+       {0, 0},
+       true,
+       [](Profile&, Hardware& h) {
+         Target t;
+         t.secondary = &h.secondary.kind;
+         return t;
+       }},
+      // The disc shooter's bit, as [ports] disc_shooter (one of the two).
+      {"secondary", "bit", Kind::Bit, {0, 7}, true, I(h.disc_shooter_bit)},
+      // The arena's disc table holds two full magazines (a rules file
+      // refuses more than its own limit, Appendix A's fifteen).
+      {"secondary",
+       "magazine",
+       Kind::Count,
+       {0, kMaxDiscsPerLauncher},
+       true,
+       I(h.secondary.magazine)},
+      // Thesis VIII.B: a weapon "must be safe enough for a person to take a
+      // hit"; the standard gun's ball leaves at 105 ft/s.
+      {"secondary", "launch_speed", Kind::Speed, {1, 150}, true, D(h.secondary.launch_speed_fps)},
+      // Appendix A: a robot at most 4.0 ft tall.
+      {"secondary",
+       "launch_height",
+       Kind::Length,
+       {0.05, 4},
+       true,
+       D(h.secondary.launch_height_ft)},
+      {"secondary", "drag_time", Kind::Time, {0.01, 60}, true, D(h.secondary.drag_time_s)},
+      // Below launch_speed (checked with it in parseHardware).
+      {"secondary", "stop_speed", Kind::Speed, {0.01, 150}, true, D(h.secondary.stop_speed_fps)},
+      // Up to 2 ft: no wider than a robot.
+      {"secondary", "diameter", Kind::Length, {0.01, 2}, true, D(h.secondary.diameter_ft)},
+  };
+  return keys;
+}
+
 #undef D
 #undef I
 #undef B

@@ -59,15 +59,20 @@ inline constexpr std::array<std::pair<const char*, vm::CpuRevision>, 2> kCpuChoi
     {"z80180", vm::CpuRevision::Z80180},
     {"z8s180", vm::CpuRevision::Z8S180},
 }};
+// A hardware file's [secondary] kind.
+inline constexpr std::array<std::pair<const char*, plant::SecondaryKind>, 1> kSecondaryChoices = {{
+    {"disc", plant::SecondaryKind::Disc},
+}};
 
 // Where one key's value lands: exactly one pointer is set, by the kind (a
-// Choice key's: `choice` or `cpu`).
+// Choice key's: `choice`, `cpu` or `secondary`).
 struct Target {
   double* d = nullptr;
   int* i = nullptr;
   bool* b = nullptr;
   vm::TimerService* choice = nullptr;
   vm::CpuRevision* cpu = nullptr;
+  plant::SecondaryKind* secondary = nullptr;
   std::array<double, 16>* table = nullptr;
 };
 
@@ -94,6 +99,9 @@ const std::vector<KeyDef>& courseTable();
 // are (the caller checks the ones it requires).
 void walkKeys(const toml::table& doc, const std::vector<const KeyDef*>& defs,
               const std::string& file, const std::vector<std::string>& plainStrings, Profile& p);
+// A hardware file's [secondary] keys (a secondary weapon: the disc
+// launcher). When the table is there, every key but `bit` must be.
+const std::vector<KeyDef>& secondaryTable();
 
 // Conversion factor to the internal unit, or NaN if the unit is not allowed.
 double unitFactor(Kind k, std::string_view u);

@@ -18,7 +18,9 @@
 // method restarts for free at an input (ARKODE's reset keeps its planned
 // step), where CVODE's multistep method started again at order 1 with a
 // tiny step. Balls in flight are closed forms too (straight line at the
-// muzzle speed, z = h - g t^2 / 2) that live only in the root functions.
+// muzzle speed, z = h - g t^2 / 2) that live only in the root functions,
+// and so are a disc launcher's discs (arena_discs.cpp: a straight line,
+// s = v0 tau (1 - e^{-t/tau}), flat).
 // A zero time constant starts the segment at the target.
 //
 // Contacts are rigid (contact.h): while a body pushes against a wall, the
@@ -217,12 +219,20 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
       ev.push(e);
     }
   }
+  // A disc launcher sends its disc at the edge's tick (arena_discs.cpp);
+  // without one the bit is only logged.
+  bool discLaunch = false;
   if (bit(value, hw.disc_shooter_bit) && !bit(old.portB, hw.disc_shooter_bit)) {
     Event e{EventKind::DiscShooter};
     e.robot = static_cast<std::int8_t>(robot);
-    ev.push(e);
+    if (hw.secondary.kind != SecondaryKind::Disc)
+      ev.push(e);
+    else if (old.discsLeft > 0)
+      discLaunch = true;  // its disc_fire comes with the launch below
+    else
+      ev.push(Event{EventKind::DiscEmpty, e.robot});
   }
-  if (!rhsChanges && !scheduleChanges) {
+  if (!rhsChanges && !scheduleChanges && !discLaunch) {
     // Nothing that moves changes: the prediction stays valid.
     for (Discrete* d : {&m.D, &m.pendingD}) {
       d->r[static_cast<std::size_t>(robot)].portB = value;
@@ -232,6 +242,7 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
   }
   m.rewindTo(tick);
   m.D.r[static_cast<std::size_t>(robot)] = next;
+  if (discLaunch) m.launchDisc(m.D, m.tmp, robot, m.timeOfTick(tick), ev);
   m.reinit(tick, m.timeOfTick(tick), m.tmp);
   return ev;
 }
@@ -303,6 +314,8 @@ bool Arena::ballsInFlight() const {
     if (d == &m.pendingD && !m.pending) break;
     for (const Ball& b : d->balls)
       if (b.active) return true;
+    for (const Disc& c : d->discs)
+      if (c.active) return true;
     if (m.nextLaunchIn(*d) >= 0) return true;
   }
   return false;
@@ -383,6 +396,19 @@ int Arena::hits(int robot) const {
   return m.discreteAt(m.now).r[static_cast<std::size_t>(robot)].hits;
 }
 
+int Arena::discShots(int robot) const {
+  const Impl& m = *impl_;
+  return m.discreteAt(m.now).r[static_cast<std::size_t>(robot)].discShots;
+}
+int Arena::discHits(int robot) const {
+  const Impl& m = *impl_;
+  return m.discreteAt(m.now).r[static_cast<std::size_t>(robot)].discHits;
+}
+int Arena::discsLeft(int robot) const {
+  const Impl& m = *impl_;
+  return m.discreteAt(m.now).r[static_cast<std::size_t>(robot)].discsLeft;
+}
+
 IntegratorStats Arena::stats() const {
   const Impl& m = *impl_;
   // ARKODE's counters run on over resets (a reset keeps them); the dense
@@ -429,8 +455,20 @@ const char* eventKindName(EventKind k) {
       return "gun_jammed";
     case EventKind::DiscShooter:
       return "disc_shooter";
+    case EventKind::DiscFire:
+      return "disc_fire";
+    case EventKind::DiscEmpty:
+      return "disc_empty";
+    case EventKind::DiscHit:
+      return "disc_hit";
+    case EventKind::DiscMiss:
+      return "disc_miss";
   }
   return "?";
+}
+
+const char* secondaryKindName(SecondaryKind k) {
+  return k == SecondaryKind::Disc ? "disc" : "none";
 }
 
 }  // namespace simbot::plant

@@ -38,7 +38,8 @@ int Arena::Impl::reported(const int* found, RootKind k, int who) const {
 // Applies everything that happens at tick T (time te) to (d, y) and lists
 // the events, in this fixed order: ball launches; ball outcomes (floor,
 // divider, hit, leaving the field -- the floor first, so a ball reaching
-// floor and robot together is a miss, thesis VIII.H); per robot: referee
+// floor and robot together is a miss, thesis VIII.H); disc outcomes (the
+// end of the path, then a hit, as a ball's divider before its hit); per robot: referee
 // put-back, reflex end; contacts (robot-robot, divider, wall) and the
 // reflexes they start; edge detectors; the referee's turn. A put-back
 // moves a robot, so contacts and edges are reconciled again after it; a
@@ -178,6 +179,9 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
       b.active = false;
     }
   }
+  // -- discs
+  for (int k = 0; k < kMaxDiscs; ++k)
+    if (d.discs[static_cast<std::size_t>(k)].active) discOutcome(k, te, d, ys, found, ev);
   // -- robots
   bool moved = false;
   for (int i = 0; i < nR; ++i) {

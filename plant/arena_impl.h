@@ -38,7 +38,9 @@ constexpr int kXY = 2;
 // are never reloaded, so a launch always finds a free slot.
 constexpr int kMaxBalls = 64;
 static_assert(kMaxBalls >= 2 * 2 * kMaxBallsPerGun, "the ball table must hold every magazine");
-constexpr int kMaxRoots = 2 * 7 + 1 + kMaxBalls * 5;
+// Every disc two launchers with full magazines can have in flight.
+constexpr int kMaxDiscs = 2 * kMaxDiscsPerLauncher;
+constexpr int kMaxRoots = 2 * 7 + 1 + kMaxBalls * 5 + kMaxDiscs * 2;
 constexpr int kRing = 16;
 static_assert(kRing > kMaxRefereeLimit, "the referee must see one event more than its limit");
 // ARKODE's tout in its one-step mode only bounds the first step's guess
@@ -70,6 +72,11 @@ enum class RootKind : std::uint8_t {
   // ball that rises above it (elevation dispersion): its descent through
   // that height over the body is a hit on the top of the cylinder.
   BallTop,
+  // A disc (arena_discs.cpp): the path left to its end (sEnd - s(t)), and
+  // the hit function of a ball with the target's radius grown by the
+  // disc's.
+  DiscEnd,
+  DiscHit,
 };
 
 struct RootDesc {
@@ -85,6 +92,22 @@ struct Ball {
   double x0 = 0, y0 = 0, z0 = 0, vx = 0, vy = 0, vz = 0;
   // Smallest distance to the other robot's body seen at an event tick or
   // at the closest-approach root of the hit function (for ball_miss).
+  double closest = HUGE_VAL;
+};
+
+// A disc in flight (arena_discs.cpp): its centre moves from (x0, y0) along
+// the unit vector (ux, uy) by s(t) = v0 tau (1 - e^{-(t - t0)/tau}), flat
+// at height z, and its flight ends at path length sEnd (a wall, the
+// divider, or its stop speed: `end`) unless it hits a robot first.
+struct Disc {
+  bool active = false;
+  int shooter = 0;
+  double t0 = 0;
+  double x0 = 0, y0 = 0, z = 0, ux = 0, uy = 0;
+  double v0 = 0, tau = 1, radius = 0;
+  double sEnd = 0;
+  MissReason end = MissReason::None;
+  // As Ball::closest.
   double closest = HUGE_VAL;
 };
 
@@ -126,12 +149,14 @@ struct RobotDisc {
   std::array<Dispersion, 2> launchDispersion{};  // drawDispersion, likewise
   std::array<int, 2> ballsLeft{};
   int shots = 0, hits = 0;
+  int discsLeft = 0, discShots = 0, discHits = 0;
 };
 
 struct Discrete {
   std::array<RobotDisc, 2> r{};
   bool robotContact = false;
   std::array<Ball, kMaxBalls> balls{};
+  std::array<Disc, kMaxDiscs> discs{};
 };
 
 // One robot's closed-form motion within a segment (DESIGN.md "Continuous
@@ -367,6 +392,25 @@ struct Arena::Impl : ArenaState {
   double ballGap(const Ball& b, double t, const double* y) const;
   double ballOutG(const Ball& b, double t) const;
   double ballDividerG(const Ball& b, double t) const;
+
+  // ---- discs (arena_discs.cpp)
+  double discPath(const Disc& d, double t) const;
+  void discAt(const Disc& d, double t, double& x, double& yy) const;
+  double discHitG(const Disc& d, double t, const double* y, double& perp2, double& dist2) const;
+  double discGap(const Disc& d, double t, const double* y) const;
+  // Path length along which a disc of `radius` at height z, its centre
+  // leaving p along the unit vector u, first touches something fixed
+  // (field walls, divider: the one place a fixed shape is added), and
+  // what; +inf and None if nothing.
+  double discStrike(const Vec2& p, const Vec2& u, double z, double radius, MissReason& what) const;
+  // Appends the root functions of the discs in flight to `roots`.
+  void addDiscRoots();
+  // A disc leaves robot i's rim at tick T (time te), state y; its events
+  // into ev, and its strike there if it touches something at once.
+  void launchDisc(Discrete& d, const std::vector<double>& y, int i, double te, EventList& ev);
+  // Disc k's outcome at time te: the end of its path, then a hit.
+  void discOutcome(int k, double te, Discrete& d, const double* ys, const int* found,
+                   EventList& ev);
 
   double rootValue(const RootDesc& rd, double t, const double* y) const;
   // Root j of the list as ARKODE, crossedTick() and the event rules see it

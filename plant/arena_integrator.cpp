@@ -82,6 +82,8 @@ Arena::Impl::Impl(const ArenaConfig& c)
     RobotDisc& d = D.r[static_cast<std::size_t>(i)];
     d.latched = MotorFrame{};  // stopped until the first frame latches
     d.ballsLeft = {rs.params.balls_per_gun, rs.params.balls_per_gun};
+    if (rs.hardware.secondary.kind == SecondaryKind::Disc)
+      d.discsLeft = rs.hardware.secondary.magazine;
   }
   // Initial flags from geometry, silently (nothing has happened yet): a
   // body put down touching something starts in contact with it.
@@ -155,13 +157,15 @@ double Arena::Impl::stepBound(const double* y, double ahead) const {
   return std::max(floor, d / v - ahead);
 }
 
-// Every wheel and its target at rest and no ball in flight: the state and
+// Every wheel and its target at rest and no ball or disc in flight: the state and
 // every root function are then constant until the next reset (nothing
 // changes the right-hand side without one), so no crossing can hide inside
 // a step and only kRestStep bounds it.
 bool Arena::Impl::atRest() const {
   for (const Ball& b : D.balls)
     if (b.active) return false;
+  for (const Disc& c : D.discs)
+    if (c.active) return false;
   for (int i = 0; i < nR; ++i) {
     const Motion& m = motion[static_cast<std::size_t>(i)];
     if (m.vl0 != 0 || m.vr0 != 0 || m.tl != 0 || m.tr != 0) return false;
@@ -583,11 +587,14 @@ bool Arena::Impl::eventsAt(std::int64_t T, double te, const int* found, EventLis
   pendingD = D;
   ev.clear();
   process(T, te, pendingD, pendingY, found, ev);
-  if (ev.empty())  // nothing happens here, but a ball may pass closest to its
-                   // target
+  if (ev.empty()) {  // nothing happens here, but a ball or disc may pass closest to its target
     for (int s = 0; s < kMaxBalls; ++s)
       D.balls[static_cast<std::size_t>(s)].closest =
           pendingD.balls[static_cast<std::size_t>(s)].closest;
+    for (int k = 0; k < kMaxDiscs; ++k)
+      D.discs[static_cast<std::size_t>(k)].closest =
+          pendingD.discs[static_cast<std::size_t>(k)].closest;
+  }
   return !ev.empty();
 }
 

@@ -2,9 +2,9 @@
 //
 // Every discrete change of the arena is the zero of one of these functions
 // of time and state (arena.cpp, "Events"): edge detectors, walls, divider,
-// field, reflex end, robot-robot contact and the balls' closed-form
-// flights. buildRoots() lists the ones the current discrete state needs;
-// ARKODE evaluates them through rootThunk; crossedTick() decides the tick of
+// field, reflex end, robot-robot contact and the balls' and discs'
+// closed-form flights (the discs' in arena_discs.cpp). buildRoots() lists the ones the current
+// discrete state needs; ARKODE evaluates them through rootThunk; crossedTick() decides the tick of
 // a crossing ARKODE reported. They only read the state: the rules that act
 // on a crossing are in arena_events.cpp.
 #include "plant/arena_impl.h"
@@ -166,6 +166,14 @@ double Arena::Impl::rootValue(const RootDesc& rd, double t, const double* y) con
       ballAt(b, t, x, yy, z);
       return z - P(1 - b.shooter).target_height_ft;
     }
+    case RootKind::DiscEnd: {
+      const Disc& d = D.discs[static_cast<std::size_t>(rd.robot)];
+      return d.sEnd - discPath(d, t);
+    }
+    case RootKind::DiscHit: {
+      double p2, d2;
+      return discHitG(D.discs[static_cast<std::size_t>(rd.robot)], t, y, p2, d2);
+    }
   }
   return 1.0;
 }
@@ -276,6 +284,7 @@ void Arena::Impl::buildRoots() {
             P(1 - ball.shooter).target_height_ft)
       add(RootKind::BallTop, b);
   }
+  addDiscRoots();
 }
 
 // DESIGN.md: an event happens at the first integer tick at which its root

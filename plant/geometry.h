@@ -81,4 +81,64 @@ inline bool segmentHitsRect(const Vec2& a, const Vec2& b, const Rect& r) {
   return true;
 }
 
+// Rays, for a disc's straight path (arena_discs.cpp): p + s u, s >= 0,
+// u a unit vector. Each gives the smallest s >= 0 at which the ray is in
+// the closed shape (0 if p is in it already), or +inf if it never is.
+
+// A circle of radius r about c. With w = p - c: |w + s u|^2 = r^2, the
+// smaller root s = -b - sqrt(b^2 - k), b = w.u, k = |w|^2 - r^2, written
+// as k / (-b + sqrt(b^2 - k)) so that a far circle loses no digits.
+inline double rayEntersCircle(const Vec2& p, const Vec2& u, const Vec2& c, double r) {
+  const Vec2 w = p - c;
+  const double b = w.dot(u), k = w.squaredNorm() - r * r;
+  if (k <= 0) return 0.0;
+  const double disc = b * b - k;
+  if (b >= 0 || disc < 0) return HUGE_VAL;  // moving away, or passing by
+  return k / (-b + std::sqrt(disc));
+}
+
+// An axis-aligned rectangle: slab clipping of [0, inf) against both axes.
+inline double rayEntersRect(const Vec2& p, const Vec2& u, const Rect& r) {
+  double lo = 0.0, hi = HUGE_VAL;
+  const double mins[2] = {r.x0, r.y0}, maxs[2] = {r.x1, r.y1};
+  for (int i = 0; i < 2; ++i) {
+    if (u[i] == 0.0) {
+      if (p[i] < mins[i] || p[i] > maxs[i]) return HUGE_VAL;
+      continue;
+    }
+    double t0 = (mins[i] - p[i]) / u[i], t1 = (maxs[i] - p[i]) / u[i];
+    if (t0 > t1) std::swap(t0, t1);
+    lo = std::max(lo, t0);
+    hi = std::min(hi, t1);
+  }
+  return lo <= hi ? lo : HUGE_VAL;
+}
+
+// Where a disc of radius r, its centre on the ray, first touches the
+// rectangle: where the ray enters the rectangle grown by r (their
+// Minkowski sum: the rectangle widened by r across x, across y, and a
+// circle of radius r at each corner).
+inline double discPathToRect(const Vec2& p, const Vec2& u, double r, const Rect& rect) {
+  double s = std::min(rayEntersRect(p, u, Rect{rect.x0 - r, rect.y0, rect.x1 + r, rect.y1}),
+                      rayEntersRect(p, u, Rect{rect.x0, rect.y0 - r, rect.x1, rect.y1 + r}));
+  for (const Vec2& corner : {Vec2(rect.x0, rect.y0), Vec2(rect.x1, rect.y0), Vec2(rect.x0, rect.y1),
+                             Vec2(rect.x1, rect.y1)})
+    s = std::min(s, rayEntersCircle(p, u, corner, r));
+  return s;
+}
+
+// Where a disc of radius r, its centre on the ray from inside the square
+// |x|, |y| <= hw, first touches the square's edge (the field's walls): 0
+// if it touches already.
+inline double discPathToSquareEdge(const Vec2& p, const Vec2& u, double r, double hw) {
+  const double inner = hw - r;
+  if (std::abs(p.x()) >= inner || std::abs(p.y()) >= inner) return 0.0;
+  double s = HUGE_VAL;
+  for (int i = 0; i < 2; ++i) {
+    if (u[i] > 0) s = std::min(s, (inner - p[i]) / u[i]);
+    if (u[i] < 0) s = std::min(s, (-inner - p[i]) / u[i]);
+  }
+  return s;
+}
+
 }  // namespace simbot::plant::geom

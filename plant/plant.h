@@ -141,11 +141,39 @@ struct RefereeParams {
   bool scatter_scores = true;
 };
 
+// A launcher's magazine holds at most this many discs (the thesis,
+// Appendix A: a secondary weapon's magazine at most fifteen rounds; a rules
+// file may refuse more). The arena's table of discs in flight is sized
+// from it (arena_impl.h kMaxDiscs).
+inline constexpr int kMaxDiscsPerLauncher = 16;
+
+// A secondary weapon (DESIGN.md "The wider competition"), from a hardware
+// file's [secondary] table. None: the disc shooter's bit is logged only.
+enum class SecondaryKind : std::uint8_t { None, Disc };
+// "disc" (the hardware file's and the trace's word); "none" for None.
+const char* secondaryKindName(SecondaryKind k);
+
+// The disc launcher: a rising edge of its port B bit (Hardware::
+// disc_shooter_bit) sends one disc from the body's rim along the heading,
+// flat at launch_height_ft, its speed decaying with linear drag,
+// v = v0 e^{-t/tau}, until it strikes a robot, a wall or the divider, or
+// its speed falls below stop_speed_fps (docs/plant.md, "The disc launcher").
+struct SecondaryWeapon {
+  SecondaryKind kind = SecondaryKind::None;
+  int magazine = 0;  // discs, at most kMaxDiscsPerLauncher
+  double launch_speed_fps = 0;
+  double launch_height_ft = 0;
+  double drag_time_s = 0;  // tau
+  double stop_speed_fps = 0;
+  double diameter_ft = 0;
+};
+
 // Port B bindings of one robot (bits 0..7).
 struct Hardware {
   std::array<int, 2> gun_motor_bit{3, 7};
   std::array<int, 2> gun_solenoid_bit{4, 5};
-  int disc_shooter_bit = 6;  // logged only
+  int disc_shooter_bit = 6;  // logged only, unless `secondary` is a disc launcher
+  SecondaryWeapon secondary;
 };
 
 // The integrator failed (a SUNDIALS call returned an error). The profile
@@ -239,7 +267,9 @@ double dividerClearance(double x, double y, double radius, const FieldParams& fi
 enum class Detector : std::uint8_t { Fore = 0, Aft = 1 };
 enum class Bumper : std::uint8_t { Front = 0, Back = 1 };
 enum class ContactWith : std::uint8_t { None, Robot, Divider, Wall };
-enum class MissReason : std::uint8_t { None, Floor, Divider, LeftField };
+// Why a ball or disc flight ended without a hit. LeftField: it reached a
+// field wall; Stopped: a disc slowed below its stop speed.
+enum class MissReason : std::uint8_t { None, Floor, Divider, LeftField, Stopped };
 
 enum class EventKind : std::uint8_t {
   EdgeEnter,       // robot, detector: detector now reads low
@@ -259,6 +289,11 @@ enum class EventKind : std::uint8_t {
   GunMisfire,      // (from setPortB) robot, gun: the stroke launched nothing
   GunJammed,       // (from setPortB) robot, gun: jammed now or before, launched nothing
   DiscShooter,     // (from setPortB) robot: disc shooter bit rose (logged only)
+  // The disc launcher (Hardware::secondary); `ball` is the disc's number.
+  DiscFire,   // (from setPortB) robot, ball; x, y, z, vx, vy: the flight's start
+  DiscEmpty,  // (from setPortB) robot: the bit rose, the magazine is empty
+  DiscHit,    // robot = shooter, ball, other = target; x, y, z: where
+  DiscMiss,   // robot = shooter, ball, miss; x, y, z: where; closest_ft
 };
 const char* eventKindName(EventKind k);
 
@@ -271,7 +306,7 @@ struct Event {
   ContactWith with = ContactWith::None;
   MissReason miss = MissReason::None;
   std::int8_t gun = -1;
-  std::int8_t ball = -1;
+  std::int8_t ball = -1;  // a ball's slot, or a disc's (disc events)
   // Balls: position (ft) at the event, and at a launch the velocity (ft/s):
   // the flight is x + vx s, y + vy s, z + vz s - g s^2 / 2 after the launch
   // tick; and the shooter's heading (deg) then, from which the ball's
@@ -454,12 +489,13 @@ class Arena {
   // Returns false (no reinit) if the drive is already these speeds.
   bool setDrive(int robot, double leftFps, double rightFps, std::int64_t tick);
   // A write to PIO port B. Returns the immediate events (solenoid strokes,
-  // empty guns, misfires and jams, disc shooter); launches come later from
-  // advance(). `gunLuck` draws a stroke's jam or misfire (one draw per
-  // stroke that would launch, only if the robot's probabilities are not
-  // both 0); null: guns never jam or misfire.
-  // `muzzle` draws each launching stroke's muzzleFactor (null: factor 1),
-  // `dispersion` its drawDispersion (null: along the heading, horizontal).
+  // empty guns, misfires and jams, disc shooter; a disc launcher's disc
+  // leaves at the write's tick, with its strike there if it touches
+  // something at once); launches and strikes come later from advance(). `gunLuck` draws a stroke's
+  // jam or misfire (one draw per stroke that would launch, only if the robot's probabilities are
+  // not both 0); null: guns never jam or misfire. `muzzle` draws each launching stroke's
+  // muzzleFactor (null: factor 1), `dispersion` its drawDispersion (null: along the heading,
+  // horizontal).
   EventList setPortB(int robot, std::uint8_t value, std::int64_t tick,
                      RandomBits* gunLuck = nullptr, RandomBits* muzzle = nullptr,
                      RandomBits* dispersion = nullptr);
@@ -477,8 +513,8 @@ class Arena {
   // its stop. The integrator's steps stay (as after an advance() whose last
   // step overshot its stop).
   void retreat(std::int64_t tick);
-  // A ball is in flight or a launch is scheduled (at now(), after any
-  // pending events).
+  // A ball or disc is in flight or a launch is scheduled (at now(), after
+  // any pending events).
   bool ballsInFlight() const;
 
   Pose pose(int robot, std::int64_t tick) const;
@@ -492,6 +528,11 @@ class Arena {
   int ballsLeft(int robot, int gun) const;
   int shots(int robot) const;
   int hits(int robot) const;
+  // The disc launcher's discs sent, hits and discs left (0 without one);
+  // its hits are not in hits().
+  int discShots(int robot) const;
+  int discHits(int robot) const;
+  int discsLeft(int robot) const;
   IntegratorStats stats() const;
 
   // The program's PIO (edge) interrupt handler was entered at `tick` (the

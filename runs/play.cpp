@@ -46,6 +46,14 @@ json faultsJson(const std::vector<scheduler::FaultInfo>& faults) {
   return out;
 }
 
+// A robot's secondary weapon, only for a robot that carries one (so that
+// the JSON of a run without one is as before): {"shots": n, "hits": n},
+// hits apart from the guns' `hits` (docs/trace.md, "The JSON result").
+void addSecondary(json& robot, const scheduler::RobotResult& rr) {
+  if (rr.secondary)
+    robot["secondary"] = {{"shots", rr.secondary->shots}, {"hits", rr.secondary->hits}};
+}
+
 }  // namespace
 
 json faultJson(const std::optional<scheduler::FaultInfo>& f) {
@@ -253,6 +261,7 @@ json soloJson(const Played& played) {
       {"interrupts", a.interrupts},
       {"final_pose", poseJson(a.finalPose)},
       {"scatter_shots", scatterJson(a)}};
+  addSecondary(j, a);
   return j;
 }
 
@@ -260,7 +269,7 @@ json matchJson(const Played& played) {
   const auto& r = played.result;
   const double wall = played.wallSeconds;
   json robots = json::array();
-  for (const auto& rr : r.robots)
+  for (const auto& rr : r.robots) {
     robots.push_back({{"name", rr.name},
                       {"program", rr.program},
                       {"hits", rr.hits},
@@ -277,6 +286,8 @@ json matchJson(const Played& played) {
                       {"final_pose", poseJson(rr.finalPose)},
                       {"console_lines", rr.console.size()},
                       {"scatter_shots", scatterJson(rr)}});
+    addSecondary(robots.back(), rr);
+  }
   json j = {{"sim_seconds", timebase::secondsFromTicks(r.endTick)},
             {"wall_seconds", wall},
             {"seed", played.seed},

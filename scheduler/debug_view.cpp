@@ -89,6 +89,11 @@ std::string Match::describe(Tick t) const {
       out += "             " + waiting + "\n";
     out += fmt::format("  guns       {} shots, {} hits\n", arena_.shots(r->index),
                        arena_.hits(r->index));
+    // Only a robot that carries one, so that other sessions read as before.
+    if (arenaConfig_->robots[static_cast<size_t>(r->index)].hardware.secondary.kind ==
+        plant::SecondaryKind::Disc)
+      out += fmt::format("  discs      {} shots, {} hits, {} left\n", arena_.discShots(r->index),
+                         arena_.discHits(r->index), arena_.discsLeft(r->index));
   }
   return out;
 }

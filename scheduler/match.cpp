@@ -318,6 +318,14 @@ void Match::emitSetup() {
                                 setup.hardware.gun_solenoid_bit[1],
                                 setup.hardware.disc_shooter_bit},
          {});
+    const plant::SecondaryWeapon& w = setup.hardware.secondary;
+    if (w.kind != plant::SecondaryKind::None)
+      emit(
+          0,
+          trace::rec::Secondary{r->index, plant::secondaryKindName(w.kind),
+                                setup.hardware.disc_shooter_bit, w.magazine, w.launch_speed_fps,
+                                w.launch_height_ft, w.drag_time_s, w.stop_speed_fps, w.diameter_ft},
+          {});
   }
 }
 
@@ -444,6 +452,7 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
   const auto missed = [](plant::MissReason m) {
     return m == plant::MissReason::Floor     ? "floor"
            : m == plant::MissReason::Divider ? "divider"
+           : m == plant::MissReason::Stopped ? "stopped"
                                              : "wall";
   };
   switch (e.kind) {
@@ -485,6 +494,29 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
       return rec::GunJammed{r, e.gun};
     case plant::EventKind::DiscShooter:
       return rec::DiscShooter{r, -1};
+    case plant::EventKind::DiscFire:
+      return rec::DiscFire{
+          r,
+          e.ball,
+          e.x,
+          e.y,
+          e.z,
+          e.vx,
+          e.vy,
+          arenaConfig_->robots[static_cast<size_t>(r)].hardware.secondary.drag_time_s,
+          e.heading_deg};
+    case plant::EventKind::DiscEmpty:
+      return rec::DiscEmpty{r};
+    case plant::EventKind::DiscHit:
+      return rec::DiscHit{r, e.other, e.ball, e.x, e.y, e.z};
+    case plant::EventKind::DiscMiss:
+      return rec::DiscMiss{r,
+                           e.ball,
+                           missed(e.miss),
+                           e.x,
+                           e.y,
+                           e.z,
+                           e.closest_ft >= 0 ? std::optional<double>(e.closest_ft) : std::nullopt};
   }
   throw std::logic_error("plant event without a trace record");
 }
@@ -756,6 +788,13 @@ void Match::finish(MatchResult& result) {
     rr.hits = arena_.hits(r->index) - unscoredHits_[at];
     if (arenaConfig_->referee.judge_scatter) rr.scatterShots = scatterShots_[at];
     rr.shots = arena_.shots(r->index);
+    // A secondary weapon's shots and hits, apart from the guns' (the
+    // winner is decided on the guns' hits).
+    const plant::SecondaryKind secondary =
+        arenaConfig_->robots[static_cast<size_t>(r->index)].hardware.secondary.kind;
+    if (secondary != plant::SecondaryKind::None)
+      rr.secondary = SecondaryResult{plant::secondaryKindName(secondary),
+                                     arena_.discShots(r->index), arena_.discHits(r->index)};
     // The clock at main's return, or at the end of the run: a VM's clock
     // runs on to the last round's horizon after main returns, and may stand
     // one instruction past the end.
@@ -797,6 +836,11 @@ void Match::finish(MatchResult& result) {
                                    rr.framesOverwritten, static_cast<int64_t>(rr.cycles),
                                    rr.fault.has_value(), rr.reloads, rr.exited},
            {});
+      if (rr.secondary)
+        emit(result.endTick,
+             trace::rec::SecondaryResult{i, rr.secondary->kind, rr.secondary->shots,
+                                         rr.secondary->hits},
+             {});
     }
     emit(result.endTick, trace::rec::End{result.winner, result.tieBrokenByCoin}, {});
   }

@@ -253,12 +253,20 @@ struct FaultInfo {
   std::string calls;  // their chain, ending at the fault: main:12 > deep:7 x 251
 };
 
+// A robot's secondary weapon (plant::Hardware::secondary) when the run
+// ended: discs sent and hits, counted apart from the guns' shots and hits.
+struct SecondaryResult {
+  std::string kind;  // "disc"
+  int shots = 0, hits = 0;
+};
+
 struct RobotResult {
   std::string name, program;
   int hits = 0, shots = 0;
   // Detect to Engage (the arena's referee judge_scatter): launches with
   // neither eye above the rules' threshold. None when no rules judge them.
   std::optional<int> scatterShots;
+  std::optional<SecondaryResult> secondary;  // none without a secondary weapon
   int framesLatched = 0, framesRejected = 0;
   // Sends that restarted the serial library before it had fetched the last
   // byte of the previous send (its NUL): that frame can never latch.
