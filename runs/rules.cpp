@@ -20,12 +20,16 @@ void checkRunAgainstRules(const config::Profile& profile, const scheduler::Match
     const plant::RobotParams& params = config.arena.robots[i].params;
     uses.magazines.push_back({static_cast<int>(i), params.balls_per_gun,
                               hardwareFiles[i].empty() ? profile.file : hardwareFiles[i]});
+    const plant::SecondaryWeapon& secondary = config.arena.robots[i].hardware.secondary;
+    if (secondary.kind != plant::SecondaryKind::None)
+      uses.secondaryWeapons.push_back({static_cast<int>(i),
+                                       plant::secondaryKindName(secondary.kind), secondary.magazine,
+                                       hardwareFiles[i]});
   }
   // The other parts of issue 40 add here what they put in a run: the
   // arena's obstacles with mine = true (uses.mines, with the scenario or
-  // rules file that places each), each robot's hardware [[deployables]]
-  // (uses.deployables: kind and count, its hardware file) and secondary
-  // weapon (uses.secondaryWeapons: kind "disc", its magazine, its file).
+  // rules file that places each) and each robot's hardware [[deployables]]
+  // (uses.deployables: kind and count, its hardware file).
   config::checkRules(profile.course, uses);
 }
 
