@@ -61,15 +61,23 @@ scheduler::Injection parseInjection(const std::string& text, int robotCount) {
     in.source = scheduler::InjectSource::BumperFront;
   else if (source == "bumper_back")
     in.source = scheduler::InjectSource::BumperBack;
+  else if (source == "reset")
+    in.source = scheduler::InjectSource::Reset;
   else
     throw std::invalid_argument("'" + text +
                                 "': SOURCE must be edge_fore, edge_aft, "
-                                "bumper_front or bumper_back");
+                                "bumper_front, bumper_back or reset");
   const bool pass = when.rfind("pass:", 0) == 0;
   if (when.rfind("line:", 0) == 0 || pass) {
     const auto hash = when.find('#');
     if (hash == std::string::npos)
       throw std::invalid_argument("'" + text + "': a program point is line:N#K or pass:N#K");
+    // A reset stops the whole board: at a program point the VM has run on
+    // past it by the time the scheduler could act, so only times are taken.
+    if (in.source == scheduler::InjectSource::Reset)
+      throw std::invalid_argument("'" + text +
+                                  "': a reset is injected at a time (12.5s, 115200000t), not at "
+                                  "a program point");
     in.pass = pass;
     in.line = parsePositive(when.substr(5, hash - 5), text, "the line N");
     in.count = parsePositive(when.substr(hash + 1), text, "the execution count K");

@@ -219,6 +219,7 @@ class Checker {
     for (const KeyDef* d : defs) {
       if (std::find(seen.begin(), seen.end(), d) != seen.end()) continue;
       const toml::node* sec = doc.get(d->section);
+      if (d->optionalSection && !sec) continue;
       fail(sec ? sec->source() : doc.source(),
            fmt::format("missing key '{}' in [{}]", d->key, d->section));
     }
@@ -227,6 +228,17 @@ class Checker {
  private:
   std::string file_;
 };
+
+// [battery]'s values against each other (a profile's, or a hardware
+// file's after its overrides), reported at the [battery] table.
+void batteryChecks(const plant::BatteryParams& b, const Checker& c, const toml::table& doc) {
+  const toml::node* n = doc.get("battery");
+  if (!n) return;
+  if (b.voltage_empty_v >= b.voltage_full_v)
+    c.fail(n->source(), "battery.voltage_empty must be below battery.voltage_full");
+  if (b.brownout_v >= b.voltage_full_v)
+    c.fail(n->source(), "battery.brownout_voltage must be below battery.voltage_full");
+}
 
 void crossChecks(const Profile& p, const Checker& c, const toml::table& doc) {
   // Checks between keys; reported at the section that holds the second key.
@@ -270,6 +282,7 @@ void crossChecks(const Profile& p, const Checker& c, const toml::table& doc) {
       c.fail(where("robot"), "trim_spread takes a wheel's trim outside 0.5..2");
   if (p.referee.putback_ft * 2 >= p.field.size_ft - 2 * p.field.wire_inset_ft)
     c.fail(where("referee"), "putback leaves no room inside the wire");
+  batteryChecks(p.robot.battery, c, doc);
 }
 
 // A hardware file's [secondary] table, once walked: every key but `bit`
@@ -370,6 +383,17 @@ Hardware parseHardware(std::string_view text, const std::string& sourceName,
       const toml::node* n = doc.get("robot");
       c.fail(n ? n->source() : doc.source(), "trim_spread takes a wheel's trim outside 0.5..2");
     }
+  // A hardware file that enables a battery the profile has no [battery]
+  // for (capacity 0) gives all of it (every key required, as in a profile).
+  if (const toml::node* n = doc.get("battery"); n && p.robot.battery.enabled) {
+    const toml::table* t = n->as_table();
+    for (const KeyDef& d : keys::keyTable())
+      if (d.optionalSection && params.battery.capacity_c == 0 && t && !t->contains(d.key))
+        c.fail(n->source(), fmt::format("missing key '{}' in [battery] (the profile has no "
+                                        "battery, so the hardware file gives all of it)",
+                                        d.key));
+  }
+  batteryChecks(p.robot.battery, c, doc);
   params = p.robot;
   controller = p.controller;
   return h;

@@ -38,6 +38,14 @@ using plant::kMaxRefereeLimit;
     return t;                   \
   }
 
+namespace {
+// A [battery] key: per robot, its section optional.
+KeyDef BK(const char* key, Kind kind, Bounds bounds,
+          std::function<Target(Profile&, plant::Hardware&)> target) {
+  return KeyDef{"battery", key, kind, bounds, true, std::move(target), true};
+}
+}  // namespace
+
 const std::vector<KeyDef>& keyTable() {
   static const std::vector<KeyDef> keys = {
       {"field", "size", Kind::Length, {1, 100}, false, D(p.field.size_ft)},
@@ -124,6 +132,21 @@ const std::vector<KeyDef>& keyTable() {
        {0, 1},
        true,
        D(p.robot.misfire_probability)},
+      // [battery] (optional: without it no battery runs down). Ranges span
+      // any pack a 1996-97 student robot carried (docs/plant.md, "Batteries").
+      BK("enabled", Kind::Bool, {0, 0}, B(p.robot.battery.enabled)),
+      BK("capacity", Kind::Charge, {36, 360000}, D(p.robot.battery.capacity_c)),
+      BK("voltage_full", Kind::Voltage, {1, 60}, D(p.robot.battery.voltage_full_v)),
+      BK("voltage_empty", Kind::Voltage, {0.5, 60}, D(p.robot.battery.voltage_empty_v)),
+      BK("nominal_voltage", Kind::Voltage, {1, 60}, D(p.robot.battery.nominal_v)),
+      BK("internal_resistance", Kind::Resistance, {0, 10}, D(p.robot.battery.resistance_ohm)),
+      BK("board_current", Kind::Current, {0, 5}, D(p.robot.battery.board_a)),
+      BK("drive_current", Kind::Current, {0, 50}, D(p.robot.battery.drive_a)),
+      BK("gun_motor_current", Kind::Current, {0, 50}, D(p.robot.battery.gun_motor_a)),
+      BK("solenoid_current", Kind::Current, {0, 50}, D(p.robot.battery.solenoid_a)),
+      BK("brownout_voltage", Kind::Voltage, {0.5, 60}, D(p.robot.battery.brownout_v)),
+      BK("recovery_hysteresis", Kind::Voltage, {0, 10}, D(p.robot.battery.hysteresis_v)),
+      BK("reset_hold", Kind::Time, {0, 10}, D(p.robot.battery.reset_hold_s)),
       {"controller", "random_memory", Kind::Bool, {0, 0}, true, B(p.controller.randomMemory)},
       {"controller",
        "timer_service",
@@ -328,6 +351,23 @@ double unitFactor(Kind k, std::string_view u) {
     case Kind::Bit:
       if (u == "bit") return 1.0;
       break;
+    case Kind::Charge:
+      if (u == "Ah") return 3600.0;
+      if (u == "mAh") return 3.6;
+      if (u == "C") return 1.0;
+      break;
+    case Kind::Voltage:
+      if (u == "V") return 1.0;
+      if (u == "mV") return 1e-3;
+      break;
+    case Kind::Current:
+      if (u == "A") return 1.0;
+      if (u == "mA") return 1e-3;
+      break;
+    case Kind::Resistance:
+      if (u == "ohm") return 1.0;
+      if (u == "mohm") return 1e-3;
+      break;
     case Kind::Bool:
     case Kind::Choice:
       break;
@@ -361,6 +401,14 @@ const char* allowedUnits(Kind k) {
       return "step";
     case Kind::Bit:
       return "bit";
+    case Kind::Charge:
+      return "Ah, mAh, C";
+    case Kind::Voltage:
+      return "V, mV";
+    case Kind::Current:
+      return "A, mA";
+    case Kind::Resistance:
+      return "ohm, mohm";
     case Kind::Bool:
     case Kind::Choice:
       return "(none)";
@@ -383,6 +431,14 @@ const char* internalUnit(Kind k) {
       return "ft/s^2";
     case Kind::Mass:
       return "lb";
+    case Kind::Charge:
+      return "C";
+    case Kind::Voltage:
+      return "V";
+    case Kind::Current:
+      return "A";
+    case Kind::Resistance:
+      return "ohm";
     default:
       return allowedUnits(k);
   }

@@ -36,6 +36,10 @@ enum class Kind {
   Bool,         // no unit
   Choice,       // no unit; one of the words in kChoices
   SpeedTable,   // array of 16 speeds
+  Charge,       // Ah, mAh, C (stored in coulombs)
+  Voltage,      // V, mV
+  Current,      // A, mA
+  Resistance,   // ohm, mohm
 };
 
 // The physically sensible values of a key, in internal units (ft, s,
@@ -83,6 +87,9 @@ struct KeyDef {
   Bounds bounds;
   bool perRobot;
   std::function<Target(Profile&, plant::Hardware&)> target;
+  // A key of a section a profile may leave out as a whole ([battery]: no
+  // battery); when the section is there, every key of it is required.
+  bool optionalSection = false;
 };
 
 // Every profile key, in file order.

@@ -158,6 +158,28 @@ bool Arena::setDrive(int robot, double leftFps, double rightFps, std::int64_t ti
   return true;
 }
 
+bool Arena::setSupply(int robot, double scale, std::int64_t tick) {
+  Impl& m = *impl_;
+  const Journal::Entry entry =
+      m.enter({.kind = Journal::Kind::SetSupply, .robot = robot, .tick = tick, .left = scale});
+  m.checkRobot(robot);
+  m.checkInputTick(tick);
+  if (!(scale > 0) || !std::isfinite(scale))
+    throw std::invalid_argument("plant: a supply scale must be positive and finite");
+  const bool committedAtTick = m.pending && tick == m.pendingTick;
+  const RobotDisc& r = (committedAtTick ? m.pendingD : m.D).r[static_cast<std::size_t>(robot)];
+  if (r.supply == scale) return false;
+  m.rewindTo(tick);
+  m.D.r[static_cast<std::size_t>(robot)].supply = scale;
+  m.reinit(tick, m.timeOfTick(tick), m.tmp);
+  return true;
+}
+
+double Arena::supply(int robot) const {
+  impl_->checkRobot(robot);
+  return impl_->D.r[static_cast<std::size_t>(robot)].supply;
+}
+
 EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, RandomBits* gunLuck,
                           RandomBits* muzzle, RandomBits* dispersion) {
   Impl& m = *impl_;

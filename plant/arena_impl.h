@@ -144,6 +144,9 @@ struct RobotDisc {
   std::uint8_t portB = 0;
   std::array<bool, 2> gunOn{};
   std::array<bool, 2> gunJammed{};
+  // The battery's terminal voltage over the nominal one (Arena::setSupply):
+  // scales the wheel and gun-wheel targets. Exactly 1 without a battery.
+  double supply = 1;
   std::array<std::int64_t, 2> launchTick{-1, -1};
   std::array<double, 2> launchFactor{1, 1};      // muzzleFactor drawn at the stroke
   std::array<Dispersion, 2> launchDispersion{};  // drawDispersion, likewise

@@ -250,6 +250,14 @@ void Arena::Impl::computeTargets(const Discrete& d) {
     auto& gt = gunTarget[static_cast<std::size_t>(i)];
     gt[0] = r.gunOn[0] || p.gun_motors_always_on ? 1.0 : 0.0;
     gt[1] = r.gunOn[1] || p.gun_motors_always_on ? 1.0 : 0.0;
+    // A battery's voltage (setSupply); without one the targets stay as
+    // they are, bit for bit.
+    if (r.supply != 1) {
+      wt[0] *= r.supply;
+      wt[1] *= r.supply;
+      gt[0] *= r.supply;
+      gt[1] *= r.supply;
+    }
   }
 }
 

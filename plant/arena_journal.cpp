@@ -73,6 +73,9 @@ void Journal::replay(Arena& arena, std::size_t callCount, std::size_t drawCount)
       case Kind::EdgeHandlerEntered:
         arena.edgeHandlerEntered(c.robot, c.tick);
         break;
+      case Kind::SetSupply:
+        arena.setSupply(c.robot, c.left, c.tick);
+        break;
       case Kind::Advance:
         arena.advance(c.tick);
         break;

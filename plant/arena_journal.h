@@ -28,6 +28,7 @@ struct Journal {
     SetPortB,
     TriggerReflex,
     EdgeHandlerEntered,
+    SetSupply,
     Advance,
     Retreat
   };

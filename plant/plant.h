@@ -56,6 +56,25 @@ struct Pose {
 // arena's table of balls in flight is sized from it (arena.cpp kMaxBalls).
 inline constexpr int kMaxBallsPerGun = 16;
 
+// A robot's battery (the profile's [battery], optional; battery.h has the
+// model). Internal units: coulombs, volts, amperes, ohms, seconds. Off: the
+// wheels and gun wheels run at the speed table's speeds for the whole run.
+struct BatteryParams {
+  bool enabled = false;
+  double capacity_c = 0;                           // charge when full
+  double voltage_full_v = 0, voltage_empty_v = 0;  // open circuit, linear in the charge
+  double nominal_v = 0;       // the voltage the speed table and muzzle speed hold at
+  double resistance_ohm = 0;  // internal resistance
+  double board_a = 0;         // the controller board (always, in reset too)
+  double drive_a = 0;         // one drive motor at step 15 (linear in the step)
+  double gun_motor_a = 0;     // one gun-wheel motor on
+  double solenoid_a = 0;      // one solenoid while its bit is high
+  double brownout_v = 0;      // the board resets at or below this
+  double hysteresis_v = 0;    // ... and restarts only at brownout_v + this or above
+  double reset_hold_s = 0;    // ... and not before this long after the reset
+  bool operator==(const BatteryParams&) const = default;
+};
+
 struct RobotParams {
   // body
   double body_diameter_ft = 0;
@@ -100,6 +119,7 @@ struct RobotParams {
   // later, this match), or misfires (launches nothing; the ball stays
   // chambered for the next stroke). DESIGN.md: an option.
   double jam_probability = 0, misfire_probability = 0;
+  BatteryParams battery;
 };
 
 struct FieldParams {
@@ -488,6 +508,11 @@ class Arena {
   // motor frames no longer move this robot; the bumper reflex still does.
   // Returns false (no reinit) if the drive is already these speeds.
   bool setDrive(int robot, double leftFps, double rightFps, std::int64_t tick);
+  // The robot's battery (battery.h): from `tick` its wheel and gun-wheel
+  // targets are the speed table's times `scale` (terminal over nominal
+  // voltage, > 0). Returns false (no reinit) if the scale is already this.
+  bool setSupply(int robot, double scale, std::int64_t tick);
+  double supply(int robot) const;  // the scale now in force (1 without a battery)
   // A write to PIO port B. Returns the immediate events (solenoid strokes,
   // empty guns, misfires and jams, disc shooter; a disc launcher's disc
   // leaves at the write's tick, with its strike there if it touches

@@ -239,6 +239,17 @@ Played play(const std::vector<std::string>& programs, const RunOptions& o, bool 
   return played;
 }
 
+namespace {
+// Board resets by cause (scheduler/power.cpp), and the battery's last
+// terminal voltage (null: no battery).
+json resetsJson(const scheduler::RobotResult& r) {
+  return {{"brown_out", r.resetsBrownOut}, {"injected", r.resetsInjected}};
+}
+json batteryJson(const scheduler::RobotResult& r) {
+  return r.batteryVFinal ? json(*r.batteryVFinal) : json(nullptr);
+}
+}  // namespace
+
 json soloJson(const Played& played) {
   const auto& r = played.result;
   const double wall = played.wallSeconds;
@@ -254,6 +265,8 @@ json soloJson(const Played& played) {
       {"fault", faultJson(a.fault)},
       {"faults", faultsJson(a.faults)},
       {"reloads", a.reloads},
+      {"resets", resetsJson(a)},
+      {"battery_v_final", batteryJson(a)},
       {"plant_fault", faultJson(r.plantFault)},
       {"motor_frames_latched", a.framesLatched},
       {"motor_frames_rejected", a.framesRejected},
@@ -285,7 +298,9 @@ json matchJson(const Played& played) {
                       {"reloads", rr.reloads},
                       {"final_pose", poseJson(rr.finalPose)},
                       {"console_lines", rr.console.size()},
-                      {"scatter_shots", scatterJson(rr)}});
+                      {"scatter_shots", scatterJson(rr)},
+                      {"resets", resetsJson(rr)},
+                      {"battery_v_final", batteryJson(rr)}});
     addSecondary(robots.back(), rr);
   }
   json j = {{"sim_seconds", timebase::secondsFromTicks(r.endTick)},

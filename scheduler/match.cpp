@@ -138,6 +138,15 @@ Match::Match(const MatchConfig& config) : MatchState(config), arena_(*arenaConfi
       queue_.schedule(0, EventClass::MotorLatch,
                       {QueuedEvent::Kind::DriveLeg, static_cast<int>(i), 0});
   }
+  // Batteries (power.cpp): a robot with a program whose profile has one
+  // draws its board's current from tick 0.
+  for (auto& r : robots_) {
+    const plant::BatteryParams& b =
+        arenaConfig_->robots[static_cast<size_t>(r->index)].params.battery;
+    if (!b.enabled || !r->spec.path.empty()) continue;
+    r->battery.emplace(b);
+    powerChanged(r->index, 0);
+  }
   for (size_t k = 0; k < config.injections.size(); ++k) {
     const Injection& in = config.injections[k];
     if (in.robot < 0 || in.robot >= static_cast<int>(robots_.size()))
@@ -194,7 +203,7 @@ void Match::orderRobots() {
 
 void Match::bringOthersTo(int robot, Tick t) {
   for (const auto& r : robots_)
-    if (r->index != robot && !r->vm().fault() && r->now() < t) r->runTo(t);
+    if (r->index != robot && r->running() && r->now() < t) r->runTo(t);
 }
 
 plant::Pose Match::pose(int robot, Tick t) const {
@@ -204,14 +213,14 @@ plant::Pose Match::pose(int robot, Tick t) const {
 Tick MatchState::earliestClock() const {
   Tick t = INT64_MAX;
   for (const auto& r : robots_)
-    if (!r->vm().fault()) t = std::min(t, r->now());
+    if (r->running()) t = std::min(t, r->now());
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 
 Tick Match::earliestAction() const {
   Tick t = INT64_MAX;
   for (const auto& r : robots_)
-    if (!r->vm().fault()) t = std::min(t, r->quietUntil());
+    if (r->running()) t = std::min(t, r->quietUntil());
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 
@@ -425,6 +434,9 @@ void Match::applyInputs() {
       if (config_.observer) config_.observer->onPlantEvent(w.tick, e);
       emitPlant(w.tick, e, watch, w.robot);
     }
+    Robot& r = *robots_[static_cast<size_t>(w.robot)];
+    r.portB = w.value;
+    if (r.battery) powerChanged(w.robot, w.tick);
   }
   inputs_.clear();
 }
@@ -540,6 +552,11 @@ void Match::handlePlantEvents(Tick t, const plant::EventList& events, const trac
     }
     emitPlant(t, e, watch, watchRobot);
     if (arenaConfig_->referee.judge_scatter) judgeLaunch(t, e);
+    if (e.kind == plant::EventKind::ReflexStart || e.kind == plant::EventKind::ReflexEnd) {
+      Robot& r = *robots_[static_cast<size_t>(e.robot)];
+      r.reflexOn = e.kind == plant::EventKind::ReflexStart;
+      if (r.battery) powerChanged(e.robot, t);
+    }
     if (config_.debugger &&
         (e.kind == plant::EventKind::Contact || e.kind == plant::EventKind::BallLaunch))
       robots_[static_cast<size_t>(e.robot)]->debugEvent(
@@ -695,7 +712,9 @@ void Match::rounds(Tick pause) {
       step.events.clear();
     }
     if (!inputs_.empty()) {
+      inputsHorizon_ = horizon;
       applyInputs();
+      inputsHorizon_ = -1;
       // A re-initialisation discarded the plant's prediction: find it again.
       advancePlantTo(horizon, step);
     }
@@ -720,6 +739,9 @@ void Match::rounds(Tick pause) {
         case QueuedEvent::Kind::Reload:
           sampleUpTo(horizon);
           robots_[static_cast<size_t>(entry.payload.robot)]->reload(horizon);
+          break;
+        case QueuedEvent::Kind::Power:
+          powerEvent(entry.payload.robot, entry.payload.index, horizon);
           break;
         case QueuedEvent::Kind::ReleaseEdge: {
           Robot& r = *robots_[static_cast<size_t>(entry.payload.robot)];
@@ -810,6 +832,7 @@ void Match::finish(MatchResult& result) {
     for (vm::Irq irq : {vm::Irq::Pio, vm::Irq::Timer, vm::Irq::SerialTx})
       rr.interrupts[std::string(vm::irqName(irq))] +=
           r->board.interruptCounts[static_cast<size_t>(irq)];
+    if (r->battery) rr.batteryVFinal = r->battery->voltage(result.endTick);
     // After a plant fault the plant answers only from its last re-initialisation.
     rr.finalPose =
         arena_.pose(r->index, std::clamp(result.endTick, arena_.lastReinitTick(), arena_.now()));

@@ -92,7 +92,9 @@ struct RobotSpec {
 
 // An interrupt source injected by the user (DESIGN.md tool contract;
 // config::parseInjection reads --inject's text).
-enum class InjectSource : uint8_t { EdgeFore, EdgeAft, BumperFront, BumperBack };
+// Reset: the board's reset at that tick (a "fried" board, DESIGN.md "The
+// wider competition"): the program starts again from main at once.
+enum class InjectSource : uint8_t { EdgeFore, EdgeAft, BumperFront, BumperBack, Reset };
 
 struct Injection {
   int robot = 0;
@@ -286,6 +288,10 @@ struct RobotResult {
   std::optional<FaultInfo> fault;  // the first fault
   std::vector<FaultInfo> faults;   // every fault, in order (more than one after reloads)
   int reloads = 0;                 // MatchConfig::reloadOnFault
+  // Board resets by cause: the battery browned out, or --inject A:reset@WHEN.
+  int resetsBrownOut = 0, resetsInjected = 0;
+  // The battery's terminal voltage when the run ended (none: no battery).
+  std::optional<double> batteryVFinal;
   plant::Pose finalPose;
   std::vector<std::string> console;
   bool exited = false;

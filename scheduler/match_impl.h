@@ -22,6 +22,7 @@
 
 #include "board/board.h"
 #include "inspect/inspect.h"
+#include "plant/battery.h"
 #include "plant/motor_receiver.h"
 #include "scheduler/event_queue.h"
 #include "scheduler/match.h"
@@ -37,9 +38,17 @@ constexpr Tick kRoundLookahead = 8 * timebase::kTicksPerChar;
 
 // Queued events; the plant's own events come from Arena::advance.
 struct QueuedEvent {
-  enum class Kind : uint8_t { SerialByte, DriveLeg, Inject, ReleaseEdge, Reload, EndOfRound } kind;
+  enum class Kind : uint8_t {
+    SerialByte,
+    DriveLeg,
+    Inject,
+    ReleaseEdge,
+    Reload,
+    Power,  // index kBrownOutCheck or kRestart (power.cpp)
+    EndOfRound
+  } kind;
   int robot = 0;
-  int index = 0;  // injection number, path leg, or the detector bit to release
+  int index = 0;  // injection number, path leg, the detector bit to release, or a power event
 };
 
 // A plant input made by a robot during a round: a port B write, a bump
@@ -86,6 +95,22 @@ class Robot : public vm::Bus {
   // --reload-on-fault: the controller's reset at t; the faulted program
   // starts again.
   void reload(Tick t);
+  // The board's reset at t, as at power-on (reload, a brown-out's end, an
+  // injected reset): the program starts again from main.
+  void restartProgram(Tick t);
+  // Power (power.cpp, docs/plant.md "Batteries"): the robot's battery (none
+  // when its profile has no battery, or it follows a scripted path), the
+  // board held in reset by a brown-out, and what draws current: the motor
+  // controller's latched command, its bumper reflex, port B.
+  std::optional<plant::Battery> battery;
+  bool powerOff = false;
+  plant::MotorFrame motorCommand{};
+  bool reflexOn = false;
+  uint8_t portB = 0;
+  Tick brownOutCheckAt = -1;  // the earliest brown-out check queued, or -1
+  Tick restartAt = -1;        // the end of the brown-out's reset, or -1
+  // The VM runs (not faulted, not held in reset).
+  bool running() const { return !board.cpu.fault() && !powerOff; }
   bool reloadPending = false;
   bool faultSeen = false;  // this VM's fault is recorded
 
@@ -252,6 +277,9 @@ struct MatchState {
   // The run so far: runUntil stops between rounds and goes on later.
   bool begun_ = false, over_ = false;
   Tick roundStart_ = 0;  // the tick the current round began at
+  // While a round's inputs are applied: its horizon, which every VM has run
+  // to (power.cpp takes a brown-out no earlier), else -1.
+  Tick inputsHorizon_ = -1;
   MatchResult result_;
   Tick nextSample_ = 0;
   uint64_t rounds_ = 0;
@@ -300,6 +328,17 @@ class Match : public MatchView, private MatchState {
   bool tracingCostates() const { return config_.traceCostate && trace_.on(); }
   // Robot `robot` faulted at t: its reload, if the run asks for one.
   void faulted(int robot, Tick t);
+  // Power (power.cpp). What robot `robot` draws changed at t (a latched
+  // frame, a port B write, a reflex's start or end): its battery's current,
+  // the wheels' supply scale and its next brown-out check.
+  void powerChanged(int robot, Tick t);
+  // A queued power event of robot `robot` at t.
+  void powerEvent(int robot, int what, Tick t);
+  // The board's reset at t: by a brown-out (held until the voltage
+  // recovers), or injected (the program starts again at t).
+  void resetBoard(int robot, Tick t, bool injected);
+  void brownOutEnds(int robot, Tick t);
+  void queueBrownOutCheck(int robot, Tick t);
   // Injection `injection` (one of config_.injections) fired.
   void fired(const Injection& injection) {
     fired_[static_cast<size_t>(&injection - config_.injections.data())] = true;
@@ -345,7 +384,7 @@ class Match : public MatchView, private MatchState {
   Tick earliestAction() const;
   bool allExited() const {
     return std::all_of(robots_.begin(), robots_.end(), [](const auto& r) {
-      return (r->result.exited || r->vm().fault()) && !r->reloadPending;
+      return (r->result.exited || r->vm().fault()) && !r->reloadPending && !r->powerOff;
     });
   }
   void applyInputs();

@@ -38,28 +38,35 @@ void Robot::attach(Match& m) {
 
 void Robot::reload(Tick t) {
   reloadPending = false;
-  costates.clear();  // the reloaded program's costatements start afresh
-  // The delay is long enough that no byte is left in the port. The VM
-  // keeps its breakpoints (main's return, the injections) and counters.
+  // A brown-out's reset holds the board: its end starts the program.
+  if (powerOff) return;
+  // The delay is long enough that no byte is left in the port.
+  restartProgram(t);
+  ++result.reloads;
+  if (match->tracing()) match->emit(t, trace::rec::Reload{index, result.reloads});
+  if (match->observer()) match->observer()->onReload(index, t);
+}
+
+void Robot::restartProgram(Tick t) {
+  costates.clear();  // the restarted program's costatements start afresh
+  // The VM keeps its breakpoints (main's return, the injections) and counters.
   board.reset(t);
   faultSeen = false;
-  ++result.reloads;
   result.exited = false;
   // The motor controller keeps its latched command; the receiver's partial
   // frame is dropped (a fragment from before the crash never joins the
   // reloaded program's frames).
   receiver.clear();
   serialEventAt = -1;
-  // Samples up to t were taken from the faulted program: the reloaded one's start at
-  // the next sample tick.
+  // Samples up to t were taken from the program before: the restarted one's
+  // start at the next sample tick.
   snapshots.clear();
   const Tick interval = match->sampleInterval();
   nextSnapshot = (t / interval + 1) * interval;
-  if (match->tracing()) match->emit(t, trace::rec::Reload{index, result.reloads});
-  if (match->observer()) match->observer()->onReload(index, t);
 }
 
 void Robot::runTo(Tick horizon) {
+  if (powerOff) return;  // held in reset: no instruction runs
   DebugHook* hook = match->debugger();
   if (hook && index == match->debugRobot()) return debugRunTo(horizon);
   const bool tracing = match->tracing();

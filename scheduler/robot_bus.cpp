@@ -177,6 +177,8 @@ void Robot::byteDone(Tick t) {
       ++result.framesLatched;
       const PartScope plant(match->clock(), PartClock::Plant);
       match->arena().setWheels(index, *frame->command, t);
+      motorCommand = *frame->command;
+      if (battery) match->powerChanged(index, t);
       debugEvent(t, DebugEvent::FrameLatched);
     } else {
       ++result.framesRejected;
@@ -276,6 +278,10 @@ void Robot::inject(Tick t, const Injection& injection) {
                               {QueuedEvent::Kind::ReleaseEdge, index, bit});
       return;
     }
+    case InjectSource::Reset:
+      // Only at a time (config/inject.cpp refuses a program point): between rounds.
+      match->resetBoard(index, t, true);
+      return;
     case InjectSource::BumperFront:
     case InjectSource::BumperBack: {
       const plant::Bumper side = injection.source == InjectSource::BumperFront

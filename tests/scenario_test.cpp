@@ -162,8 +162,8 @@ TEST(Scenario, EveryMistakeNamesItsLine) {
       {"[A]\ninject = \"edge_fore@1s\"\n",
        "s.toml:2:10: error: 'A.inject' must be an array of \"SOURCE@WHEN\" strings"},
       {"[A]\ninject = [\n  \"edge_fore@1s\",\n  \"edge_side@1s\",\n]\n",
-       "s.toml:4:3: error: 'edge_side@1s': SOURCE must be edge_fore, edge_aft, bumper_front or "
-       "bumper_back"},
+       "s.toml:4:3: error: 'edge_side@1s': SOURCE must be edge_fore, edge_aft, bumper_front, "
+       "bumper_back or reset"},
       {"[A]\ninject = [\"edge_fore@soon\"]\n",
        "s.toml:2:11: error: 'edge_fore@soon': WHEN must be a time (12.5s, 800ms, 300us, "
        "115200000t) or a program point (line:N#K, pass:N#K)"},
