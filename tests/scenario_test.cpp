@@ -105,7 +105,7 @@ TEST(Scenario, EveryMistakeNamesItsLine) {
   const Bad cases[] = {
       {"speed = 3\n",
        "s.toml:1:1: error: unknown key 'speed' in the scenario (expected one of: profile, seconds, "
-       "seed, A, B)"},
+       "seed, A, B, obstacles)"},
       // Times in timebase/written.h's grammar: a number of seconds, or a
       // string with its unit; a whole number of ticks (300 us is 2,764.8).
       {"\nseconds = -1\n",
