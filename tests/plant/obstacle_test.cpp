@@ -314,3 +314,34 @@ TEST(Obstacles, ATallObstacleHidesTheBeaconALowOneDoesNot) {
 }
 
 }  // namespace
+
+namespace {
+
+// Obstacles are configuration, not state: an arena copied (its checkpoint
+// restored and its calls made again) while a robot is held against a box
+// goes on bit for bit as the original, through the contact's end and the
+// reflex after it.
+TEST(Obstacles, AnArenaCopiedDuringAContactGoesOnAsTheOriginal) {
+  using namespace plant_test;
+  Profile p = defaults();
+  ArenaConfig cfg = config(p, {Pose{-1, 0, 40}});
+  cfg.field.obstacles = {makeBox(0.5, 1.6, 2.2, 1.2, 25, 2)};
+  Arena a(cfg);
+  a.keepJournal();
+  a.advance(777'777);
+  a.setWheels(0, frame("ffg0ffg0"), 777'777);
+  const auto c = runUntil(a, EventKind::Contact, 80'000'000);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->event.with, ContactWith::Obstacle);
+  Arena b(a);
+  for (std::int64_t t = c->tick + 9'216; t < c->tick + 20'000'000; t += 9'216) {
+    AdvanceResult ra = a.advance(t), rb = b.advance(t);
+    ASSERT_EQ(ra.tick, rb.tick);
+    ASSERT_EQ(ra.events.size(), rb.events.size());
+    const Pose pa = a.pose(0, ra.tick), pb = b.pose(0, rb.tick);
+    ASSERT_EQ(pa.x_ft, pb.x_ft) << t;
+    ASSERT_EQ(pa.y_ft, pb.y_ft) << t;
+  }
+}
+
+}  // namespace
