@@ -7,7 +7,7 @@
 // centre has gone s(t) = v0 tau (1 - e^{-t/tau}) along a straight line.
 // Everything fixed it can strike lies on that line, so where its flight
 // ends is known at the launch in closed form (discStrike: the field's
-// walls, the divider; the stop speed v_stop is reached after
+// walls, the divider, the obstacles; the stop speed v_stop is reached after
 // s = tau (v0 - v_stop)), and one root function, sEnd - s(t), puts that end
 // on its exact tick. Robots move: a hit is the root of the ball's
 // non-grazing hit function (arena_roots.cpp) with the target's radius grown
@@ -54,22 +54,31 @@ double Arena::Impl::discGap(const Disc& d, double t, const double* y) const {
 }
 
 double Arena::Impl::discStrike(const Vec2& p, const Vec2& u, double z, double radius,
-                               MissReason& what) const {
+                               MissReason& what, int& obstacle) const {
   // The field's walls stop every disc (as they do a ball), at its edge.
   double best = geom::discPathToSquareEdge(p, u, radius, half);
   what = MissReason::LeftField;
   // The divider, if the disc flies no higher than it is tall.
-  if (z <= cfg.field.divider_height_ft) {
+  if (cfg.field.divider && z <= cfg.field.divider_height_ft) {
     const double s = geom::discPathToRect(p, u, radius, bodies.divider);
     if (s < best) {
       best = s;
       what = MissReason::Divider;
     }
   }
-  // A fixed obstacle's test goes here, like the divider's: the path
-  // length at which the disc's circle first touches the shape (the ray
-  // entering the shape grown by the disc's radius), if the disc flies no
-  // higher than the obstacle is tall.
+  // A fixed obstacle, like the divider: where the disc's circle first
+  // touches the shape, if the disc flies no higher than it is tall.
+  obstacle = -1;
+  for (int k = 0; k < bodies.obstacleCount; ++k) {
+    if (z > cfg.field.obstacles[static_cast<std::size_t>(k)].height_ft) continue;
+    const double s =
+        geom::discPathToConvex(p, u, radius, bodies.obstacles[static_cast<std::size_t>(k)]);
+    if (s < best) {
+      best = s;
+      what = MissReason::Obstacle;
+      obstacle = k;
+    }
+  }
   return best;
 }
 
@@ -111,10 +120,12 @@ void Arena::Impl::launchDisc(Discrete& d, const std::vector<double>& y, int i, d
   // v0 e^{-t/tau} falls to v_stop at t = tau ln(v0 / v_stop), when the
   // disc has gone v0 tau (1 - v_stop / v0) = tau (v0 - v_stop).
   MissReason what = MissReason::None;
-  const double fixed = discStrike(rim, u, c.z, c.radius, what);
+  int obstacle = -1;
+  const double fixed = discStrike(rim, u, c.z, c.radius, what, obstacle);
   const double stop = c.tau * (c.v0 - w.stop_speed_fps);
   c.sEnd = stop <= fixed ? stop : fixed;
   c.end = stop <= fixed ? MissReason::Stopped : what;
+  c.obstacle = static_cast<std::int8_t>(stop <= fixed ? -1 : obstacle);
   Event e{EventKind::DiscFire};
   e.robot = static_cast<std::int8_t>(i);
   e.ball = static_cast<std::int8_t>(slot);
@@ -146,6 +157,7 @@ void Arena::Impl::discOutcome(int k, double te, Discrete& d, const double* ys, c
   e.closest_ft = nR == 2 ? c.closest : -1;
   if (reported(found, RootKind::DiscEnd, k) < 0 || discPath(c, te) >= c.sEnd) {
     e.miss = c.end;
+    e.obstacle = c.obstacle;
     ev.push(e);
     c.active = false;
     return;

@@ -234,4 +234,54 @@ TEST(Disc, TheMagazineRunsOut) {
   EXPECT_FALSE(plain.ballsInFlight());
 }
 
+// Fixed obstacles stop a disc no higher than they are tall, where its
+// circle (radius r = 1/6 ft) first touches the shape. Robot A at (-3, 0)
+// heading east; its rim, where the disc starts, is at x0 = -2.46875; v0 =
+// 20 ft/s, tau = 1 s, so a disc that has gone s ft has flown
+// t = -ln(1 - s / 20) s. Worked by hand for each shape:
+// - a circle of radius 0.5 at the origin: touched when the centre is at
+//   x = -0.5 - 1/6, s = 1.8020833, t = 0.0944252 s = 870,222.23 ticks;
+// - a unit square turned 45 deg about the origin (a diamond whose west
+//   vertex is at x = -sqrt(1/2)), met on the disc's axis: at its vertex,
+//   x = -0.7071068 - 1/6, s = 1.5949766, t = 0.0831086 s = 765,929.16;
+// - the same diamond with the disc's axis at y = 0.2 (robot at (-3, 0.2)):
+//   on its north-west edge -x + y = sqrt(1/2), at distance r from it:
+//   x = 0.2 - sqrt(1/2) - r sqrt(2) = -0.7428090 (the foot of the
+//   perpendicular, y = 0.2 - r / sqrt(2) = 0.082, lies on the edge),
+//   s = 1.7259410, t = 0.0902498 s = 831,741.77 ticks.
+// At 3 ft up the disc clears all of them (they are 2 ft tall) and meets
+// the east wall.
+TEST(Disc, AnObstacleStopsADiscNoHigherThanItWhereItsEdgeTouches) {
+  struct Case {
+    Obstacle obstacle;
+    double y;
+    std::int64_t ticks;
+  };
+  Obstacle circle;
+  circle.kind = Obstacle::Kind::Circle;
+  circle.radius_ft = 0.5;
+  circle.height_ft = 2;
+  const Obstacle diamond = makeBox(0, 0, 1, 1, 45, 2);
+  for (const Case& c :
+       {Case{circle, 0, 870'223}, Case{diamond, 0, 765'930}, Case{diamond, 0.2, 831'742}}) {
+    ArenaConfig low = arena({Pose{-3, c.y, 90}}, disc(20, 0.75, 1, 1, 4));
+    low.field.obstacles = {c.obstacle};
+    Arena a(low);
+    const Fired f = fireAt(a, kLaunch, kLaunch + 2 * kTicksPerSecond);
+    const Found* miss = find(f.later, EventKind::DiscMiss);
+    ASSERT_NE(miss, nullptr);
+    EXPECT_EQ(miss->event.miss, MissReason::Obstacle);
+    EXPECT_EQ(miss->event.obstacle, 0);
+    EXPECT_EQ(miss->tick, kLaunch + c.ticks);
+
+    ArenaConfig high = arena({Pose{-3, c.y, 90}}, disc(20, 3, 1, 1, 4));
+    high.field.obstacles = {c.obstacle};
+    Arena b(high);
+    const Fired over = fireAt(b, kLaunch, kLaunch + 2 * kTicksPerSecond);
+    const Found* wall = find(over.later, EventKind::DiscMiss);
+    ASSERT_NE(wall, nullptr);
+    EXPECT_EQ(wall->event.miss, MissReason::LeftField);
+  }
+}
+
 }  // namespace
