@@ -67,7 +67,7 @@ asan_skip=(
   'Explain\.FromTheJsonlFile'
   # Python, Chromium and statsmodels drivers (batch runs killed and resumed,
   # the replay page, the statistics' oracle)
-  'batch\.kill_and_resume' 'browser\.viewer' 'stats\.oracle'
+  'batch\.kill_and_resume' 'browser\.viewer' 'browser\.course' 'stats\.oracle'
   # every superinstruction against its unfused run at 3,000 horizons and
   # interrupt ticks (each a copy of two VMs)
   'VmSuperinstruction\.EveryHorizonStopsWhereTheUnfusedRunStops'
