@@ -248,6 +248,12 @@ struct ArenaState {
   Discrete pendingD;
   std::vector<double> pendingY;
 
+  // ---- deployables (deployables.cpp): every item set down so far, in
+  // tick order, and what each robot's tables have left. Empty without
+  // [[deployables]].
+  std::vector<Deployed> deployed;
+  std::array<std::array<int, kMaxDeployKinds>, 2> deployLeft{};
+
   // ---- time
   std::int64_t now = 0;      // tick reached
   std::int64_t segTick = 0;  // tick of the last reset
