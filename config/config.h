@@ -200,6 +200,20 @@ struct ScenarioRobot {
   std::vector<Inject> inject;
 };
 
+// One obstacle of a scenario's (or rules file's) [[obstacles]], with where
+// it is written (config/obstacles.h reads them).
+struct ObstacleSpec {
+  plant::Obstacle obstacle;
+  SourcePos pos;
+};
+
+// Checks obstacles against the field and the robots' start poses of a
+// run's arena (`arena.field`'s size, `arena.robots`' starts and body
+// radii): each must lie inside the field and clear of every start pose.
+// Throws ConfigError "FILE:LINE:COL: error: ..." at the obstacle.
+void checkObstacles(const std::vector<ObstacleSpec>& obstacles, const std::string& file,
+                    const plant::ArenaConfig& arena);
+
 struct Scenario {
   std::string file;
   std::optional<std::string> profile;     // a profile name, or a resolved path
@@ -212,6 +226,7 @@ struct Scenario {
   std::string program;    // B's program (resolved path)
   std::vector<PathLeg> path;
   bool repeatPath = false;
+  std::vector<ObstacleSpec> obstacles;  // [[obstacles]]
 };
 
 // Relative paths in the file (profile, hardware, program) are taken from

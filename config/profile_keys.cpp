@@ -57,6 +57,8 @@ const std::vector<KeyDef>& keyTable() {
       {"field", "divider_north", Kind::Length, {-50, 50}, false, D(p.field.divider_north_ft)},
       {"field", "divider_thickness", Kind::Length, {0, 2}, false, D(p.field.divider_thickness_ft)},
       {"field", "divider_height", Kind::Length, {0, 20}, false, D(p.field.divider_height_ft)},
+      // Obstacles taller than this hide the beacon (plant.h FieldParams).
+      {"field", "beacon_height", Kind::Length, {0.05, 10}, false, D(p.field.beacon_height_ft)},
       {"start", "a_x", Kind::Length, {-50, 50}, false, D(p.field.start[0].x_ft)},
       {"start", "a_y", Kind::Length, {-50, 50}, false, D(p.field.start[0].y_ft)},
       {"start", "a_heading", Kind::Angle, {-360, 360}, false, D(p.field.start[0].heading_deg)},

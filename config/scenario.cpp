@@ -19,6 +19,7 @@
 #include <limits>
 
 #include "config/config.h"
+#include "config/obstacles.h"
 #include "config/text.h"
 #include "timebase/written.h"
 
@@ -204,7 +205,8 @@ class Walker {
   Scenario walk(const toml::table& root) const {
     Scenario s;
     s.file = file_;
-    onlyKeys(root, "the scenario", {"profile", "rules", "seconds", "seed", "A", "B"});
+    onlyKeys(root, "the scenario", {"profile", "rules", "seconds", "seed", "A", "B", "obstacles"});
+    if (const toml::node* n = root.get("obstacles")) s.obstacles = parseObstacles(*n, file_);
     if (const toml::node* n = root.get("profile")) {
       const std::string v = string(*n, "profile");
       const bool isPath = v.find('/') != std::string::npos || fs::path(v).extension() == ".toml";

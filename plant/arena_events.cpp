@@ -37,10 +37,10 @@ int Arena::Impl::reported(const int* found, RootKind k, int who) const {
 
 // Applies everything that happens at tick T (time te) to (d, y) and lists
 // the events, in this fixed order: ball launches; ball outcomes (floor,
-// divider, hit, leaving the field -- the floor first, so a ball reaching
+// divider, obstacle, hit, leaving the field -- the floor first, so a ball reaching
 // floor and robot together is a miss, thesis VIII.H); disc outcomes (the
 // end of the path, then a hit, as a ball's divider before its hit); per robot: referee
-// put-back, reflex end; contacts (robot-robot, divider, wall) and the
+// put-back, reflex end; contacts (robot-robot, divider, wall, obstacles) and the
 // reflexes they start; edge detectors; the referee's turn. A put-back
 // moves a robot, so contacts and edges are reconciled again after it; a
 // turn moves its edge detectors, so edges are.
@@ -88,6 +88,7 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
                across * flight.x(),
                across * flight.y(),
                speed * std::sin(elevation)};
+      if (bodies.obstacleCount > 0) ballMeetsObstacle(b);
       Event e{EventKind::BallLaunch};
       e.robot = static_cast<std::int8_t>(i);
       e.gun = static_cast<std::int8_t>(g);
@@ -131,6 +132,7 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
         b.y0 += b.vy * dt;
         b.t0 += dt;
         b.rolling = true;
+        if (bodies.obstacleCount > 0) ballMeetsObstacle(b);
         z = 0;
         Event skip = e;
         skip.kind = EventKind::BallSkip;
@@ -151,6 +153,13 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
     if (cfg.field.divider && inSlab && yy >= cfg.field.divider_south_ft &&
         yy <= cfg.field.divider_north_ft && z <= cfg.field.divider_height_ft) {
       e.miss = MissReason::Divider;
+      ev.push(e);
+      b.active = false;
+      continue;
+    }
+    if (b.meetObstacle >= 0 && (reported(found, RootKind::BallObstacle, s) < 0 || te >= b.meetT)) {
+      e.miss = MissReason::Obstacle;
+      e.obstacle = static_cast<std::int8_t>(b.meetObstacle);
       ev.push(e);
       b.active = false;
       continue;
@@ -275,20 +284,32 @@ void Arena::Impl::contacts(std::int64_t T, Discrete& d, std::vector<double>& y, 
     }
     d.robotContact = c;
   }
-  // A robot against a fixed obstacle: contact starts (the bumper on the
-  // side facing the obstacle, and its reflex) or ends.
-  auto obstacle = [&](int i, RootKind rk, contact::Kind ck, bool& touching, ContactWith with) {
-    const bool c = touchingNow(rk, ck, i);
+  // A robot against a fixed obstacle (a wall, the divider, one of the
+  // field's obstacles): contact starts (the bumper on the side facing the
+  // obstacle, and its reflex) or ends.
+  auto obstacle = [&](int i, RootKind rk, contact::Kind ck, bool& touching, ContactWith with,
+                      int k = -1) {
+    const int who = k < 0 ? i : obstacleRoot(i, k);
+    const int rep = reported(found, rk, who);
+    const bool c = rep != 0 ? rep < 0 : sided(rk, who, contactG(ck, i, ys, std::max(k, 0))) < 0;
+    auto event = [&](EventKind kind, Bumper side) {
+      Event e{kind};
+      e.robot = static_cast<std::int8_t>(i);
+      e.bumper = side;
+      e.with = with;
+      e.obstacle = static_cast<std::int8_t>(k);
+      ev.push(e);
+    };
     if (c && !touching) {
       std::array<double, 2 * kXY> q{};
       centresOf(ys, q.data());
       Vec2 normal;
-      contact::gap(bodies, contact::Constraint{ck, i}, q.data(), &normal);
+      contact::gap(bodies, contact::Constraint{ck, i, std::max(k, 0)}, q.data(), &normal);
       const Bumper side = sideOf(heading(ys, i), -normal);
-      contactEvent(EventKind::Contact, i, side, with, -1);
+      event(EventKind::Contact, side);
       startReflex(d, y, i, side, T, ev);
     } else if (!c && touching) {
-      contactEvent(EventKind::ContactEnd, i, Bumper::Front, with, -1);
+      event(EventKind::ContactEnd, Bumper::Front);
     }
     touching = c;
   };
@@ -301,6 +322,9 @@ void Arena::Impl::contacts(std::int64_t T, Discrete& d, std::vector<double>& y, 
       obstacle(i, RootKind::WallX, contact::Kind::WallX, r.wallContact[0], ContactWith::Wall);
       obstacle(i, RootKind::WallY, contact::Kind::WallY, r.wallContact[1], ContactWith::Wall);
     }
+    for (int k = 0; k < bodies.obstacleCount; ++k)
+      obstacle(i, RootKind::Obstacle, contact::Kind::Obstacle,
+               r.obstacleContact[static_cast<std::size_t>(k)], ContactWith::Obstacle, k);
   }
 }
 

@@ -40,7 +40,8 @@ constexpr int kMaxBalls = 64;
 static_assert(kMaxBalls >= 2 * 2 * kMaxBallsPerGun, "the ball table must hold every magazine");
 // Every disc two launchers with full magazines can have in flight.
 constexpr int kMaxDiscs = 2 * kMaxDiscsPerLauncher;
-constexpr int kMaxRoots = 2 * 7 + 1 + kMaxBalls * 5 + kMaxDiscs * 2;
+// Per robot 7 and one per obstacle, the pair's contact, per ball 6, per disc 2.
+constexpr int kMaxRoots = 2 * (7 + kMaxObstacles) + 1 + kMaxBalls * 6 + kMaxDiscs * 2;
 constexpr int kRing = 16;
 static_assert(kRing > kMaxRefereeLimit, "the referee must see one event more than its limit");
 // ARKODE's tout in its one-step mode only bounds the first step's guess
@@ -77,12 +78,19 @@ enum class RootKind : std::uint8_t {
   // disc's.
   DiscEnd,
   DiscHit,
+  // A robot against an obstacle (a contact, as WallX to Divider).
+  Obstacle,
+  // A ball that meets an obstacle: the time it does (closed form, found at
+  // its launch) less t. Only for a ball that meets one.
+  BallObstacle,
 };
 
 struct RootDesc {
   RootKind kind;
-  int robot;  // or ball slot for ball roots
+  int robot;  // or ball slot for ball roots; for Obstacle obstacleRoot()
 };
+// The `robot` of robot i's root against obstacle o.
+constexpr int obstacleRoot(int robot, int obstacle) { return robot * kMaxObstacles + obstacle; }
 
 struct Ball {
   bool active = false;
@@ -93,6 +101,10 @@ struct Ball {
   // Smallest distance to the other robot's body seen at an event tick or
   // at the closest-approach root of the hit function (for ball_miss).
   double closest = HUGE_VAL;
+  // The first obstacle its flight meets below the obstacle's height and
+  // when (s), from the closed form (ballMeetsObstacle); -1: none.
+  int meetObstacle = -1;
+  double meetT = HUGE_VAL;
 };
 
 // A disc in flight (arena_discs.cpp): its centre moves from (x0, y0) along
@@ -140,6 +152,7 @@ struct RobotDisc {
   // the contact's constraint is active (contact.h).
   std::array<bool, 2> wallContact{};
   bool dividerContact = false;
+  std::array<bool, kMaxObstacles> obstacleContact{};
   Ring reflexTicks, eventTicks;
   std::uint8_t portB = 0;
   std::array<bool, 2> gunOn{};
@@ -384,17 +397,20 @@ struct Arena::Impl : ArenaState {
   void centresOf(const double* y, double* q) const;
   // Gap (ft) between robot i's body and a wall, the divider or (i = 0) the
   // other robot: contact.h's, on a full state.
-  double gapOf(contact::Kind k, int i, const double* y) const;
+  double gapOf(contact::Kind k, int i, const double* y, int obstacle = 0) const;
   double reflexG(const double* y, int i, const Discrete& d) const;
   // The contact functions: the gap while inactive, minus the force while
   // active (contact.h); negative exactly while touching.
-  double contactG(contact::Kind k, int i, const double* y) const;
+  double contactG(contact::Kind k, int i, const double* y, int obstacle = 0) const;
 
   void ballAt(const Ball& b, double t, double& x, double& yy, double& z) const;
   double ballHitG(const Ball& b, double t, const double* y, double& perp2, double& dist2) const;
   double ballGap(const Ball& b, double t, const double* y) const;
   double ballOutG(const Ball& b, double t) const;
   double ballDividerG(const Ball& b, double t) const;
+  // Sets b.meetObstacle and b.meetT: the first obstacle its flight from
+  // b.t0 meets below the obstacle's height (closed form), if any.
+  void ballMeetsObstacle(Ball& b) const;
 
   // ---- discs (arena_discs.cpp)
   double discPath(const Disc& d, double t) const;

@@ -51,6 +51,15 @@ Arena::Impl::Impl(const ArenaConfig& c)
   bodies.robots = nR;
   bodies.half = half;
   bodies.divider = geom::dividerRect(cfg.field);
+  if (cfg.field.obstacles.size() > static_cast<std::size_t>(kMaxObstacles))
+    throw std::invalid_argument("Arena: more than " + std::to_string(kMaxObstacles) + " obstacles");
+  for (const Obstacle& o : cfg.field.obstacles) {
+    if (o.kind != Obstacle::Kind::Circle &&
+        (o.points.size() < 3 || o.points.size() > static_cast<std::size_t>(kMaxObstacleVertices)))
+      throw std::invalid_argument("Arena: an obstacle's polygon has 3 to " +
+                                  std::to_string(kMaxObstacleVertices) + " vertices");
+    bodies.obstacles[static_cast<std::size_t>(bodies.obstacleCount++)] = geom::convexOf(o);
+  }
   double massSum = 0;
   for (int i = 0; i < nR; ++i) massSum += P(i).mass_lb;
   for (int i = 0; i < nR; ++i) {
@@ -96,6 +105,9 @@ Arena::Impl::Impl(const ArenaConfig& c)
           gapOf(k == 0 ? contact::Kind::WallX : contact::Kind::WallY, i, y.data()) <= 0;
     }
     d.dividerContact = cfg.field.divider && gapOf(contact::Kind::Divider, i, y.data()) <= 0;
+    for (int k = 0; k < bodies.obstacleCount; ++k)
+      d.obstacleContact[static_cast<std::size_t>(k)] =
+          gapOf(contact::Kind::Obstacle, i, y.data(), k) <= 0;
   }
   D.robotContact = nR == 2 && gapOf(contact::Kind::Robot, 0, y.data()) <= 0;
 
@@ -147,6 +159,8 @@ double Arena::Impl::stepBound(const double* y, double ahead) const {
   for (int i = 0; i < nR; ++i) {
     d = std::min({d, std::abs(edgeG(y, i, 0)), std::abs(edgeG(y, i, 1))});
     if (cfg.field.divider) d = std::min(d, std::abs(gapOf(contact::Kind::Divider, i, y)));
+    for (int k = 0; k < bodies.obstacleCount; ++k)
+      d = std::min(d, std::abs(gapOf(contact::Kind::Obstacle, i, y, k)));
     if (cfg.field.field_walls)
       d = std::min({d, std::abs(gapOf(contact::Kind::WallX, i, y)),
                     std::abs(gapOf(contact::Kind::WallY, i, y))});
@@ -318,6 +332,18 @@ void Arena::Impl::setActive(const Discrete& d) {
     if (r.wallContact[0]) add(contact::Kind::WallX, i);
     if (r.wallContact[1]) add(contact::Kind::WallY, i);
     if (r.dividerContact) add(contact::Kind::Divider, i);
+    int touching = 0;
+    for (int k = 0; k < bodies.obstacleCount; ++k) {
+      if (!r.obstacleContact[static_cast<std::size_t>(k)]) continue;
+      // The constraint table is fixed (no allocation in the step): a body
+      // wedged among more obstacles than it holds ends the run.
+      if (++touching > kMaxObstacleContacts)
+        throw SolverError("plant: robot " + std::string(1, static_cast<char>('A' + i)) +
+                          " touches more than " + std::to_string(kMaxObstacleContacts) +
+                          " obstacles at once");
+      cand.c[static_cast<std::size_t>(cand.count++)] =
+          contact::Constraint{contact::Kind::Obstacle, i, k};
+    }
   }
   if (nR == 2 && d.robotContact) add(contact::Kind::Robot, 0);
   active = cand;

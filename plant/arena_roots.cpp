@@ -2,7 +2,7 @@
 //
 // Every discrete change of the arena is the zero of one of these functions
 // of time and state (arena.cpp, "Events"): edge detectors, walls, divider,
-// field, reflex end, robot-robot contact and the balls' and discs'
+// obstacles, field, reflex end, robot-robot contact and the balls' and discs'
 // closed-form flights (the discs' in arena_discs.cpp). buildRoots() lists the ones the current
 // discrete state needs; ARKODE evaluates them through rootThunk; crossedTick() decides the tick of
 // a crossing ARKODE reported. They only read the state: the rules that act
@@ -37,18 +37,18 @@ void Arena::Impl::centresOf(const double* y, double* q) const {
   }
 }
 
-double Arena::Impl::gapOf(contact::Kind k, int i, const double* y) const {
+double Arena::Impl::gapOf(contact::Kind k, int i, const double* y, int obstacle) const {
   std::array<double, 2 * kXY> q{};
   centresOf(y, q.data());
-  return contact::gap(bodies, contact::Constraint{k, i}, q.data());
+  return contact::gap(bodies, contact::Constraint{k, i, obstacle}, q.data());
 }
 
-double Arena::Impl::contactG(contact::Kind k, int i, const double* y) const {
+double Arena::Impl::contactG(contact::Kind k, int i, const double* y, int obstacle) const {
   std::array<double, 2 * kXY> q{};
   centresOf(y, q.data());
   for (int j = 0; j < active.count; ++j) {
     const contact::Constraint& c = active.c[static_cast<std::size_t>(j)];
-    if (c.kind != k || c.robot != i) continue;
+    if (c.kind != k || c.robot != i || c.obstacle != obstacle) continue;
     // Pushing in this segment: minus its force, which reaches 0 when the
     // body would start to move away. (The free velocities only here: most
     // calls are gaps, and a root evaluation makes seven.)
@@ -63,7 +63,7 @@ double Arena::Impl::contactG(contact::Kind k, int i, const double* y) const {
     contact::project(bodies, active, q.data(), vf.data(), v.data(), mu.data());
     return -mu[static_cast<std::size_t>(j)];
   }
-  return contact::gap(bodies, contact::Constraint{k, i}, q.data());
+  return contact::gap(bodies, contact::Constraint{k, i, obstacle}, q.data());
 }
 
 double Arena::Impl::reflexG(const double* y, int i, const Discrete& d) const {
@@ -129,6 +129,47 @@ double Arena::Impl::ballDividerG(const Ball& b, double t) const {
   return dir * (x - cfg.field.divider_x_ft) + cfg.field.divider_thickness_ft / 2;
 }
 
+// The ball's straight horizontal path p0 + v s (s >= 0, until the floor or
+// forever while rolling) meets obstacle k's footprint over [s_in, s_out]
+// (geom::clipLine); within it the ball is below the obstacle's height
+// first at s_in if it is low enough there, else where its concave height
+// z0 + vz s - g s^2 / 2 comes down through that height, if it does before
+// s_out. The earliest over all obstacles is the ball's meeting: a known
+// time, so its root function t_meet - t is linear and no step can pass
+// over it.
+void Arena::Impl::ballMeetsObstacle(Ball& b) const {
+  b.meetObstacle = -1;
+  b.meetT = HUGE_VAL;
+  const double g = cfg.field.gravity_fps2;
+  const Vec2 p0(b.x0, b.y0), v(b.vx, b.vy);
+  for (int k = 0; k < bodies.obstacleCount; ++k) {
+    const double h = cfg.field.obstacles[static_cast<std::size_t>(k)].height_ft;
+    double lo = 0, hi = 0;
+    if (!geom::clipLine(p0, v, bodies.obstacles[static_cast<std::size_t>(k)], 0.0, HUGE_VAL, lo,
+                        hi))
+      continue;
+    double s = HUGE_VAL;
+    if (b.rolling) {
+      s = lo;
+    } else {
+      const auto z = [&](double u) { return b.z0 + b.vz * u - 0.5 * g * u * u; };
+      if (z(lo) <= h) {
+        s = lo;
+      } else {
+        // z(u) = h on the way down: the larger root of
+        // g/2 u^2 - vz u + (h - z0) = 0 (real: z(lo) > h).
+        const double disc = b.vz * b.vz + 2 * g * (b.z0 - h);
+        const double down = (b.vz + std::sqrt(std::max(disc, 0.0))) / g;
+        if (down >= lo && down <= hi) s = down;
+      }
+    }
+    if (b.t0 + s < b.meetT) {
+      b.meetT = b.t0 + s;
+      b.meetObstacle = k;
+    }
+  }
+}
+
 double Arena::Impl::rootValue(const RootDesc& rd, double t, const double* y) const {
   switch (rd.kind) {
     case RootKind::EdgeFore:
@@ -160,6 +201,11 @@ double Arena::Impl::rootValue(const RootDesc& rd, double t, const double* y) con
       return ballOutG(D.balls[static_cast<std::size_t>(rd.robot)], t);
     case RootKind::BallDivider:
       return ballDividerG(D.balls[static_cast<std::size_t>(rd.robot)], t);
+    case RootKind::Obstacle:
+      return contactG(contact::Kind::Obstacle, rd.robot / kMaxObstacles, y,
+                      rd.robot % kMaxObstacles);
+    case RootKind::BallObstacle:
+      return D.balls[static_cast<std::size_t>(rd.robot)].meetT - t;
     case RootKind::BallTop: {
       const Ball& b = D.balls[static_cast<std::size_t>(rd.robot)];
       double x, yy, z;
@@ -228,6 +274,12 @@ void Arena::Impl::sideRoots(double t0, const std::vector<double>& y) {
       case RootKind::RobotRobot:
         side = D.robotContact ? -1 : 1;
         break;
+      case RootKind::Obstacle:
+        side = D.r[static_cast<std::size_t>(rd.robot / kMaxObstacles)]
+                       .obstacleContact[static_cast<std::size_t>(rd.robot % kMaxObstacles)]
+                   ? -1
+                   : 1;
+        break;
       default:
         break;
     }
@@ -268,6 +320,7 @@ void Arena::Impl::buildRoots() {
     }
     if (cfg.field.divider) add(RootKind::Divider, i);
     if (D.r[static_cast<std::size_t>(i)].reflex) add(RootKind::ReflexEnd, i);
+    for (int k = 0; k < bodies.obstacleCount; ++k) add(RootKind::Obstacle, obstacleRoot(i, k));
   }
   if (nR == 2) add(RootKind::RobotRobot, 0);
   for (int b = 0; b < kMaxBalls; ++b) {
@@ -277,6 +330,7 @@ void Arena::Impl::buildRoots() {
     if (nR == 2) add(RootKind::BallHit, b);
     add(RootKind::BallOut, b);
     if (cfg.field.divider) add(RootKind::BallDivider, b);
+    if (ball.meetObstacle >= 0) add(RootKind::BallObstacle, b);
     // Only a ball whose apex, z0 + vz^2 / 2g, clears the other robot's
     // height can come down on its top; no other ball pays for the root.
     if (nR == 2 && !ball.rolling && ball.vz > 0 &&

@@ -28,6 +28,9 @@ double gap(const Bodies& b, const Constraint& c, const double* q, Vec2* normal) 
       if (normal) *normal = len > 0 ? Vec2(d / len) : Vec2(1.0, 0.0);
       return len - b.radius[i];
     }
+    case Kind::Obstacle:
+      return geom::signedDistance(p, b.obstacles[static_cast<std::size_t>(c.obstacle)], normal) -
+             b.radius[i];
     case Kind::Robot: {
       const Vec2 d = Vec2(q[0], q[1]) - Vec2(q[2], q[3]);
       const double len = d.norm();

@@ -1,5 +1,6 @@
 // plant/contact.h -- internal: rigid contacts between the robots' bodies,
-// the field walls and the divider (DESIGN.md "Continuous motion").
+// the field walls, the divider and the obstacles (DESIGN.md "Continuous
+// motion").
 //
 // Bodies are rigid and round. While a contact is active its gap g (distance
 // between the surfaces, ft) may not shrink: the velocities the wheels would
@@ -16,7 +17,7 @@
 // arena) when mu_c reaches 0; it starts when its gap reaches 0.
 //
 // The model this is (each assumption also in docs/plant.md):
-// - A wall or the divider is fixed and frictionless: it takes away the
+// - A wall, the divider or an obstacle is fixed and frictionless: it takes away the
 //   normal component and the centre slides along it at the tangential
 //   speed the wheels give (the wheels slip sideways). The contact force
 //   passes through the centre of the round body, so it exerts no torque and
@@ -41,26 +42,29 @@
 
 namespace simbot::plant::contact {
 
-enum class Kind : std::uint8_t { WallX, WallY, Divider, Robot };
+enum class Kind : std::uint8_t { WallX, WallY, Divider, Robot, Obstacle };
 
 // Each robot can touch one of the east/west walls, one of the north/south
-// walls and the divider; and the two robots each other.
-inline constexpr int kMaxActive = 2 * 3 + 1;
+// walls, the divider and up to kMaxObstacleContacts obstacles; and the two
+// robots each other.
+inline constexpr int kMaxActive = 2 * (3 + kMaxObstacleContacts) + 1;
 
 struct Constraint {
   Kind kind = Kind::WallX;
-  int robot = 0;  // the robot (for Robot: 0, the pair)
+  int robot = 0;     // the robot (for Robot: 0, the pair)
+  int obstacle = 0;  // for Obstacle: its index in Bodies::obstacles
 };
 
 struct Active {
   int count = 0;
   std::array<Constraint, kMaxActive> c{};
   // Any constraint whose normal turns as the bodies move (the divider's
-  // corners, the other robot): curvature then needs the full derivative.
+  // or an obstacle's corners, a round obstacle, the other robot):
+  // curvature then needs the full derivative.
   bool turning() const {
     for (int j = 0; j < count; ++j)
-      if (c[static_cast<std::size_t>(j)].kind == Kind::Divider ||
-          c[static_cast<std::size_t>(j)].kind == Kind::Robot)
+      if (c[static_cast<std::size_t>(j)].kind != Kind::WallX &&
+          c[static_cast<std::size_t>(j)].kind != Kind::WallY)
         return true;
     return false;
   }
@@ -73,6 +77,9 @@ struct Bodies {
   std::array<double, 2> invMass{1, 1};
   double half = 8;  // the field walls are at |x|, |y| = half
   geom::Rect divider{};
+  // The field's obstacles (fixed, like the divider).
+  int obstacleCount = 0;
+  std::array<geom::Convex, kMaxObstacles> obstacles{};
 };
 
 // Gap (ft) of constraint c at centres q (x0, y0, x1, y1), and its unit

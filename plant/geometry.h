@@ -10,7 +10,9 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <utility>
 
 #include "plant/plant.h"
 
@@ -139,6 +141,122 @@ inline double discPathToSquareEdge(const Vec2& p, const Vec2& u, double r, doubl
     if (u[i] < 0) s = std::min(s, (-inner - p[i]) / u[i]);
   }
   return s;
+}
+
+// An obstacle's footprint as the plant evaluates it: a circle, or a convex
+// polygon with its counter-clockwise vertices and each edge's outward unit
+// normal (edge k runs from v[k] to v[k + 1]). Fixed size: nothing is
+// allocated where a root function or an eye reads it.
+struct Convex {
+  bool circle = true;
+  Vec2 c{0, 0};
+  double r = 0;
+  int n = 0;
+  std::array<Vec2, kMaxObstacleVertices> v{}, normal{};
+};
+
+inline Convex convexOf(const Obstacle& o) {
+  Convex s;
+  s.circle = o.kind == Obstacle::Kind::Circle;
+  s.c = Vec2(o.x_ft, o.y_ft);
+  s.r = o.radius_ft;
+  if (s.circle) return s;
+  s.n = static_cast<int>(std::min<std::size_t>(o.points.size(), kMaxObstacleVertices));
+  for (int k = 0; k < s.n; ++k)
+    s.v[static_cast<std::size_t>(k)] = Vec2(o.points[static_cast<std::size_t>(k)].x_ft,
+                                            o.points[static_cast<std::size_t>(k)].y_ft);
+  for (int k = 0; k < s.n; ++k) {
+    const Vec2 e = s.v[static_cast<std::size_t>((k + 1) % s.n)] - s.v[static_cast<std::size_t>(k)];
+    // Counter-clockwise: the outside is to the right of each edge.
+    s.normal[static_cast<std::size_t>(k)] = Vec2(e.y(), -e.x()).normalized();
+  }
+  return s;
+}
+
+// Signed distance from p to the shape's boundary (positive outside), and
+// the outward unit normal there: outside, from the nearest boundary point
+// towards p; inside, the nearest edge's. Continuous across the boundary,
+// as a contact's root function must be.
+inline double signedDistance(const Vec2& p, const Convex& s, Vec2* normal) {
+  if (s.circle) {
+    const Vec2 d = p - s.c;
+    const double len = d.norm();
+    if (normal) *normal = len > 0 ? Vec2(d / len) : Vec2(1.0, 0.0);
+    return len - s.r;
+  }
+  // The largest signed distance past an edge's line: <= 0 exactly inside.
+  double worst = -HUGE_VAL;
+  int face = 0;
+  for (int k = 0; k < s.n; ++k) {
+    const double dk =
+        s.normal[static_cast<std::size_t>(k)].dot(p - s.v[static_cast<std::size_t>(k)]);
+    if (dk > worst) {
+      worst = dk;
+      face = k;
+    }
+  }
+  if (worst <= 0) {
+    if (normal) *normal = s.normal[static_cast<std::size_t>(face)];
+    return worst;
+  }
+  // Outside: the nearest point of the nearest edge.
+  double best = HUGE_VAL;
+  Vec2 nearest = s.v[0];
+  for (int k = 0; k < s.n; ++k) {
+    const Vec2& a = s.v[static_cast<std::size_t>(k)];
+    const Vec2 e = s.v[static_cast<std::size_t>((k + 1) % s.n)] - a;
+    const double u = std::clamp((p - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
+    const Vec2 q = a + u * e;
+    const double d2 = (p - q).squaredNorm();
+    if (d2 < best) {
+      best = d2;
+      nearest = q;
+    }
+  }
+  const double len = std::sqrt(best);
+  if (normal) *normal = Vec2((p - nearest) / len);
+  return len;
+}
+
+// The parameters [lo, hi] (clipped to [lo0, hi0]) at which p + s d lies
+// in the closed shape; false when it never does. Cyrus-Beck clipping for a
+// polygon, the quadratic's roots for a circle.
+inline bool clipLine(const Vec2& p, const Vec2& d, const Convex& s, double lo0, double hi0,
+                     double& lo, double& hi) {
+  lo = lo0;
+  hi = hi0;
+  if (s.circle) {
+    const Vec2 m = p - s.c;
+    const double a = d.squaredNorm(), b = m.dot(d), c = m.squaredNorm() - s.r * s.r;
+    if (a == 0) return c <= 0;
+    const double disc = b * b - a * c;
+    if (disc < 0) return false;
+    const double root = std::sqrt(disc);
+    // The stable pair of roots of a s^2 + 2 b s + c.
+    const double q = b >= 0 ? -(b + root) : -(b - root);
+    double s0 = q / a, s1 = q != 0 ? c / q : s0;
+    if (s0 > s1) std::swap(s0, s1);
+    lo = std::max(lo, s0);
+    hi = std::min(hi, s1);
+    return lo <= hi;
+  }
+  for (int k = 0; k < s.n; ++k) {
+    const Vec2& nk = s.normal[static_cast<std::size_t>(k)];
+    // Inside the edge's half-plane: nk . (p + s d - v_k) <= 0.
+    const double num = nk.dot(p - s.v[static_cast<std::size_t>(k)]);
+    const double den = nk.dot(d);
+    if (den == 0) {
+      if (num > 0) return false;
+      continue;
+    }
+    const double t = -num / den;
+    if (den > 0)
+      hi = std::min(hi, t);
+    else
+      lo = std::max(lo, t);
+    if (lo > hi) return false;
+  }
+  return true;
 }
 
 }  // namespace simbot::plant::geom

@@ -1,7 +1,8 @@
 // plant/optics.cpp -- the eyes: a pure function of two poses (thesis VII).
 //
 // DESIGN.md fixes the model: the beacon is seen only for |gamma| < 90 deg
-// and when the segment between the centres misses the divider. The near eye
+// and when the segment between the centres misses the divider and every
+// obstacle taller than the beacon. The near eye
 // (on the opponent's side) sees S = max within r_sat, else kappa / r^2 +
 // background with kappa = (max - background) r_sat^2 (Appendix C's MAX_EYE;
 // the printed 36578/38578 are typos). The far eye sees S * f with
@@ -95,6 +96,8 @@ EyeGeometry eyeGeometry(const Pose& self, const Pose& opp, const RobotParams& p,
   g.gamma_deg = geom::wrap180(bearing - self.heading_deg);
   if (!(std::abs(g.gamma_deg) < 90.0)) return g;
   if (dividerBlocks(self.x_ft, self.y_ft, opp.x_ft, opp.y_ft, field)) return g;
+  if (!field.obstacles.empty() && obstacleBlocks(self.x_ft, self.y_ft, opp.x_ft, opp.y_ft, field))
+    return g;
   g.seen = true;
   if (g.range_ft <= p.eye_saturation_ft) {
     g.near_signal = p.eye_max;

@@ -122,6 +122,45 @@ struct RobotParams {
   BatteryParams battery;
 };
 
+// ---------------------------------------------------------------- obstacles
+// Fixed obstacles on the field (DESIGN.md "The wider competition": a
+// weighted mine, the mountain), placed by a scenario or a rules file and
+// checked by config/ (a convex shape inside the field, clear of the start
+// poses). Rigid like the divider: a body touching one is a contact at its
+// exact tick (contact.h), a ball that meets one below its height ends
+// there (a miss, "obstacle"), and one taller than the beacon hides the
+// beacon from an eye when it stands between them.
+inline constexpr int kMaxObstacles = 16;
+inline constexpr int kMaxObstacleVertices = 16;
+// At most this many obstacles touch one robot at once (contact.h's fixed
+// constraint table); one more is the run's plant fault.
+inline constexpr int kMaxObstacleContacts = 4;
+
+struct ObstaclePoint {
+  double x_ft = 0, y_ft = 0;
+};
+struct Obstacle {
+  enum class Kind : std::uint8_t { Circle, Box, Polygon };
+  Kind kind = Kind::Circle;
+  std::string name;   // empty: "obstacle N" (obstacleLabel)
+  bool mine = false;  // an instructor's weighted mine (a rules file may forbid them)
+  double height_ft = 0;
+  double x_ft = 0, y_ft = 0;  // a circle's or box's centre; a polygon's vertex mean
+  double radius_ft = 0;       // a circle's
+  // A box: width along x and depth along y before it is turned clockwise
+  // (as headings turn) by angle_deg about its centre.
+  double width_ft = 0, depth_ft = 0, angle_deg = 0;
+  // A box's corners or a polygon's vertices, convex, counter-clockwise
+  // (makeBox, makePolygon); empty for a circle.
+  std::vector<ObstaclePoint> points;
+};
+// A box's obstacle with its corners; a polygon's from its vertices in
+// either order (counter-clockwise afterwards). makePolygon does not check
+// convexity: config/ refuses what is not convex before.
+Obstacle makeBox(double x, double y, double width, double depth, double angleDeg, double height);
+Obstacle makePolygon(const std::vector<ObstaclePoint>& points, double height);
+const char* obstacleKindName(Obstacle::Kind k);
+
 struct FieldParams {
   double size_ft = 0;              // square side
   double wire_inset_ft = 0;        // wire ring inside the edge
@@ -140,7 +179,14 @@ struct FieldParams {
   double placement_heading_deg = 0;
   double gravity_fps2 = 0;
   bool count_floor_skips = false;
+  // The standard beacon's height above the floor (every robot carries the
+  // course's beacon on the course's base): an obstacle taller hides it.
+  double beacon_height_ft = 0.75;
+  std::vector<Obstacle> obstacles;  // at most kMaxObstacles
 };
+// How traces and messages name obstacle `index` (0-based) of the field:
+// "obstacle N" (N from 1), and "obstacle N (NAME)" when it has a name.
+std::string obstacleLabel(const FieldParams& field, int index);
 
 // The referee's limits are at most this; arena.cpp keeps the last
 // kMaxRefereeLimit + 1 event ticks per robot, enough to see one too many.
@@ -282,14 +328,21 @@ bool dividerBlocks(double ax, double ay, double bx, double by, const FieldParams
 // Gap between a round body (centre x, y; radius) and the divider, in ft;
 // negative when they overlap.
 double dividerClearance(double x, double y, double radius, const FieldParams& field);
+// True if the segment between the two points passes through an obstacle
+// taller than the field's beacon height (which hides the beacon).
+bool obstacleBlocks(double ax, double ay, double bx, double by, const FieldParams& field);
+// Gap between a round body and an obstacle's footprint, in ft; negative
+// when they overlap.
+double obstacleClearance(double x, double y, double radius, const Obstacle& obstacle);
 
 // ---------------------------------------------------------------- events
 enum class Detector : std::uint8_t { Fore = 0, Aft = 1 };
 enum class Bumper : std::uint8_t { Front = 0, Back = 1 };
-enum class ContactWith : std::uint8_t { None, Robot, Divider, Wall };
+enum class ContactWith : std::uint8_t { None, Robot, Divider, Wall, Obstacle };
 // Why a ball or disc flight ended without a hit. LeftField: it reached a
-// field wall; Stopped: a disc slowed below its stop speed.
-enum class MissReason : std::uint8_t { None, Floor, Divider, LeftField, Stopped };
+// field wall; Stopped: a disc slowed below its stop speed; Obstacle: a
+// ball met a fixed obstacle (Event::obstacle names it).
+enum class MissReason : std::uint8_t { None, Floor, Divider, LeftField, Stopped, Obstacle };
 
 enum class EventKind : std::uint8_t {
   EdgeEnter,       // robot, detector: detector now reads low
@@ -326,7 +379,8 @@ struct Event {
   ContactWith with = ContactWith::None;
   MissReason miss = MissReason::None;
   std::int8_t gun = -1;
-  std::int8_t ball = -1;  // a ball's slot, or a disc's (disc events)
+  std::int8_t ball = -1;      // a ball's slot, or a disc's (disc events)
+  std::int8_t obstacle = -1;  // with Obstacle, or a miss on one: its index in the field's list
   // Balls: position (ft) at the event, and at a launch the velocity (ft/s):
   // the flight is x + vx s, y + vy s, z + vz s - g s^2 / 2 after the launch
   // tick; and the shooter's heading (deg) then, from which the ball's
@@ -426,14 +480,16 @@ struct ArenaConfig {
 // words per attempt from streams[i]: radius R sqrt(u1), direction 2 pi u2,
 // heading offset H (2 u3 - 1) (R, H: the field's placement_radius_ft and
 // placement_heading_deg). An attempt is kept if the body lies inside the
-// field, clear of the divider and of every robot placed before it;
+// field, clear of the divider, the obstacles and every robot placed
+// before it;
 // otherwise the robot draws again, at most kPlacementAttempts times, and
 // after that stays exactly at its start pose. streams.size() must be
 // config.robots.size().
 inline constexpr int kPlacementAttempts = 16;
 void placeByHand(ArenaConfig& config, const std::vector<RandomBits*>& streams);
 // True if a robot of radius r centred at (x, y) lies inside the field and
-// clear of the divider (the placement test above, without other robots).
+// clear of the divider and every obstacle (the placement test above,
+// without other robots).
 bool placementFits(double x, double y, double r, const FieldParams& field);
 // Per-match wheel trims: left then right, one word each, each trim times
 // 1 + trim_spread (2 u - 1). No draw if trim_spread is 0.

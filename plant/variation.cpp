@@ -34,7 +34,10 @@ bool placementFits(double x, double y, double r, const FieldParams& field) {
   // the start (field_walls), which no hand placement does.
   const double half = field.size_ft / 2;
   if (!(std::abs(x) + r < half && std::abs(y) + r < half)) return false;
-  return dividerClearance(x, y, r, field) > 0;
+  if (!(dividerClearance(x, y, r, field) > 0)) return false;
+  for (const Obstacle& o : field.obstacles)
+    if (!(obstacleClearance(x, y, r, o) > 0)) return false;
+  return true;
 }
 
 void placeByHand(ArenaConfig& config, const std::vector<RandomBits*>& streams) {

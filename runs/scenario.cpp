@@ -156,6 +156,12 @@ void applyScenario(const Scenario& s, ScenarioUse use, const config::Profile& pr
     if (std::hypot(a.x_ft - b.x_ft, a.y_ft - b.y_ft) <= touch)
       fail(s.b.start ? s.b.startPos : s.a.startPos, "the two robots' start poses overlap");
   }
+  if (!s.obstacles.empty()) {
+    config.arena.field.obstacles.clear();
+    for (const config::ObstacleSpec& o : s.obstacles)
+      config.arena.field.obstacles.push_back(o.obstacle);
+    config::checkObstacles(s.obstacles, s.file, config.arena);
+  }
   if (robots == 2 && s.opponent == Scenario::Opponent::Beacon && !s.path.empty()) {
     config.robots[1].path = driveLegs(s.file, s.path, config.arena.robots[1].params);
     config.robots[1].repeatPath = s.repeatPath;

@@ -293,6 +293,18 @@ void Match::emitSetup() {
          trace::rec::Rules{config_.rulesName, config_.rulesFile, f.divider, f.count_floor_skips,
                            referee.detect_threshold, referee.scatter_scores},
          {});
+  for (std::size_t k = 0; k < f.obstacles.size(); ++k) {
+    const plant::Obstacle& o = f.obstacles[k];
+    std::vector<double> points;
+    for (const plant::ObstaclePoint& p : o.points) {
+      points.push_back(p.x_ft);
+      points.push_back(p.y_ft);
+    }
+    emit(0,
+         trace::rec::Obstacle{static_cast<int64_t>(k + 1), o.name, plant::obstacleKindName(o.kind),
+                              o.mine, o.height_ft, o.x_ft, o.y_ft, o.radius_ft, std::move(points)},
+         {});
+  }
   for (const auto& r : robots_) {
     const plant::RobotSetup& setup = arenaConfig_->robots[static_cast<size_t>(r->index)];
     const plant::RobotParams& p = setup.params;
@@ -456,16 +468,19 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
   namespace rec = trace::rec;
   const int r = e.robot;
   const auto side = [](plant::Bumper b) { return b == plant::Bumper::Front ? "front" : "back"; };
-  const auto with = [](plant::ContactWith w) {
-    return w == plant::ContactWith::Robot     ? "robot"
-           : w == plant::ContactWith::Divider ? "divider"
-                                              : "wall";
+  const auto obstacle = [&](int index) { return plant::obstacleLabel(arenaConfig_->field, index); };
+  const auto with = [&](plant::ContactWith w, int index) -> std::string {
+    return w == plant::ContactWith::Robot      ? "robot"
+           : w == plant::ContactWith::Divider  ? "divider"
+           : w == plant::ContactWith::Obstacle ? obstacle(index)
+                                               : "wall";
   };
-  const auto missed = [](plant::MissReason m) {
-    return m == plant::MissReason::Floor     ? "floor"
-           : m == plant::MissReason::Divider ? "divider"
-           : m == plant::MissReason::Stopped ? "stopped"
-                                             : "wall";
+  const auto missed = [&](plant::MissReason m, int index) -> std::string {
+    return m == plant::MissReason::Floor      ? "floor"
+           : m == plant::MissReason::Divider  ? "divider"
+           : m == plant::MissReason::Stopped  ? "stopped"
+           : m == plant::MissReason::Obstacle ? obstacle(index)
+                                              : "wall";
   };
   switch (e.kind) {
     case plant::EventKind::EdgeEnter:
@@ -473,9 +488,9 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
     case plant::EventKind::EdgeLeave:
       return rec::EdgeLeave{r, e.detector == plant::Detector::Fore ? "fore" : "aft"};
     case plant::EventKind::Contact:
-      return rec::Contact{r, side(e.bumper), with(e.with)};
+      return rec::Contact{r, side(e.bumper), with(e.with, e.obstacle)};
     case plant::EventKind::ContactEnd:
-      return rec::ContactEnd{r, with(e.with)};
+      return rec::ContactEnd{r, with(e.with, e.obstacle)};
     case plant::EventKind::ReflexStart:
       return rec::ReflexStart{r, side(e.bumper)};
     case plant::EventKind::ReflexEnd:
@@ -489,7 +504,7 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
     case plant::EventKind::BallMiss:
       return rec::BallMiss{
           r,      e.gun,
-          e.ball, missed(e.miss),
+          e.ball, missed(e.miss, e.obstacle),
           e.x,    e.y,
           e.z,    e.closest_ft >= 0 ? std::optional<double>(e.closest_ft) : std::nullopt};
     case plant::EventKind::RefereePutBack:
@@ -524,7 +539,7 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
     case plant::EventKind::DiscMiss:
       return rec::DiscMiss{r,
                            e.ball,
-                           missed(e.miss),
+                           missed(e.miss, e.obstacle),
                            e.x,
                            e.y,
                            e.z,

@@ -120,6 +120,13 @@ trace::Entry traceEntry(const json& j) {
         v = it->get<double>();
       else
         throw bad("a number or null");
+    } else if constexpr (std::is_same_v<V, std::vector<double>>) {
+      if (!it->is_array()) throw bad("an array of numbers");
+      v.clear();
+      for (const auto& x : *it) {
+        if (!x.is_number()) throw bad("an array of numbers");
+        v.push_back(x.get<double>());
+      }
     }
   });
   if (const auto w = j.find("watch"); w != j.end()) {

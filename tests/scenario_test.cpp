@@ -105,7 +105,7 @@ TEST(Scenario, EveryMistakeNamesItsLine) {
   const Bad cases[] = {
       {"speed = 3\n",
        "s.toml:1:1: error: unknown key 'speed' in the scenario (expected one of: profile, rules, "
-       "seconds, seed, A, B)"},
+       "seconds, seed, A, B, obstacles)"},
       {"rules = \"no-such\"\n",
        "s.toml:1:9: error: 'rules': no rule set 'no-such' in rules/ (or give a path to a .toml)"},
       // Times in timebase/written.h's grammar: a number of seconds, or a

@@ -33,7 +33,7 @@ namespace simbot::trace {
 
 using timebase::Tick;
 
-enum class FieldKind : std::uint8_t { Robot, Int, Real, Bool, Text, Bytes, OptInt, OptReal };
+enum class FieldKind : std::uint8_t { Robot, Int, Real, Bool, Text, Bytes, OptInt, OptReal, Reals };
 
 template <FieldKind>
 struct FieldTypeOf;
@@ -68,6 +68,10 @@ struct FieldTypeOf<FieldKind::OptInt> {
 template <>
 struct FieldTypeOf<FieldKind::OptReal> {
   using type = std::optional<double>;
+};
+template <>
+struct FieldTypeOf<FieldKind::Reals> {
+  using type = std::vector<double>;
 };
 
 // One struct per record kind, members in definition order.
