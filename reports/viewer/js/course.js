@@ -10,9 +10,10 @@
 // was set down); a block's later positions from any record that names it
 // (`block` or `deployable`) with x_ft and y_ft, held between records.
 
-// Number of a deployable in a record: the deploy branch's field name.
+// A deployable's number in a record (`deploy` has `number`, from 1 per
+// item of its robot's table; a block's later records `block` or `number`).
 function deployableId(c, i) {
-  for (const f of ['deployable', 'block', 'number', 'index'])
+  for (const f of ['block', 'deployable', 'number', 'index'])
     if (c[f] && c[f][i] !== undefined && c[f][i] !== null) return c[f][i];
   return i;
 }
@@ -75,15 +76,17 @@ function deployables(K) {
       size: get('size_ft', get('side_ft', 0.5)), width: get('width_ft', 2), height: get('height_ft', 1),
       moves: { t: [], x: [], y: [] } };
     out.push(d);
-    byId.set(d.id, d);
+    byId.set(`${d.robot}:${d.kind}:${d.id}`, d);
   }
-  // A block's later positions: records other than deploy that name it.
+  // A block's later positions: records other than deploy that name it, by
+  // its owner (`owner`, else the record's robot) and number.
   for (const kind of Object.keys(K)) {
     if (kind === 'deploy' || !kind.startsWith('block')) continue;
     const r = K[kind];
     if (!r.x_ft || !r.y_ft) continue;
     for (let i = 0; i < r.t.length; ++i) {
-      const d = byId.get(deployableId(r, i));
+      const owner = r.owner ? r.owner[i] : r.robot ? r.robot[i] : 0;
+      const d = byId.get(`${owner}:block:${deployableId(r, i)}`);
       if (!d) continue;
       d.moves.t.push(r.t[i]); d.moves.x.push(r.x_ft[i]); d.moves.y.push(r.y_ft[i]);
     }

@@ -298,6 +298,7 @@ const EVENT_STYLE = {
   disc_miss: { glyph: 'd', color: '#909090', label: 'disc miss' },
   disc_empty: { glyph: '|', color: '#908860', label: 'disc magazine empty' },
   deploy: { glyph: 'B', color: '#b08850', label: 'deployed (block / decoy)' },
+  deploy_empty: { glyph: '|', color: '#806040', label: 'nothing left to deploy' },
   block_push: { glyph: 'b', color: '#d0a060', label: 'block pushed' },
 };
 
@@ -329,7 +330,8 @@ function describeEvent(kind, c, i) {
     case 'disc_hit': return `disc ${c.disc[i]} hit ${ROBOT_NAMES[c.target[i]]}`;
     case 'disc_miss': return `disc ${c.disc[i]}: ${c.hit[i]}` +
       (c.closest_ft[i] === null ? '' : `, closest ${c.closest_ft[i].toFixed(2)} ft`);
-    case 'deploy': return c.kind ? c.kind[i] : '';
+    case 'deploy': return `${c.kind[i]} ${c.number[i]} (bit ${c.bit[i]})`;
+    case 'deploy_empty': return `no ${c.kind[i]} left (bit ${c.bit[i]})`;
     default: return '';
   }
 }
@@ -369,7 +371,7 @@ const STEP_KINDS = [
   ['scatter', 'scatter shots', ['scatter_shot']],
   ['resets', 'resets', ['reset', 'restart']],
   ['discs', 'discs', ['disc_fire', 'disc_hit', 'disc_miss', 'disc_empty']],
-  ['deploys', 'deployed', ['deploy', 'block_push']],
+  ['deploys', 'deployed', ['deploy', 'deploy_empty', 'block_push']],
 ];
 
 function stepLists(K) {
