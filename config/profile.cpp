@@ -61,6 +61,7 @@ class Checker {
   }
 
   toml::table parse(std::string_view text) const { return parseToml(text, file_); }
+  const std::string& file() const { return file_; }
 
   // Fails unless v (internal units) is within the key's bounds.
   void checkBounds(const KeyDef& def, const toml::node& at, const std::string& name,
@@ -303,6 +304,63 @@ void checkSecondary(const toml::table& doc, const Checker& c, const Hardware& h)
            "secondary.stop_speed must be below secondary.launch_speed");
 }
 
+// A hardware file's [[deployables]]: each table's `kind` (a plain
+// string), then the keys that kind needs, all of them and no other, each
+// a { value, unit, source } entry checked as a profile's. Appended to
+// h.deployables in file order.
+void readDeployables(const toml::table& doc, const Checker& c, Profile& p, Hardware& h) {
+  const toml::node* node = doc.get("deployables");
+  if (!node) return;
+  const toml::array* arr = node->as_array();
+  if (!arr || !arr->is_array_of_tables())
+    c.fail(node->source(), "'deployables' must be an array of tables ([[deployables]])");
+  struct KindKeys {
+    const char* word;
+    plant::DeployKind kind;
+    std::vector<std::string> keys;
+  };
+  static const std::array<KindKeys, 3> kinds = {{
+      {"block",
+       plant::DeployKind::Block,
+       {"bit", "count", "width", "depth", "height", "mass", "floor_friction"}},
+      {"decoy_light", plant::DeployKind::DecoyLight, {"bit", "count", "intensity", "height"}},
+      {"decoy_screen", plant::DeployKind::DecoyScreen, {"bit", "count", "width", "height"}},
+  }};
+  for (const toml::node& e : *arr) {
+    const toml::table& t = *e.as_table();
+    const toml::node* kindNode = t.get("kind");
+    if (!kindNode) c.fail(t.source(), "[[deployables]] has no 'kind'");
+    const auto word = kindNode->value<std::string>();
+    const KindKeys* kk = nullptr;
+    for (const KindKeys& k : kinds)
+      if (word && *word == k.word) kk = &k;
+    if (!kk)
+      c.fail(kindNode->source(),
+             "'deployables.kind' must be \"block\", \"decoy_light\" or \"decoy_screen\"");
+    if (h.deployables.size() >= static_cast<std::size_t>(plant::kMaxDeployKinds))
+      c.fail(t.source(), fmt::format("at most {} [[deployables]]", plant::kMaxDeployKinds));
+    h.deployables.push_back(plant::Deployable{});
+    h.deployables.back().kind = kk->kind;
+    for (auto&& [k, v] : t) {
+      if (k.str() == "kind") continue;
+      const KeyDef* def = nullptr;
+      for (const KeyDef& d : keys::deployableTable())
+        if (k.str() == d.key) def = &d;
+      if (!def || std::find(kk->keys.begin(), kk->keys.end(), k.str()) == kk->keys.end()) {
+        std::string list;
+        for (const std::string& w : kk->keys) list += (list.empty() ? "" : ", ") + w;
+        failAt(c.file(), k.source(),
+               fmt::format("unknown key '{}' in a {} [[deployables]] (expected one of: kind, {})",
+                           k.str(), kk->word, list));
+      }
+      c.apply(*def, v, def->target(p, h));
+    }
+    for (const std::string& key : kk->keys)
+      if (!t.contains(key))
+        c.fail(t.source(), fmt::format("missing key '{}' in a {} [[deployables]]", key, kk->word));
+  }
+}
+
 }  // namespace
 
 Profile parseProfile(std::string_view text, const std::string& sourceName) {
@@ -357,10 +415,29 @@ Hardware parseHardware(std::string_view text, const std::string& sourceName,
         c.fail(sk.source(),
                fmt::format("[{}] is arena-wide and cannot be overridden per robot", d.section));
   }
-  c.walk(doc, defs, false, {"name", "description"}, p, h, nullptr);
+  toml::table rest = doc;  // [[deployables]] is read apart (readDeployables)
+  rest.erase("deployables");
+  c.walk(rest, defs, false, {"name", "description"}, p, h, nullptr);
   checkSecondary(doc, c, h);
+  readDeployables(doc, c, p, h);
   std::array<int, 5> bits = {h.gun_motor_bit[0], h.gun_solenoid_bit[0], h.gun_motor_bit[1],
                              h.gun_solenoid_bit[1], h.disc_shooter_bit};
+  // A deployable's bit may be no weapon's and no other deployable's.
+  for (std::size_t k = 0; k < h.deployables.size(); ++k) {
+    const int b = h.deployables[k].bit;
+    const toml::node& at = *doc.get("deployables")->as_array()->get(k)->as_table()->get("bit");
+    for (std::size_t j = 0; j < bits.size(); ++j)
+      if (bits[j] == b)
+        c.fail(at.source(), fmt::format("port B bit {} is bound twice: a [[deployables]] "
+                                        "and {}",
+                                        b,
+                                        std::array<const char*, 5>{
+                                            "gun 1's motor", "gun 1's solenoid", "gun 2's motor",
+                                            "gun 2's solenoid", "the disc shooter"}[j]));
+    for (std::size_t j = 0; j < k; ++j)
+      if (h.deployables[j].bit == b)
+        c.fail(at.source(), fmt::format("port B bit {} is bound twice: two [[deployables]]", b));
+  }
   for (std::size_t i = 0; i < bits.size(); ++i)
     for (std::size_t j = i + 1; j < bits.size(); ++j)
       if (bits[i] == bits[j]) {

@@ -4,6 +4,7 @@
 #include "config/profile_keys.h"
 
 #include <cmath>
+#include <type_traits>
 
 #include "timebase/written.h"
 
@@ -98,6 +99,10 @@ const std::vector<KeyDef>& keyTable() {
       // Only the ratio of the two robots' masses matters (contact.h: how
       // one pushes the other); the range spans any robot a student builds.
       {"robot", "mass", Kind::Mass, {0.5, 500}, true, D(p.robot.mass_lb)},
+      // The wheels' Coulomb friction on the floor: traction = mass g times
+      // it, what a robot pushes a deployed block with (docs/plant.md
+      // "Deployables"). Rubber on a hard floor is about 0.5 to 1.
+      {"robot", "wheel_friction", Kind::Ratio, {0.05, 2}, true, D(p.robot.wheel_friction)},
       {"bumper", "reflex_distance", Kind::Length, {0.05, 20}, true, D(p.robot.reflex_distance_ft)},
       {"bumper", "reflex_speed_step", Kind::Step, {0, 15}, true, I(p.robot.reflex_speed_step)},
       {"eyes", "max", Kind::Reading, {16, 65535}, true, D(p.robot.eye_max)},
@@ -298,6 +303,50 @@ const std::vector<KeyDef>& secondaryTable() {
       {"secondary", "stop_speed", Kind::Speed, {0.01, 150}, true, D(h.secondary.stop_speed_fps)},
       // Up to 2 ft: no wider than a robot.
       {"secondary", "diameter", Kind::Length, {0.01, 2}, true, D(h.secondary.diameter_ft)},
+  };
+  return keys;
+}
+
+const std::vector<KeyDef>& deployableTable() {
+  // Each lands in the last of h.deployables: the loader appends one per
+  // [[deployables]] table before walking its keys.
+  const auto last = [](auto member) {
+    return [member](Profile&, Hardware& h) {
+      Target t;
+      using M = std::remove_reference_t<decltype(h.deployables.back().*member)>;
+      if constexpr (std::is_same_v<M, int>)
+        t.i = &(h.deployables.back().*member);
+      else
+        t.d = &(h.deployables.back().*member);
+      return t;
+    };
+  };
+  using plant::Deployable;
+  static const std::vector<KeyDef> keys = {
+      {"deployables", "bit", Kind::Bit, {0, 7}, true, last(&Deployable::bit)},
+      {"deployables",
+       "count",
+       Kind::Count,
+       {1, plant::kMaxDeployCount},
+       true,
+       last(&Deployable::count)},
+      // Appendix A: a robot at most 4.0 ft tall and, with what it carries,
+      // 35 lb; a block or screen no bigger than the robot.
+      {"deployables", "width", Kind::Length, {0.05, 4}, true, last(&Deployable::width_ft)},
+      {"deployables", "depth", Kind::Length, {0.05, 4}, true, last(&Deployable::depth_ft)},
+      {"deployables", "height", Kind::Length, {0.02, 4}, true, last(&Deployable::height_ft)},
+      {"deployables", "mass", Kind::Mass, {0.01, 35}, true, last(&Deployable::mass_lb)},
+      // Thesis IX.C (line 1033): blocks "wrapped in non skid material";
+      // any Coulomb coefficient a floor and a wrapping can have.
+      {"deployables",
+       "floor_friction",
+       Kind::Ratio,
+       {0, 3},
+       true,
+       last(&Deployable::floor_friction)},
+      // Its kappa over the standard beacon's: thesis VII.D (line 930) has
+      // decoys "not at the same ... intensity of the robot beacon".
+      {"deployables", "intensity", Kind::Ratio, {0.01, 100}, true, last(&Deployable::intensity)},
   };
   return keys;
 }

@@ -109,6 +109,9 @@ void walkKeys(const toml::table& doc, const std::vector<const KeyDef*>& defs,
 // A hardware file's [secondary] keys (a secondary weapon: the disc
 // launcher). When the table is there, every key but `bit` must be.
 const std::vector<KeyDef>& secondaryTable();
+// A hardware file's [[deployables]] keys (every kind's; the loader says
+// which a kind needs).
+const std::vector<KeyDef>& deployableTable();
 
 // Conversion factor to the internal unit, or NaN if the unit is not allowed.
 double unitFactor(Kind k, std::string_view u);

@@ -254,6 +254,27 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
     else
       ev.push(Event{EventKind::DiscEmpty, e.robot});
   }
+  // Deployables: one item set down at the edge's tick while the table has
+  // any left (deployables.cpp). Nothing that moves changes.
+  for (std::size_t k = 0; k < hw.deployables.size(); ++k) {
+    const Deployable& dep = hw.deployables[k];
+    if (!bit(value, dep.bit) || bit(old.portB, dep.bit)) continue;
+    int& left = m.deployLeft[static_cast<std::size_t>(robot)][k];
+    Event e{left > 0 ? EventKind::Deploy : EventKind::DeployEmpty};
+    e.robot = static_cast<std::int8_t>(robot);
+    e.gun = static_cast<std::int8_t>(k);
+    if (left > 0) {
+      const Deployed item = placeDeployable(dep, robot, static_cast<int>(k), tick,
+                                            pose(robot, tick), m.radius(robot));
+      m.deployed.push_back(item);
+      --left;
+      e.ball = static_cast<std::int8_t>(dep.count - left);
+      e.x = item.x_ft;
+      e.y = item.y_ft;
+      e.heading_deg = item.heading_deg;
+    }
+    ev.push(e);
+  }
   if (!rhsChanges && !scheduleChanges && !discLaunch) {
     // Nothing that moves changes: the prediction stays valid.
     for (Discrete* d : {&m.D, &m.pendingD}) {
@@ -375,9 +396,15 @@ EyeReadings Arena::eyeReadings(int robot, std::int64_t tick, RandomBits* noise,
                                EyeChannels channels) const {
   const Impl& m = *impl_;
   const Pose self = pose(robot, tick);
-  if (m.nR < 2) return computeEyes(self, nullptr, m.P(robot), m.cfg.field, noise, channels);
+  // The items set down by `tick` (deployed is in tick order).
+  EyeScene scene{m.deployed.data(), 0};
+  while (scene.count < static_cast<int>(m.deployed.size()) &&
+         m.deployed[static_cast<std::size_t>(scene.count)].tick <= tick)
+    ++scene.count;
+  if (m.nR < 2)
+    return computeEyes(self, nullptr, m.P(robot), m.cfg.field, noise, channels, &scene, robot);
   const Pose other = pose(1 - robot, tick);
-  return computeEyes(self, &other, m.P(robot), m.cfg.field, noise, channels);
+  return computeEyes(self, &other, m.P(robot), m.cfg.field, noise, channels, &scene, robot);
 }
 
 std::vector<BallView> Arena::balls(std::int64_t tick) const {
@@ -422,6 +449,8 @@ int Arena::discShots(int robot) const {
   const Impl& m = *impl_;
   return m.discreteAt(m.now).r[static_cast<std::size_t>(robot)].discShots;
 }
+const std::vector<Deployed>& Arena::deployed() const { return impl_->deployed; }
+
 int Arena::discHits(int robot) const {
   const Impl& m = *impl_;
   return m.discreteAt(m.now).r[static_cast<std::size_t>(robot)].discHits;
@@ -485,6 +514,10 @@ const char* eventKindName(EventKind k) {
       return "disc_hit";
     case EventKind::DiscMiss:
       return "disc_miss";
+    case EventKind::Deploy:
+      return "deploy";
+    case EventKind::DeployEmpty:
+      return "deploy_empty";
   }
   return "?";
 }

@@ -37,10 +37,11 @@ int Arena::Impl::reported(const int* found, RootKind k, int who) const {
 
 // Applies everything that happens at tick T (time te) to (d, y) and lists
 // the events, in this fixed order: ball launches; ball outcomes (floor,
-// divider, obstacle, hit, leaving the field -- the floor first, so a ball reaching
-// floor and robot together is a miss, thesis VIII.H); disc outcomes (the
-// end of the path, then a hit, as a ball's divider before its hit); per robot: referee
-// put-back, reflex end; contacts (robot-robot, divider, wall, obstacles) and the
+// divider, obstacle, hit, leaving the field -- the floor first, so a ball
+// reaching floor and robot together is a miss, thesis VIII.H); disc
+// outcomes (the end of the path, then a hit, as a ball's divider before its
+// hit); per robot: referee put-back, reflex end; contacts (robot-robot,
+// divider, wall, obstacles) and the
 // reflexes they start; edge detectors; the referee's turn. A put-back
 // moves a robot, so contacts and edges are reconciled again after it; a
 // turn moves its edge detectors, so edges are.

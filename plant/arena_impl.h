@@ -40,7 +40,8 @@ constexpr int kMaxBalls = 64;
 static_assert(kMaxBalls >= 2 * 2 * kMaxBallsPerGun, "the ball table must hold every magazine");
 // Every disc two launchers with full magazines can have in flight.
 constexpr int kMaxDiscs = 2 * kMaxDiscsPerLauncher;
-// Per robot 7 and one per obstacle, the pair's contact, per ball 6, per disc 2.
+// Per robot 7 and one per obstacle, the pair's contact, per ball 6, per
+// disc 2.
 constexpr int kMaxRoots = 2 * (7 + kMaxObstacles) + 1 + kMaxBalls * 6 + kMaxDiscs * 2;
 constexpr int kRing = 16;
 static_assert(kRing > kMaxRefereeLimit, "the referee must see one event more than its limit");
@@ -245,6 +246,12 @@ struct ArenaState {
   double pendingTime = 0;
   Discrete pendingD;
   std::vector<double> pendingY;
+
+  // ---- deployables (deployables.cpp): every item set down so far, in
+  // tick order, and what each robot's tables have left. Empty without
+  // [[deployables]].
+  std::vector<Deployed> deployed;
+  std::array<std::array<int, kMaxDeployKinds>, 2> deployLeft{};
 
   // ---- time
   std::int64_t now = 0;      // tick reached

@@ -93,6 +93,8 @@ Arena::Impl::Impl(const ArenaConfig& c)
     d.ballsLeft = {rs.params.balls_per_gun, rs.params.balls_per_gun};
     if (rs.hardware.secondary.kind == SecondaryKind::Disc)
       d.discsLeft = rs.hardware.secondary.magazine;
+    for (std::size_t k = 0; k < rs.hardware.deployables.size() && k < kMaxDeployKinds; ++k)
+      deployLeft[static_cast<std::size_t>(i)][k] = rs.hardware.deployables[k].count;
   }
   // Initial flags from geometry, silently (nothing has happened yet): a
   // body put down touching something starts in contact with it.

@@ -2,9 +2,10 @@
 //
 // Every discrete change of the arena is the zero of one of these functions
 // of time and state (arena.cpp, "Events"): edge detectors, walls, divider,
-// obstacles, field, reflex end, robot-robot contact and the balls' and discs'
-// closed-form flights (the discs' in arena_discs.cpp). buildRoots() lists the ones the current
-// discrete state needs; ARKODE evaluates them through rootThunk; crossedTick() decides the tick of
+// obstacles, field, reflex end, robot-robot contact and the balls' and
+// discs' closed-form flights (the discs' in arena_discs.cpp). buildRoots()
+// lists the ones the current discrete state needs; ARKODE evaluates them
+// through rootThunk; crossedTick() decides the tick of
 // a crossing ARKODE reported. They only read the state: the rules that act
 // on a crossing are in arena_events.cpp.
 #include "plant/arena_impl.h"

@@ -113,9 +113,12 @@ EyeGeometry eyeGeometry(const Pose& self, const Pose& opp, const RobotParams& p,
 }
 
 EyeReadings computeEyes(const Pose& self, const Pose* opponent, const RobotParams& p,
-                        const FieldParams& field, RandomBits* noise, EyeChannels channels) {
+                        const FieldParams& field, RandomBits* noise, EyeChannels channels,
+                        const EyeScene* scene, int selfRobot) {
   double sLeft = p.eye_background, sRight = p.eye_background;
-  if (opponent) {
+  if (scene && scene->count > 0) {
+    eyeSignalsAmong(self, selfRobot, opponent, p, field, *scene, sLeft, sRight);
+  } else if (opponent) {
     const EyeGeometry g = eyeGeometry(self, *opponent, p, field);
     if (g.seen) {
       double nearS = g.near_signal, farS = g.near_signal * g.far_fraction;

@@ -90,6 +90,10 @@ struct RobotParams {
   double trim_spread = 0;
   double motor_lag_s = 0;  // first-order lag; 0 = instant
   double mass_lb = 35;     // how hard it pushes the other robot (contact.h)
+  // Wheel-floor Coulomb friction coefficient: the robot's traction is
+  // mass_lb * wheel_friction * g (a force), what it can push a block with
+  // (DESIGN.md "The wider competition"; docs/plant.md "Deployables").
+  double wheel_friction = 0.7;
   // bumper reflex (hard-wired in the motor controller)
   double reflex_distance_ft = 0;
   int reflex_speed_step = 15;
@@ -234,12 +238,73 @@ struct SecondaryWeapon {
   double diameter_ft = 0;
 };
 
+// ---------------------------------------------------------------- deployables
+// What a robot carries and sets down behind it on a rising edge of a port B
+// bit (DESIGN.md "The wider competition"; docs/plant.md "Deployables"), from
+// a hardware file's [[deployables]]. At most one per bit.
+enum class DeployKind : std::uint8_t { Block, DecoyLight, DecoyScreen };
+// "block", "decoy_light", "decoy_screen" (the hardware file's and the
+// trace's words).
+const char* deployKindName(DeployKind k);
+inline constexpr int kMaxDeployKinds = 8;  // one per port B bit at most
+inline constexpr int kMaxDeployCount = 16;
+
+struct Deployable {
+  DeployKind kind = DeployKind::Block;
+  int bit = 0;
+  int count = 0;
+  // A block: width across the robot's heading, depth along it, height; a
+  // screen: width (across the heading) and height; a light: its height.
+  double width_ft = 0, depth_ft = 0, height_ft = 0;
+  double mass_lb = 0, floor_friction = 0;  // a block
+  // A light's kappa over the eye's own beacon kappa ((max - background)
+  // r_sat^2): 1 is as bright as the standard beacon.
+  double intensity = 0;
+};
+
+// One item set down on the field (Arena::deployed): what, whose, where.
+// A block's or screen's footprint is turned by `heading_deg` (the robot's
+// at release): its width across that heading.
+struct Deployed {
+  DeployKind kind = DeployKind::Block;
+  int robot = 0;
+  int table = 0;  // index in the robot's Hardware::deployables
+  std::int64_t tick = 0;
+  double x_ft = 0, y_ft = 0, heading_deg = 0;
+  double width_ft = 0, depth_ft = 0, height_ft = 0, intensity = 0;
+};
+
+// An item is set down this far behind the body's back rim (assumption:
+// clear of the rim, so the robot that drops it does not touch it then).
+inline constexpr double kDeployClearanceFt = 0.02;
+
+// The item `d` (table `table` of robot `robot`'s deployables) set down at
+// `tick` behind a robot at `pose` with a body of `bodyRadius`: its centre
+// on the line of the heading, kDeployClearanceFt behind the back rim (a
+// block's back face there, its near face half its depth behind).
+Deployed placeDeployable(const Deployable& d, int robot, int table, std::int64_t tick,
+                         const Pose& pose, double bodyRadius);
+
+// The items on the field an eye reads among (deployables.cpp).
+struct EyeScene {
+  const Deployed* items = nullptr;
+  int count = 0;
+};
+// The unquantised signals of robot selfRobot's eyes with the items of
+// `scene` on the field: the opponent's beacon and the opponent's decoy
+// lights add (docs/plant.md "Deployables": c_i = min(intensity_i kappa /
+// r_i^2, max - background) on the near eye, c_i f_i on the far one), each
+// hidden by the divider, an obstacle, a block or a screen taller than it.
+void eyeSignalsAmong(const Pose& self, int selfRobot, const Pose* opponent, const RobotParams& p,
+                     const FieldParams& field, const EyeScene& scene, double& left, double& right);
+
 // Port B bindings of one robot (bits 0..7).
 struct Hardware {
   std::array<int, 2> gun_motor_bit{3, 7};
   std::array<int, 2> gun_solenoid_bit{4, 5};
   int disc_shooter_bit = 6;  // logged only, unless `secondary` is a disc launcher
   SecondaryWeapon secondary;
+  std::vector<Deployable> deployables;  // [[deployables]], at most one per bit
 };
 
 // The integrator failed (a SUNDIALS call returned an error). The profile
@@ -309,9 +374,13 @@ class SplitMix64 final : public RandomBits {
 // `channels` selects the eyes computed; the other one reads as the default
 // 16 but its noise words are drawn all the same (optics.cpp).
 enum class EyeChannels : std::uint8_t { Both, Left, Right };
+// `scene` (robot selfRobot's view of the deployed items): the eyes read
+// eyeSignalsAmong's signals instead; null, or no items: chapter VII's one
+// beacon, as always.
 EyeReadings computeEyes(const Pose& self, const Pose* opponent, const RobotParams& eyes,
                         const FieldParams& field, RandomBits* noise = nullptr,
-                        EyeChannels channels = EyeChannels::Both);
+                        EyeChannels channels = EyeChannels::Both, const EyeScene* scene = nullptr,
+                        int selfRobot = 0);
 // Unquantised signal S of the near eye and the far-eye fraction f; exposed
 // for tests and the viewer. seen=false when out of view or blocked.
 struct EyeGeometry {
@@ -341,7 +410,7 @@ enum class Bumper : std::uint8_t { Front = 0, Back = 1 };
 enum class ContactWith : std::uint8_t { None, Robot, Divider, Wall, Obstacle };
 // Why a ball or disc flight ended without a hit. LeftField: it reached a
 // field wall; Stopped: a disc slowed below its stop speed; Obstacle: a
-// ball met a fixed obstacle (Event::obstacle names it).
+// fixed obstacle (Event::obstacle names it).
 enum class MissReason : std::uint8_t { None, Floor, Divider, LeftField, Stopped, Obstacle };
 
 enum class EventKind : std::uint8_t {
@@ -367,6 +436,11 @@ enum class EventKind : std::uint8_t {
   DiscEmpty,  // (from setPortB) robot: the bit rose, the magazine is empty
   DiscHit,    // robot = shooter, ball, other = target; x, y, z: where
   DiscMiss,   // robot = shooter, ball, miss; x, y, z: where; closest_ft
+  // (from setPortB) robot, gun = its deployables table: an item set down
+  // (ball = its number in the table, from 1; x, y, heading_deg: where),
+  // or the table was empty.
+  Deploy,
+  DeployEmpty,
 };
 const char* eventKindName(EventKind k);
 
@@ -613,6 +687,8 @@ class Arena {
   // its hits are not in hits().
   int discShots(int robot) const;
   int discHits(int robot) const;
+  // Every item set down so far (deployables), in tick order.
+  const std::vector<Deployed>& deployed() const;
   int discsLeft(int robot) const;
   IntegratorStats stats() const;
 

@@ -166,7 +166,7 @@ scheduler::MatchConfig buildConfig(const std::vector<std::string>& programs, con
   std::array<std::string, 2> hardwareFiles;
   if (scenario) hardwareFiles = {scenario->a.hardware, scenario->b.hardware};
   for (const auto& [robot, file] : hwFiles) hardwareFiles[static_cast<size_t>(robot)] = file;
-  checkRunAgainstRules(profile, config, hardwareFiles);
+  checkRunAgainstRules(profile, config, hardwareFiles, scenario ? scenario->file : "");
   for (const auto& text : o.injections) {
     try {
       config.injections.push_back(
@@ -248,6 +248,11 @@ json resetsJson(const scheduler::RobotResult& r) {
 json batteryJson(const scheduler::RobotResult& r) {
   return r.batteryVFinal ? json(*r.batteryVFinal) : json(nullptr);
 }
+// Items of [[deployables]] set down, by kind: always the three kinds.
+json deployedJson(const scheduler::RobotResult& r) {
+  return {
+      {"block", r.deployed[0]}, {"decoy_light", r.deployed[1]}, {"decoy_screen", r.deployed[2]}};
+}
 }  // namespace
 
 json soloJson(const Played& played) {
@@ -273,7 +278,8 @@ json soloJson(const Played& played) {
       {"motor_frames_overwritten", a.framesOverwritten},
       {"interrupts", a.interrupts},
       {"final_pose", poseJson(a.finalPose)},
-      {"scatter_shots", scatterJson(a)}};
+      {"scatter_shots", scatterJson(a)},
+      {"deployed", deployedJson(a)}};
   addSecondary(j, a);
   return j;
 }
@@ -300,7 +306,8 @@ json matchJson(const Played& played) {
                       {"console_lines", rr.console.size()},
                       {"scatter_shots", scatterJson(rr)},
                       {"resets", resetsJson(rr)},
-                      {"battery_v_final", batteryJson(rr)}});
+                      {"battery_v_final", batteryJson(rr)},
+                      {"deployed", deployedJson(rr)}});
     addSecondary(robots.back(), rr);
   }
   json j = {{"sim_seconds", timebase::secondsFromTicks(r.endTick)},

@@ -100,10 +100,12 @@ std::string runRules(const RunOptions& o, const std::optional<config::Scenario>&
 
 // What a run's robots use that a rule set may forbid (config::RunUses),
 // each with the file that put it there: `hardwareFiles[i]` is robot i's
-// hardware file ("" when none). Then refused where the profile's rules
+// hardware file ("" when none), `obstaclesFile` the file that placed the
+// field's obstacles (the scenario's). Then refused where the profile's rules
 // forbid it (config::checkRules; a ConfigError at the rule).
 void checkRunAgainstRules(const config::Profile& profile, const scheduler::MatchConfig& config,
-                          const std::array<std::string, 2>& hardwareFiles);
+                          const std::array<std::string, 2>& hardwareFiles,
+                          const std::string& obstaclesFile = "");
 
 // A run's fault lines shown (reportFaults, match's table): the first ten
 // and the last three, the others counted (a reload storm faults thousands

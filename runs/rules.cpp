@@ -13,7 +13,8 @@ std::string runRules(const RunOptions& o, const std::optional<config::Scenario>&
 }
 
 void checkRunAgainstRules(const config::Profile& profile, const scheduler::MatchConfig& config,
-                          const std::array<std::string, 2>& hardwareFiles) {
+                          const std::array<std::string, 2>& hardwareFiles,
+                          const std::string& obstaclesFile) {
   if (!profile.course.present) return;
   config::RunUses uses;
   for (size_t i = 0; i < config.arena.robots.size() && i < 2; ++i) {
@@ -26,10 +27,14 @@ void checkRunAgainstRules(const config::Profile& profile, const scheduler::Match
                                        plant::secondaryKindName(secondary.kind), secondary.magazine,
                                        hardwareFiles[i]});
   }
-  // The other parts of issue 40 add here what they put in a run: the
-  // arena's obstacles with mine = true (uses.mines, with the scenario or
-  // rules file that places each) and each robot's hardware [[deployables]]
-  // (uses.deployables: kind and count, its hardware file).
+  // The arena's obstacles with mine = true, with the file that places them.
+  for (const plant::Obstacle& o : config.arena.field.obstacles)
+    if (o.mine) uses.mines.push_back({o.name, obstaclesFile});
+  // Each robot's hardware [[deployables]]: kind and count.
+  for (size_t i = 0; i < config.arena.robots.size() && i < 2; ++i)
+    for (const plant::Deployable& d : config.arena.robots[i].hardware.deployables)
+      uses.deployables.push_back(
+          {static_cast<int>(i), plant::deployKindName(d.kind), d.count, hardwareFiles[i]});
   config::checkRules(profile.course, uses);
 }
 

@@ -534,6 +534,14 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
           e.heading_deg};
     case plant::EventKind::DiscEmpty:
       return rec::DiscEmpty{r};
+    case plant::EventKind::Deploy:
+    case plant::EventKind::DeployEmpty: {
+      const plant::Deployable& d = arenaConfig_->robots[static_cast<size_t>(r)]
+                                       .hardware.deployables[static_cast<size_t>(e.gun)];
+      if (e.kind == plant::EventKind::DeployEmpty)
+        return rec::DeployEmpty{r, plant::deployKindName(d.kind), d.bit};
+      return rec::Deploy{r, plant::deployKindName(d.kind), e.ball, d.bit, e.x, e.y, e.heading_deg};
+    }
     case plant::EventKind::DiscHit:
       return rec::DiscHit{r, e.other, e.ball, e.x, e.y, e.z};
     case plant::EventKind::DiscMiss:
@@ -832,6 +840,8 @@ void Match::finish(MatchResult& result) {
     if (secondary != plant::SecondaryKind::None)
       rr.secondary = SecondaryResult{plant::secondaryKindName(secondary),
                                      arena_.discShots(r->index), arena_.discHits(r->index)};
+    for (const plant::Deployed& item : arena_.deployed())
+      if (item.robot == r->index) ++rr.deployed[static_cast<size_t>(item.kind)];
     // The clock at main's return, or at the end of the run: a VM's clock
     // runs on to the last round's horizon after main returns, and may stand
     // one instruction past the end.

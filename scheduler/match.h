@@ -40,6 +40,7 @@
 // and samples up to the plant's clock were taken at the end of the last
 // round. Records before that bound are written then.
 #pragma once
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <map>
@@ -269,6 +270,9 @@ struct RobotResult {
   // neither eye above the rules' threshold. None when no rules judge them.
   std::optional<int> scatterShots;
   std::optional<SecondaryResult> secondary;  // none without a secondary weapon
+  // Items of [[deployables]] set down, by plant::DeployKind (block, decoy
+  // light, decoy screen); zeros without any.
+  std::array<int, 3> deployed{};
   int framesLatched = 0, framesRejected = 0;
   // Sends that restarted the serial library before it had fetched the last
   // byte of the previous send (its NUL): that frame can never latch.

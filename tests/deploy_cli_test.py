@@ -1,0 +1,126 @@
+#!/usr/bin/env python3
+"""Deployables from the command line: release ticks, counts, JSON, errors.
+
+Usage: deploy_cli_test.py SIMBOT SOURCE_DIR SHARED_DIR OUTDIR
+
+The oracle is what the program wrote: programs/dropper.dc raises port B
+bits 0, 1 and 2 together every 1.5 s, so every `port_b` record whose value
+sets a bit the previous value had clear is a rising edge of that bit, and
+each rising edge of a bound bit gives, at that same tick, a `deploy`
+record while the table has items left (numbered 1..count) and a
+`deploy_empty` after. The JSON's `deployed` counts the `deploy` records by
+kind and is all zeros without [[deployables]]. Bad [[deployables]] are one
+line, FILE:LINE:COL, exit 1; a rule set that forbids decoys refuses them
+in one line.
+"""
+import json
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+SIMBOT, SOURCE, SHARED, OUT = sys.argv[1:5]
+OUT = Path(OUT)
+shutil.rmtree(OUT, ignore_errors=True)
+OUT.mkdir(parents=True)
+FIG92 = f"{SHARED}/programs/fig92.dc"
+DROPPER = f"{SOURCE}/programs/dropper.dc"
+LIGHT = f"{SOURCE}/profiles/hardware/decoy-light.toml"
+BLOCKS = f"{SOURCE}/profiles/hardware/blocks.toml"
+failures = []
+
+
+def check(ok, message):
+    if not ok:
+        failures.append(message)
+        print("FAIL:", message)
+
+
+def run(*args):
+    return subprocess.run([SIMBOT, *args], capture_output=True, text=True, timeout=300)
+
+
+def tables(path):
+    """(kind, bit, count) of each [[deployables]] in a hardware file."""
+    out, cur = [], None
+    for line in Path(path).read_text().splitlines():
+        if line.startswith("[[deployables]]"):
+            cur = {}
+            out.append(cur)
+        elif cur is not None and "=" in line:
+            key, value = line.split("=", 1)
+            key = key.strip()
+            if key == "kind":
+                cur["kind"] = value.strip().strip('"')
+            elif key in ("bit", "count"):
+                cur[key] = int(re.search(r"value\s*=\s*(\d+)", value).group(1))
+    return out
+
+
+for hw in (LIGHT, BLOCKS):
+    trace = OUT / (Path(hw).stem + ".jsonl")
+    p = run("match", DROPPER, FIG92, "--seconds", "12", "--seed", "1", "--hw", f"A={hw}",
+            "--trace", str(trace), "--json")
+    check(p.returncode == 0, f"{hw}: exit {p.returncode}: {p.stderr[-300:]}")
+    result = json.loads(p.stdout)
+    recs = [json.loads(l) for l in trace.read_text().splitlines()]
+    edges = {}  # bit -> ticks of its rising edges
+    last = 0
+    for r in recs:
+        if r["type"] == "port_b" and r["robot"] == "A":
+            for b in range(8):
+                if (r["value"] >> b) & 1 and not (last >> b) & 1:
+                    edges.setdefault(b, []).append(r["t"])
+            last = r["value"]
+    counted = {"block": 0, "decoy_light": 0, "decoy_screen": 0}
+    for d in tables(hw):
+        ticks = edges.get(d["bit"], [])
+        check(len(ticks) > d["count"], f"{hw}: the run must exhaust bit {d['bit']}")
+        got = [(r["t"], r.get("number")) for r in recs
+               if r["type"] == "deploy" and r["bit"] == d["bit"]]
+        empty = [r["t"] for r in recs if r["type"] == "deploy_empty" and r["bit"] == d["bit"]]
+        want = [(t, i + 1) for i, t in enumerate(ticks[:d["count"]])]
+        check(got == want, f"{hw} bit {d['bit']}: deploy {got} != edges {want}")
+        check(empty == ticks[d["count"]:], f"{hw} bit {d['bit']}: deploy_empty {empty}")
+        counted[d["kind"]] += len(got)
+    check(result["robots"][0]["deployed"] == counted,
+          f"{hw}: JSON deployed {result['robots'][0]['deployed']} != {counted}")
+    check(result["robots"][1]["deployed"] == {"block": 0, "decoy_light": 0, "decoy_screen": 0},
+          f"{hw}: B deployed {result['robots'][1]['deployed']}")
+
+# Bad [[deployables]]: one line, FILE:LINE:COL (the line given), exit 1.
+light = Path(LIGHT).read_text()
+for name, old, new, says in [
+        ("clash_gun", "value = 1,   unit = \"bit\"", "value = 3,   unit = \"bit\"",
+         "port B bit 3 is bound twice: a [[deployables]] and gun 1's motor"),
+        ("two_on_one_bit", "value = 0,  unit = \"bit\"", "value = 1,  unit = \"bit\"",
+         "port B bit 1 is bound twice: two [[deployables]]"),
+        ("intensity", "value = 2.0, unit = \"1\"", "value = 200, unit = \"1\"",
+         "'deployables.intensity' must be between 0.01 and 100"),
+        ("kind", "kind   = \"decoy_screen\"", "kind   = \"smoke\"",
+         "'deployables.kind' must be"),
+        ("missing", "height = { value = 12", "depth = { value = 12",
+         "unknown key 'depth' in a decoy_screen [[deployables]]")]:
+    assert old in light, old
+    text = light.replace(old, new, 1)
+    line = next(i for i, l in enumerate(text.splitlines()) if new in l) + 1
+    bad = OUT / f"bad_{name}.toml"
+    bad.write_text(text)
+    p = run("solo", DROPPER, "--seconds", "1", "--hw", str(bad), "--json")
+    err = p.stderr.strip().splitlines()
+    check(p.returncode == 1, f"bad {name}: exit {p.returncode}")
+    check(len(err) == 1 and re.match(re.escape(str(bad)) + rf":{line}:\d+: error: ", err[0])
+          and says in err[0], f"bad {name}: line {line}: {p.stderr!r}")
+
+# A rule set without decoys refuses them before the match, in one line.
+p = run("match", DROPPER, FIG92, "--seconds", "1", "--rules", "se3015-1997w", "--hw",
+        f"A={LIGHT}")
+err = [l for l in p.stderr.splitlines() if ": error: " in l]  # fig92 compiles with warnings
+check(p.returncode == 1 and len(err) == 1 and "course.decoy_lights = false forbids robot" in err[0],
+      f"rules: {p.returncode} {p.stderr!r}")
+
+if failures:
+    print(f"{len(failures)} failure(s)")
+    sys.exit(1)
+print("deployables: release ticks, counts, JSON and errors as documented")
