@@ -464,6 +464,18 @@ struct Explainer::State {
   void on(Tick t, const rec::DiscEmpty& x) {
     course(x.robot, t, "disc launcher fired empty: nothing flies");
   }
+  void on(Tick t, const rec::Deploy& x) {
+    std::string kind = x.kind;
+    std::replace(kind.begin(), kind.end(), '_', ' ');
+    course(x.robot, t,
+           fmt::format("set down {} {} (bit {}) at ({:.2f}, {:.2f}) ft", kind, x.number, x.bit,
+                       x.x_ft, x.y_ft));
+  }
+  void on(Tick t, const rec::DeployEmpty& x) {
+    std::string kind = x.kind;
+    std::replace(kind.begin(), kind.end(), '_', ' ');
+    course(x.robot, t, fmt::format("no {} left to set down (bit {})", kind, x.bit));
+  }
   void on(Tick t, const rec::RefereePutBack& x) {
     report.referee.push_back(
         {x.robot, t, "put back inside the wire (its centre left the field)", 0, "", 0});

@@ -19,6 +19,8 @@ Usage: explain_course_test.py SIMBOT SOURCE_DIR ICEMAN FIG92 OUTDIR
   each ball_miss on an obstacle "stopped by an obstacle".
 - ICEMAN with a disc launcher (its fire() writes 0x40, port B bit 6; fig92 never does) under se3015-1997w: each disc_fire, disc_hit
   and disc_miss named; the VCD names A's bit 6 A_disc_launcher.
+- scenarios/course-1996.toml's decoy lights: each deploy record named
+  where it was set down, and each release with none left.
 - A run without any of these: no Course section, and explain --json
   has no course key.
 """
@@ -138,6 +140,20 @@ for m in stopped:
     check(f"  {m['robot']} {at(m['t'])} ball {m['ball']} (gun " in text and
           f"stopped by an obstacle: {m['hit']}\n" in text, f"ball {m['ball']} stopped at {at(m['t'])}")
 print(f"mines: {len(tripped)} mine contacts, {len(stopped)} balls stopped by an obstacle")
+
+# ---- deployables: course-1996's decoy lights, set down from 42 s on
+decoys = OUT / "decoys.jsonl"
+run("match", ICEMAN, FIG92, "--scenario", "scenarios/course-1996.toml", "--seconds", "50",
+    "--trace", decoys)
+text = explain(decoys)
+deploys = records(decoys, "deploy")
+check(len(deploys) == 2, f"two decoy lights set down: {deploys}")
+for d in deploys:
+    want = (f"  {d['robot']} {at(d['t'])} set down decoy light {d['number']} (bit {d['bit']}) at "
+            f"({d['x_ft']:.2f}, {d['y_ft']:.2f}) ft\n")
+    check(want in text, f"named: {want!r}")
+empties = records(decoys, "deploy_empty")
+check(text.count("no decoy light left to set down") == len(empties), "each empty release named")
 
 # ---- discs
 discs, discs_vcd = OUT / "discs.jsonl", OUT / "discs.vcd"

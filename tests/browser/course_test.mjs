@@ -8,7 +8,8 @@
 // where the test's own closed form puts it (x0 + vx tau (1 - e^{-s/tau}),
 // from the disc_fire record), the legend names obstacles, mines and discs,
 // the timeline marks the scatter shots and discs it draws, and every camera
-// renders.
+// renders. The two decoy lights of scenarios/course-1996.toml are drawn
+// from their deploy records' tick on, at their places.
 //
 // Usage: node course_test.mjs SIMBOT ICEMAN FIG92 SOURCE_DIR OUTDIR
 import { execFileSync } from 'node:child_process';
@@ -45,6 +46,7 @@ function run(name, args) {
   return { trace, page };
 }
 const mines = run('mines', ['--scenario', 'scenarios/mines.toml', '--rules', 'se3015-1996', '--seconds', '60']);
+const decoys = run('decoys', ['--scenario', 'scenarios/course-1996.toml', '--seconds', '50']);
 const discs = run('discs', ['--rules', 'se3015-1997w', '--hw', 'A=profiles/hardware/disc-launcher.toml',
   '--seconds', '60']);
 
@@ -126,6 +128,23 @@ const redPixels = () => page.evaluate(() => {
 });
 const withObstacles = await redPixels();
 await page.screenshot({ path: join(out, 'course-mines.png') });
+
+// ---- decoy lights (scenarios/course-1996.toml: ICEMAN sets down two)
+await open(decoys.page);
+const deploys = records(decoys.trace, 'deploy');
+check(deploys.length === 2 && deploys.every((d) => d.kind === 'decoy_light'), `two decoy lights set down (${deploys.length})`);
+if (deploys.length) {
+  const last = deploys[deploys.length - 1].t;
+  await page.evaluate((t) => window.simbotViewer.seek(t - 1), deploys[0].t);
+  check((await page.evaluate(() => window.simbotViewer.courseDrawn())).decoy_lights === 0, 'no decoy light before the first is set down');
+  await page.evaluate((t) => window.simbotViewer.seek(t + 9216000), last);
+  check((await page.evaluate(() => window.simbotViewer.courseDrawn())).decoy_lights === deploys.length, 'every decoy light drawn after');
+  for (const d of deploys) {
+    const got = await probe(d.x_ft, d.y_ft);
+    check(near(got, rgb('#ff5050')), `decoy light ${d.number} at (${d.x_ft.toFixed(2)}, ${d.y_ft.toFixed(2)}) drawn ${got}`);
+  }
+  check((await legend()).includes('field:decoy_light'), 'the legend names decoy lights');
+}
 
 // ---- discs
 await open(discs.page);
