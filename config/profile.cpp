@@ -62,6 +62,8 @@ class Checker {
 
   toml::table parse(std::string_view text) const { return parseToml(text, file_); }
   const std::string& file() const { return file_; }
+  // A hardware file's walk leaves [[deployables]] to readDeployables.
+  void skipDeployables() { skipDeployables_ = true; }
 
   // Fails unless v (internal units) is within the key's bounds.
   void checkBounds(const KeyDef& def, const toml::node& at, const std::string& name,
@@ -196,6 +198,7 @@ class Checker {
     std::vector<const KeyDef*> seen;
     for (auto&& [sk, sv] : doc) {
       const std::string section(sk.str());
+      if (skipDeployables_ && section == "deployables") continue;
       if (std::find(plainStrings.begin(), plainStrings.end(), section) != plainStrings.end()) {
         if (!sv.is_string()) fail(sv.source(), fmt::format("'{}' must be a string", section));
         if (seenStrings) seenStrings->push_back(section);
@@ -228,6 +231,7 @@ class Checker {
 
  private:
   std::string file_;
+  bool skipDeployables_ = false;
 };
 
 // [battery]'s values against each other (a profile's, or a hardware
@@ -415,9 +419,8 @@ Hardware parseHardware(std::string_view text, const std::string& sourceName,
         c.fail(sk.source(),
                fmt::format("[{}] is arena-wide and cannot be overridden per robot", d.section));
   }
-  toml::table rest = doc;  // [[deployables]] is read apart (readDeployables)
-  rest.erase("deployables");
-  c.walk(rest, defs, false, {"name", "description"}, p, h, nullptr);
+  c.skipDeployables();  // [[deployables]] is read apart (readDeployables)
+  c.walk(doc, defs, false, {"name", "description"}, p, h, nullptr);
   checkSecondary(doc, c, h);
   readDeployables(doc, c, p, h);
   std::array<int, 5> bits = {h.gun_motor_bit[0], h.gun_solenoid_bit[0], h.gun_motor_bit[1],
