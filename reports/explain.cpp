@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <set>
 #include <sstream>
+#include <string>
 #include <tuple>
 #include <utility>
 
@@ -340,6 +342,8 @@ struct Explainer::State {
   }
   void on(Tick t, const rec::Contact& x) {
     report.contacts.push_back({x.robot, t, std::nullopt, x.bumper, x.with, false});
+    if (mines.contains(x.with))
+      course(x.robot, t, fmt::format("{} bumper tripped by a mine: {}", x.bumper, x.with));
     r[x.robot].touch[x.with] = report.contacts.size() - 1;
     eachOpenRun(x.robot, [](HandlerRun& h) { ++h.contacts; });
   }
@@ -403,6 +407,74 @@ struct Explainer::State {
     s.ended = x.hit;
     s.miss_ft = x.closest_ft;
     flying.erase(it);
+    if (x.hit.starts_with("obstacle"))
+      course(x.robot, t,
+             fmt::format("ball {} (gun {}) stopped by an obstacle: {}", x.ball, s.gun + 1, x.hit));
+  }
+  // ---- the wider competition (DESIGN.md)
+  std::set<std::string> mines;  // the labels of the obstacles with mine = true
+  void course(int robot, Tick t, std::string what) {
+    report.course.push_back({robot, t, std::move(what), 0, "", 0});
+  }
+  void on(Tick t, const rec::Obstacle& x) {
+    const std::string label = x.name.empty() ? fmt::format("obstacle {}", x.index)
+                                             : fmt::format("obstacle {} ({})", x.index, x.name);
+    if (x.mine) mines.insert(label);
+    const std::string shape =
+        x.kind == "circle" ? fmt::format("circle of radius {:.2f} ft", x.radius_ft) : x.kind;
+    course(-1, t,
+           fmt::format("{}: {} at ({:.2f}, {:.2f}) ft, {:.2f} ft high{}", label, shape, x.x_ft,
+                       x.y_ft, x.height_ft, x.mine ? ", a mine" : ""));
+  }
+  void on(Tick t, const rec::ScatterShot& x) {
+    ++report.scatter_shots[x.robot & 1];
+    course(x.robot, t,
+           fmt::format("scatter shot: gun {} ball {} fired with eyes {}/{}, neither above {:g}{}",
+                       x.gun + 1, x.ball, x.eye_left, x.eye_right, x.threshold,
+                       x.scores ? "" : "; its hit would not score"));
+  }
+  void on(Tick t, const rec::Reset& x) {
+    const std::string volts = x.voltage_v ? fmt::format(" ({:.2f} V)", *x.voltage_v) : "";
+    course(x.robot, t,
+           x.cause == "brown_out"
+               ? fmt::format("brown-out at {:.1f} s{}: the board reset (brown-out {})",
+                             static_cast<double>(t) / tps(), volts, x.resets)
+               : fmt::format("injected reset at {:.1f} s{}: the board reset (injected {})",
+                             static_cast<double>(t) / tps(), volts, x.resets));
+  }
+  void on(Tick t, const rec::Restart& x) {
+    course(x.robot, t,
+           fmt::format("restarted from main at {:.1f} s{}", static_cast<double>(t) / tps(),
+                       x.voltage_v ? fmt::format(" ({:.2f} V)", *x.voltage_v) : ""));
+  }
+  void on(Tick t, const rec::DiscFire& x) {
+    course(x.robot, t,
+           fmt::format("disc {} fired, heading {:.1f} deg, {:.1f} ft/s", x.disc, x.heading_deg,
+                       std::hypot(x.vx_fps, x.vy_fps)));
+  }
+  void on(Tick t, const rec::DiscHit& x) {
+    course(x.robot, t, fmt::format("disc {} hit {}", x.disc, kRobotNames[x.target & 1]));
+  }
+  void on(Tick t, const rec::DiscMiss& x) {
+    const std::string how = x.hit == "stopped" ? "stopped on the floor" : "struck the " + x.hit;
+    course(x.robot, t,
+           fmt::format("disc {} missed: {} at ({:.2f}, {:.2f}) ft{}", x.disc, how, x.x_ft, x.y_ft,
+                       x.closest_ft ? fmt::format(", closest {:.2f} ft", *x.closest_ft) : ""));
+  }
+  void on(Tick t, const rec::DiscEmpty& x) {
+    course(x.robot, t, "disc launcher fired empty: nothing flies");
+  }
+  void on(Tick t, const rec::Deploy& x) {
+    std::string kind = x.kind;
+    std::replace(kind.begin(), kind.end(), '_', ' ');
+    course(x.robot, t,
+           fmt::format("set down {} {} (bit {}) at ({:.2f}, {:.2f}) ft", kind, x.number, x.bit,
+                       x.x_ft, x.y_ft));
+  }
+  void on(Tick t, const rec::DeployEmpty& x) {
+    std::string kind = x.kind;
+    std::replace(kind.begin(), kind.end(), '_', ' ');
+    course(x.robot, t, fmt::format("no {} left to set down (bit {})", kind, x.bit));
   }
   void on(Tick t, const rec::RefereePutBack& x) {
     report.referee.push_back(
@@ -500,6 +572,7 @@ Report onlyRobot(const Report& in, int robot) {
   keep(out.contacts);
   keep(out.referee);
   keep(out.faults);
+  keep(out.course);
   return out;
 }
 

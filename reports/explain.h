@@ -10,7 +10,8 @@
 // no motor frame latched for more than 1 s, stall.h: thesis chapter X's
 // one-eye dead-lock is one),
 // overwritten sends, time inside handlers and what the robot did meanwhile,
-// contacts, referee actions and faults.
+// contacts, referee actions and faults, and what the wider competition
+// added (obstacles and mines, scatter shots, discs, deployables, resets).
 //
 // The Explainer is a trace sink: `simbot explain` feeds it a JSONL trace,
 // the replay page (reports/viewer.cpp) feeds it the run's records, so the
@@ -184,6 +185,11 @@ struct Report {
   std::vector<Contact> contacts;
   std::vector<Event> referee;
   std::vector<Event> faults;  // faults, exits, reloads and plant faults, in tick order
+  // The wider competition (DESIGN.md), in tick order: obstacles on the
+  // field, mines that tripped a bumper, balls stopped by an obstacle,
+  // scatter shots, discs, deployables set down, resets. Empty (and not printed) without them.
+  std::vector<Event> course;
+  int scatter_shots[2] = {0, 0};
 };
 
 class Explainer final : public trace::Sink {

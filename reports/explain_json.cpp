@@ -155,6 +155,12 @@ nlohmann::json json(const Report& r) {
   };
   j["referee"] = events(r.referee);
   j["faults"] = events(r.faults);
+  // Only for a run with the wider competition's elements: the JSON of any
+  // other run stays as it was.
+  if (!r.course.empty()) {
+    j["course"] = events(r.course);
+    j["scatter_shots"] = {r.scatter_shots[0], r.scatter_shots[1]};
+  }
   return j;
 }
 

@@ -250,6 +250,16 @@ std::vector<TextLine> textLines(const Report& r) {
   add(fmt::format("Faults, exits and reloads ({})", r.faults.size()));
   for (const Event& x : r.faults)
     add(fmt::format("  {} {} s {}{}", f.name(x.robot), f.s(x.t), x.what, Fmt::faultWhere(x)), x.t);
+  if (r.course.empty()) return out;
+  add("");
+  add(fmt::format("Course: obstacles, mines, scatter shots, discs, deployables, resets ({})",
+                  r.course.size()));
+  for (std::size_t i = 0; i < r.robots.size(); ++i)
+    if (r.scatter_shots[i])
+      add(fmt::format("  {} scatter shots (Detect to Engage): {}", r.robots[i].name,
+                      r.scatter_shots[i]));
+  for (const Event& x : r.course)
+    add(fmt::format("  {} {} s {}", f.name(x.robot), f.s(x.t), x.what), x.t);
   return out;
 }
 
@@ -350,6 +360,16 @@ std::string markdown(const Report& r) {
   for (const Event& x : r.faults)
     o += fmt::format("- **{}** {} s {}{}\n", f.name(x.robot), f.s(x.t), cell(x.what),
                      cell(Fmt::faultWhere(x)));
+  if (r.course.empty()) return o;
+  o += fmt::format(
+      "\n## Course: obstacles, mines, scatter shots, discs, deployables, resets ({})\n\n",
+      r.course.size());
+  for (std::size_t i = 0; i < r.robots.size(); ++i)
+    if (r.scatter_shots[i])
+      o += fmt::format("- **{}** scatter shots (Detect to Engage): {}\n", r.robots[i].name,
+                       r.scatter_shots[i]);
+  for (const Event& x : r.course)
+    o += fmt::format("- **{}** {} s {}\n", f.name(x.robot), f.s(x.t), cell(x.what));
   return o;
 }
 

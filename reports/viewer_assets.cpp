@@ -32,6 +32,7 @@ namespace {
 SIMBOT_INCBIN(html, SIMBOT_VIEWER_DIR "/page.html")
 SIMBOT_INCBIN(css, SIMBOT_VIEWER_DIR "/page.css")
 SIMBOT_INCBIN(model, SIMBOT_VIEWER_DIR "/js/model.js")
+SIMBOT_INCBIN(course, SIMBOT_VIEWER_DIR "/js/course.js")
 SIMBOT_INCBIN(field2d, SIMBOT_VIEWER_DIR "/js/field2d.js")
 SIMBOT_INCBIN(scene3d, SIMBOT_VIEWER_DIR "/js/scene3d.js")
 SIMBOT_INCBIN(timeline, SIMBOT_VIEWER_DIR "/js/timeline.js")
@@ -45,10 +46,10 @@ SIMBOT_INCBIN(orbit, SIMBOT_ORBIT_JS)
 std::string_view viewerHtml() { return asset_html(); }
 std::string_view viewerCss() { return asset_css(); }
 std::vector<std::pair<std::string_view, std::string_view>> viewerScripts() {
-  return {{"model.js", asset_model()},     {"field2d.js", asset_field2d()},
-          {"scene3d.js", asset_scene3d()}, {"timeline.js", asset_timeline()},
-          {"source.js", asset_source()},   {"explain.js", asset_explain()},
-          {"app.js", asset_app()}};
+  return {{"model.js", asset_model()},       {"course.js", asset_course()},
+          {"field2d.js", asset_field2d()},   {"scene3d.js", asset_scene3d()},
+          {"timeline.js", asset_timeline()}, {"source.js", asset_source()},
+          {"explain.js", asset_explain()},   {"app.js", asset_app()}};
 }
 std::string_view threeJs() { return asset_three(); }
 std::string_view orbitControlsJs() { return asset_orbit(); }

@@ -37,6 +37,7 @@ enum Wire : int {
   kEyeLeft,
   kEyeRight,
   kConsole,
+  kReset,  // held in reset (reset record to restart record; an injected one: one tick)
   kSignalsPerRobot
 };
 
@@ -53,6 +54,7 @@ struct RobotState {
   int pioDepth = 0;
   int serialDepth = 0;
   std::int64_t consoleLines = 0;
+  trace::Tick resetAt = -1;  // the latest reset record's tick
 };
 
 struct Later {
@@ -182,7 +184,8 @@ constexpr std::pair<int, const char*> kWireNames[] = {{kTxd, "txd"},
                                                       {kRightCmd, "right_cmd"},
                                                       {kEyeLeft, "eye_left"},
                                                       {kEyeRight, "eye_right"},
-                                                      {kConsole, "console_lines"}};
+                                                      {kConsole, "console_lines"},
+                                                      {kReset, "reset"}};
 
 // Every robot's signals, with their power-on values, then the header.
 void VcdSink::State::declareSignals() {
@@ -197,7 +200,7 @@ void VcdSink::State::declareSignals() {
     }
     for (int w = 0; w < kSignalsPerRobot; ++w) {
       Signal& s = sig(r, w);
-      s.real = w >= kLeftCmd;
+      s.real = w >= kLeftCmd && w <= kConsole;
       s.id = idFor(n++);
       const bool high = w == kTxd || w == kEdgeFore || w == kEdgeAft || w == kIff1;
       s.written = s.now = s.real ? "r0" : high ? "1" : "0";
@@ -258,6 +261,17 @@ void VcdSink::State::record(const trace::Entry& e) {
         names[static_cast<size_t>(bit)] = name;
     return;
   }
+  // The set-up records at t = 0 before the first that moves a signal: the
+  // disc launcher's bit gets its name; rules and obstacles move none.
+  if (const auto* secondary = std::get_if<rec::Secondary>(&e.record)) {
+    if (secondary->bit >= 0 && secondary->bit < 8)
+      portBNames[static_cast<size_t>(secondary->robot & 1)][static_cast<size_t>(secondary->bit)] =
+          "disc_launcher";
+    return;
+  }
+  if (std::holds_alternative<rec::Rules>(e.record) ||
+      std::holds_alternative<rec::Obstacle>(e.record))
+    return;
   if (!headerDone) declareSignals();
   advanceTo(e.t);
   applyDue(e.t);
@@ -310,6 +324,16 @@ void VcdSink::State::record(const trace::Entry& e) {
           set(r, x.channel == 0 ? kEyeLeft : kEyeRight, realValue(x.value));
         } else if constexpr (std::is_same_v<R, rec::Console>) {
           set(r, kConsole, realValue(++st.consoleLines));
+        } else if constexpr (std::is_same_v<R, rec::Reset>) {
+          st.resetAt = e.t;
+          set(r, kReset, "1");
+        } else if constexpr (std::is_same_v<R, rec::Restart>) {
+          // An injected reset restarts at its own tick: held one tick, so
+          // that the pulse shows.
+          if (e.t > st.resetAt)
+            set(r, kReset, "0");
+          else
+            schedule(e.t + 1, Later::SetWire, r, kReset, '0');
         }
       },
       e.record);

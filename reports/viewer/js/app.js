@@ -108,6 +108,23 @@ function startViewer() {
     item.appendChild(document.createTextNode(s.label));
     $('legend').appendChild(item);
   }
+  // ---- the field's legend: what the course puts on the field, for a run that has it
+  const present = new Set();
+  for (const o of model.course.obstacles) present.add(o.mine ? 'mine' : 'obstacle');
+  if (model.course.discs.length) present.add('disc');
+  for (const d of model.course.deployables) present.add(COURSE_STYLE[d.kind] ? d.kind : 'block');
+  for (const [key, style] of Object.entries(COURSE_STYLE)) {
+    if (!present.has(key)) continue;
+    const item = document.createElement('span');
+    item.className = 'legend-item course';
+    item.dataset.symbol = `field:${key}`;
+    const swatch = document.createElement('span');
+    swatch.className = 'swatch';
+    swatch.style.background = style.color;
+    item.appendChild(swatch);
+    item.appendChild(document.createTextNode(`field: ${style.label}`));
+    $('legend').appendChild(item);
+  }
   $('trails').addEventListener('change', () => { field.setTrails($('trails').checked); render(); });
 
   createExplainPanel($('explain-body'), data.explain || [], (t) => seek(t));
@@ -262,6 +279,10 @@ function startViewer() {
     view3dStats: () => scene.stats(),
     explainText: () => $('explain-body').textContent,
     trails: () => field.trails(),
+    courseDrawn: () => field.courseDrawn(),
+    fieldPixelOf: (x, y) => field.pixelOf(x, y),
+    course: () => ({ obstacles: model.course.obstacles.length, discs: model.course.discs.length,
+      deployables: model.course.deployables.length }),
     timelineSymbols: () => timeline.symbols(),
     setWindow: (from, to) => timeline.setWindow(from, to),
   });

@@ -12,6 +12,7 @@ function createField2d(canvas, model, labelLayer) {
   const ctx = canvas.getContext('2d');
   let trails = true;
   let trailPoints = [];  // per robot, the points of the path the last draw drew
+  let courseDrawn = {};  // what the last draw drew of the course (course.js)
   const half = model.run.field_size_ft / 2;
   const margin = 0.6;  // ft around the field
   let scale = 1, cx = 0, cy = 0;
@@ -226,6 +227,7 @@ function createField2d(canvas, model, labelLayer) {
     drawField();
     model.robots.forEach((robot, i) => drawEyes(robot, poses[i]));
     drawTrails(t, poses);
+    courseDrawn = drawCourse2d(ctx, px, py, scale, model, t);
     drawBalls(t);
     model.robots.forEach((robot, i) => drawRobot(robot, poses[i], states[i]));
     drawMarks(t);
@@ -237,5 +239,8 @@ function createField2d(canvas, model, labelLayer) {
     resize,
     setTrails(on) { trails = Boolean(on); },
     trails: () => trailPoints.slice(),
+    courseDrawn: () => Object.assign({}, courseDrawn),
+    // Canvas pixel (device pixels) of a field point, for a test's probe.
+    pixelOf: (x, y) => ({ x: px(x), y: py(y) }),
   };
 }

@@ -82,6 +82,7 @@ function buildModel(data) {
   const model = {
     run, tps, endTick, robots,
     balls: pairBalls(K),
+    course: buildCourse(K),
     marks: fieldMarks(K),
     events: eventList(K),
     faults: rowsOf(K.fault),
@@ -289,6 +290,16 @@ const EVENT_STYLE = {
   frame_overwritten: { glyph: 'W', color: '#ff8080', label: 'send overwritten' },
   console: { glyph: 'c', color: '#c0c0c0', label: 'console' },
   exit: { glyph: 'E', color: '#c0c0c0', label: 'main returned' },
+  scatter_shot: { glyph: 'S', color: '#ffd040', label: 'scatter shot (Detect to Engage)' },
+  reset: { glyph: 'Z', color: '#ff6060', label: 'board reset (brown-out / injected)' },
+  restart: { glyph: 'M', color: '#60ff60', label: 'restart from main' },
+  disc_fire: { glyph: 'D', color: '#f5f0a0', label: 'disc fired' },
+  disc_hit: { glyph: '#', color: '#ff4040', label: 'disc hit' },
+  disc_miss: { glyph: 'd', color: '#909090', label: 'disc miss' },
+  disc_empty: { glyph: '|', color: '#908860', label: 'disc magazine empty' },
+  deploy: { glyph: 'B', color: '#b08850', label: 'deployed (block / decoy)' },
+  deploy_empty: { glyph: '|', color: '#806040', label: 'nothing left to deploy' },
+  block_push: { glyph: 'b', color: '#d0a060', label: 'block pushed' },
 };
 
 function describeEvent(kind, c, i) {
@@ -310,6 +321,17 @@ function describeEvent(kind, c, i) {
         `${c.fetched[i]} of its ${c.previous_count[i]} bytes`;
     }
     case 'console': return c.text[i];
+    case 'scatter_shot': return `gun ${c.gun[i] + 1}, ball ${c.ball[i]}: eyes ${c.eye_left[i]}/${c.eye_right[i]} ` +
+      `not above ${c.threshold[i]}` + (c.scores[i] ? '' : ' (does not score)');
+    case 'reset': return c.cause[i] === 'brown_out'
+      ? `brown-out` + (c.voltage_v[i] === null ? '' : ` at ${c.voltage_v[i].toFixed(2)} V`) : 'injected reset';
+    case 'restart': return 'main starts again' + (c.voltage_v[i] === null ? '' : ` (${c.voltage_v[i].toFixed(2)} V)`);
+    case 'disc_fire': return `disc ${c.disc[i]}`;
+    case 'disc_hit': return `disc ${c.disc[i]} hit ${ROBOT_NAMES[c.target[i]]}`;
+    case 'disc_miss': return `disc ${c.disc[i]}: ${c.hit[i]}` +
+      (c.closest_ft[i] === null ? '' : `, closest ${c.closest_ft[i].toFixed(2)} ft`);
+    case 'deploy': return `${c.kind[i]} ${c.number[i]} (bit ${c.bit[i]})`;
+    case 'deploy_empty': return `no ${c.kind[i]} left (bit ${c.bit[i]})`;
     default: return '';
   }
 }
@@ -346,6 +368,10 @@ const STEP_KINDS = [
   ['injections', 'injections', ['injection']],
   ['faults', 'faults and reloads', ['fault', 'reload']],
   ['console', 'console', ['console']],
+  ['scatter', 'scatter shots', ['scatter_shot']],
+  ['resets', 'resets', ['reset', 'restart']],
+  ['discs', 'discs', ['disc_fire', 'disc_hit', 'disc_miss', 'disc_empty']],
+  ['deploys', 'deployed', ['deploy', 'deploy_empty', 'block_push']],
 ];
 
 function stepLists(K) {

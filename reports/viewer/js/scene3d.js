@@ -27,6 +27,7 @@ function createScene3d(container, model) {
 
   buildArena(scene, model, half);
   const robots = model.robots.map((robot) => buildRobot(scene, robot));
+  const updateCourse = createCourse3d(scene, model);
   const ballGeometry = new THREE.SphereGeometry(0.09, 12, 8);
   const ballMaterial = new THREE.MeshPhongMaterial({ color: 0xffffff });
   const ballMeshes = [];
@@ -96,6 +97,7 @@ function createScene3d(container, model) {
       ++n;
     }
     for (let k = n; k < ballMeshes.length; ++k) ballMeshes[k].visible = false;
+    updateCourse(t);
     placeCamera();
     renderer.render(scene, camera);
   }
