@@ -58,21 +58,6 @@ class ObstacleReader {
     return v;
   }
 
-  void onlyKeys(const toml::table& t, const std::string& where,
-                std::initializer_list<const char*> allowed) const {
-    for (auto&& [key, value] : t) {
-      bool known = false;
-      std::string list;
-      for (const char* a : allowed) {
-        known = known || key.str() == a;
-        list += list.empty() ? a : std::string(", ") + a;
-      }
-      if (!known)
-        failAt(file_, key.source(),
-               fmt::format("unknown key '{}' in {} (expected one of: {})", key.str(), where, list));
-    }
-  }
-
   // points_ft = [[x, y], ...]: 3 to kMaxObstacleVertices points, a convex
   // polygon that is not degenerate (no repeated or collinear corner, some
   // area) and winds round once.
@@ -138,7 +123,7 @@ class ObstacleReader {
       fail(*kind, fmt::format("'{}.kind' must be \"circle\", \"box\" or \"polygon\"", where));
     plant::Obstacle o;
     if (*k == "circle") {
-      onlyKeys(*t, where + " (a circle)",
+      onlyKeys(*t, file_, where + " (a circle)",
                {"kind", "name", "mine", "x_ft", "y_ft", "radius_ft", "height_ft"});
       o.kind = plant::Obstacle::Kind::Circle;
       o.x_ft = coordinate(*t, "x_ft", where);
@@ -146,7 +131,7 @@ class ObstacleReader {
       o.radius_ft = size(*t, "radius_ft", where);
       o.height_ft = size(*t, "height_ft", where);
     } else if (*k == "box") {
-      onlyKeys(*t, where + " (a box)",
+      onlyKeys(*t, file_, where + " (a box)",
                {"kind", "name", "mine", "x_ft", "y_ft", "width_ft", "depth_ft", "angle_deg",
                 "height_ft"});
       const double x = coordinate(*t, "x_ft", where), y = coordinate(*t, "y_ft", where);
@@ -160,7 +145,8 @@ class ObstacleReader {
       }
       o = plant::makeBox(x, y, w, d, angle, size(*t, "height_ft", where));
     } else {
-      onlyKeys(*t, where + " (a polygon)", {"kind", "name", "mine", "points_ft", "height_ft"});
+      onlyKeys(*t, file_, where + " (a polygon)",
+               {"kind", "name", "mine", "points_ft", "height_ft"});
       const auto pts = points(need(*t, "points_ft", where), where);
       o = plant::makePolygon(pts, size(*t, "height_ft", where));
     }

@@ -47,22 +47,6 @@ class Walker {
 
   toml::table parse(std::string_view text) const { return parseToml(text, file_); }
 
-  // Every key of `table` must be one of `allowed`.
-  void onlyKeys(const toml::table& table, const char* where,
-                std::initializer_list<const char*> allowed) const {
-    for (auto&& [key, value] : table) {
-      bool known = false;
-      std::string list;
-      for (const char* a : allowed) {
-        known = known || key.str() == a;
-        list += list.empty() ? a : std::string(", ") + a;
-      }
-      if (!known)
-        fail(posOf(key.source()),
-             fmt::format("unknown key '{}' in {} (expected one of: {})", key.str(), where, list));
-    }
-  }
-
   // A number within [lo, hi]. Integers are read as integers: toml++ gives
   // no double for one it cannot represent exactly (beyond 2^53).
   double number(const toml::node& n, const std::string& name, double lo, double hi) const {
@@ -106,7 +90,7 @@ class Walker {
     if (!t)
       fail(n, fmt::format("'{}' must be a table {{ x_ft = ..., y_ft = ..., heading_deg = ... }}",
                           name));
-    onlyKeys(*t, ("'" + name + "'").c_str(), {"x_ft", "y_ft", "heading_deg"});
+    onlyKeys(*t, file_, "'" + name + "'", {"x_ft", "y_ft", "heading_deg"});
     auto need = [&](const char* key) {
       const toml::node* v = t->get(key);
       if (!v) fail(n, fmt::format("'{}' has no '{}'", name, key));
@@ -157,7 +141,7 @@ class Walker {
     if (!t)
       fail(n, fmt::format("'{}' must be a table (forward_ft, arc_radius_ft, spin_deg or wait_s)",
                           name));
-    onlyKeys(*t, ("'" + name + "'").c_str(),
+    onlyKeys(*t, file_, "'" + name + "'",
              {"forward_ft", "arc_radius_ft", "turn_deg", "spin_deg", "wait_s", "speed_fps"});
     PathLeg leg;
     leg.pos = posOf(n.source());
@@ -205,7 +189,8 @@ class Walker {
   Scenario walk(const toml::table& root) const {
     Scenario s;
     s.file = file_;
-    onlyKeys(root, "the scenario", {"profile", "rules", "seconds", "seed", "A", "B", "obstacles"});
+    onlyKeys(root, file_, "the scenario",
+             {"profile", "rules", "seconds", "seed", "A", "B", "obstacles"});
     if (const toml::node* n = root.get("obstacles")) s.obstacles = parseObstacles(*n, file_);
     if (const toml::node* n = root.get("profile")) {
       const std::string v = string(*n, "profile");
@@ -243,13 +228,14 @@ class Walker {
     if (const toml::node* n = root.get("A")) {
       const toml::table* t = n->as_table();
       if (!t) fail(*n, "'A' must be a table ([A])");
-      onlyKeys(*t, "[A]", {"start", "hardware", "inject"});
+      onlyKeys(*t, file_, "[A]", {"start", "hardware", "inject"});
       robot(*t, "A", s.a);
     }
     if (const toml::node* n = root.get("B")) {
       const toml::table* t = n->as_table();
       if (!t) fail(*n, "'B' must be a table ([B])");
-      onlyKeys(*t, "[B]", {"program", "beacon", "start", "hardware", "inject", "path", "repeat"});
+      onlyKeys(*t, file_, "[B]",
+               {"program", "beacon", "start", "hardware", "inject", "path", "repeat"});
       robot(*t, "B", s.b);
       s.opponentPos = posOf(n->source());
       const toml::node* program = t->get("program");

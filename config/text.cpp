@@ -47,6 +47,21 @@ void failAt(const std::string& file, const toml::source_region& where, const std
                     message);
 }
 
+void onlyKeys(const toml::table& table, const std::string& file, const std::string& where,
+              std::initializer_list<const char*> allowed) {
+  for (auto&& [key, value] : table) {
+    bool known = false;
+    std::string list;
+    for (const char* a : allowed) {
+      known = known || key.str() == a;
+      list += list.empty() ? a : std::string(", ") + a;
+    }
+    if (!known)
+      failAt(file, key.source(),
+             fmt::format("unknown key '{}' in {} (expected one of: {})", key.str(), where, list));
+  }
+}
+
 scheduler::Tick timeValue(const toml::node& node, const std::string& file, const std::string& name,
                           bool runLength) {
   std::string written;  // as the user wrote it, for the messages

@@ -5,6 +5,7 @@
 #include <toml++/toml.h>
 
 #include <cstdint>
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -20,6 +21,11 @@ std::string readFile(const std::string& path);
 // ConfigError at the start of `where` in `file`.
 [[noreturn]] void failAt(const std::string& file, const toml::source_region& where,
                          const std::string& message);
+
+// Every key of `table` must be one of `allowed`; otherwise ConfigError
+// "unknown key 'K' in WHERE (expected one of: ...)" at the key.
+void onlyKeys(const toml::table& table, const std::string& file, const std::string& where,
+              std::initializer_list<const char*> allowed);
 
 // A seed: a TOML integer >= 0, or a string of decimal digits up to
 // 2^64 - 1 (TOML's integers stop at 2^63 - 1, and runs.csv prints seeds
