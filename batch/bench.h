@@ -152,6 +152,11 @@ double reachedByHorizon(const BenchConfig& config);
 std::vector<ProgramSummary> summarize(const BenchResult& result);
 nlohmann::json summaryJson(const BenchResult& result);
 std::string summaryMarkdown(const BenchResult& result);
+// An estimate or a limit as the summaries write it: JSON has no infinity,
+// so an unbounded upper limit is null (with "ci95_high_unbounded": true);
+// the tables give 4 significant digits, and nothing for no estimate.
+nlohmann::json estimateJson(const std::optional<double>& v);
+std::string estimateText(const std::optional<double>& v);
 // The observations of one time metric over the runs given, censored at the
 // runs' end (a leg of the edge sequence: only runs that began it, censored
 // at the time left after it began).

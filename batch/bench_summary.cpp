@@ -199,15 +199,15 @@ std::vector<ProgramSummary> summarize(const BenchResult& result) {
   return all;
 }
 
-namespace {
-
-// JSON has no infinity: an unbounded upper limit is null with
-// "ci95_high_unbounded": true.
-nlohmann::json optionalJson(const std::optional<double>& v) {
+nlohmann::json estimateJson(const std::optional<double>& v) {
   return v && std::isfinite(*v) ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }
 
-std::string number(const std::optional<double>& v) { return v ? fmt::format("{:.4g}", *v) : ""; }
+std::string estimateText(const std::optional<double>& v) {
+  return v ? fmt::format("{:.4g}", *v) : "";
+}
+
+namespace {
 
 std::string interval(const std::optional<double>& low, const std::optional<double>& high) {
   if (!low) return "";
@@ -241,14 +241,14 @@ nlohmann::json summaryJson(const BenchResult& result) {
                             {"estimator", e.estimator},
                             {"n", e.n},
                             {"events", e.events},
-                            {"estimate", optionalJson(e.estimate)},
-                            {"ci95_low", optionalJson(e.low)},
-                            {"ci95_high", optionalJson(e.high)},
+                            {"estimate", estimateJson(e.estimate)},
+                            {"ci95_low", estimateJson(e.low)},
+                            {"ci95_high", estimateJson(e.high)},
                             {"ci95_high_unbounded", e.high && !std::isfinite(*e.high)}};
         if (metricKind(e.metric) == MetricKind::Time) {
           m["censored"] = e.n - e.events;
           m["reached_by_s"] = e.reachedByS;
-          m["reached_by"] = optionalJson(e.reachedBy);
+          m["reached_by"] = estimateJson(e.reachedBy);
         }
         if (metricKind(e.metric) == MetricKind::Ratio) m["trials"] = e.trials;
         metrics.push_back(std::move(m));
@@ -268,9 +268,9 @@ nlohmann::json summaryJson(const BenchResult& result) {
                     {"won_by_b", s.games - s.winsA},
                     {"a_won_by_coin", s.coinWins},
                     {"estimator", "Wilson"},
-                    {"win_rate_a", optionalJson(s.winRate)},
-                    {"ci95_low", optionalJson(s.winLow)},
-                    {"ci95_high", optionalJson(s.winHigh)}};
+                    {"win_rate_a", estimateJson(s.winRate)},
+                    {"ci95_low", estimateJson(s.winLow)},
+                    {"ci95_high", estimateJson(s.winHigh)}};
     j["programs"].push_back(std::move(p));
   }
   return j;
@@ -310,7 +310,8 @@ std::string summaryMarkdown(const BenchResult& result) {
                                   : kind == MetricKind::Continuous ? std::string("")
                                                                    : fmt::format("{}", e.events);
         out += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", e.metric, e.estimator, e.n,
-                           count, number(e.estimate), interval(e.low, e.high), number(e.reachedBy));
+                           count, estimateText(e.estimate), interval(e.low, e.high),
+                           estimateText(e.reachedBy));
       }
       out += '\n';
     }

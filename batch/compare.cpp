@@ -151,27 +151,21 @@ std::vector<CompareRow> compareRuns(const BenchResult& a, const BenchResult& b) 
 
 namespace {
 
-nlohmann::json optionalJson(const std::optional<double>& v) {
-  return v && std::isfinite(*v) ? nlohmann::json(*v) : nlohmann::json(nullptr);
-}
-
-nlohmann::json estimateJson(const MetricEstimate& e, int64_t reached, int64_t total) {
+nlohmann::json metricJson(const MetricEstimate& e, int64_t reached, int64_t total) {
   return {{"estimator", e.estimator},
           {"reached", reached},
           {"total", total},
           {"n", e.n},
           {"events", e.events},
-          {"estimate", optionalJson(e.estimate)},
-          {"ci95_low", optionalJson(e.low)},
-          {"ci95_high", optionalJson(e.high)}};
+          {"estimate", estimateJson(e.estimate)},
+          {"ci95_low", estimateJson(e.low)},
+          {"ci95_high", estimateJson(e.high)}};
 }
-
-std::string number(const std::optional<double>& v) { return v ? fmt::format("{:.4g}", *v) : ""; }
 
 std::string side(const MetricEstimate& e) {
   if (!e.estimate) return "";
-  if (!e.low) return number(e.estimate);
-  return fmt::format("{} [{:.4g}, {}]", number(e.estimate), *e.low,
+  if (!e.low) return estimateText(e.estimate);
+  return fmt::format("{} [{:.4g}, {}]", estimateText(e.estimate), *e.low,
                      std::isfinite(*e.high) ? fmt::format("{:.4g}", *e.high) : "inf");
 }
 
@@ -182,10 +176,10 @@ nlohmann::json compareJson(const CompareResult& r) {
   for (const auto& row : r.rows)
     rows.push_back({{"metric", row.metric},
                     {"test", row.test},
-                    {"a", estimateJson(row.a, row.reachedA, row.totalA)},
-                    {"b", estimateJson(row.b, row.reachedB, row.totalB)},
-                    {"statistic", optionalJson(row.statistic)},
-                    {"p", optionalJson(row.p)}});
+                    {"a", metricJson(row.a, row.reachedA, row.totalA)},
+                    {"b", metricJson(row.b, row.reachedB, row.totalB)},
+                    {"statistic", estimateJson(row.statistic)},
+                    {"p", estimateJson(row.p)}});
   return {{"family", benchLabel(r.a.config)},
           {"seeds", r.a.config.seeds},
           {"seconds", r.a.config.seconds},
@@ -209,7 +203,8 @@ std::string compareMarkdown(const CompareResult& r) {
   for (const auto& row : r.rows)
     out += fmt::format("| {} | {} | {}/{} | {} | {}/{} | {} | {} | {} | {} |\n", row.metric,
                        row.a.estimator, row.reachedA, row.totalA, side(row.a), row.reachedB,
-                       row.totalB, side(row.b), row.test, number(row.statistic), number(row.p));
+                       row.totalB, side(row.b), row.test, estimateText(row.statistic),
+                       estimateText(row.p));
   out +=
       "\nreached / total: times, the runs that got there of the runs measured (a median is blank "
       "while fewer than half got there); hit_ratio, hits of shots; counts, the runs with at least "

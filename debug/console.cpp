@@ -16,6 +16,8 @@
 #include <ostream>
 #include <sstream>
 
+#include "debug/trim.h"
+
 namespace simbot::debug {
 
 using scheduler::DebugEvent;
@@ -49,26 +51,19 @@ class StreamLines final : public LineSource {
   bool echo_;
 };
 
-std::string trim(const std::string& s) {
-  const auto a = s.find_first_not_of(" \t\r");
-  if (a == std::string::npos) return "";
-  const auto b = s.find_last_not_of(" \t\r");
-  return s.substr(a, b - a + 1);
-}
-
 // The first word and the rest.
 // "EXPR if COND" (break and watch): the two, trimmed; COND "" when absent.
 std::pair<std::string, std::string> splitCondition(const std::string& s) {
   const auto at = (" " + s + " ").find(" if ");
-  if (at == std::string::npos) return {trim(s), ""};
-  return {trim(s.substr(0, at)), trim(s.substr(std::min(s.size(), at + 3)))};
+  if (at == std::string::npos) return {trim(s, " \t\r"), ""};
+  return {trim(s.substr(0, at), " \t\r"), trim(s.substr(std::min(s.size(), at + 3)), " \t\r")};
 }
 
 std::pair<std::string, std::string> split(const std::string& s) {
-  const std::string t = trim(s);
+  const std::string t = trim(s, " \t\r");
   const auto space = t.find_first_of(" \t");
   if (space == std::string::npos) return {t, ""};
-  return {t.substr(0, space), trim(t.substr(space))};
+  return {t.substr(0, space), trim(t.substr(space), " \t\r")};
 }
 
 bool integer(const std::string& s, long& value) {
@@ -143,14 +138,14 @@ Resume Console::stopped(Session& s, const Stop& why) {
       return quit;
     }
     // A transcript shows the commands, not a script's comments.
-    if (lines_.echo() && (trim(line).empty() || trim(line)[0] != '#'))
+    if (lines_.echo() && (trim(line, " \t\r").empty() || trim(line, " \t\r")[0] != '#'))
       out_ << kPrompt << line << "\n";
-    if (trim(line).empty()) {
+    if (trim(line, " \t\r").empty()) {
       line = lastCommand_;
-    } else if (trim(line)[0] != '#') {
+    } else if (trim(line, " \t\r")[0] != '#') {
       lastCommand_ = line;
     }
-    if (trim(line).empty() || trim(line)[0] == '#') continue;
+    if (trim(line, " \t\r").empty() || trim(line, " \t\r")[0] == '#') continue;
     Resume how;
     try {
       if (execute(s, line, how)) {
@@ -432,7 +427,7 @@ bool Console::execute(Session& s, const std::string& line, Resume& how) {
   // gdb's format letters follow a slash: print/x EXPR, display/x EXPR, x/4xb ADDRESS.
   const std::string verb = command.substr(0, command.find('/'));
   const std::string letters = command.substr(verb.size());
-  const std::string formatted = letters.empty() ? args : trim(letters + " " + args);
+  const std::string formatted = letters.empty() ? args : trim(letters + " " + args, " \t\r");
   if (verb == "print" || verb == "p" || verb == "output") {
     if (formatted.empty()) throw Error("print needs an expression");
     printExpression(s, formatted, "");

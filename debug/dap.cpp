@@ -17,6 +17,7 @@
 #include <set>
 
 #include "debug/dap_wire.h"
+#include "debug/trim.h"
 
 namespace simbot::debug {
 
@@ -47,22 +48,15 @@ bool samePath(const std::string& a, const std::string& b) {
   return !ea && !eb && ca == cb;
 }
 
-std::string trim(const std::string& s) {
-  const auto a = s.find_first_not_of(" \t\r\n");
-  if (a == std::string::npos) return "";
-  const auto b = s.find_last_not_of(" \t\r\n");
-  return s.substr(a, b - a + 1);
-}
-
 // A hit condition: "N", ">=N" or "==N" stop from the N-th hit on, ">N"
 // after the N-th. The hits to pass over first.
 int hitsToIgnore(const std::string& text) {
-  std::string t = trim(text);
+  std::string t = trim(text, " \t\r\n");
   int extra = 0;
   if (t.rfind(">=", 0) == 0 || t.rfind("==", 0) == 0) {
-    t = trim(t.substr(2));
+    t = trim(t.substr(2), " \t\r\n");
   } else if (t.rfind('>', 0) == 0) {
-    t = trim(t.substr(1));
+    t = trim(t.substr(1), " \t\r\n");
     extra = 1;
   }
   int n = 0;
@@ -272,7 +266,7 @@ struct DapServer::Impl {
         if (held < 0)
           throw Error(fmt::format("'robot': this run has no robot '{}'", launchRequest.robot));
       } catch (const std::exception& e) {
-        return fail(m, trim(e.what()));
+        return fail(m, trim(e.what(), " \t\r\n"));
       }
       respond(m);
       event("initialized");
@@ -284,7 +278,7 @@ struct DapServer::Impl {
         Session session(run->config, run->programs, held);
         session.run(self, inbox->interrupt());
       } catch (const std::exception& e) {
-        log(trim(e.what()) + "\n");
+        log(trim(e.what(), " \t\r\n") + "\n");
       }
       handles.clear();
       // The terminate that stopped the session sends the event as it is
@@ -619,8 +613,9 @@ struct DapServer::Impl {
 
   // Condition and hit count of breakpoint `id` (Error: the caller removes it).
   void qualify(Session& s, int id, const json& b) {
-    if (const std::string c = text(b, "condition"); !trim(c).empty()) s.setCondition(id, trim(c));
-    if (const std::string h = text(b, "hitCondition"); !trim(h).empty())
+    if (const std::string c = text(b, "condition"); !trim(c, " \t\r\n").empty())
+      s.setCondition(id, trim(c, " \t\r\n"));
+    if (const std::string h = text(b, "hitCondition"); !trim(h, " \t\r\n").empty())
       s.setIgnore(id, hitsToIgnore(h));
   }
 
@@ -689,7 +684,9 @@ struct DapServer::Impl {
   // takes (Session::breakAt): FUNCTION or ROBOT:FUNCTION (a handler too), a
   // time (12.5s, 20ms, tick N), an event (frame, edge, contact, shot,
   // fault), or a line.
-  int functionBreakpoint(Session& s, const std::string& name) { return s.breakAt(trim(name)).id; }
+  int functionBreakpoint(Session& s, const std::string& name) {
+    return s.breakAt(trim(name, " \t\r\n")).id;
+  }
 
   void setFunctionBreakpoints(Session& s, const DapIncoming& m, const json& args) {
     const json& wanted = list(args, "breakpoints");
@@ -950,12 +947,12 @@ struct DapServer::Impl {
   // `goto TIME` or `goto TICK` (a time as simbot debug's goto takes it),
   // which goes there, either way, and stops: true with `how` set.
   bool evaluate(Session& s, const DapIncoming& m, const json& args, Resume& how) {
-    const std::string expression = trim(text(args, "expression"));
+    const std::string expression = trim(text(args, "expression"), " \t\r\n");
     if (expression.empty()) throw Error("evaluate needs an expression");
     if (text(args, "context") == "repl" && expression.rfind("goto ", 0) == 0) {
       how = Resume{};
       how.kind = Resume::Kind::Goto;
-      how.tick = parseTime(trim(expression.substr(5)));
+      how.tick = parseTime(trim(expression.substr(5), " \t\r\n"));
       respond(m, {{"result", fmt::format("going to tick {} ({})", how.tick, secondsText(how.tick))},
                   {"variablesReference", 0}});
       last = how.kind;

@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "debug/session.h"
+#include "debug/trim.h"
 #include "timebase/written.h"
 
 namespace simbot::debug {
@@ -38,13 +39,6 @@ size_t findHeader(std::string_view bytes, size_t from) {
     if (k == kContentLength.size()) return at;
   }
   return std::string_view::npos;
-}
-
-std::string trim(std::string_view s) {
-  const auto a = s.find_first_not_of(" \t");
-  if (a == std::string_view::npos) return "";
-  const auto b = s.find_last_not_of(" \t");
-  return std::string(s.substr(a, b - a + 1));
 }
 
 bool isToken(std::string_view name) {
@@ -282,7 +276,7 @@ void DapReader::readHeaderBlock() {
     }
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (end) {
-      if (lines > 0 || !trim(line).empty())
+      if (lines > 0 || !trim(line, " \t").empty())
         problem(
             "the input ended inside a header block (a message starts with Content-Length: N "
             "and a blank line)");
@@ -316,7 +310,7 @@ void DapReader::readHeaderBlock() {
     }
     std::string name = line.substr(0, colon);
     for (char& c : name) c = lower(c);
-    const std::string value = trim(std::string_view(line).substr(colon + 1));
+    const std::string value = trim(std::string_view(line).substr(colon + 1), " \t");
     if (name != "content-length") {
       ignored.push_back(line.substr(0, colon));
       continue;
