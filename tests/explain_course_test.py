@@ -115,9 +115,10 @@ if resets:
         check(changes[1:2] == [(ps(restarts[0]["t"]), "0")],
               f"A_reset falls at the restart: {changes[:2]}, restart t {restarts[0]['t']}")
 
-# ---- mines (on the robots' paths) and a mountain that stops balls
-mines, mountain = OUT / "mines.jsonl", OUT / "mountain.jsonl"
-run("match", ICEMAN, FIG92, "--scenario", "scenarios/course-1996.toml", "--seconds", "30",
+# ---- mines (on the robots' paths) and a mountain that stops balls; the
+# course-1996 match also sets down decoy lights (below)
+mines, mountain = OUT / "course-1996.jsonl", OUT / "mountain.jsonl"
+run("match", ICEMAN, FIG92, "--scenario", "scenarios/course-1996.toml", "--seconds", "50",
     "--trace", mines)
 run("match", ICEMAN, FIG92, "--scenario", "scenarios/mines.toml", "--rules", "se3015-1996",
     "--seconds", "60", "--trace", mountain)
@@ -142,9 +143,7 @@ for m in stopped:
 print(f"mines: {len(tripped)} mine contacts, {len(stopped)} balls stopped by an obstacle")
 
 # ---- deployables: course-1996's decoy lights, set down from 42 s on
-decoys = OUT / "decoys.jsonl"
-run("match", ICEMAN, FIG92, "--scenario", "scenarios/course-1996.toml", "--seconds", "50",
-    "--trace", decoys)
+decoys = mines
 text = explain(decoys)
 deploys = records(decoys, "deploy")
 check(len(deploys) == 2, f"two decoy lights set down: {deploys}")
