@@ -347,6 +347,8 @@ void Match::emitSetup() {
                                 setup.hardware.disc_shooter_bit, w.magazine, w.launch_speed_fps,
                                 w.launch_height_ft, w.drag_time_s, w.stop_speed_fps, w.diameter_ft},
           {});
+    for (const plant::Deployable& d : setup.hardware.deployables)
+      emit(0, trace::rec::Deployables{r->index, plant::deployKindName(d.kind), d.bit, d.count}, {});
   }
 }
 

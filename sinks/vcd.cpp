@@ -269,6 +269,13 @@ void VcdSink::State::record(const trace::Entry& e) {
           "disc_launcher";
     return;
   }
+  // A deployables table's bit: "deploy_" and its kind (deploy_block).
+  if (const auto* table = std::get_if<rec::Deployables>(&e.record)) {
+    if (table->bit >= 0 && table->bit < 8)
+      portBNames[static_cast<size_t>(table->robot & 1)][static_cast<size_t>(table->bit)] =
+          "deploy_" + table->kind;
+    return;
+  }
   if (std::holds_alternative<rec::Rules>(e.record) ||
       std::holds_alternative<rec::Obstacle>(e.record))
     return;

@@ -65,6 +65,11 @@ def at(t):
     return f"{t / TPS:.3f} s"
 
 
+def ps(t):
+    """The VCD's time of tick t: t * 10^12 / TPS picoseconds, the nearest (halves up)."""
+    return (t * 10**12 * 2 + TPS) // (2 * TPS)
+
+
 def vcd_changes(path, name):
     """(ps, value) of the scalar signal NAME."""
     ident, now, out = None, 0, []
@@ -108,7 +113,6 @@ if resets:
     check(want in text, f"named: {want!r}")
     ident, changes = vcd_changes(weak_vcd, "A_reset")
     check(ident is not None, "the VCD has A_reset")
-    ps = lambda t: (t * 10**12 * 2 + TPS) // (2 * TPS)  # nearest picosecond, halves up
     restarts = [r for r in records(weak, "restart") if r["robot"] == "A"]
     check(changes[:1] == [(ps(first["t"]), "1")], f"A_reset rises at the reset: {changes[:2]}")
     if restarts:
@@ -118,8 +122,9 @@ if resets:
 # ---- mines (on the robots' paths) and a mountain that stops balls; the
 # course-1996 match also sets down decoy lights (below)
 mines, mountain = OUT / "course-1996.jsonl", OUT / "mountain.jsonl"
+course_vcd = OUT / "course-1996.vcd"
 run("match", ICEMAN, FIG92, "--scenario", "scenarios/course-1996.toml", "--seconds", "50",
-    "--trace", mines)
+    "--trace", mines, "--vcd", course_vcd)
 run("match", ICEMAN, FIG92, "--scenario", "scenarios/mines.toml", "--rules", "se3015-1996",
     "--seconds", "60", "--trace", mountain)
 text = explain(mines) + explain(mountain)
@@ -153,6 +158,15 @@ for d in deploys:
     check(want in text, f"named: {want!r}")
 empties = records(decoys, "deploy_empty")
 check(text.count("no decoy light left to set down") == len(empties), "each empty release named")
+# The VCD names the release bit by its table's kind, and the bit rises at
+# each release's tick, whether an item was left or not (a deploy or a
+# deploy_empty record), and at no other tick.
+for robot in sorted({d["robot"] for d in deploys + empties}):
+    ident, changes = vcd_changes(course_vcd, f"{robot}_deploy_decoy_light")
+    check(ident is not None, f"the VCD has {robot}_deploy_decoy_light")
+    rises = [t for t, v in changes if v == "1"]
+    releases = sorted(ps(d["t"]) for d in deploys + empties if d["robot"] == robot)
+    check(rises == releases, f"{robot}'s release bit rises at its releases: {rises} vs {releases}")
 
 # ---- discs
 discs, discs_vcd = OUT / "discs.jsonl", OUT / "discs.vcd"
