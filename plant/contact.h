@@ -77,9 +77,10 @@ struct Bodies {
   std::array<double, 2> invMass{1, 1};
   double half = 8;  // the field walls are at |x|, |y| = half
   geom::Rect divider{};
-  // The field's obstacles (fixed, like the divider).
+  // The field's obstacles (fixed, like the divider), then from index
+  // kMaxObstacles the blocks on the field where they rest (arena_blocks.cpp).
   int obstacleCount = 0;
-  std::array<geom::Convex, kMaxObstacles> obstacles{};
+  std::array<geom::Convex, kMaxObstacles + kMaxBlocks> obstacles{};
 };
 
 // Gap (ft) of constraint c at centres q (x0, y0, x1, y1), and its unit
