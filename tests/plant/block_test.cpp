@@ -268,6 +268,75 @@ TEST(Blocks, ABallStopsAtABlock) {
   EXPECT_NEAR(miss->event.x, 1.75, 105.0 / 9'216'000);
 }
 
+// A disc launcher on A (30 ft/s, tau 0.3 s, stop at 2 ft/s, 4 in across,
+// 0.5 ft high) fires east from (-5, -1) at kStart at the same block 2 ft
+// high: its centre leaves the rim at x = -4.46875 and goes s(t) = 9 (1 -
+// e^{-t/0.3}); its edge touches the west face (x = 1.75) when s = 1.75 -
+// 1/6 + 4.46875 = 6.0520833 ft, before its stop after 0.3 x 28 = 8.4 ft:
+// t = -0.3 ln(1 - 6.0520833 / 9) = 0.334839 s, a miss on "block 1".
+TEST(Blocks, ADiscStopsAtABlock) {
+  Profile p = thesis();
+  ArenaConfig c = config(p, {Pose{-5, -1, 90}, Pose{2, -0.2, 0}});
+  c.field.divider = false;
+  c.robots[1].hardware.deployables = {blockKind(0.5, 0.5, 2, 2, 0.9)};
+  SecondaryWeapon& w = c.robots[0].hardware.secondary;
+  w.kind = SecondaryKind::Disc;
+  w.magazine = 1;
+  w.launch_speed_fps = 30;
+  w.launch_height_ft = 0.5;
+  w.drag_time_s = 0.3;
+  w.stop_speed_fps = 2;
+  w.diameter_ft = 4.0 / 12;
+  Arena a(c);
+  a.advance(kDeployTick);
+  ASSERT_EQ(a.setPortB(1, 1u << 2, kDeployTick)[0].kind, EventKind::Deploy);
+  a.advance(kStart);
+  a.setPortB(0, 1u << 6, kStart);
+  const auto miss = runUntil(a, EventKind::DiscMiss, kStart + ticks(2));
+  ASSERT_TRUE(miss.has_value());
+  const LD s = 1.75L - 1.0L / 6 + 4.46875L;
+  EXPECT_EQ(miss->tick, tickAfter(kStart, -0.3L * std::log(1 - s / 9)));
+  EXPECT_EQ(miss->event.miss, MissReason::Block);
+  EXPECT_EQ(miss->event.obstacle, 0);
+}
+
+// Blocks are state: an arena copied (its checkpoint restored, its calls
+// made again) during a push, or while its robot is held against the block
+// that the wall stopped, goes on bit for bit as the original. The wall
+// test's scene.
+TEST(Blocks, AnArenaCopiedDuringAPushGoesOnAsTheOriginal) {
+  Profile p = defaults();
+  p.robot.reflex_speed_step = 0;
+  for (const bool afterEnd : {false, true}) {
+    ArenaConfig c = config(p, {Pose{2, -2.80125, 90}, Pose{7.35, -2, 0}});
+    c.field.divider = false;
+    c.robots[1].hardware.deployables = {blockKind(1.2, 0.5, 0.5, 2, 0.9)};
+    Arena a(c);
+    a.keepJournal();
+    a.advance(kDeployTick);
+    a.setPortB(1, 1u << 2, kDeployTick);
+    a.setWheels(1, frame("ffg0ffg0"), kDeployTick);
+    a.advance(kDeployTick + ticks(2));
+    a.setWheels(1, frame("0fs00fs0"), a.now());
+    const std::int64_t go = a.now() + kStart;
+    a.advance(go);
+    a.setWheels(0, frame("ffg0ffg0"), go);
+    const auto mark =
+        runUntil(a, afterEnd ? EventKind::PushEnd : EventKind::PushStart, go + ticks(10), 0);
+    ASSERT_TRUE(mark.has_value());
+    a.advance(mark->tick + ticks(0.05));
+    Arena b(a);
+    for (std::int64_t t = a.now() + 9'216; t < mark->tick + ticks(3); t += 9'216) {
+      AdvanceResult ra = a.advance(t), rb = b.advance(t);
+      ASSERT_EQ(ra.tick, rb.tick);
+      ASSERT_EQ(ra.events.size(), rb.events.size());
+      ASSERT_EQ(a.pose(0, ra.tick).x_ft, b.pose(0, rb.tick).x_ft) << t;
+      ASSERT_EQ(a.blockCentre(0, ra.tick).x_ft, b.blockCentre(0, rb.tick).x_ft) << t;
+    }
+    EXPECT_EQ(a.blockPushedFt(0), b.blockPushedFt(0));
+  }
+}
+
 // A block that would overlap something is not set down: B against the
 // south wall (its centre 0.6 ft from it) would put the block's far face
 // beyond the field's edge.
