@@ -6,6 +6,7 @@
 // there at the tick its travel reaches the gap; a ball meets a block at
 // the tick its flight reaches it.
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "plant_support.h"
@@ -298,6 +299,51 @@ TEST(Blocks, ADiscStopsAtABlock) {
   EXPECT_EQ(miss->tick, tickAfter(kStart, -0.3L * std::log(1 - s / 9)));
   EXPECT_EQ(miss->event.miss, MissReason::Block);
   EXPECT_EQ(miss->event.obstacle, 0);
+}
+
+// The other robot touching a block being pushed holds it. B, heading east
+// at (2, -2.80125), sets a 0.5 x 0.5 block down behind it: centre x = 2 -
+// 0.80125 = 1.19875, east face 0.02 ft from B's back rim. A coasts into its
+// west face as in the test above; the block's travel (1 - F/T) v0 tau (1 -
+// e^{-t/tau}) reaches 0.02 ft at t = -tau ln(1 - 0.02 / ((1 - F/T) v0
+// tau)): there B's back bumper trips on "block 1" and the push ends, "by"
+// the robot (B), with the block 0.02 ft on (to a tick's travel, 2e-7 ft).
+TEST(Blocks, TheOtherRobotTouchingAPushedBlockHoldsIt) {
+  Profile p = defaults();
+  p.robot.reflex_speed_step = 0;
+  ArenaConfig c = config(p, {Pose{-3, -2.80125, 90}, Pose{2, -2.80125, 90}});
+  c.field.divider = false;
+  c.robots[1].hardware.deployables = {blockKind(0.5, 0.5, 0.5, 2, 0.9)};
+  Arena a(c);
+  a.advance(kDeployTick);
+  ASSERT_EQ(a.setPortB(1, 1u << 2, kDeployTick)[0].kind, EventKind::Deploy);
+  a.advance(kStart);
+  a.setWheels(0, frame("ffg0ffg0"), kStart);
+  const auto start = runUntil(a, EventKind::PushStart, kStart + ticks(10), 0);
+  ASSERT_TRUE(start.has_value());
+  std::optional<Found> touch, end;
+  while (a.now() < start->tick + ticks(2) && !end) {
+    const AdvanceResult r = a.advance(start->tick + ticks(2));
+    for (const Event& e : r.events) {
+      if (e.kind == EventKind::Contact && e.robot == 1) touch = Found{r.tick, e};
+      if (e.kind == EventKind::PushEnd) end = Found{r.tick, e};
+    }
+  }
+  ASSERT_TRUE(touch && end);
+  const LD v = 1.45L, tau = 0.15L, k = 1 - 1.8L / 24.5L;
+  const LD v0 = v * (1 - std::exp(-(start->tick - kStart) / kN / tau));
+  EXPECT_EQ(end->tick, tickAfter(start->tick, -tau * std::log(1 - 0.02L / (k * v0 * tau))));
+  EXPECT_EQ(touch->tick, end->tick);
+  EXPECT_EQ(touch->event.with, ContactWith::Block);
+  EXPECT_EQ(touch->event.bumper, Bumper::Back);
+  EXPECT_EQ(end->event.with, ContactWith::Robot);
+  EXPECT_EQ(end->event.other, 1);
+  EXPECT_NEAR(end->event.z, 0.02, 2e-7);
+  // Held: A stalls against it and it stays.
+  const std::int64_t later = end->tick + ticks(1);
+  while (a.now() < later) a.advance(later);
+  EXPECT_EQ(a.blockCentre(0, later).x_ft, end->event.x);
+  EXPECT_GE(end->event.x - 0.25 - 0.53125 - a.pose(0, later).x_ft, -1e-6);
 }
 
 // Blocks are state: an arena copied (its checkpoint restored, its calls
