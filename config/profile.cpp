@@ -362,6 +362,13 @@ void readDeployables(const toml::table& doc, const Checker& c, Profile& p, Hardw
     for (const std::string& key : kk->keys)
       if (!t.contains(key))
         c.fail(t.source(), fmt::format("missing key '{}' in a {} [[deployables]]", key, kk->word));
+    // The plant's block table is fixed (plant.h kMaxBlocks).
+    int blocks = 0;
+    for (const plant::Deployable& d : h.deployables)
+      if (d.kind == plant::DeployKind::Block) blocks += d.count;
+    if (blocks > plant::kMaxBlocksPerRobot)
+      c.fail(t.source(), fmt::format("at most {} blocks in a robot's [[deployables]], {} here",
+                                     plant::kMaxBlocksPerRobot, blocks));
   }
 }
 

@@ -255,7 +255,11 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
       ev.push(Event{EventKind::DiscEmpty, e.robot});
   }
   // Deployables: one item set down at the edge's tick while the table has
-  // any left (deployables.cpp). Nothing that moves changes.
+  // any left (deployables.cpp). Nothing that moves changes, but a block is
+  // a new body (arena_blocks.cpp): it must fit where it is set down, and
+  // the root functions are made again with it.
+  std::array<Block, kMaxDeployKinds> newBlocks{};
+  int nNewBlocks = 0;
   for (std::size_t k = 0; k < hw.deployables.size(); ++k) {
     const Deployable& dep = hw.deployables[k];
     if (!bit(value, dep.bit) || bit(old.portB, dep.bit)) continue;
@@ -266,6 +270,40 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
     if (left > 0) {
       const Deployed item = placeDeployable(dep, robot, static_cast<int>(k), tick,
                                             pose(robot, tick), m.radius(robot));
+      if (dep.kind == DeployKind::Block) {
+        const Discrete& now = m.discreteAt(tick);
+        if (now.blockCount + nNewBlocks >= kMaxBlocks)
+          throw std::logic_error("plant: the block table is full (see kMaxBlocks)");
+        Block& b = newBlocks[static_cast<std::size_t>(nNewBlocks)];
+        b.item = static_cast<int>(m.deployed.size());
+        b.robot = robot;
+        b.x = item.x_ft;
+        b.y = item.y_ft;
+        const double h = geom::degToRad(item.heading_deg);
+        b.ax = std::cos(h);
+        b.ay = -std::sin(h);
+        b.halfWidth = item.width_ft / 2;
+        b.halfDepth = item.depth_ft / 2;
+        b.height = item.height_ft;
+        b.load = dep.mass_lb * dep.floor_friction;
+        // Against what is on the field then (and the blocks released with it).
+        Discrete probe = now;
+        for (int j = 0; j < nNewBlocks; ++j)
+          probe.blocks[static_cast<std::size_t>(probe.blockCount++)] =
+              newBlocks[static_cast<std::size_t>(j)];
+        probe.blocks[static_cast<std::size_t>(probe.blockCount)] = b;
+        m.stateAt(tick, m.blockY);
+        if (!m.blockFits(probe, m.blockShape(probe, probe.blockCount, m.blockY.data()),
+                         m.blockY.data())) {
+          e.kind = EventKind::DeployBlocked;
+          e.x = item.x_ft;
+          e.y = item.y_ft;
+          e.heading_deg = item.heading_deg;
+          ev.push(e);
+          continue;
+        }
+        ++nNewBlocks;
+      }
       m.deployed.push_back(item);
       --left;
       e.ball = static_cast<std::int8_t>(dep.count - left);
@@ -275,7 +313,7 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
     }
     ev.push(e);
   }
-  if (!rhsChanges && !scheduleChanges && !discLaunch) {
+  if (!rhsChanges && !scheduleChanges && !discLaunch && nNewBlocks == 0) {
     // Nothing that moves changes: the prediction stays valid.
     for (Discrete* d : {&m.D, &m.pendingD}) {
       d->r[static_cast<std::size_t>(robot)].portB = value;
@@ -285,6 +323,12 @@ EventList Arena::setPortB(int robot, std::uint8_t value, std::int64_t tick, Rand
   }
   m.rewindTo(tick);
   m.D.r[static_cast<std::size_t>(robot)] = next;
+  if (nNewBlocks > 0) {
+    for (int j = 0; j < nNewBlocks; ++j)
+      m.D.blocks[static_cast<std::size_t>(m.D.blockCount++)] =
+          newBlocks[static_cast<std::size_t>(j)];
+    m.flightsSeeBlocks(m.D, m.tmp.data(), m.timeOfTick(tick));
+  }
   if (discLaunch) m.launchDisc(m.D, m.tmp, robot, m.timeOfTick(tick), ev);
   m.reinit(tick, m.timeOfTick(tick), m.tmp);
   return ev;
@@ -401,6 +445,20 @@ EyeReadings Arena::eyeReadings(int robot, std::int64_t tick, RandomBits* noise,
   while (scene.count < static_cast<int>(m.deployed.size()) &&
          m.deployed[static_cast<std::size_t>(scene.count)].tick <= tick)
     ++scene.count;
+  // Blocks where they are at `tick` (a push moves them).
+  const Discrete& d = m.discreteAt(tick);
+  if (d.blockCount > 0) {
+    m.eyeItems.assign(m.deployed.begin(), m.deployed.begin() + scene.count);
+    m.stateAt(tick, m.blockY);
+    for (int k = 0; k < d.blockCount; ++k) {
+      const auto item = static_cast<std::size_t>(d.blocks[static_cast<std::size_t>(k)].item);
+      if (item >= m.eyeItems.size()) continue;
+      const Vec2 c = m.blockAt(d, k, m.blockY.data());
+      m.eyeItems[item].x_ft = c.x();
+      m.eyeItems[item].y_ft = c.y();
+    }
+    scene.items = m.eyeItems.data();
+  }
   if (m.nR < 2)
     return computeEyes(self, nullptr, m.P(robot), m.cfg.field, noise, channels, &scene, robot);
   const Pose other = pose(1 - robot, tick);
@@ -450,6 +508,24 @@ int Arena::discShots(int robot) const {
   return m.discreteAt(m.now).r[static_cast<std::size_t>(robot)].discShots;
 }
 const std::vector<Deployed>& Arena::deployed() const { return impl_->deployed; }
+
+Pose Arena::blockCentre(int k, std::int64_t tick) const {
+  const Impl& m = *impl_;
+  m.checkQueryTick(tick);
+  const Discrete& d = m.discreteAt(tick);
+  if (k < 0 || k >= d.blockCount) throw std::out_of_range("plant: block index");
+  m.stateAt(tick, m.blockY);
+  const Vec2 c = m.blockAt(d, k, m.blockY.data());
+  return Pose{
+      c.x(), c.y(),
+      m.deployed[static_cast<std::size_t>(d.blocks[static_cast<std::size_t>(k)].item)].heading_deg};
+}
+
+double Arena::blockPushedFt(int robot) const {
+  const Impl& m = *impl_;
+  m.checkRobot(robot);
+  return m.discreteAt(m.now).r[static_cast<std::size_t>(robot)].pushedFt;
+}
 
 int Arena::discHits(int robot) const {
   const Impl& m = *impl_;
@@ -518,6 +594,12 @@ const char* eventKindName(EventKind k) {
       return "deploy";
     case EventKind::DeployEmpty:
       return "deploy_empty";
+    case EventKind::DeployBlocked:
+      return "deploy_blocked";
+    case EventKind::PushStart:
+      return "push_start";
+    case EventKind::PushEnd:
+      return "push_end";
   }
   return "?";
 }

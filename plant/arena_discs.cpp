@@ -121,7 +121,17 @@ void Arena::Impl::launchDisc(Discrete& d, const std::vector<double>& y, int i, d
   // disc has gone v0 tau (1 - v_stop / v0) = tau (v0 - v_stop).
   MissReason what = MissReason::None;
   int obstacle = -1;
-  const double fixed = discStrike(rim, u, c.z, c.radius, what, obstacle);
+  double fixed = discStrike(rim, u, c.z, c.radius, what, obstacle);
+  // The blocks where they stand now (arena_blocks.cpp, flightsSeeBlocks).
+  for (int k = 0; k < d.blockCount; ++k) {
+    if (c.z > d.blocks[static_cast<std::size_t>(k)].height) continue;
+    const double s = geom::discPathToConvex(rim, u, c.radius, blockShape(d, k, y.data()));
+    if (s < fixed) {
+      fixed = s;
+      what = MissReason::Block;
+      obstacle = k;
+    }
+  }
   const double stop = c.tau * (c.v0 - w.stop_speed_fps);
   c.sEnd = stop <= fixed ? stop : fixed;
   c.end = stop <= fixed ? MissReason::Stopped : what;

@@ -89,7 +89,7 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
                across * flight.x(),
                across * flight.y(),
                speed * std::sin(elevation)};
-      if (bodies.obstacleCount > 0) ballMeetsObstacle(b);
+      if (bodies.obstacleCount > 0 || d.blockCount > 0) ballMeetings(b, d, ys, te);
       Event e{EventKind::BallLaunch};
       e.robot = static_cast<std::int8_t>(i);
       e.gun = static_cast<std::int8_t>(g);
@@ -133,7 +133,7 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
         b.y0 += b.vy * dt;
         b.t0 += dt;
         b.rolling = true;
-        if (bodies.obstacleCount > 0) ballMeetsObstacle(b);
+        if (bodies.obstacleCount > 0 || d.blockCount > 0) ballMeetings(b, d, ys, te);
         z = 0;
         Event skip = e;
         skip.kind = EventKind::BallSkip;
@@ -159,8 +159,10 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
       continue;
     }
     if (b.meetObstacle >= 0 && (reported(found, RootKind::BallObstacle, s) < 0 || te >= b.meetT)) {
-      e.miss = MissReason::Obstacle;
-      e.obstacle = static_cast<std::int8_t>(b.meetObstacle);
+      const bool block = b.meetObstacle >= kMaxObstacles;
+      e.miss = block ? MissReason::Block : MissReason::Obstacle;
+      e.obstacle =
+          static_cast<std::int8_t>(block ? b.meetObstacle - kMaxObstacles : b.meetObstacle);
       ev.push(e);
       b.active = false;
       continue;
@@ -198,6 +200,10 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
     RobotDisc& r = d.r[static_cast<std::size_t>(i)];
     double* ry = ys + i * kPerRobot;
     if (reported(found, RootKind::OutOfField, i) < 0 || outG(ys, i) < 0) {
+      // Its pushes end where it left the field.
+      for (int k = 0; k < d.blockCount; ++k)
+        if (d.blocks[static_cast<std::size_t>(k)].pusher == i)
+          endPush(d, k, ys, te, ContactWith::None, -1, ev);
       const double hb = wireHalf - cfg.referee.putback_ft;
       ry[X] = std::clamp(ry[X], -hb, hb);
       ry[Y] = std::clamp(ry[Y], -hb, hb);
@@ -221,7 +227,10 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
     // the sign of a function that is zero to round-off at the tick of its
     // crossing could end a contact at the tick it began, or not, by the
     // last bit (a robot turned at its wall contact's tick, parallel to it).
-    if (pass == 0 || moved) contacts(T, d, y, f, ev);
+    if (pass == 0 || moved) {
+      contacts(T, d, y, f, ev);
+      blockContacts(T, te, d, y, f, ev);
+    }
     edges(d, y, f, ev);
     bool turned = false;
     for (int i = 0; i < nR; ++i) turned = refereeTurn(T, d, y, i, ev) || turned;

@@ -40,9 +40,10 @@ constexpr int kMaxBalls = 64;
 static_assert(kMaxBalls >= 2 * 2 * kMaxBallsPerGun, "the ball table must hold every magazine");
 // Every disc two launchers with full magazines can have in flight.
 constexpr int kMaxDiscs = 2 * kMaxDiscsPerLauncher;
-// Per robot 7 and one per obstacle, the pair's contact, per ball 6, per
-// disc 2.
-constexpr int kMaxRoots = 2 * (7 + kMaxObstacles) + 1 + kMaxBalls * 6 + kMaxDiscs * 2;
+// Per robot 7, one per obstacle and one per block, the pair's contact, per
+// ball 6, per disc 2, per block pushed 1.
+constexpr int kMaxRoots =
+    2 * (7 + kMaxObstacles + kMaxBlocks) + 1 + kMaxBalls * 6 + kMaxDiscs * 2 + kMaxBlocks;
 constexpr int kRing = 16;
 static_assert(kRing > kMaxRefereeLimit, "the referee must see one event more than its limit");
 // ARKODE's tout in its one-step mode only bounds the first step's guess
@@ -84,6 +85,14 @@ enum class RootKind : std::uint8_t {
   // A ball that meets an obstacle: the time it does (closed form, found at
   // its launch) less t. Only for a ball that meets one.
   BallObstacle,
+  // A robot and a block on the field (arena_blocks.cpp): as Obstacle while
+  // the block rests (its gap, or minus the force of a rigid contact); while
+  // the robot pushes it, the larger of the robot's free speed along the
+  // push's normal and its gap less kPushSlipFt, negative while it pushes.
+  Block,
+  // A block being pushed: how far it can still go before it meets
+  // something (its reach at the push's start less its travel).
+  BlockStop,
 };
 
 struct RootDesc {
@@ -92,6 +101,31 @@ struct RootDesc {
 };
 // The `robot` of robot i's root against obstacle o.
 constexpr int obstacleRoot(int robot, int obstacle) { return robot * kMaxObstacles + obstacle; }
+// The `robot` of robot i's root against block b.
+constexpr int blockRoot(int robot, int block) { return robot * kMaxBlocks + block; }
+// A block's rigid contact is contact.h's Obstacle constraint of this index.
+constexpr int blockObstacle(int block) { return kMaxObstacles + block; }
+
+// A block on the field (arena_blocks.cpp): a box that translates, never
+// turns. Resting, its centre is (x, y); while robot `pusher` pushes it, it
+// is (x, y) + n ((p - p0) . n), p the pusher's centre and p0 that centre at
+// the push's start: it follows the pusher's motion along the contact
+// normal n (unit, from the block towards the pusher) and nothing else.
+struct Block {
+  int item = 0;   // its index in ArenaState::deployed
+  int robot = 0;  // who set it down
+  double x = 0, y = 0;
+  double ax = 1, ay = 0;  // its width axis (unit): the releasing robot's right
+  double halfWidth = 0, halfDepth = 0, height = 0;
+  double load = 0;  // mass (lb) times floor friction: F / g
+  int pusher = -1;
+  double nx = 0, ny = 0, px = 0, py = 0;
+  // How far the push can move it (ft) before it touches a wall, the
+  // divider, an obstacle or another block (`stopWith`, `stopIndex`).
+  double reach = HUGE_VAL;
+  ContactWith stopWith = ContactWith::None;
+  int stopIndex = -1;
+};
 
 struct Ball {
   bool active = false;
@@ -155,6 +189,10 @@ struct RobotDisc {
   std::array<bool, 2> wallContact{};
   bool dividerContact = false;
   std::array<bool, kMaxObstacles> obstacleContact{};
+  // Touching block b: pushing it (Block::pusher) or rigidly (a contact.h
+  // Obstacle constraint, blockObstacle(b)).
+  std::array<bool, kMaxBlocks> blockContact{};
+  double pushedFt = 0;  // blocks pushed so far, ft
   Ring reflexTicks, eventTicks;
   std::uint8_t portB = 0;
   std::array<bool, 2> gunOn{};
@@ -175,6 +213,8 @@ struct Discrete {
   bool robotContact = false;
   std::array<Ball, kMaxBalls> balls{};
   std::array<Disc, kMaxDiscs> discs{};
+  int blockCount = 0;  // blocks set down; 0: none of their rules run
+  std::array<Block, kMaxBlocks> blocks{};
 };
 
 // One robot's closed-form motion within a segment (DESIGN.md "Continuous
@@ -315,6 +355,7 @@ struct ArenaState {
   // each reset, read at every step.
   double segSpeed = 0;     // pointSpeed()
   bool segRest = false;    // atRest()
+  bool segPushes = false;  // a block is being pushed (arena_blocks.cpp)
   double maxStepSet = -1;  // the value last given to ARKODE's maximum step
 };
 
@@ -378,8 +419,9 @@ struct Arena::Impl : ArenaState {
 
   // ---- scratch
   std::vector<double> tmp;
-  mutable std::vector<double> qtmp;   // for const queries
-  mutable std::vector<double> rootY;  // the full state inside the root function
+  mutable std::vector<double> qtmp;    // for const queries
+  mutable std::vector<double> rootY;   // the full state inside the root function
+  mutable std::vector<double> blockY;  // the state for the blocks' queries
 
   explicit Impl(const ArenaConfig& c);
 
@@ -419,6 +461,43 @@ struct Arena::Impl : ArenaState {
   // Sets b.meetObstacle and b.meetT: the first obstacle its flight from
   // b.t0 meets below the obstacle's height (closed form), if any.
   void ballMeetsObstacle(Ball& b) const;
+  // Then the blocks of d (at state y) where the flight is at tFrom or
+  // later: meetObstacle blockObstacle(k) for block k, if it meets one first.
+  void ballMeetsBlocks(Ball& b, const Discrete& d, const double* y, double tFrom) const;
+  // Both, as a launch or a skip needs them.
+  void ballMeetings(Ball& b, const Discrete& d, const double* y, double tFrom) const;
+
+  // ---- blocks (arena_blocks.cpp)
+  // Block k's footprint at full state y (where its pusher has taken it).
+  geom::Convex blockShape(const Discrete& d, int k, const double* y) const;
+  Vec2 blockAt(const Discrete& d, int k, const double* y) const;
+  // Gap (ft) between robot i's body and block k at state y, and the
+  // normal from the block towards the robot.
+  double blockGap(const Discrete& d, int i, int k, const double* y, Vec2* normal = nullptr) const;
+  // Robot i's free velocity (the wheels' alone) at full state y.
+  Vec2 freeVelocityOf(const double* y, int i) const;
+  double blockRootValue(int who, const double* y) const;
+  double blockStopValue(const Discrete& d, int k, const double* y) const;
+  // The resting blocks of d as contact.h's obstacles (their rigid contacts).
+  void refreshBlockShapes(const Discrete& d);
+  // The pushes of d slow their pushers' velocities v (and accelerations a).
+  void applyPushes(const Discrete& d, double* v, double* a = nullptr) const;
+  // Pushes ending at tick T, contacts with blocks starting (and pushes
+  // with them) or ending: process()'s blocks, into ev.
+  void blockContacts(std::int64_t T, double te, Discrete& d, std::vector<double>& y,
+                     const int* found, EventList& ev);
+  // Block k's push ends at time te (state y), stopped by `with`.
+  void endPush(Discrete& d, int k, const double* y, double te, ContactWith with, int index,
+               EventList& ev);
+  // How far block k (resting) can move along u before it touches
+  // something fixed or another block.
+  double blockReach(const Discrete& d, int k, const Vec2& u, const double* y, ContactWith& with,
+                    int& index) const;
+  // Whether a block of footprint `s` fits on the field of d at state y.
+  bool blockFits(const Discrete& d, const geom::Convex& s, const double* y) const;
+  // A block set down (or moved) in d: balls and discs in flight meet it.
+  void flightsSeeBlocks(Discrete& d, const double* y, double te) const;
+  mutable std::vector<Deployed> eyeItems;  // the eyes' scene, blocks where they are
 
   // ---- discs (arena_discs.cpp)
   double discPath(const Disc& d, double t) const;
@@ -478,6 +557,8 @@ struct Arena::Impl : ArenaState {
     return target > 0 ? p.gun_wheel_lag_s : p.gun_wheel_coast_s;
   }
 
+  // Robot i's wheel targets (ft/s) under d: reflex, drive or frame, supply.
+  std::array<double, 2> wheelTargetsOf(const Discrete& d, int i) const;
   void computeTargets(const Discrete& d);
   void applyJumps(std::vector<double>& y) const;
   void setMotion(double t0, const std::vector<double>& y);

@@ -70,6 +70,7 @@ Arena::Impl::Impl(const ArenaConfig& c)
   tmp.assign(static_cast<std::size_t>(n), 0.0);
   qtmp.assign(static_cast<std::size_t>(n), 0.0);
   rootY.assign(static_cast<std::size_t>(n), 0.0);
+  blockY.assign(static_cast<std::size_t>(n), 0.0);
   segY.assign(static_cast<std::size_t>(n), 0.0);
   endY.assign(static_cast<std::size_t>(nx), 0.0);
   endF.assign(static_cast<std::size_t>(nx), 0.0);
@@ -93,8 +94,17 @@ Arena::Impl::Impl(const ArenaConfig& c)
     d.ballsLeft = {rs.params.balls_per_gun, rs.params.balls_per_gun};
     if (rs.hardware.secondary.kind == SecondaryKind::Disc)
       d.discsLeft = rs.hardware.secondary.magazine;
-    for (std::size_t k = 0; k < rs.hardware.deployables.size() && k < kMaxDeployKinds; ++k)
+    int blocks = 0;
+    for (std::size_t k = 0; k < rs.hardware.deployables.size() && k < kMaxDeployKinds; ++k) {
       deployLeft[static_cast<std::size_t>(i)][k] = rs.hardware.deployables[k].count;
+      if (rs.hardware.deployables[k].kind == DeployKind::Block)
+        blocks += rs.hardware.deployables[k].count;
+    }
+    if (blocks > kMaxBlocksPerRobot)
+      throw std::invalid_argument("Arena: more than " + std::to_string(kMaxBlocksPerRobot) +
+                                  " blocks on one robot");
+    if (!rs.hardware.deployables.empty())
+      eyeItems.reserve(static_cast<std::size_t>(2 * kMaxDeployKinds * kMaxDeployCount));
   }
   // Initial flags from geometry, silently (nothing has happened yet): a
   // body put down touching something starts in contact with it.
@@ -207,6 +217,7 @@ void Arena::Impl::freeVelocities(double t, double* v, double* a) const {
 
 void Arena::Impl::rhs(double t, const double* xy, double* f, double* accel) const {
   freeVelocities(t, f, accel);
+  if (segPushes) applyPushes(D, f, accel);
   if (active.count == 0) return;
   contact::project(bodies, active, xy, f, f);
   if (!accel) return;
@@ -248,29 +259,38 @@ void Arena::Impl::fullState(double t, const double* xy, double* out) const {
 
 // ------------------------------------------------------------ targets and
 // reset
+std::array<double, 2> Arena::Impl::wheelTargetsOf(const Discrete& d, int i) const {
+  const RobotParams& p = P(i);
+  const RobotDisc& r = d.r[static_cast<std::size_t>(i)];
+  std::array<double, 2> wt{};
+  if (r.reflex) {
+    WheelCommand c{p.reflex_speed_step, r.reflexSide == Bumper::Back, true, '0'};
+    wt[0] = wheelSpeedFps(c, p, true);
+    wt[1] = wheelSpeedFps(c, p, false);
+  } else if (r.driven) {
+    wt = r.drive;
+  } else {
+    wt[0] = wheelSpeedFps(r.latched.left, p, true);
+    wt[1] = wheelSpeedFps(r.latched.right, p, false);
+  }
+  // A battery's voltage (setSupply); without one the targets stay as
+  // they are, bit for bit.
+  if (r.supply != 1) {
+    wt[0] *= r.supply;
+    wt[1] *= r.supply;
+  }
+  return wt;
+}
+
 void Arena::Impl::computeTargets(const Discrete& d) {
   for (int i = 0; i < nR; ++i) {
     const RobotParams& p = P(i);
     const RobotDisc& r = d.r[static_cast<std::size_t>(i)];
-    auto& wt = wheelTarget[static_cast<std::size_t>(i)];
-    if (r.reflex) {
-      WheelCommand c{p.reflex_speed_step, r.reflexSide == Bumper::Back, true, '0'};
-      wt[0] = wheelSpeedFps(c, p, true);
-      wt[1] = wheelSpeedFps(c, p, false);
-    } else if (r.driven) {
-      wt = r.drive;
-    } else {
-      wt[0] = wheelSpeedFps(r.latched.left, p, true);
-      wt[1] = wheelSpeedFps(r.latched.right, p, false);
-    }
+    wheelTarget[static_cast<std::size_t>(i)] = wheelTargetsOf(d, i);
     auto& gt = gunTarget[static_cast<std::size_t>(i)];
     gt[0] = r.gunOn[0] || p.gun_motors_always_on ? 1.0 : 0.0;
     gt[1] = r.gunOn[1] || p.gun_motors_always_on ? 1.0 : 0.0;
-    // A battery's voltage (setSupply); without one the targets stay as
-    // they are, bit for bit.
     if (r.supply != 1) {
-      wt[0] *= r.supply;
-      wt[1] *= r.supply;
       gt[0] *= r.supply;
       gt[1] *= r.supply;
     }
@@ -325,6 +345,12 @@ void Arena::Impl::setMotion(double t0, const std::vector<double>& y) {
 // body already moves away: an instant reflex, a new frame with no motor
 // lag) ends when its gap opens (contactG).
 void Arena::Impl::setActive(const Discrete& d) {
+  segPushes = false;
+  if (d.blockCount > 0) {
+    refreshBlockShapes(d);
+    for (int k = 0; k < d.blockCount; ++k)
+      segPushes = segPushes || d.blocks[static_cast<std::size_t>(k)].pusher >= 0;
+  }
   contact::Active cand;
   auto add = [&](contact::Kind k, int i) {
     cand.c[static_cast<std::size_t>(cand.count++)] = contact::Constraint{k, i};
@@ -346,6 +372,19 @@ void Arena::Impl::setActive(const Discrete& d) {
       cand.c[static_cast<std::size_t>(cand.count++)] =
           contact::Constraint{contact::Kind::Obstacle, i, k};
     }
+    // A block touched and not pushed by this robot: a fixed box, counted
+    // with the obstacles.
+    for (int k = 0; k < d.blockCount; ++k) {
+      if (!r.blockContact[static_cast<std::size_t>(k)] ||
+          d.blocks[static_cast<std::size_t>(k)].pusher == i)
+        continue;
+      if (++touching > kMaxObstacleContacts)
+        throw SolverError("plant: robot " + std::string(1, static_cast<char>('A' + i)) +
+                          " touches more than " + std::to_string(kMaxObstacleContacts) +
+                          " obstacles and blocks at once");
+      cand.c[static_cast<std::size_t>(cand.count++)] =
+          contact::Constraint{contact::Kind::Obstacle, i, blockObstacle(k)};
+    }
   }
   if (nR == 2 && d.robotContact) add(contact::Kind::Robot, 0);
   active = cand;
@@ -353,6 +392,7 @@ void Arena::Impl::setActive(const Discrete& d) {
   std::array<double, 2 * kXY> xy{}, v{}, vf{}, af{};
   centresOf(segY.data(), xy.data());
   freeVelocities(segT0, vf.data(), af.data());
+  if (segPushes) applyPushes(d, vf.data(), af.data());
   // A force this small is zero: round-off of speeds of order 1 ft/s.
   constexpr double kZeroForce = 1e-12;  // ft/s
   for (;;) {

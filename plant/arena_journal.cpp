@@ -134,6 +134,7 @@ void Arena::Impl::restore(const Checkpoint& cp) {
   rhsEvalsOffset = cp.rhsEvals - ode.rhsEvals();
   rootFlagCarried = false;
   checkpointSerial = reinitSerial;
+  refreshBlockShapes(D);  // contact.h's copies of the blocks (not in the state)
 }
 
 Arena::Mark Arena::mark() const {

@@ -60,6 +60,7 @@ double Arena::Impl::contactG(contact::Kind k, int i, const double* y, int obstac
       vf[static_cast<std::size_t>(kXY * r + X)] = sp * std::sin(s[H]);
       vf[static_cast<std::size_t>(kXY * r + Y)] = sp * std::cos(s[H]);
     }
+    if (segPushes) applyPushes(D, vf.data());
     std::array<double, contact::kMaxActive> mu{};
     contact::project(bodies, active, q.data(), vf.data(), v.data(), mu.data());
     return -mu[static_cast<std::size_t>(j)];
@@ -207,6 +208,10 @@ double Arena::Impl::rootValue(const RootDesc& rd, double t, const double* y) con
                       rd.robot % kMaxObstacles);
     case RootKind::BallObstacle:
       return D.balls[static_cast<std::size_t>(rd.robot)].meetT - t;
+    case RootKind::Block:
+      return blockRootValue(rd.robot, y);
+    case RootKind::BlockStop:
+      return blockStopValue(D, rd.robot, y);
     case RootKind::BallTop: {
       const Ball& b = D.balls[static_cast<std::size_t>(rd.robot)];
       double x, yy, z;
@@ -281,6 +286,12 @@ void Arena::Impl::sideRoots(double t0, const std::vector<double>& y) {
                    ? -1
                    : 1;
         break;
+      case RootKind::Block:
+        side = D.r[static_cast<std::size_t>(rd.robot / kMaxBlocks)]
+                       .blockContact[static_cast<std::size_t>(rd.robot % kMaxBlocks)]
+                   ? -1
+                   : 1;
+        break;
       default:
         break;
     }
@@ -322,7 +333,10 @@ void Arena::Impl::buildRoots() {
     if (cfg.field.divider) add(RootKind::Divider, i);
     if (D.r[static_cast<std::size_t>(i)].reflex) add(RootKind::ReflexEnd, i);
     for (int k = 0; k < bodies.obstacleCount; ++k) add(RootKind::Obstacle, obstacleRoot(i, k));
+    for (int k = 0; k < D.blockCount; ++k) add(RootKind::Block, blockRoot(i, k));
   }
+  for (int k = 0; k < D.blockCount; ++k)
+    if (D.blocks[static_cast<std::size_t>(k)].pusher >= 0) add(RootKind::BlockStop, k);
   if (nR == 2) add(RootKind::RobotRobot, 0);
   for (int b = 0; b < kMaxBalls; ++b) {
     const Ball& ball = D.balls[static_cast<std::size_t>(b)];

@@ -17,7 +17,8 @@
 // arena) when mu_c reaches 0; it starts when its gap reaches 0.
 //
 // The model this is (each assumption also in docs/plant.md):
-// - A wall, the divider or an obstacle is fixed and frictionless: it takes away the
+// - A wall, the divider, an obstacle or a resting block (arena_blocks.cpp;
+//   a block being pushed is no constraint) is fixed and frictionless: it takes away the
 //   normal component and the centre slides along it at the tangential
 //   speed the wheels give (the wheels slip sideways). The contact force
 //   passes through the centre of the round body, so it exerts no torque and
@@ -77,9 +78,10 @@ struct Bodies {
   std::array<double, 2> invMass{1, 1};
   double half = 8;  // the field walls are at |x|, |y| = half
   geom::Rect divider{};
-  // The field's obstacles (fixed, like the divider).
+  // The field's obstacles (fixed, like the divider), then from index
+  // kMaxObstacles the blocks on the field where they rest (arena_blocks.cpp).
   int obstacleCount = 0;
-  std::array<geom::Convex, kMaxObstacles> obstacles{};
+  std::array<geom::Convex, kMaxObstacles + kMaxBlocks> obstacles{};
 };
 
 // Gap (ft) of constraint c at centres q (x0, y0, x1, y1), and its unit

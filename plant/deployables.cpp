@@ -53,14 +53,20 @@ bool hiddenBy(const Deployed& item, const Vec2& a, const Vec2& b, double sourceH
   if (item.kind == DeployKind::DecoyScreen) return segmentsCross(a, b, c - w, c + w);
   if (item.kind == DeployKind::Block) {
     const Vec2 f = geom::headingDir(geom::degToRad(item.heading_deg)) * (item.depth_ft / 2);
-    // Counter-clockwise: back-right, front-right, front-left, back-left.
-    Obstacle o;
-    o.kind = Obstacle::Kind::Box;
-    o.height_ft = item.height_ft;
-    for (const Vec2& p : {Vec2(c - f + w), Vec2(c + f + w), Vec2(c + f - w), Vec2(c - f - w)})
-      o.points.push_back({p.x(), p.y()});
+    // Counter-clockwise: back-right, front-right, front-left, back-left;
+    // built as convexOf() builds a box's, without allocating (the eyes
+    // read at every sample).
+    geom::Convex s;
+    s.circle = false;
+    s.c = c;
+    s.n = 4;
+    s.v = {Vec2(c - f + w), Vec2(c + f + w), Vec2(c + f - w), Vec2(c - f - w)};
+    for (int k = 0; k < 4; ++k) {
+      const Vec2 e = s.v[static_cast<std::size_t>((k + 1) % 4)] - s.v[static_cast<std::size_t>(k)];
+      s.normal[static_cast<std::size_t>(k)] = Vec2(e.y(), -e.x()).normalized();
+    }
     double lo = 0, hi = 0;
-    return geom::clipLine(a, b - a, geom::convexOf(o), 0.0, 1.0, lo, hi);
+    return geom::clipLine(a, b - a, s, 0.0, 1.0, lo, hi);
   }
   return false;
 }

@@ -248,6 +248,11 @@ enum class DeployKind : std::uint8_t { Block, DecoyLight, DecoyScreen };
 const char* deployKindName(DeployKind k);
 inline constexpr int kMaxDeployKinds = 8;  // one per port B bit at most
 inline constexpr int kMaxDeployCount = 16;
+// Blocks are bodies of the plant (arena_blocks.cpp): its fixed tables hold
+// kMaxBlocks on the field, so config/ refuses a robot whose [[deployables]]
+// carry more than kMaxBlocksPerRobot blocks over all its block tables.
+inline constexpr int kMaxBlocksPerRobot = 16;
+inline constexpr int kMaxBlocks = 2 * kMaxBlocksPerRobot;
 
 struct Deployable {
   DeployKind kind = DeployKind::Block;
@@ -407,11 +412,12 @@ double obstacleClearance(double x, double y, double radius, const Obstacle& obst
 // ---------------------------------------------------------------- events
 enum class Detector : std::uint8_t { Fore = 0, Aft = 1 };
 enum class Bumper : std::uint8_t { Front = 0, Back = 1 };
-enum class ContactWith : std::uint8_t { None, Robot, Divider, Wall, Obstacle };
+enum class ContactWith : std::uint8_t { None, Robot, Divider, Wall, Obstacle, Block };
 // Why a ball or disc flight ended without a hit. LeftField: it reached a
 // field wall; Stopped: a disc slowed below its stop speed; Obstacle: it met
-// a fixed obstacle (the event's `obstacle`).
-enum class MissReason : std::uint8_t { None, Floor, Divider, LeftField, Stopped, Obstacle };
+// a fixed obstacle (the event's `obstacle`); Block: a block set down (the
+// event's `obstacle` is the block's index on the field).
+enum class MissReason : std::uint8_t { None, Floor, Divider, LeftField, Stopped, Obstacle, Block };
 
 enum class EventKind : std::uint8_t {
   EdgeEnter,       // robot, detector: detector now reads low
@@ -441,6 +447,17 @@ enum class EventKind : std::uint8_t {
   // or the table was empty.
   Deploy,
   DeployEmpty,
+  // (from setPortB) robot, gun = its table: a block that would not fit
+  // where it would be set down (x, y: there) stays on the robot.
+  DeployBlocked,
+  // A robot starts or stops pushing a block (arena_blocks.cpp): robot,
+  // ball = the block's index on the field (from 0, in release order);
+  // x, y: the block's centre; at the end z = the distance pushed (ft) and
+  // `with` (and `obstacle`, `other`) what stopped the block: None when the
+  // robot stopped driving into it or slid off it, else a wall, the
+  // divider, an obstacle, another block, or the other robot touching it.
+  PushStart,
+  PushEnd,
 };
 const char* eventKindName(EventKind k);
 
@@ -453,8 +470,10 @@ struct Event {
   ContactWith with = ContactWith::None;
   MissReason miss = MissReason::None;
   std::int8_t gun = -1;
-  std::int8_t ball = -1;      // a ball's slot, or a disc's (disc events)
-  std::int8_t obstacle = -1;  // with Obstacle, or a miss on one: its index in the field's list
+  std::int8_t ball = -1;  // a ball's slot, or a disc's (disc events)
+  // With Obstacle, or a miss on one: its index in the field's list; with
+  // Block: the block's index on the field (release order, from 0).
+  std::int8_t obstacle = -1;
   // Balls: position (ft) at the event, and at a launch the velocity (ft/s):
   // the flight is x + vx s, y + vy s, z + vz s - g s^2 / 2 after the launch
   // tick; and the shooter's heading (deg) then, from which the ball's
@@ -687,8 +706,13 @@ class Arena {
   // its hits are not in hits().
   int discShots(int robot) const;
   int discHits(int robot) const;
-  // Every item set down so far (deployables), in tick order.
+  // Every item set down so far (deployables), in tick order, where it was
+  // set down (a block pushed since is elsewhere: blockCentre).
   const std::vector<Deployed>& deployed() const;
+  // Block k's centre (k: its index on the field, release order) at `tick`.
+  Pose blockCentre(int k, std::int64_t tick) const;
+  // The distance robot `robot` has pushed blocks so far, ft.
+  double blockPushedFt(int robot) const;
   int discsLeft(int robot) const;
   IntegratorStats stats() const;
 

@@ -410,6 +410,9 @@ struct Explainer::State {
     if (x.hit.starts_with("obstacle"))
       course(x.robot, t,
              fmt::format("ball {} (gun {}) stopped by an obstacle: {}", x.ball, s.gun + 1, x.hit));
+    if (x.hit.starts_with("block"))
+      course(x.robot, t,
+             fmt::format("ball {} (gun {}) stopped by a block: {}", x.ball, s.gun + 1, x.hit));
   }
   // ---- the wider competition (DESIGN.md)
   std::set<std::string> mines;  // the labels of the obstacles with mine = true
@@ -470,6 +473,22 @@ struct Explainer::State {
     course(x.robot, t,
            fmt::format("set down {} {} (bit {}) at ({:.2f}, {:.2f}) ft", kind, x.number, x.bit,
                        x.x_ft, x.y_ft));
+  }
+  void on(Tick t, const rec::DeployBlocked& x) {
+    course(x.robot, t,
+           fmt::format("could not set down a block (bit {}): no room at ({:.2f}, {:.2f}) ft", x.bit,
+                       x.x_ft, x.y_ft));
+  }
+  // A push in one sentence at its end: how far, where to, what stopped it.
+  void on(Tick t, const rec::PushEnd& x) {
+    const bool named = x.by.starts_with("obstacle") || x.by.starts_with("block");
+    const std::string why = x.by == "drive" ? ""
+                            : x.by == "robot"
+                                ? "; the other robot held it"
+                                : (named ? "; stopped by " : "; stopped by the ") + x.by;
+    course(x.robot, t,
+           fmt::format("pushed block {} {:.3f} ft, to ({:.2f}, {:.2f}) ft{}", x.block, x.pushed_ft,
+                       x.x_ft, x.y_ft, why));
   }
   void on(Tick t, const rec::DeployEmpty& x) {
     std::string kind = x.kind;

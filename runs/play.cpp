@@ -279,7 +279,8 @@ json soloJson(const Played& played) {
       {"interrupts", a.interrupts},
       {"final_pose", poseJson(a.finalPose)},
       {"scatter_shots", scatterJson(a)},
-      {"deployed", deployedJson(a)}};
+      {"deployed", deployedJson(a)},
+      {"block_push_ft", a.blockPushFt}};
   addSecondary(j, a);
   return j;
 }
@@ -307,7 +308,8 @@ json matchJson(const Played& played) {
                       {"scatter_shots", scatterJson(rr)},
                       {"resets", resetsJson(rr)},
                       {"battery_v_final", batteryJson(rr)},
-                      {"deployed", deployedJson(rr)}});
+                      {"deployed", deployedJson(rr)},
+                      {"block_push_ft", rr.blockPushFt}});
     addSecondary(robots.back(), rr);
   }
   json j = {{"sim_seconds", timebase::secondsFromTicks(r.endTick)},

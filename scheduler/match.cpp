@@ -475,6 +475,7 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
     return w == plant::ContactWith::Robot      ? "robot"
            : w == plant::ContactWith::Divider  ? "divider"
            : w == plant::ContactWith::Obstacle ? obstacle(index)
+           : w == plant::ContactWith::Block    ? fmt::format("block {}", index + 1)
                                                : "wall";
   };
   const auto missed = [&](plant::MissReason m, int index) -> std::string {
@@ -482,6 +483,7 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
            : m == plant::MissReason::Divider  ? "divider"
            : m == plant::MissReason::Stopped  ? "stopped"
            : m == plant::MissReason::Obstacle ? obstacle(index)
+           : m == plant::MissReason::Block    ? fmt::format("block {}", index + 1)
                                               : "wall";
   };
   switch (e.kind) {
@@ -537,15 +539,28 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
     case plant::EventKind::DiscEmpty:
       return rec::DiscEmpty{r};
     case plant::EventKind::Deploy:
-    case plant::EventKind::DeployEmpty: {
+    case plant::EventKind::DeployEmpty:
+    case plant::EventKind::DeployBlocked: {
       const plant::Deployable& d = arenaConfig_->robots[static_cast<size_t>(r)]
                                        .hardware.deployables[static_cast<size_t>(e.gun)];
       if (e.kind == plant::EventKind::DeployEmpty)
         return rec::DeployEmpty{r, plant::deployKindName(d.kind), d.bit};
+      if (e.kind == plant::EventKind::DeployBlocked)
+        return rec::DeployBlocked{r, plant::deployKindName(d.kind), d.bit, e.x, e.y};
       return rec::Deploy{r, plant::deployKindName(d.kind), e.ball, d.bit, e.x, e.y, e.heading_deg};
     }
     case plant::EventKind::DiscHit:
       return rec::DiscHit{r, e.other, e.ball, e.x, e.y, e.z};
+    case plant::EventKind::PushStart:
+      return rec::PushStart{r, e.ball + 1, e.x, e.y};
+    case plant::EventKind::PushEnd:
+      return rec::PushEnd{
+          r,
+          e.ball + 1,
+          e.x,
+          e.y,
+          e.z,
+          e.with == plant::ContactWith::None ? std::string("drive") : with(e.with, e.obstacle)};
     case plant::EventKind::DiscMiss:
       return rec::DiscMiss{r,
                            e.ball,
@@ -844,6 +859,7 @@ void Match::finish(MatchResult& result) {
                                      arena_.discShots(r->index), arena_.discHits(r->index)};
     for (const plant::Deployed& item : arena_.deployed())
       if (item.robot == r->index) ++rr.deployed[static_cast<size_t>(item.kind)];
+    rr.blockPushFt = arena_.blockPushedFt(r->index);
     // The clock at main's return, or at the end of the run: a VM's clock
     // runs on to the last round's horizon after main returns, and may stand
     // one instruction past the end.

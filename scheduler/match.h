@@ -273,6 +273,7 @@ struct RobotResult {
   // Items of [[deployables]] set down, by plant::DeployKind (block, decoy
   // light, decoy screen); zeros without any.
   std::array<int, 3> deployed{};
+  double blockPushFt = 0;  // blocks this robot pushed, ft (plant/arena_blocks.cpp)
   int framesLatched = 0, framesRejected = 0;
   // Sends that restarted the serial library before it had fetched the last
   // byte of the previous send (its NUL): that frame can never latch.

@@ -120,6 +120,54 @@ err = [l for l in p.stderr.splitlines() if ": error: " in l]  # fig92 compiles w
 check(p.returncode == 1 and len(err) == 1 and "course.decoy_lights = false forbids robot" in err[0],
       f"rules: {p.returncode} {p.stderr!r}")
 
+# Blocks are bodies (docs/plant.md "Deployables"): seed 2's 180 s has fig92
+# (B) shoving A's first block between its reflexes. Each robot's JSON
+# `block_push_ft` is the sum of its push_end records' pushed_ft; every
+# push_end follows a push_start of the same robot and block, and each
+# push_start of a block follows that robot's contact with "block N".
+trace = OUT / "pushes.jsonl"
+p = run("match", DROPPER, FIG92, "--seed", "2", "--hw", f"A={BLOCKS}", "--trace", str(trace),
+        "--json")
+check(p.returncode == 0, f"pushes: exit {p.returncode}: {p.stderr[-300:]}")
+result = json.loads(p.stdout)
+recs = [json.loads(l) for l in trace.read_text().splitlines()]
+open_push, touching, pushed = {}, set(), {"A": 0.0, "B": 0.0}
+for r in recs:
+    if r["type"] == "contact" and r["with"].startswith("block "):
+        touching.add((r["robot"], int(r["with"].split()[1])))
+    elif r["type"] == "contact_end" and r["with"].startswith("block "):
+        touching.discard((r["robot"], int(r["with"].split()[1])))
+    elif r["type"] == "push_start":
+        check((r["robot"], r["block"]) in touching, f"push_start without contact at {r['t']}")
+        open_push[(r["robot"], r["block"])] = r["t"]
+    elif r["type"] == "push_end":
+        check(open_push.pop((r["robot"], r["block"]), None) is not None,
+              f"push_end without push_start at {r['t']}")
+        pushed[r["robot"]] += r["pushed_ft"]
+check(pushed["B"] > 0, "pushes: seed 2 must push a block")
+for i, name in enumerate("AB"):
+    got = result["robots"][i]["block_push_ft"]
+    check(abs(got - pushed[name]) <= 1e-12 * max(1.0, pushed[name]),
+          f"pushes: {name} block_push_ft {got} != {pushed[name]}")
+
+# More blocks than the plant's table holds per robot (plant.h
+# kMaxBlocksPerRobot = 16): one line at the table that passes the limit.
+blocks = Path(BLOCKS).read_text()
+old = "count          = { value = 4,"
+assert old in blocks
+second = blocks[blocks.index("[[deployables]]"):].replace("value = 2,   unit = \"bit\"",
+                                                          "value = 1,   unit = \"bit\"", 1)
+text = blocks.replace(old, "count          = { value = 16,", 1) + "\n" + second
+line = text.splitlines().index("[[deployables]]", text.splitlines().index("[[deployables]]") + 1) + 1
+bad = OUT / "bad_blocks.toml"
+bad.write_text(text)
+p = run("solo", DROPPER, "--seconds", "1", "--hw", str(bad), "--json")
+err = p.stderr.strip().splitlines()
+check(p.returncode == 1 and len(err) == 1 and
+      re.match(re.escape(str(bad)) + rf":{line}:\d+: error: ", err[0]) and
+      "at most 16 blocks in a robot's [[deployables]], 20 here" in err[0],
+      f"too many blocks: {p.returncode} {p.stderr!r}")
+
 if failures:
     print(f"{len(failures)} failure(s)")
     sys.exit(1)

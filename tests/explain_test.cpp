@@ -665,6 +665,37 @@ TEST(Explain, AHandlerThatNeverReturnsHasItsDuration) {
 
 // The stall rule itself (reports/stall.h) on hand-made timelines, in ticks
 // (1 s = 9,216,000).
+// Pushes (plant/arena_blocks.cpp's push_end records) in one sentence each,
+// from the record's own fields: "pushed block N D ft, to (X, Y) ft" with D
+// to 0.001 ft (a shove between reflexes is hundredths), X, Y to 0.01 ft,
+// then what stopped the block if something did. Records made here: A
+// shoves block 1 by 0.8049 ft (0.805) to (-6.4182, -6.7361), a drive's
+// end; B pushes block 2 by 0.05 ft to (7.4, 0) where the wall stops it; A
+// pushes block 3 0.1251 ft (0.125) into "obstacle 2 (mountain)"; B's push
+// of block 1 ends when A touches it (0.004); a block that
+// did not fit, with its bit and where.
+TEST(Explain, NamesPushesAndBlocks) {
+  ex::Explainer e;
+  e.write({100, rec::PushStart{0, 1, -7.2231, -6.7361}, {}});
+  e.write({200, rec::PushEnd{0, 1, -6.4182, -6.7361, 0.8049, "drive"}, {}});
+  e.write({300, rec::PushEnd{1, 2, 7.4, 0.0, 0.05, "wall"}, {}});
+  e.write({400, rec::PushEnd{0, 3, 1.0, 2.0, 0.1251, "obstacle 2 (mountain)"}, {}});
+  e.write({500, rec::PushEnd{1, 1, -6.4182, -6.7321, 0.004, "robot"}, {}});
+  e.write({600, rec::DeployBlocked{1, "block", 2, 2.0, -8.20125}, {}});
+  const ex::Report r = e.report();
+  ASSERT_EQ(r.course.size(), 5u);
+  EXPECT_EQ(r.course[0].what, "pushed block 1 0.805 ft, to (-6.42, -6.74) ft");
+  EXPECT_EQ(r.course[0].robot, 0);
+  EXPECT_EQ(r.course[0].t, 200);
+  EXPECT_EQ(r.course[1].what, "pushed block 2 0.050 ft, to (7.40, 0.00) ft; stopped by the wall");
+  EXPECT_EQ(r.course[1].robot, 1);
+  EXPECT_EQ(r.course[2].what,
+            "pushed block 3 0.125 ft, to (1.00, 2.00) ft; stopped by obstacle 2 (mountain)");
+  EXPECT_EQ(r.course[3].what,
+            "pushed block 1 0.004 ft, to (-6.42, -6.73) ft; the other robot held it");
+  EXPECT_EQ(r.course[4].what, "could not set down a block (bit 2): no room at (2.00, -8.20) ft");
+}
+
 TEST(StallWatch, AWindowLongerThanASecondIsAStallCountedWhole) {
   reports::StallWatch w;
   constexpr trace::Tick s = scheduler::kTicksPerSecond;

@@ -91,6 +91,19 @@ function deployables(K) {
       d.moves.t.push(r.t[i]); d.moves.x.push(r.x_ft[i]); d.moves.y.push(r.y_ft[i]);
     }
   }
+  // The plant's pushes (push_start, push_end): `block` is the block's
+  // number on the field, from 1 in the order blocks were set down, which
+  // is the order of the block `deploy` records.
+  const blocks = out.filter((d) => d.kind === 'block');
+  for (const kind of ['push_start', 'push_end']) {
+    const r = K[kind];
+    if (!r) continue;
+    for (let i = 0; i < r.t.length; ++i) {
+      const d = blocks[r.block[i] - 1];
+      if (!d) continue;
+      d.moves.t.push(r.t[i]); d.moves.x.push(r.x_ft[i]); d.moves.y.push(r.y_ft[i]);
+    }
+  }
   for (const d of out) {
     const order = d.moves.t.map((_, k) => k).sort((a, b) => d.moves.t[a] - d.moves.t[b]);
     d.moves = { t: order.map((k) => d.moves.t[k]), x: order.map((k) => d.moves.x[k]), y: order.map((k) => d.moves.y[k]) };

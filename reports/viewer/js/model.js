@@ -299,7 +299,7 @@ const EVENT_STYLE = {
   disc_empty: { glyph: '|', color: '#908860', label: 'disc magazine empty' },
   deploy: { glyph: 'B', color: '#b08850', label: 'deployed (block / decoy)' },
   deploy_empty: { glyph: '|', color: '#806040', label: 'nothing left to deploy' },
-  block_push: { glyph: 'b', color: '#d0a060', label: 'block pushed' },
+  push_end: { glyph: 'b', color: '#d0a060', label: 'block pushed' },
 };
 
 function describeEvent(kind, c, i) {
@@ -332,6 +332,7 @@ function describeEvent(kind, c, i) {
       (c.closest_ft[i] === null ? '' : `, closest ${c.closest_ft[i].toFixed(2)} ft`);
     case 'deploy': return `${c.kind[i]} ${c.number[i]} (bit ${c.bit[i]})`;
     case 'deploy_empty': return `no ${c.kind[i]} left (bit ${c.bit[i]})`;
+    case 'push_end': return `pushed block ${c.block[i]} ${c.pushed_ft[i].toFixed(2)} ft (${c.by[i]})`;
     default: return '';
   }
 }
@@ -371,7 +372,7 @@ const STEP_KINDS = [
   ['scatter', 'scatter shots', ['scatter_shot']],
   ['resets', 'resets', ['reset', 'restart']],
   ['discs', 'discs', ['disc_fire', 'disc_hit', 'disc_miss', 'disc_empty']],
-  ['deploys', 'deployed', ['deploy', 'deploy_empty', 'block_push']],
+  ['deploys', 'deployed', ['deploy', 'deploy_empty', 'push_end']],
 ];
 
 function stepLists(K) {
