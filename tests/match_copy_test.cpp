@@ -119,7 +119,7 @@ TEST(MatchCopy, AfterTheTimersInterruptInCostateHunterVsIceman) {
 
 TEST(MatchCopy, AfterAFaultAndAReload) {
   expectCopiesGoOn({kSource + "/tests/faulting/unbound_vector.dc", kSource + "/programs/turret.dc"},
-                   30, true, {"fault or exit", "reload"});
+                   22, true, {"fault or exit", "reload"});
 }
 
 }  // namespace
