@@ -7,24 +7,25 @@
 // meeting it below its height ends there, and it hides what is lower.
 //
 // A push. A robot of traction T = M g mu_w meeting a block that resists
-// with F = m g mu_b pushes it when T > F, the block can move along the
-// push (nothing touches it there) and the other robot does not touch it:
-// from the contact's tick the block follows the robot's motion along the
-// contact normal n (Block), and the robot's velocity loses F / T of its
-// normal part, v - (F / T)(v . n) n: the quasi-static drive under a load,
-// whose force-speed line runs from the free speed at no load to a stall at
-// T. The tangential part stays (the robot slides along the block's face,
-// as along a wall). The push ends at the exact tick of one of its root
+// with F = m g mu_b pushes it when T > F, the robot drives into it, the
+// block can move along the push (nothing touches it there) and the other
+// robot does not touch it. A push is no contact (DESIGN.md: the robot is
+// only slowed by the friction): no contact record, no bumper. From the
+// touch's tick the block follows the robot's motion along the contact
+// normal n (Block), and the robot's velocity loses F / T of its normal
+// part, v - (F / T)(v . n) n: the quasi-static drive under a load, whose
+// force-speed line runs from the free speed at no load to a stall at T.
+// The tangential part stays (the robot slides along the block's face, as
+// along a wall). The push ends at the exact tick of one of its root
 // functions: the robot's free velocity along n reaches 0 (it no longer
-// drives into the block), the robot slides off the block's face or round
-// its corner (its gap exceeds kPushSlipFt: it then slides along the block
-// as along a fixed box, still touching it), or the block has gone its reach, the distance it can
-// translate along -n before it touches a wall, the divider, an obstacle or
-// another block (computed at the push's start in closed form: a convex
-// shape swept along a line) -- then the block stands there and the robot
-// meets it as a fixed box (its wheels slip). A push is a contact: the
-// bumper trips as at any contact, so with the bumper reflex a push lasts
-// while the motor lag still drives the wheels into the block.
+// drives into the block) or the robot slides off the block's face or
+// round its corner (its gap exceeds kPushSlipFt) -- then the robot is free
+// of the block, no contact -- or the block has gone its reach, the
+// distance it can translate along -n before it touches a wall, the
+// divider, an obstacle or another block (computed at the push's start in
+// closed form: a convex shape swept along a line) -- then the block stands
+// there and the robot meets it as a fixed box at that tick: a contact, its
+// bumper trips. A block that cannot be pushed is met so at once.
 #include "plant/arena_impl.h"
 
 namespace simbot::plant {
@@ -321,7 +322,9 @@ void Arena::Impl::blockContacts(std::int64_t T, double te, Discrete& d, std::vec
     const int who = blockRoot(i, k);
     ended[static_cast<std::size_t>(k)] = i;
     if (reported(found, RootKind::BlockStop, k) < 0 || blockStopValue(d, k, ys) <= 0) {
+      // The block stands at what stopped it: the robot meets a fixed box.
       endPush(d, k, ys, te, b.stopWith, b.stopIndex, ev);
+      meetBlock(d, y, i, k, T, ev);
       continue;
     }
     const int rep = reported(found, RootKind::Block, who);
@@ -331,9 +334,9 @@ void Arena::Impl::blockContacts(std::int64_t T, double te, Discrete& d, std::vec
       ended[static_cast<std::size_t>(k)] = -1;
       continue;
     }
-    // The robot stays in contact: it slides along the block, now resting,
-    // as along a fixed box, and the contact ends when its gap opens (a
-    // robot that slid off a face or round a corner still touches it).
+    // The robot no longer drives into the block or has slid off it: the
+    // block rests and the robot is free of it (no contact); driving into it
+    // again is a new meeting, pushed or met as a fixed box.
     endPush(d, k, ys, te, ContactWith::None, -1, ev);
   }
   for (int i = 0; i < nR; ++i) {
@@ -351,57 +354,77 @@ void Arena::Impl::blockContacts(std::int64_t T, double te, Discrete& d, std::vec
                            touching ? contactG(contact::Kind::Obstacle, i, ys, blockObstacle(k))
                                     : blockGap(d, i, k, ys)) < 0;
       if (c == touching) continue;
-      Event e{c ? EventKind::Contact : EventKind::ContactEnd};
-      e.robot = static_cast<std::int8_t>(i);
-      e.with = ContactWith::Block;
-      e.obstacle = static_cast<std::int8_t>(k);
-      touching = c;
       if (!c) {
+        Event e{EventKind::ContactEnd};
+        e.robot = static_cast<std::int8_t>(i);
+        e.with = ContactWith::Block;
+        e.obstacle = static_cast<std::int8_t>(k);
+        touching = false;
         ev.push(e);
         continue;
       }
-      Vec2 normal;
-      blockGap(d, i, k, ys, &normal);
-      e.bumper = sideOf(heading(ys, i), -normal);
-      ev.push(e);
-      startReflex(d, y, i, e.bumper, T, ev);
       if (b.pusher >= 0) {
-        // The other robot touches a block being pushed: it holds it.
+        // The other robot touches a block being pushed: it holds it, and
+        // both meet it as a fixed box.
+        const int pusher = b.pusher;
+        meetBlock(d, y, i, k, T, ev);
         endPush(d, k, ys, te, ContactWith::Robot, i, ev);
+        meetBlock(d, y, pusher, k, T, ev);
+        ended[static_cast<std::size_t>(k)] = pusher;
         continue;
       }
-      // The robot's speed as the next segment starts: the wheels' targets
-      // at once without a motor lag (the reflex just started), else the
-      // speed they have now.
-      const RobotParams& p = P(i);
-      const std::array<double, 2> wt = wheelTargetsOf(d, i);
-      const double sp = p.motor_lag_s <= 0
-                            ? 0.5 * (wt[0] + wt[1])
-                            : 0.5 * (ys[i * kPerRobot + VL] + ys[i * kPerRobot + VR]);
-      const double into = sp * geom::headingDir(heading(ys, i)).dot(normal);
-      const bool heldByOther =
-          nR == 2 && d.r[static_cast<std::size_t>(1 - i)].blockContact[static_cast<std::size_t>(k)];
-      if (!(p.mass_lb * p.wheel_friction > b.load) || heldByOther || !(into < 0)) continue;
-      ContactWith with = ContactWith::None;
-      int index = -1;
-      const double reach = blockReach(d, k, -normal, ys, with, index);
-      if (!(reach > kMinReachFt)) continue;
-      b.pusher = i;
-      b.nx = normal.x();
-      b.ny = normal.y();
-      b.px = ys[i * kPerRobot + X];
-      b.py = ys[i * kPerRobot + Y];
-      b.reach = reach;
-      b.stopWith = with;
-      b.stopIndex = index;
-      Event s{EventKind::PushStart};
-      s.robot = static_cast<std::int8_t>(i);
-      s.ball = static_cast<std::int8_t>(k);
-      s.x = b.x;
-      s.y = b.y;
-      ev.push(s);
+      if (!startPush(d, ys, i, k, ev)) meetBlock(d, y, i, k, T, ev);
     }
   }
+}
+
+void Arena::Impl::meetBlock(Discrete& d, std::vector<double>& y, int i, int k, std::int64_t T,
+                            EventList& ev) {
+  Event e{EventKind::Contact};
+  e.robot = static_cast<std::int8_t>(i);
+  e.with = ContactWith::Block;
+  e.obstacle = static_cast<std::int8_t>(k);
+  d.r[static_cast<std::size_t>(i)].blockContact[static_cast<std::size_t>(k)] = true;
+  Vec2 normal;
+  blockGap(d, i, k, y.data(), &normal);
+  e.bumper = sideOf(heading(y.data(), i), -normal);
+  ev.push(e);
+  startReflex(d, y, i, e.bumper, T, ev);
+}
+
+bool Arena::Impl::startPush(Discrete& d, const double* ys, int i, int k, EventList& ev) const {
+  Block& b = d.blocks[static_cast<std::size_t>(k)];
+  Vec2 normal;
+  blockGap(d, i, k, ys, &normal);
+  // The robot's speed as the next segment starts: the wheels' targets at
+  // once without a motor lag, else the speed they have now.
+  const RobotParams& p = P(i);
+  const std::array<double, 2> wt = wheelTargetsOf(d, i);
+  const double sp = p.motor_lag_s <= 0 ? 0.5 * (wt[0] + wt[1])
+                                       : 0.5 * (ys[i * kPerRobot + VL] + ys[i * kPerRobot + VR]);
+  const double into = sp * geom::headingDir(heading(ys, i)).dot(normal);
+  const bool heldByOther =
+      nR == 2 && d.r[static_cast<std::size_t>(1 - i)].blockContact[static_cast<std::size_t>(k)];
+  if (!(p.mass_lb * p.wheel_friction > b.load) || heldByOther || !(into < 0)) return false;
+  ContactWith with = ContactWith::None;
+  int index = -1;
+  const double reach = blockReach(d, k, -normal, ys, with, index);
+  if (!(reach > kMinReachFt)) return false;
+  b.pusher = i;
+  b.nx = normal.x();
+  b.ny = normal.y();
+  b.px = ys[i * kPerRobot + X];
+  b.py = ys[i * kPerRobot + Y];
+  b.reach = reach;
+  b.stopWith = with;
+  b.stopIndex = index;
+  Event s{EventKind::PushStart};
+  s.robot = static_cast<std::int8_t>(i);
+  s.ball = static_cast<std::int8_t>(k);
+  s.x = b.x;
+  s.y = b.y;
+  ev.push(s);
+  return true;
 }
 
 }  // namespace simbot::plant

@@ -329,6 +329,10 @@ struct ArenaState {
   int nRoots = 0;
   int nRootsRegistered = -1;
   std::array<double, kMaxRoots> rootShift{};
+  // A push's end function is >= 0 as the segment starts (a wheel command
+  // stopped or reversed its robot at once, without motor lag): no root
+  // can cross, so the push ends at the segment's first tick.
+  bool pushEndDue = false;
   std::vector<int> rootsFound;
 
   // ---- dense output: one quintic Hermite polynomial a step for x and y
@@ -486,6 +490,11 @@ struct Arena::Impl : ArenaState {
   // with them) or ending: process()'s blocks, into ev.
   void blockContacts(std::int64_t T, double te, Discrete& d, std::vector<double>& y,
                      const int* found, EventList& ev);
+  // Robot i meets block k as a fixed box: a contact, its bumper and reflex.
+  void meetBlock(Discrete& d, std::vector<double>& y, int i, int k, std::int64_t T, EventList& ev);
+  // Robot i, just touching block k, starts pushing it if it can (traction
+  // above the block's friction, driving into it, not held, room to move).
+  bool startPush(Discrete& d, const double* ys, int i, int k, EventList& ev) const;
   // Block k's push ends at time te (state y), stopped by `with`.
   void endPush(Discrete& d, int k, const double* y, double te, ContactWith with, int index,
                EventList& ev);

@@ -709,11 +709,12 @@ AdvanceResult Arena::Impl::advance(std::int64_t stopTick) {
   AdvanceResult res;
   commit();
   res.tick = now;
+  const bool due = launchesDue(now) || (pushEndDue && segTick == now);
   if (stopTick <= now) {
-    if (launchesDue(now)) predict(now, timeOfTick(now), nullptr, res.events);
+    if (due) predict(now, timeOfTick(now), nullptr, res.events);
     return res;
   }
-  if (launchesDue(now) && predict(now, timeOfTick(now), nullptr, res.events)) return res;
+  if (due && predict(now, timeOfTick(now), nullptr, res.events)) return res;
   std::int64_t stop = stopTick;
   const std::int64_t nl = nextLaunch();
   if (nl > now && nl < stop) stop = nl;  // ARKODE's stop time is set there

@@ -257,6 +257,7 @@ void Arena::Impl::rootThunk(double t, const double* y, double* g, void* user) {
 // below the distance a robot moves in a tick; it holds for the whole
 // segment, in ARKODE's root finding, crossedTick() and the event rules.
 void Arena::Impl::sideRoots(double t0, const std::vector<double>& y) {
+  pushEndDue = false;
   for (int j = 0; j < nRoots; ++j) {
     const RootDesc& rd = roots[static_cast<std::size_t>(j)];
     auto robot = [&]() -> const RobotDisc& { return D.r[static_cast<std::size_t>(rd.robot)]; };
@@ -287,8 +288,11 @@ void Arena::Impl::sideRoots(double t0, const std::vector<double>& y) {
                    : 1;
         break;
       case RootKind::Block:
+        // Touching as a fixed box, or pushing it: negative.
         side = D.r[static_cast<std::size_t>(rd.robot / kMaxBlocks)]
-                       .blockContact[static_cast<std::size_t>(rd.robot % kMaxBlocks)]
+                           .blockContact[static_cast<std::size_t>(rd.robot % kMaxBlocks)] ||
+                       D.blocks[static_cast<std::size_t>(rd.robot % kMaxBlocks)].pusher ==
+                           rd.robot / kMaxBlocks
                    ? -1
                    : 1;
         break;
@@ -298,7 +302,13 @@ void Arena::Impl::sideRoots(double t0, const std::vector<double>& y) {
     double shift = 0;
     if (side != 0) {
       const double g0 = rootValue(rd, t0, y.data());
-      if (side * g0 <= 0) shift = g0 - side * std::max(std::abs(g0), kMinSide);
+      const bool pushEnds =
+          rd.kind == RootKind::Block && g0 >= 0 &&
+          D.blocks[static_cast<std::size_t>(rd.robot % kMaxBlocks)].pusher == rd.robot / kMaxBlocks;
+      if (pushEnds)
+        pushEndDue = true;  // unshifted: the event rules see it ended
+      else if (side * g0 <= 0)
+        shift = g0 - side * std::max(std::abs(g0), kMinSide);
     }
     rootShift[static_cast<std::size_t>(j)] = shift;
   }

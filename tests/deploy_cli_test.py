@@ -121,10 +121,14 @@ check(p.returncode == 1 and len(err) == 1 and "course.decoy_lights = false forbi
       f"rules: {p.returncode} {p.stderr!r}")
 
 # Blocks are bodies (docs/plant.md "Deployables"): seed 2's 180 s has fig92
-# (B) shoving A's first block between its reflexes. Each robot's JSON
-# `block_push_ft` is the sum of its push_end records' pushed_ft; every
-# push_end follows a push_start of the same robot and block, and each
-# push_start of a block follows that robot's contact with "block N".
+# (B) pushing A's first block. Each robot's JSON `block_push_ft` is the
+# sum of its push_end records' pushed_ft; every push_end follows a
+# push_start of the same robot and block. A push is no contact: a robot
+# starts one only while it has no contact with that block, and has none
+# during it; a contact_end with a block always follows its contact; a
+# push stopped by something (`by` not "drive") is followed at its tick by
+# the robot's contact with that block (it meets it as a fixed box), one
+# that ends by "drive" by none.
 trace = OUT / "pushes.jsonl"
 p = run("match", DROPPER, FIG92, "--seed", "2", "--hw", f"A={BLOCKS}", "--trace", str(trace),
         "--json")
@@ -132,18 +136,33 @@ check(p.returncode == 0, f"pushes: exit {p.returncode}: {p.stderr[-300:]}")
 result = json.loads(p.stdout)
 recs = [json.loads(l) for l in trace.read_text().splitlines()]
 open_push, touching, pushed = {}, set(), {"A": 0.0, "B": 0.0}
+stopped = {}  # (robot, block) -> (t, by) of a push_end awaiting its contact
 for r in recs:
     if r["type"] == "contact" and r["with"].startswith("block "):
-        touching.add((r["robot"], int(r["with"].split()[1])))
+        key = (r["robot"], int(r["with"].split()[1]))
+        check(key not in open_push, f"contact during a push at {r['t']}")
+        check(key not in touching, f"second contact without contact_end at {r['t']}")
+        end = stopped.pop(key, None)
+        check(end is None or (end[0] == r["t"] and end[1] != "drive"),
+              f"contact after a push_end {end} at {r['t']}")
+        touching.add(key)
     elif r["type"] == "contact_end" and r["with"].startswith("block "):
-        touching.discard((r["robot"], int(r["with"].split()[1])))
+        key = (r["robot"], int(r["with"].split()[1]))
+        check(key in touching, f"contact_end without contact at {r['t']}")
+        touching.discard(key)
     elif r["type"] == "push_start":
-        check((r["robot"], r["block"]) in touching, f"push_start without contact at {r['t']}")
-        open_push[(r["robot"], r["block"])] = r["t"]
+        key = (r["robot"], r["block"])
+        check(key not in touching, f"push_start while in contact at {r['t']}")
+        open_push[key] = r["t"]
     elif r["type"] == "push_end":
-        check(open_push.pop((r["robot"], r["block"]), None) is not None,
-              f"push_end without push_start at {r['t']}")
+        key = (r["robot"], r["block"])
+        check(open_push.pop(key, None) is not None, f"push_end without push_start at {r['t']}")
         pushed[r["robot"]] += r["pushed_ft"]
+        if r["by"] != "drive":
+            stopped[key] = (r["t"], r["by"])
+    for key, (t, by) in list(stopped.items()):
+        check(r["t"] == t, f"push_end by {by} at {t} without the robot's contact")
+check(not stopped, f"push_ends without their contacts: {stopped}")
 check(pushed["B"] > 0, "pushes: seed 2 must push a block")
 for i, name in enumerate("AB"):
     got = result["robots"][i]["block_push_ft"]

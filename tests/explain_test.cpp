@@ -667,9 +667,9 @@ TEST(Explain, AHandlerThatNeverReturnsHasItsDuration) {
 // (1 s = 9,216,000).
 // Pushes (plant/arena_blocks.cpp's push_end records) in one sentence each,
 // from the record's own fields: "pushed block N D ft, to (X, Y) ft" with D
-// to 0.001 ft (a shove between reflexes is hundredths), X, Y to 0.01 ft,
-// then what stopped the block if something did. Records made here: A
-// shoves block 1 by 0.8049 ft (0.805) to (-6.4182, -6.7361), a drive's
+// to 0.001 ft (a push stopped soon by something is hundredths), X, Y to
+// 0.01 ft, then what stopped the block if something did. Records made
+// here: A pushes block 1 by 0.8049 ft (0.805) to (-6.4182, -6.7361), a drive's
 // end; B pushes block 2 by 0.05 ft to (7.4, 0) where the wall stops it; A
 // pushes block 3 0.1251 ft (0.125) into "obstacle 2 (mountain)"; B's push
 // of block 1 ends when A touches it (0.004); a block that

@@ -128,31 +128,25 @@ TEST(Blocks, AnUnpushableBlockIsAFixedBox) {
   EXPECT_NEAR(s.arena.pose(0, later).y_ft, box.pose(0, later).y_ft, 1e-9);
 }
 
-// The default profile: speed 15 is v = 1.45 ft/s, motor lag tau = 0.15 s,
-// 35 lb at wheel friction 0.7: T = 24.5 lbf (g cancels). blocks.toml's
-// block: 2 lb at floor friction 0.9, F = 1.8 lbf, so 1 - F/T = 0.926531.
-// B at (1, -2) sets a 0.5 x 0.5 block down at (1, -2.80125) and leaves;
-// A, heading east on y = -2.80125 from x = -4, meets its west face head
-// on. From the contact's tick Tc (A's speed then v0 = v (1 - e^{-(Tc -
-// go) / N tau}), within 1e-8 of v, A starting at `go`) the bumper's reflex drives the
-// wheels towards -v: speed -v + (v0 + v) e^{-t/tau}, into the block until
-// t* = tau ln((v0 + v) / v) (tau ln 2 = 0.10397 s). Meanwhile the pair
-// moves at (1 - F/T) of it: d = (1 - F/T)(v0 tau - v t*), with v0 = v
-// 1.45 x 0.15 x (1 - ln 2) x 0.926531 = 0.061837 ft (a straight push at
-// constant v for tau would be v tau (1 - F/T) = 0.2015 ft: the next test).
+// A push is no contact: the pusher's bumper does not trip while it moves
+// the block. Push collects robot 0's first Contact, its push's start and
+// end ticks.
 struct Push {
   std::int64_t contact = -1, start = -1, end = -1;
-  Event endEvent{};
+  Event endEvent{}, contactEvent{};
 };
-Push pushOnce(Arena& a, std::int64_t go) {
+Push pushOnce(Arena& a, std::int64_t go, std::int64_t until) {
   Push out;
   a.advance(go);
   a.setWheels(0, frame("ffg0ffg0"), go);
-  while (a.now() < go + ticks(12) && out.end < 0) {
-    AdvanceResult res = a.advance(go + ticks(12));
+  while (a.now() < until && out.end < 0) {
+    AdvanceResult res = a.advance(until);
     for (const Event& e : res.events) {
       if (e.robot != 0) continue;
-      if (e.kind == EventKind::Contact && out.contact < 0) out.contact = res.tick;
+      if (e.kind == EventKind::Contact && out.contact < 0) {
+        out.contact = res.tick;
+        out.contactEvent = e;
+      }
       if (e.kind == EventKind::PushStart) out.start = res.tick;
       if (e.kind == EventKind::PushEnd) {
         out.end = res.tick;
@@ -163,89 +157,131 @@ Push pushOnce(Arena& a, std::int64_t go) {
   return out;
 }
 
-TEST(Blocks, APushLastsWhileTheLagDrivesIntoTheBlockAndMovesItByTheClosedForm) {
+// DESIGN.md's straight push: a robot driving at constant v into a block it
+// can push (traction T = M g mu_w above F = m g mu_b) moves it at v (1 -
+// F / T), so in tau seconds d = v tau (1 - m mu_b / (M mu_w)). The default
+// profile without motor lag, speed 15 set to 2 ft/s; 35 lb at 0.7,
+// blocks.toml's 2 lb at 0.9: 1 - 1.8 / 24.5 = 0.9265306, and 1 s of push
+// moves the block 2 x 0.9265306 = 1.853061 ft. B at (5.25, -2) sets a 0.5
+// x 0.5 block down at (5.25, -2.80125) (east face 5.5, 2.5 ft from the
+// east wall) and leaves; A, heading east on y = -2.80125 from x = -4.0001,
+// touches the west face (5.0) when x + 0.53125 = 5: after 8.46885 / 2 s
+// (PushStart there, no Contact). The push reaches the wall after 2.5 /
+// (2 x 0.9265306) = 1.349119 s: there it ends ("wall"), and A meets the
+// block as a fixed box: its front bumper trips at that tick.
+TEST(Blocks, AStraightPushMovesTheBlockByVTauTimesOneLessFOverTUntilTheWall) {
+  Profile p = defaults();
+  p.robot.motor_lag_s = 0;
+  p.robot.speed_table_fps[15] = 2;
+  Scene s(p, Pose{-4.0001, -2.80125, 90}, 5.25, -2, blockKind(0.5, 0.5, 0.5, 2, 0.9), true);
+  Arena& a = s.arena;
+  const LD v = 2, k = 1 - 1.8L / 24.5L;
+  const std::int64_t touch = tickAfter(s.go, (5 - 0.53125L + 4.0001L) / v);
+  // One second into the push: 1.853061 ft.
+  a.advance(s.go);
+  a.setWheels(0, frame("ffg0ffg0"), s.go);
+  std::int64_t start = -1;
+  const std::int64_t oneSecond = touch + ticks(1);
+  while (a.now() < oneSecond) {
+    const AdvanceResult r = a.advance(oneSecond);
+    for (const Event& e : r.events) {
+      if (e.robot != 0) continue;
+      EXPECT_NE(e.kind, EventKind::Contact);
+      if (e.kind == EventKind::PushStart) start = r.tick;
+    }
+  }
+  EXPECT_EQ(start, touch);
+  const double moved = a.blockCentre(0, a.now()).x_ft - 5.25;
+  EXPECT_NEAR(moved, static_cast<double>(v * k * ((a.now() - start) / kN)), 1e-9);
+  EXPECT_NEAR(moved, 1.853061, 1e-6);
+  const Push got = pushOnce(a, a.now(), touch + ticks(3));
+  EXPECT_EQ(got.start, -1);
+  ASSERT_GE(got.end, 0);
+  EXPECT_EQ(got.end, tickAfter(start, 2.5L / (v * k)));
+  EXPECT_EQ(got.endEvent.with, ContactWith::Wall);
+  EXPECT_NEAR(got.endEvent.z, 2.5, 1e-12);
+  EXPECT_NEAR(got.endEvent.x + 0.25, 8.0, 1e-12);
+  EXPECT_DOUBLE_EQ(a.blockPushedFt(0), got.endEvent.z);
+  EXPECT_EQ(got.contact, got.end);
+  EXPECT_EQ(got.contactEvent.with, ContactWith::Block);
+  EXPECT_EQ(got.contactEvent.bumper, Bumper::Front);
+  // Held by it as by a fixed box.
+  for (std::int64_t t = got.end; t < got.end + ticks(1); t += 9'973) {
+    while (a.now() < t) a.advance(t);
+    EXPECT_NEAR(a.blockCentre(0, t).x_ft, 7.75, 1e-12);
+    EXPECT_LE(a.pose(0, t).x_ft, 7.5 - 0.53125 + 1e-6);
+  }
+}
+
+// A push ends when the robot no longer drives into the block, with no
+// contact. The default profile (v = 1.45 ft/s at speed 15, motor lag tau =
+// 0.15 s): A starts at `go` (speed v (1 - e^{-t/tau})), touches the block
+// of the test above at Tc (a = Tc - go) and is stopped at Ts = Tc + 0.5 s
+// (b = Ts - go): it has then gone v ((b - a) - tau (e^{-a/tau} - e^{-b/tau}))
+// along the push and coasts v (1 - e^{-b/tau}) tau more, the speed's
+// double reaching exactly 0 only after 37 tau. The block moves (1 - F/T) of
+// that (0.926531 x 1.45 x (0.5 + 0.15) = 0.8733 ft) and A rests flush
+// against it, no Contact written. A block too heavy (30 lb at 1: F = 30
+// lbf > T) is not pushed: A's bumper trips at the touch and the body stays
+// outside it.
+TEST(Blocks, APushEndsWithoutAContactWhenTheRobotStopsDrivingIntoIt) {
   Profile p = defaults();
   ASSERT_EQ(p.robot.speed_table_fps[15], 1.45);
   ASSERT_EQ(p.robot.motor_lag_s, 0.15);
-  Scene s(p, Pose{-4, -2.80125, 90}, 1, -2, blockKind(0.5, 0.5, 0.5, 2, 0.9), true);
-  const Push got = pushOnce(s.arena, s.go);
-  ASSERT_GE(got.contact, 0);
-  EXPECT_EQ(got.start, got.contact);
-  const LD v = 1.45L, tau = 0.15L, k = 1 - 1.8L / 24.5L;
-  const LD v0 = v * (1 - std::exp(-(got.contact - s.go) / kN / tau));
-  const LD tStar = tau * std::log((v0 + v) / v);
-  EXPECT_EQ(got.end, tickAfter(got.contact, tStar));
-  const LD d = k * (v0 * tau - v * tStar);
-  EXPECT_NEAR(got.endEvent.z, static_cast<double>(d), 1e-7);
-  EXPECT_NEAR(static_cast<double>(d), 0.061837, 1e-6);
-  EXPECT_EQ(got.endEvent.with, ContactWith::None);
-  EXPECT_NEAR(got.endEvent.x, 1 + static_cast<double>(d), 1e-7);
-  EXPECT_NEAR(s.arena.blockCentre(0, s.arena.now()).x_ft, 1 + static_cast<double>(d), 1e-7);
-  EXPECT_DOUBLE_EQ(s.arena.blockPushedFt(0), got.endEvent.z);
-}
-
-// A reflex that stops the wheels (speed step 0) leaves the lag's coast:
-// speed v0 e^{-t/tau} into the block, never reversing, so the push has
-// covered (1 - F/T) v0 tau (1 - e^{-t/tau}) by t, and ends only when the
-// speed's double is exactly 0 (e^{-t/tau} below half an ulp of 1, t > 37
-// tau): by then d = v tau (1 - m mu_b / (M mu_w)) = 1.45 x 0.15 x 0.926531
-// = 0.201520 ft, the straight push at v for tau. A block too heavy (30 lb
-// at 1: F = 30 lbf > T) is not pushed at all, and the body stays outside
-// it.
-TEST(Blocks, ACoastingPushCoversVTauTimesOneLessFOverT) {
-  Profile p = defaults();
   p.robot.reflex_speed_step = 0;
   for (const double mass : {2.0, 30.0}) {
     const double friction = mass == 2.0 ? 0.9 : 1.0;
     Scene s(p, Pose{-4, -2.80125, 90}, 1, -2, blockKind(0.5, 0.5, 0.5, mass, friction), true);
     Arena& a = s.arena;
-    const Push got = pushOnce(a, s.go);
-    ASSERT_GE(got.contact, 0);
-    const LD v = 1.45L, tau = 0.15L;
-    const LD v0 = v * (1 - std::exp(-(got.contact - s.go) / kN / tau));
-    const double moved = a.blockCentre(0, a.now()).x_ft - 1;
-    if (mass == 2.0) {
-      EXPECT_EQ(got.start, got.contact);
-      EXPECT_GT(got.end, got.contact + ticks(37 * 0.15));
-      const LD d = (1 - 1.8L / 24.5L) * v0 * tau;
-      EXPECT_NEAR(got.endEvent.z, static_cast<double>(d), 1e-7);
-      EXPECT_NEAR(moved, static_cast<double>(d), 1e-7);
-      EXPECT_NEAR(moved, 0.201520, 1e-6);
-      // The pusher stays flush against the block's west face.
-      EXPECT_NEAR(a.pose(0, a.now()).x_ft, 1 + moved - 0.25 - 0.53125, 1e-6);
-    } else {
+    const LD v = 1.45L, tau = 0.15L, k = 1 - 1.8L / 24.5L;
+    if (mass == 30.0) {
+      const Push got = pushOnce(a, s.go, s.go + ticks(12));
+      ASSERT_GE(got.contact, 0);
+      EXPECT_EQ(got.contactEvent.bumper, Bumper::Front);
       EXPECT_EQ(got.start, -1);
       EXPECT_EQ(got.end, -1);
-      EXPECT_EQ(moved, 0.0);
+      EXPECT_EQ(a.blockCentre(0, a.now()).x_ft - 1, 0.0);
       EXPECT_GE(0.75 - 0.53125 - a.pose(0, a.now()).x_ft, -1e-6);
+      continue;
     }
-  }
-}
-
-// The same coasting push of a 1.2-ft-wide block whose east face stands
-// 0.05 ft from the east wall (x = 8): B at (7.35, -2) sets it down with its
-// centre at x = 7.35, east face 7.95. The block's travel (1 - F/T) v0 tau
-// (1 - e^{-t/tau}) reaches 0.05 at t = -tau ln(1 - 0.05 / ((1 - F/T) v0
-// tau)); there the push ends ("wall"), the block stands flush with the
-// wall, and the robot is held by it as by a fixed box.
-TEST(Blocks, ABlockPushedIntoAWallStopsThereAndHoldsTheRobot) {
-  Profile p = defaults();
-  p.robot.reflex_speed_step = 0;
-  Scene s(p, Pose{2, -2.80125, 90}, 7.35, -2, blockKind(1.2, 0.5, 0.5, 2, 0.9), true);
-  Arena& a = s.arena;
-  const Push got = pushOnce(a, s.go);
-  ASSERT_GE(got.contact, 0);
-  ASSERT_GE(got.end, 0);
-  const LD v = 1.45L, tau = 0.15L, k = 1 - 1.8L / 24.5L;
-  const LD v0 = v * (1 - std::exp(-(got.contact - s.go) / kN / tau));
-  EXPECT_EQ(got.end, tickAfter(got.contact, -tau * std::log(1 - 0.05L / (k * v0 * tau))));
-  EXPECT_EQ(got.endEvent.with, ContactWith::Wall);
-  EXPECT_NEAR(got.endEvent.z, 0.05, 1e-9);
-  EXPECT_NEAR(got.endEvent.x + 0.6, 8.0, 1e-9);
-  for (std::int64_t t = got.end; t < got.end + ticks(1); t += 9'973) {
-    while (a.now() < t) a.advance(t);
-    EXPECT_NEAR(a.blockCentre(0, t).x_ft, got.endEvent.x, 1e-12);
-    EXPECT_LE(a.pose(0, t).x_ft, got.endEvent.x - 0.6 - 0.53125 + 1e-6);
+    const auto start = [&] {
+      a.advance(s.go);
+      a.setWheels(0, frame("ffg0ffg0"), s.go);
+      return runUntil(a, EventKind::PushStart, s.go + ticks(10), 0);
+    }();
+    ASSERT_TRUE(start.has_value());
+    const std::int64_t stop = start->tick + ticks(0.5);
+    a.advance(stop);
+    a.setWheels(0, frame("0fs00fs0"), stop);
+    Push got;
+    while (a.now() < stop + ticks(12) && got.end < 0) {
+      const AdvanceResult r = a.advance(stop + ticks(12));
+      for (const Event& e : r.events) {
+        if (e.robot != 0) continue;
+        EXPECT_NE(e.kind, EventKind::Contact);
+        EXPECT_NE(e.kind, EventKind::ContactEnd);
+        if (e.kind == EventKind::PushEnd) {
+          got.end = r.tick;
+          got.endEvent = e;
+        }
+      }
+    }
+    ASSERT_GE(got.end, 0);
+    EXPECT_GT(got.end, stop + ticks(37 * 0.15));
+    const LD ta = (start->tick - s.go) / kN, tb = (stop - s.go) / kN;
+    const LD d = k * v *
+                 ((tb - ta) - tau * (std::exp(-ta / tau) - std::exp(-tb / tau)) +
+                  (1 - std::exp(-tb / tau)) * tau);
+    EXPECT_EQ(got.endEvent.with, ContactWith::None);
+    EXPECT_NEAR(got.endEvent.z, static_cast<double>(d), 1e-7);
+    const double moved = a.blockCentre(0, a.now()).x_ft - 1;
+    EXPECT_NEAR(moved, static_cast<double>(d), 1e-7);
+    EXPECT_NEAR(moved, 0.8733, 1e-4);
+    // Flush against the block's west face, and no contact after the push.
+    EXPECT_NEAR(a.pose(0, a.now()).x_ft, 1 + moved - 0.25 - 0.53125, 1e-6);
+    const std::int64_t later = a.now() + ticks(1);
+    while (a.now() < later)
+      for (const Event& e : a.advance(later).events) EXPECT_NE(e.kind, EventKind::Contact);
   }
 }
 
@@ -301,15 +337,18 @@ TEST(Blocks, ADiscStopsAtABlock) {
   EXPECT_EQ(miss->event.obstacle, 0);
 }
 
-// The other robot touching a block being pushed holds it. B, heading east
-// at (2, -2.80125), sets a 0.5 x 0.5 block down behind it: centre x = 2 -
-// 0.80125 = 1.19875, east face 0.02 ft from B's back rim. A coasts into its
-// west face as in the test above; the block's travel (1 - F/T) v0 tau (1 -
-// e^{-t/tau}) reaches 0.02 ft at t = -tau ln(1 - 0.02 / ((1 - F/T) v0
-// tau)): there B's back bumper trips on "block 1" and the push ends, "by"
-// the robot (B), with the block 0.02 ft on (to a tick's travel, 2e-7 ft).
+// The other robot touching a block being pushed holds it. Without motor
+// lag (speed 15: v = 1.45 ft/s at once) B, heading east at (2, -2.80125),
+// sets a 0.5 x 0.5 block down behind it: centre x = 2 - 0.80125 =
+// 1.19875, east face 0.02 ft from B's back rim. A drives into its west
+// face and pushes it at (1 - F/T) v = 0.926531 x 1.45 ft/s: it travels
+// 0.02 ft in 0.02 / (0.926531 x 1.45) s. There B's back bumper trips on
+// "block 1", the push ends "by" the robot (B), with the block 0.02 ft on
+// (to a tick's travel, 2e-7 ft), and A meets the held block as a fixed
+// box: its front bumper trips at the same tick (and not before).
 TEST(Blocks, TheOtherRobotTouchingAPushedBlockHoldsIt) {
   Profile p = defaults();
+  p.robot.motor_lag_s = 0;
   p.robot.reflex_speed_step = 0;
   ArenaConfig c = config(p, {Pose{-3, -2.80125, 90}, Pose{2, -2.80125, 90}});
   c.field.divider = false;
@@ -321,21 +360,23 @@ TEST(Blocks, TheOtherRobotTouchingAPushedBlockHoldsIt) {
   a.setWheels(0, frame("ffg0ffg0"), kStart);
   const auto start = runUntil(a, EventKind::PushStart, kStart + ticks(10), 0);
   ASSERT_TRUE(start.has_value());
-  std::optional<Found> touch, end;
+  std::optional<Found> touch, pusherTouch, end;
   while (a.now() < start->tick + ticks(2) && !end) {
     const AdvanceResult r = a.advance(start->tick + ticks(2));
     for (const Event& e : r.events) {
       if (e.kind == EventKind::Contact && e.robot == 1) touch = Found{r.tick, e};
+      if (e.kind == EventKind::Contact && e.robot == 0) pusherTouch = Found{r.tick, e};
       if (e.kind == EventKind::PushEnd) end = Found{r.tick, e};
     }
   }
-  ASSERT_TRUE(touch && end);
-  const LD v = 1.45L, tau = 0.15L, k = 1 - 1.8L / 24.5L;
-  const LD v0 = v * (1 - std::exp(-(start->tick - kStart) / kN / tau));
-  EXPECT_EQ(end->tick, tickAfter(start->tick, -tau * std::log(1 - 0.02L / (k * v0 * tau))));
+  ASSERT_TRUE(touch && pusherTouch && end);
+  const LD v = 1.45L, k = 1 - 1.8L / 24.5L;
+  EXPECT_EQ(end->tick, tickAfter(start->tick, 0.02L / (k * v)));
   EXPECT_EQ(touch->tick, end->tick);
   EXPECT_EQ(touch->event.with, ContactWith::Block);
   EXPECT_EQ(touch->event.bumper, Bumper::Back);
+  EXPECT_EQ(pusherTouch->tick, end->tick);
+  EXPECT_EQ(pusherTouch->event.bumper, Bumper::Front);
   EXPECT_EQ(end->event.with, ContactWith::Robot);
   EXPECT_EQ(end->event.other, 1);
   EXPECT_NEAR(end->event.z, 0.02, 2e-7);
@@ -400,3 +441,34 @@ TEST(Blocks, ABlockThatWouldNotFitStaysOnTheRobot) {
 }
 
 }  // namespace
+
+// Without motor lag a wheel command steps the robot's velocity: reversing
+// A half a second into a push (the default profile without its lag:
+// 1.45 ft/s at speed 15; the block of the tests above) ends the push at that very tick,
+// "drive", with no contact, the block 1.45 x 0.5 x 0.926531 = 0.671735 ft
+// on; it stays there while A backs away (it is not pulled back).
+TEST(Blocks, AReverseCommandWithoutLagEndsThePushAtItsTick) {
+  Profile p = defaults();
+  p.robot.motor_lag_s = 0;
+  Scene s(p, Pose{-4, -2.80125, 90}, 1, -2, blockKind(0.5, 0.5, 0.5, 2, 0.9), true);
+  Arena& a = s.arena;
+  a.advance(s.go);
+  a.setWheels(0, frame("ffg0ffg0"), s.go);
+  const auto start = runUntil(a, EventKind::PushStart, s.go + ticks(10), 0);
+  ASSERT_TRUE(start.has_value());
+  const std::int64_t rev = start->tick + ticks(0.5);
+  a.advance(rev);
+  a.setWheels(0, frame("frg0frg0"), rev);
+  const auto end = runUntil(a, EventKind::PushEnd, rev + ticks(1), 0);
+  ASSERT_TRUE(end.has_value());
+  EXPECT_EQ(end->tick, rev);
+  EXPECT_EQ(end->event.with, ContactWith::None);
+  const LD d = 1.45L * (1 - 1.8L / 24.5L) * ((rev - start->tick) / kN);
+  EXPECT_NEAR(end->event.z, static_cast<double>(d), 1e-9);
+  EXPECT_NEAR(end->event.z, 0.671735, 1e-6);
+  const std::int64_t later = rev + ticks(1);
+  while (a.now() < later)
+    for (const Event& e : a.advance(later).events) EXPECT_NE(e.kind, EventKind::Contact);
+  EXPECT_EQ(a.blockCentre(0, later).x_ft, end->event.x);
+  EXPECT_NEAR(a.pose(0, later).x_ft, end->event.x - 0.25 - 0.53125 - 1.45, 1e-6);
+}
