@@ -222,25 +222,13 @@ bool Arena::Impl::blockFits(const Discrete& d, const geom::Convex& s, const doub
 }
 
 // The ball's flight meets block k's footprint over [lo, hi] of its path
-// from tFrom on; as ballMeetsObstacle, below the block's height at lo or
+// from tFrom on (ballMeetsShape): below the block's height at lo or
 // where it comes down through that height before hi.
 void Arena::Impl::ballMeetsBlocks(Ball& b, const Discrete& d, const double* y, double tFrom) const {
-  const double g = cfg.field.gravity_fps2;
-  const Vec2 p0(b.x0, b.y0), v(b.vx, b.vy);
   const double from = std::max(0.0, tFrom - b.t0);
   for (int k = 0; k < d.blockCount; ++k) {
-    const double h = d.blocks[static_cast<std::size_t>(k)].height;
-    double lo = 0, hi = 0;
-    if (!geom::clipLine(p0, v, blockShape(d, k, y), from, HUGE_VAL, lo, hi)) continue;
-    double s = HUGE_VAL;
-    const auto z = [&](double u) { return b.z0 + b.vz * u - 0.5 * g * u * u; };
-    if (b.rolling || z(lo) <= h) {
-      s = lo;
-    } else {
-      const double disc = b.vz * b.vz + 2 * g * (b.z0 - h);
-      const double down = (b.vz + std::sqrt(std::max(disc, 0.0))) / g;
-      if (down >= lo && down <= hi) s = down;
-    }
+    const double s =
+        ballMeetsShape(b, blockShape(d, k, y), d.blocks[static_cast<std::size_t>(k)].height, from);
     if (b.t0 + s < b.meetT) {
       b.meetT = b.t0 + s;
       b.meetObstacle = blockObstacle(k);

@@ -462,6 +462,9 @@ struct Arena::Impl : ArenaState {
   double ballGap(const Ball& b, double t, const double* y) const;
   double ballOutG(const Ball& b, double t) const;
   double ballDividerG(const Ball& b, double t) const;
+  // Where (s after b.t0, from s = from on) the flight first meets `shape`
+  // below `height` (closed form); HUGE_VAL: not at all.
+  double ballMeetsShape(const Ball& b, const geom::Convex& shape, double height, double from) const;
   // Sets b.meetObstacle and b.meetT: the first obstacle its flight from
   // b.t0 meets below the obstacle's height (closed form), if any.
   void ballMeetsObstacle(Ball& b) const;

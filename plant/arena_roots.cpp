@@ -139,32 +139,29 @@ double Arena::Impl::ballDividerG(const Ball& b, double t) const {
 // s_out. The earliest over all obstacles is the ball's meeting: a known
 // time, so its root function t_meet - t is linear and no step can pass
 // over it.
+double Arena::Impl::ballMeetsShape(const Ball& b, const geom::Convex& shape, double height,
+                                   double from) const {
+  const double g = cfg.field.gravity_fps2;
+  double lo = 0, hi = 0;
+  if (!geom::clipLine(Vec2(b.x0, b.y0), Vec2(b.vx, b.vy), shape, from, HUGE_VAL, lo, hi))
+    return HUGE_VAL;
+  if (b.rolling) return lo;
+  const auto z = [&](double u) { return b.z0 + b.vz * u - 0.5 * g * u * u; };
+  if (z(lo) <= height) return lo;
+  // z(u) = height on the way down: the larger root of
+  // g/2 u^2 - vz u + (height - z0) = 0 (real: z(lo) > height).
+  const double disc = b.vz * b.vz + 2 * g * (b.z0 - height);
+  const double down = (b.vz + std::sqrt(std::max(disc, 0.0))) / g;
+  return down >= lo && down <= hi ? down : HUGE_VAL;
+}
+
 void Arena::Impl::ballMeetsObstacle(Ball& b) const {
   b.meetObstacle = -1;
   b.meetT = HUGE_VAL;
-  const double g = cfg.field.gravity_fps2;
-  const Vec2 p0(b.x0, b.y0), v(b.vx, b.vy);
   for (int k = 0; k < bodies.obstacleCount; ++k) {
-    const double h = cfg.field.obstacles[static_cast<std::size_t>(k)].height_ft;
-    double lo = 0, hi = 0;
-    if (!geom::clipLine(p0, v, bodies.obstacles[static_cast<std::size_t>(k)], 0.0, HUGE_VAL, lo,
-                        hi))
-      continue;
-    double s = HUGE_VAL;
-    if (b.rolling) {
-      s = lo;
-    } else {
-      const auto z = [&](double u) { return b.z0 + b.vz * u - 0.5 * g * u * u; };
-      if (z(lo) <= h) {
-        s = lo;
-      } else {
-        // z(u) = h on the way down: the larger root of
-        // g/2 u^2 - vz u + (h - z0) = 0 (real: z(lo) > h).
-        const double disc = b.vz * b.vz + 2 * g * (b.z0 - h);
-        const double down = (b.vz + std::sqrt(std::max(disc, 0.0))) / g;
-        if (down >= lo && down <= hi) s = down;
-      }
-    }
+    const double s =
+        ballMeetsShape(b, bodies.obstacles[static_cast<std::size_t>(k)],
+                       cfg.field.obstacles[static_cast<std::size_t>(k)].height_ft, 0.0);
     if (b.t0 + s < b.meetT) {
       b.meetT = b.t0 + s;
       b.meetObstacle = k;
