@@ -1,5 +1,5 @@
 // Resolves the cycle table against the calibration knobs.
-#include "vm/cost.h"
+#include "vm/cost_sums.h"
 
 #include <stdexcept>
 #include <string>

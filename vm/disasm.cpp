@@ -7,7 +7,7 @@
 #include <bit>
 #include <map>
 
-#include "vm/cost.h"
+#include "vm/cost_sums.h"
 #include "vm/vm.h"
 
 namespace simbot::vm {

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "vm/cost_sums.h"
 #include "vm/float_math.h"
 #include "vm/state.h"
 

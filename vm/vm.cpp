@@ -106,7 +106,7 @@ void Vm::State::accept() {
   pc = static_cast<uint32_t>(handler);
 }
 
-// The BIOS timer service (cost.h kTimerIsrSeq): atomic, like the serial
+// The BIOS timer service (cost_sums.h kTimerIsrSeq): atomic, like the serial
 // library's ISR: interrupts stay disabled inside it and its EI; RETI leaves
 // IFF1 set as it was at acceptance.
 void Vm::State::timerService(uint32_t interruptedPc) {

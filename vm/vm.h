@@ -17,7 +17,7 @@
 // steps, their inner loops one unit (a byte) a step, and a struct
 // assignment one byte a step, as the Z180's LDIR; a handler accepted there
 // resumes the call or the copy when it returns. The
-// serial library's calls are atomic (cost.h kLibAtomic): no boundary inside
+// serial library's calls are atomic (cost_sums.h kLibAtomic): no boundary inside
 // them, and IFF1 after them is what it was before.
 //
 // The timer: when the program uses the timer library (Image::timer) or the
