@@ -70,6 +70,8 @@ std::string recordsMarkdown() {
   return out;
 }
 
+void Collector::write(const Entry& entry) { entries.push_back(entry); }
+
 void Tracer::emit(Tick t, Record record, Watch watch) {
   if (t < flushed_)
     throw std::logic_error("trace: a record at tick " + std::to_string(t) +
