@@ -2,11 +2,11 @@
 // written beside it, along the path it takes, with the Z180's published
 // T-states; knobs act globally and stay within their hardware ranges.
 // Expected figures are summed by hand from the Z180 table in comments.
-#include "vm/cost_sums.h"
-
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+
+#include "vm/cost_sums.h"
 
 using namespace simbot::vm;
 

@@ -1,8 +1,8 @@
 // Resolves the cycle table against the calibration knobs.
-#include "vm/cost_sums.h"
-
 #include <stdexcept>
 #include <string>
+
+#include "vm/cost_sums.h"
 
 namespace simbot::vm {
 
