@@ -73,6 +73,11 @@ struct Devices {
   // returned, interrupts accepted per source (vm::Irq).
   std::array<int64_t, 2> adReads{};
   std::array<int, 2> lastAdValue{-1, -1};
+  // The decoy screen (index in the arena's deployed items) that hid the
+  // opponent's beacon at the last eye read, or -1: screen_hides is traced
+  // when it changes. Kept through a reset: it is the field's, not the
+  // program's.
+  int lastBeaconScreen = -1;
   std::array<uint64_t, vm::kIrqCount> interruptCounts{};
 };
 

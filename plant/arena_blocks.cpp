@@ -411,6 +411,8 @@ bool Arena::Impl::startPush(Discrete& d, const double* ys, int i, int k, EventLi
   s.ball = static_cast<std::int8_t>(k);
   s.x = b.x;
   s.y = b.y;
+  s.vx = b.px;  // the pusher's centre (plant.h Event)
+  s.vy = b.py;
   ev.push(s);
   return true;
 }

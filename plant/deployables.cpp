@@ -82,18 +82,26 @@ bool obstacleHides(const Vec2& a, const Vec2& b, const FieldParams& field, doubl
 
 // One source's share of each eye's signal: adds c to the near eye and
 // c f to the far one (optics.cpp's geometry, with the source's kappa).
-void addSource(const Pose& self, const Vec2& at, double sourceHeight, double intensity,
-               const RobotParams& p, const FieldParams& field, const EyeScene& scene, double& left,
-               double& right) {
+// Returns the index of the scene's item that hid it (a screen before any
+// other), or -1: seen, behind the eyes, or hidden by the divider or an
+// obstacle.
+int addSource(const Pose& self, const Vec2& at, double sourceHeight, double intensity,
+              const RobotParams& p, const FieldParams& field, const EyeScene& scene, double& left,
+              double& right) {
   const Vec2 a(self.x_ft, self.y_ft);
   const double dx = at.x() - a.x(), dy = at.y() - a.y();
   const double r = std::sqrt(dx * dx + dy * dy);
   const double gamma = geom::wrap180(geom::radToDeg(std::atan2(dx, dy)) - self.heading_deg);
-  if (!(std::abs(gamma) < 90.0)) return;
-  if (dividerBlocks(a.x(), a.y(), at.x(), at.y(), field)) return;
-  if (obstacleHides(a, at, field, sourceHeight)) return;
-  for (int k = 0; k < scene.count; ++k)
-    if (hiddenBy(scene.items[k], a, at, sourceHeight)) return;
+  if (!(std::abs(gamma) < 90.0)) return -1;
+  if (dividerBlocks(a.x(), a.y(), at.x(), at.y(), field)) return -1;
+  if (obstacleHides(a, at, field, sourceHeight)) return -1;
+  int hider = -1;
+  for (int k = 0; k < scene.count; ++k) {
+    if (!hiddenBy(scene.items[k], a, at, sourceHeight)) continue;
+    if (scene.items[k].kind == DeployKind::DecoyScreen) return k;
+    if (hider < 0) hider = k;
+  }
+  if (hider >= 0) return hider;
   const double kappa =
       intensity * (p.eye_max - p.eye_background) * p.eye_saturation_ft * p.eye_saturation_ft;
   const double c = std::min(kappa / (r * r), p.eye_max - p.eye_background);
@@ -112,6 +120,7 @@ void addSource(const Pose& self, const Vec2& at, double sourceHeight, double int
     left += c;
     right += c;
   }
+  return -1;
 }
 
 }  // namespace
@@ -149,11 +158,15 @@ Deployed placeDeployable(const Deployable& d, int robot, int table, std::int64_t
 }
 
 void eyeSignalsAmong(const Pose& self, int selfRobot, const Pose* opponent, const RobotParams& p,
-                     const FieldParams& field, const EyeScene& scene, double& left, double& right) {
+                     const FieldParams& field, const EyeScene& scene, double& left, double& right,
+                     int* beaconScreen) {
   double cl = 0, cr = 0;
+  int hider = -1;
   if (opponent)
-    addSource(self, Vec2(opponent->x_ft, opponent->y_ft), field.beacon_height_ft, 1.0, p, field,
-              scene, cl, cr);
+    hider = addSource(self, Vec2(opponent->x_ft, opponent->y_ft), field.beacon_height_ft, 1.0, p,
+                      field, scene, cl, cr);
+  if (beaconScreen)
+    *beaconScreen = hider >= 0 && scene.items[hider].kind == DeployKind::DecoyScreen ? hider : -1;
   for (int k = 0; k < scene.count; ++k) {
     const Deployed& item = scene.items[k];
     if (item.kind != DeployKind::DecoyLight || item.robot == selfRobot) continue;

@@ -116,8 +116,9 @@ EyeReadings computeEyes(const Pose& self, const Pose* opponent, const RobotParam
                         const FieldParams& field, RandomBits* noise, EyeChannels channels,
                         const EyeScene* scene, int selfRobot) {
   double sLeft = p.eye_background, sRight = p.eye_background;
+  int beaconScreen = -1;
   if (scene && scene->count > 0) {
-    eyeSignalsAmong(self, selfRobot, opponent, p, field, *scene, sLeft, sRight);
+    eyeSignalsAmong(self, selfRobot, opponent, p, field, *scene, sLeft, sRight, &beaconScreen);
   } else if (opponent) {
     const EyeGeometry g = eyeGeometry(self, *opponent, p, field);
     if (g.seen) {
@@ -135,6 +136,7 @@ EyeReadings computeEyes(const Pose& self, const Pose* opponent, const RobotParam
     }
   }
   EyeReadings r;
+  r.beaconScreen = beaconScreen;
   bool bad = false;
   int badValue = 0;
   if (channels != EyeChannels::Right) {

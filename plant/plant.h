@@ -300,8 +300,11 @@ struct EyeScene {
 // lights add (docs/plant.md "Deployables": c_i = min(intensity_i kappa /
 // r_i^2, max - background) on the near eye, c_i f_i on the far one), each
 // hidden by the divider, an obstacle, a block or a screen taller than it.
+// `beaconScreen` (if not null): the index in scene.items of the decoy
+// screen that hid the opponent's beacon, else -1.
 void eyeSignalsAmong(const Pose& self, int selfRobot, const Pose* opponent, const RobotParams& p,
-                     const FieldParams& field, const EyeScene& scene, double& left, double& right);
+                     const FieldParams& field, const EyeScene& scene, double& left, double& right,
+                     int* beaconScreen = nullptr);
 
 // Port B bindings of one robot (bits 0..7).
 struct Hardware {
@@ -347,6 +350,10 @@ double wheelSpeedFps(const WheelCommand& cmd, const RobotParams& p, bool leftWhe
 struct EyeReadings {
   int left = 16;   // channel 0
   int right = 16;  // channel 1
+  // The decoy screen (its index in Arena::deployed) that hid the opponent's
+  // beacon from these eyes, or -1: the beacon in front of them, not hidden
+  // by the divider or an obstacle (eyeSignalsAmong).
+  int beaconScreen = -1;
 };
 // Source of raw random bits (one seeded generator per purpose, owned by the
 // caller). The plant turns bits into numbers with its own code.
@@ -478,6 +485,7 @@ struct Event {
   // the flight is x + vx s, y + vy s, z + vz s - g s^2 / 2 after the launch
   // tick; and the shooter's heading (deg) then, from which the ball's
   // azimuth dispersion turned it.
+  // PushStart: x, y the block's centre, vx, vy the pusher's (ft).
   double x = 0, y = 0, z = 0, vx = 0, vy = 0, vz = 0;
   double heading_deg = 0;
   // A miss: the ball's closest distance to the other robot's body (ft), the

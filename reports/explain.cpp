@@ -474,6 +474,13 @@ struct Explainer::State {
            fmt::format("set down {} {} (bit {}) at ({:.2f}, {:.2f}) ft", kind, x.number, x.bit,
                        x.x_ft, x.y_ft));
   }
+  // Whose beacon the robot's eyes lost behind a screen, or found again.
+  void on(Tick t, const rec::ScreenHides& x) {
+    course(x.robot, t,
+           fmt::format("{} {} a decoy screen ({}'s screen {})", kRobotNames[(1 - x.robot) & 1],
+                       x.hidden ? "hidden by" : "no longer hidden by", kRobotNames[x.owner & 1],
+                       x.number));
+  }
   void on(Tick t, const rec::DeployBlocked& x) {
     course(x.robot, t,
            fmt::format("could not set down a block (bit {}): no room at ({:.2f}, {:.2f}) ft", x.bit,

@@ -552,7 +552,7 @@ trace::Record Match::plantRecord(const plant::Event& e) const {
     case plant::EventKind::DiscHit:
       return rec::DiscHit{r, e.other, e.ball, e.x, e.y, e.z};
     case plant::EventKind::PushStart:
-      return rec::PushStart{r, e.ball + 1, e.x, e.y};
+      return rec::PushStart{r, e.ball + 1, e.x, e.y, e.vx, e.vy};
     case plant::EventKind::PushEnd:
       return rec::PushEnd{
           r,

@@ -118,6 +118,7 @@ class Robot : public vm::Bus {
   void out(Tick t, uint16_t port, uint8_t value) override;
   uint8_t in(Tick t, uint16_t port) override;
   int adSample(Tick t, int channel) override;
+  void emitScreenHides(Tick t, int item, bool hidden);
   void serialSend(Tick t, uint16_t buf, uint16_t cc) override;
   void serialTxService(Tick t, vm::Vm& v) override;
   void console(Tick t, std::string_view line) override;

@@ -53,8 +53,29 @@ int Robot::adSample(Tick t, int channel) {
     if (match->tracing() && value != board.lastAdValue[c])
       match->emit(t, trace::rec::AdRead{index, channel, value, board.adReads[c]});
     board.lastAdValue[c] = value;
+    if (e.beaconScreen != board.lastBeaconScreen) {
+      if (match->tracing()) {
+        if (board.lastBeaconScreen >= 0) emitScreenHides(t, board.lastBeaconScreen, false);
+        if (e.beaconScreen >= 0) emitScreenHides(t, e.beaconScreen, true);
+      }
+      board.lastBeaconScreen = e.beaconScreen;
+    }
   }
   return value;
+}
+
+// Screen `item` of the arena's deployed items began (hidden) or ceased to
+// hide the opponent's beacon from this robot's eyes; the screen is named
+// as its deploy record names it (its robot, its number in its table).
+void Robot::emitScreenHides(Tick t, int item, bool hidden) {
+  const std::vector<plant::Deployed>& items = match->arena().deployed();
+  const plant::Deployed& screen = items[static_cast<size_t>(item)];
+  int number = 0;
+  for (int k = 0; k <= item; ++k) {
+    const plant::Deployed& d = items[static_cast<size_t>(k)];
+    if (d.robot == screen.robot && d.table == screen.table) ++number;
+  }
+  match->emit(t, trace::rec::ScreenHides{index, screen.robot, number, hidden});
 }
 
 // The call chain of the send under way: the VM's frames and then the

@@ -21,10 +21,21 @@ Usage: explain_course_test.py SIMBOT SOURCE_DIR ICEMAN FIG92 OUTDIR
   and disc_miss named; the VCD names A's bit 6 A_disc_launcher.
 - scenarios/course-1996.toml's decoy lights: each deploy record named
   where it was set down, and each release with none left.
+- fig92 with its launcher on its solenoid's line (profiles/hardware/
+  disc-on-solenoid.toml, seed 10: discs from 43.9 s): one disc for each of its port B writes
+  that raises bit 4 (0x18 after 0x08, from the program's own writes), no
+  ball, each disc named; the VCD names B's bit 4 B_disc_launcher.
+- A decoy screen between fig92 (A) and programs/dropper.dc (B,
+  scenarios/decoy-screen.toml): every screen_hides record named ("B
+  hidden by a decoy screen (B's screen N)"), and at the first sample
+  after each hidden one the segment between the robots' centres crosses
+  that screen (its deploy record's centre and heading, 18 in wide from
+  profiles/hardware/decoy-light.toml).
 - A run without any of these: no Course section, and explain --json
   has no course key.
 """
 import json
+import math
 import re
 import shutil
 import subprocess
@@ -183,6 +194,64 @@ for h in records(discs, "disc_hit"):
 for m in records(discs, "disc_miss"):
     check(f"  {m['robot']} {at(m['t'])} disc {m['disc']} missed: " in text, f"disc miss {m}")
 check(vcd_changes(discs_vcd, "A_disc_launcher")[0] is not None, "the VCD names A_disc_launcher")
+
+# ---- discs from fig92's solenoid line
+fig_discs, fig_vcd = OUT / "fig92_discs.jsonl", OUT / "fig92_discs.vcd"
+run("match", ICEMAN, FIG92, "--rules", "se3015-1997w", "--hw",
+    "B=profiles/hardware/disc-on-solenoid.toml", "--seed", "10", "--seconds", "60", "--trace",
+    fig_discs, "--vcd", fig_vcd)
+text = explain(fig_discs)
+writes = [r for r in records(fig_discs, "port_b") if r["robot"] == "B"]
+rises = sum(1 for a, b in zip([0] + [w["value"] for w in writes], [w["value"] for w in writes])
+            if b & 0x10 and not a & 0x10)
+b_fires = [f for f in records(fig_discs, "disc_fire") if f["robot"] == "B"]
+b_empty = [f for f in records(fig_discs, "disc_empty") if f["robot"] == "B"]
+check(rises > 0 and len(b_fires) + len(b_empty) == rises,
+      f"fig92: one disc per rise of bit 4: {rises} rises, {len(b_fires)} + {len(b_empty)} discs")
+check(not [b for b in records(fig_discs, "ball_launch") if b["robot"] == "B"],
+      "fig92's gun 1 (solenoid on bit 6) launches no ball")
+for f in b_fires:
+    check(f"  B {at(f['t'])} disc {f['disc']} fired, heading {f['heading_deg']:.1f} deg" in text,
+          f"fig92's disc fired at {at(f['t'])}")
+for h in (h for h in records(fig_discs, "disc_hit") if h["robot"] == "B"):
+    check(f"  B {at(h['t'])} disc {h['disc']} hit A\n" in text, f"fig92's disc hit {h}")
+check(vcd_changes(fig_vcd, "B_disc_launcher")[0] is not None, "the VCD names B_disc_launcher")
+
+# ---- a decoy screen between the robots
+screens = OUT / "screen.jsonl"
+run("match", FIG92, SOURCE / "programs/dropper.dc", "--scenario", "scenarios/decoy-screen.toml",
+    "--seconds", "10", "--trace", screens)
+text = explain(screens)
+hides = records(screens, "screen_hides")
+check(any(h["hidden"] for h in hides), f"the screen hides B from A: {hides}")
+placed = [d for d in records(screens, "deploy") if d["kind"] == "decoy_screen"]
+samples = records(screens, "sample")
+
+
+def crosses(a, b, c, d):
+    """Whether segments ab and cd cross (their points as (x, y))."""
+    def side(p, q, r):
+        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+    return side(a, b, c) * side(a, b, d) < 0 and side(c, d, a) * side(c, d, b) < 0
+
+
+for h in hides:
+    verb = "hidden by" if h["hidden"] else "no longer hidden by"
+    want = f"  {h['robot']} {at(h['t'])} B {verb} a decoy screen ({h['owner']}'s screen {h['number']})\n"
+    check(want in text, f"named: {want!r}")
+    if not h["hidden"]:
+        continue
+    scr = [d for d in placed if d["robot"] == h["owner"] and d["number"] == h["number"]]
+    after = [r for r in samples if r["t"] >= h["t"]][:2]
+    check(len(scr) == 1 and len(after) == 2, f"screen {h['number']} and the samples after {h['t']}")
+    if len(scr) == 1 and len(after) == 2:
+        d = scr[0]
+        hd = math.radians(d["heading_deg"])
+        w = (0.75 * math.cos(hd), -0.75 * math.sin(hd))  # half of 18 in, across the heading
+        ends = ((d["x_ft"] - w[0], d["y_ft"] - w[1]), (d["x_ft"] + w[0], d["y_ft"] + w[1]))
+        pos = {r["robot"]: (r["x_ft"], r["y_ft"]) for r in after}
+        check(crosses(pos["A"], pos["B"], *ends),
+              f"at {at(after[0]['t'])} the line A-B crosses B's screen {h['number']}: {pos} {ends}")
 
 # ---- none of it
 plain = OUT / "plain.jsonl"

@@ -39,14 +39,19 @@ const TPS = 9216000;
 const records = (path, type) => readFileSync(path, 'utf8').split('\n')
   .filter((l) => l.includes(`"type":"${type}"`)).map((l) => JSON.parse(l));
 
-function run(name, args) {
+function runPair(name, a, b, args) {
   const trace = join(out, `${name}.jsonl`), page = join(out, `${name}.html`);
-  execFileSync(simbot, ['match', iceman, fig92, ...args, '--trace', trace, '--replay', page],
+  execFileSync(simbot, ['match', a, b, ...args, '--trace', trace, '--replay', page],
     { stdio: ['ignore', 'ignore', 'inherit'], cwd: sourceDir });
   return { trace, page };
 }
+const run = (name, args) => runPair(name, iceman, fig92, args);
 const mines = run('mines', ['--scenario', 'scenarios/mines.toml', '--rules', 'se3015-1996', '--seconds', '60']);
 const decoys = run('decoys', ['--scenario', 'scenarios/course-1996.toml', '--seconds', '50']);
+// programs/backer.dc sets a block down behind it and backs into it: one
+// push of about 0.6 ft, ended by the wall.
+const pushes = runPair('pushes', join(sourceDir, 'programs/backer.dc'), fig92,
+  ['--hw', 'A=profiles/hardware/blocks.toml', '--seconds', '4']);
 const discs = run('discs', ['--rules', 'se3015-1997w', '--hw', 'A=profiles/hardware/disc-launcher.toml',
   '--seconds', '60']);
 
@@ -180,6 +185,39 @@ const scatter = records(discs.trace, 'scatter_shot');
 if (scatter.length) check(symbols.includes('scatter_shot'), `the timeline marks scatter shots (${scatter.length})`);
 check(symbols.includes('disc_fire'), `the timeline marks discs fired: ${symbols.join(', ')}`);
 for (const sym of symbols) check(discLegend.includes(sym), `the legend lists "${sym}"`);
+
+// ---- a pushed block moves with its pusher (not at push_start and
+// push_end only). The plant moves the block along the push by exactly the
+// robot's displacement along it (docs/plant.md "Deployables"): at each of
+// the pusher's samples inside the push the block must be at
+// push_start's place + u ((sample - robot at push_start) . u), u the unit
+// vector from the push_start place to the push_end one, all from the
+// trace; so never back, and on the segment.
+await open(pushes.page);
+const pushStarts = records(pushes.trace, 'push_start'), pushEnds = records(pushes.trace, 'push_end');
+check(pushStarts.length === 1 && pushEnds.length === 1, `backer: one push (${pushStarts.length}, ${pushEnds.length})`);
+if (pushStarts.length === 1 && pushEnds.length === 1) {
+  const s0 = pushStarts[0], s1 = pushEnds[0];
+  const dx = s1.x_ft - s0.x_ft, dy = s1.y_ft - s0.y_ft, len = Math.hypot(dx, dy);
+  check(len > 0.5, `the push moved the block ${len.toFixed(3)} ft`);
+  const inside = records(pushes.trace, 'sample').filter((r) => r.robot === s0.robot && r.t > s0.t && r.t < s1.t);
+  check(inside.length >= 10, `the pusher's samples inside the push: ${inside.length}`);
+  const index = (await page.evaluate(() => window.simbotViewer.course())).deployables - 1;
+  let last = 0, worst = 0;
+  for (const r of inside) {
+    const p = await page.evaluate(([i, t]) => window.simbotViewer.deployableAt(i, t), [index, r.t]);
+    const expected = ((r.x_ft - s0.robot_x_ft) * dx + (r.y_ft - s0.robot_y_ft) * dy) / len;
+    worst = Math.max(worst, Math.hypot(p.x - (s0.x_ft + expected * dx / len), p.y - (s0.y_ft + expected * dy / len)));
+    const along = ((p.x - s0.x_ft) * dx + (p.y - s0.y_ft) * dy) / len;
+    check(along >= last - 1e-9 && along <= len + 1e-9, `block at ${r.time_s.toFixed(3)} s: ${along.toFixed(4)} ft along, after ${last.toFixed(4)}`);
+    last = along;
+  }
+  check(worst < 1e-9, `the block moves by the pusher's displacement along the push (off by ${worst} ft)`);
+  const mid = inside[Math.floor(inside.length / 2)];
+  const pm = await page.evaluate(([i, t]) => window.simbotViewer.deployableAt(i, t), [index, mid.t]);
+  const done = ((pm.x - s0.x_ft) * dx + (pm.y - s0.y_ft) * dy) / len / len;
+  check(done > 0.2 && done < 0.8, `half way through the push the block is ${(100 * done).toFixed(0)}% of the way`);
+}
 
 check(problems.length === 0, `console: ${problems.join(' | ')}`);
 const caught = await page.evaluate(() => window.simbotViewer.errors);

@@ -119,6 +119,24 @@ TEST(Deployables, ScreenHidesExactlyWhenItCrossesTheLineOfSight) {
   EXPECT_EQ(read(nullptr, {light(0, 0, 6, 2.0), screen(0, 3, 0, 1.5, 1)}).left, 16);
 }
 
+TEST(Deployables, TheReadingNamesTheScreenThatHidTheBeacon) {
+  // As above: the beacon 10 ft ahead. The reading names the screen (its
+  // index among the items) exactly when it hides the beacon
+  // (screen_hides in the trace).
+  const Pose opp{0, 10, 180};
+  EXPECT_EQ(read(&opp, {screen(0, 5, 0, 1.5, 1)}).beaconScreen, 0);
+  EXPECT_EQ(read(&opp, {screen(2, 5, 0, 1.5, 1)}).beaconScreen, -1);
+  EXPECT_EQ(read(&opp, {screen(0, 5, 0, 1.5, 0.5)}).beaconScreen, -1);
+  EXPECT_EQ(read(&opp, {light(0, 0, 6, 2.0), screen(2, 5, 0, 1.5, 1), screen(0, 7, 0, 1.5, 1)})
+                .beaconScreen,
+            2);
+  // A light hidden by a screen is no beacon: -1.
+  EXPECT_EQ(read(nullptr, {light(0, 0, 6, 2.0), screen(0, 3, 0, 1.5, 1)}).beaconScreen, -1);
+  // The beacon behind the eyes: nothing to hide, -1.
+  const Pose behind{0, -10, 0};
+  EXPECT_EQ(read(&behind, {screen(0, -5, 0, 1.5, 1)}).beaconScreen, -1);
+}
+
 TEST(Deployables, SetDownBehindTheBackRimAlongTheHeading) {
   // A robot at (1, 2) heading 90 (east), body radius 0.53125 ft, drops a
   // block 0.125 ft deep: its centre 0.53125 + 0.02 + 0.0625 = 0.61375 ft

@@ -283,6 +283,8 @@ function startViewer() {
     fieldPixelOf: (x, y) => field.pixelOf(x, y),
     course: () => ({ obstacles: model.course.obstacles.length, discs: model.course.discs.length,
       deployables: model.course.deployables.length }),
+    // Deployable i's centre at tick t as the page draws it (null before it is set down).
+    deployableAt: (i, t) => deployablePosition(model.course.deployables[i], t, model.robots),
     timelineSymbols: () => timeline.symbols(),
     setWindow: (from, to) => timeline.setWindow(from, to),
   });

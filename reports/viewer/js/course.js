@@ -9,6 +9,12 @@
 // from `deploy` records (kind block, decoy_light or decoy_screen, where it
 // was set down); a block's later positions from any record that names it
 // (`block` or `deployable`) with x_ft and y_ft, held between records.
+// During a push (push_start to push_end) the block moves with its pusher:
+// the plant moves it along the push by exactly the robot's displacement
+// along the push's normal (plant/arena_blocks.cpp), so the page moves it
+// along the segment from its push_start to its push_end place by the
+// drawn robot's displacement along that segment from its centre at the
+// push_start (exact at the robot's samples, where the page's pose is).
 
 // A deployable's number in a record (`deploy` has `number`, from 1 per
 // item of its robot's table; a block's later records `block` or `number`).
@@ -108,13 +114,42 @@ function deployables(K) {
     const order = d.moves.t.map((_, k) => k).sort((a, b) => d.moves.t[a] - d.moves.t[b]);
     d.moves = { t: order.map((k) => d.moves.t[k]), x: order.map((k) => d.moves.x[k]), y: order.map((k) => d.moves.y[k]) };
   }
+  // Each push as one span: a push_start and the next push_end of the same
+  // block and robot.
+  for (const d of blocks) d.pushes = [];
+  const starts = rowsOf(K.push_start), ends = rowsOf(K.push_end);
+  for (const s of starts) {
+    const d = blocks[s.block - 1];
+    const e = ends.find((x) => x.block === s.block && x.robot === s.robot && x.t >= s.t);
+    if (d && e) d.pushes.push({ robot: s.robot, t0: s.t, t1: e.t, x0: s.x_ft, y0: s.y_ft, x1: e.x_ft, y1: e.y_ft,
+      rx: s.robot_x_ft, ry: s.robot_y_ft });
+  }
   return out;
 }
 
-// A deployable's centre at tick t (its last recorded position), or null
-// before it was set down.
-function deployablePosition(d, t) {
+// Where a block is during a push at tick t, t0 <= t < t1: on its push's
+// segment, as far along it as its pusher has moved along it since the
+// push_start (the robot's centre then is in the record); linear in time
+// if the page has no pose of the robot.
+function pushPosition(p, t, robots) {
+  const dx = p.x1 - p.x0, dy = p.y1 - p.y0;
+  const len = Math.hypot(dx, dy);
+  if (!(len > 0)) return { x: p.x0, y: p.y0 };
+  let along = p.t1 > p.t0 ? len * (t - p.t0) / (p.t1 - p.t0) : len;
+  const robot = robots && robots[p.robot];
+  if (robot && p.rx !== undefined && p.rx !== null) {
+    const q = poseAt(robot, t);
+    along = ((q.x_ft - p.rx) * dx + (q.y_ft - p.ry) * dy) / len;
+  }
+  const f = Math.min(1, Math.max(0, along / len));
+  return { x: p.x0 + f * dx, y: p.y0 + f * dy };
+}
+
+// A deployable's centre at tick t (moving with its pusher during a push,
+// else its last recorded position), or null before it was set down.
+function deployablePosition(d, t, robots) {
   if (t < d.t0) return null;
+  for (const p of d.pushes || []) if (p.t0 <= t && t < p.t1) return pushPosition(p, t, robots);
   const k = lastAtOrBefore(d.moves.t, t);
   return k < 0 ? { x: d.x, y: d.y } : { x: d.moves.x[k], y: d.moves.y[k] };
 }
@@ -162,7 +197,7 @@ function drawCourse2d(ctx, px, py, scale, model, t) {
     ++drawn.obstacles;
   }
   for (const d of model.course.deployables) {
-    const p = deployablePosition(d, t);
+    const p = deployablePosition(d, t, model.robots);
     if (!p) continue;
     const style = COURSE_STYLE[d.kind] || COURSE_STYLE.block;
     ctx.fillStyle = style.color;
@@ -254,7 +289,7 @@ function createCourse3d(scene, model) {
   });
   return function update(t) {
     for (const { d, mesh } of things) {
-      const p = deployablePosition(d, t);
+      const p = deployablePosition(d, t, model.robots);
       mesh.visible = p !== null;
       if (!p) continue;
       const up = d.kind === 'decoy_light' ? 0.75 : d.kind === 'decoy_screen' ? d.height / 2 : d.size / 2;

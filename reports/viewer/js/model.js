@@ -300,6 +300,7 @@ const EVENT_STYLE = {
   deploy: { glyph: 'B', color: '#b08850', label: 'deployed (block / decoy)' },
   deploy_empty: { glyph: '|', color: '#806040', label: 'nothing left to deploy' },
   push_end: { glyph: 'b', color: '#d0a060', label: 'block pushed' },
+  screen_hides: { glyph: 's', color: '#7090b0', label: 'beacon behind a decoy screen (or out)' },
 };
 
 function describeEvent(kind, c, i) {
@@ -332,6 +333,8 @@ function describeEvent(kind, c, i) {
       (c.closest_ft[i] === null ? '' : `, closest ${c.closest_ft[i].toFixed(2)} ft`);
     case 'deploy': return `${c.kind[i]} ${c.number[i]} (bit ${c.bit[i]})`;
     case 'deploy_empty': return `no ${c.kind[i]} left (bit ${c.bit[i]})`;
+    case 'screen_hides': return `${ROBOT_NAMES[1 - c.robot[i]]} ` +
+      (c.hidden[i] ? 'hidden by' : 'no longer hidden by') + ` a decoy screen (${ROBOT_NAMES[c.owner[i]]}'s screen ${c.number[i]})`;
     case 'push_end': return `pushed block ${c.block[i]} ${c.pushed_ft[i].toFixed(2)} ft (${c.by[i]})`;
     default: return '';
   }
