@@ -34,6 +34,7 @@ Subcommand addCompareCommand(CLI::App& app);
 Subcommand addTournamentCommand(CLI::App& app);
 Subcommand addExplainCommand(CLI::App& app);  // cli/explain_command.cpp
 Subcommand addSweepCommand(CLI::App& app);    // cli/sweep_command.cpp
+Subcommand addCheckCommand(CLI::App& app);    // cli/check_command.cpp
 // simbot debug (cli/debug_command.cpp): commands from --batch FILE, the
 // terminal or stdin; --robot the one held first ("A" or "B").
 int debugCommand(const std::vector<std::string>& programs, const runs::RunOptions& o);

@@ -314,6 +314,8 @@ int main(int argc, char** argv) {
   const auto explain = simbot::cli::addExplainCommand(app);
   const auto sweep = simbot::cli::addSweepCommand(app);
   addWarningOptions(sweep.app);
+  const auto check = simbot::cli::addCheckCommand(app);
+  addWarningOptions(check.app);
 
   files::removeTemporariesOnSignals();
   try {
@@ -333,8 +335,8 @@ int main(int argc, char** argv) {
   }
   try {
     // -Wno-NAME and -Werror, on every command that compiles a program.
-    for (CLI::App* cmd :
-         {solo, match, profile, debugCmd, bench.app, tournament.app, compare.app, sweep.app})
+    for (CLI::App* cmd : {solo, match, profile, debugCmd, bench.app, tournament.app, compare.app,
+                          sweep.app, check.app})
       if (*cmd) {
         compiler::Options options;
         runs::parseWarningOptions(cmd->remaining(), options, cmd->get_name());
@@ -352,6 +354,7 @@ int main(int argc, char** argv) {
     if (*tournament.app) return tournament.run();
     if (*explain.app) return explain.run();
     if (*sweep.app) return sweep.run();
+    if (*check.app) return check.run();
   } catch (const sinks::UserError& e) {
     std::cerr << e.what();
     return kExitBadInput;

@@ -24,6 +24,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "plant/plant.h"
@@ -283,6 +284,63 @@ Profile sweepProfile(const SweepSpec& spec, size_t point);
 // A path as written in the sweep file, made usable from here (relative
 // paths are from the file's directory).
 std::string sweepPath(const SweepSpec& spec, const std::string& path);
+
+// ---------------------------------------------------------------- checks
+// An expectations file (simbot check; docs/check.md): what a program (robot
+// A) must do over the runs the file names. check/ plays and judges them.
+
+// A record the trace may hold, and the values some of its fields must
+// have (compared with the record as its JSONL line has it: robots "A" or
+// "B", numbers equal, strings and booleans equal).
+struct RecordPattern {
+  std::string kind;  // a trace record kind (trace/records.def)
+  struct Field {
+    std::string name;
+    std::variant<std::int64_t, double, bool, std::string> value;
+  };
+  std::vector<Field> fields;
+};
+
+enum class CheckKind : std::uint8_t {
+  NoFault,            // no_fault = true: A never faults, nor the plant
+  HitsAtLeast,        // hits_at_least = N
+  ShotsAtMost,        // shots_at_most = N
+  NoScatterShot,      // no_scatter_shot = true (needs rules: they judge it)
+  NoOverwrittenSend,  // no_overwritten_send = true
+  FramesAtLeast,      // frames_at_least = N (frames latched)
+  Step,               // after = {...}, within_s = S, expect = {...}
+};
+
+struct Check {
+  std::string name;
+  CheckKind kind = CheckKind::NoFault;
+  std::int64_t count = 0;  // HitsAtLeast, ShotsAtMost, FramesAtLeast
+  // Step: every record matching `after` must be followed, at its tick or
+  // within `within` ticks after, by one matching `expect`.
+  RecordPattern after, expect;
+  scheduler::Tick within = 0;
+  SourcePos pos;  // the [[check]] table
+};
+
+struct Expectations {
+  std::string file;
+  scheduler::Tick length = 0;        // `seconds` (default 60 s)
+  std::vector<std::uint64_t> seeds;  // `seed`: one or a list (default 1)
+  enum class Opponent : std::uint8_t { None, Program, Stationary } opponent = Opponent::None;
+  std::string opponentProgram;  // resolved from the file's directory
+  double stationaryFt = 0;      // "stationary:8ft": a beacon this far ahead of A's start
+  std::optional<std::string> profile, rules;  // a name, or a resolved path
+  std::vector<Check> checks;
+};
+
+// At most this many seeds and checks in one file: each seed is a run.
+inline constexpr std::size_t kMaxCheckSeeds = 1000;
+inline constexpr std::size_t kMaxChecks = 1000;
+
+// Reads and checks an expectations file: ConfigError "FILE:LINE:COL:
+// error: ..." at what is wrong (an unknown key or record kind, a field the
+// record does not have, a missing name, a count out of range).
+Expectations loadExpectations(const std::string& path);
 
 // ---------------------------------------------------------------- injections
 // Parses ROBOT:SOURCE@WHEN (WHEN: a time in timebase/written.h's grammar

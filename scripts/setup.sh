@@ -29,6 +29,7 @@ packages=(
   pybind11-dev python3-dev     # the Python module
   python3-pandas python3-matplotlib  # traces as DataFrames; docs/ plots a bench
   python3-statsmodels          # test oracle for the survival and interval statistics
+  python3-junitparser          # reads simbot check's JUnit XML in its test
   python3-distributed          # sweeps on a Dask cluster
 )
 if [ "${1:-}" = --quickstart ]; then

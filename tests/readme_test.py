@@ -6,7 +6,7 @@ Usage: readme_test.py SIMBOT WORKDIR README [PAGE...]
 Each ```sh block of the README, then of each manual page (docs/*.md) in
 the order given, runs with bash -e, in a sandbox
 laid out like the project's checkout (WORKDIR/main holding build/bin/simbot,
-programs/, scenarios/, profiles/, tests/, bench/, docs/, the bench binaries
+programs/, scenarios/, profiles/, checks/, tests/, bench/, docs/, the bench binaries
 and build/python,
 beside WORKDIR/shared), so that
 the files a command writes land in WORKDIR and a later block can read them.
@@ -74,7 +74,7 @@ def sandbox(source, simbot, work):
     module = os.path.join(os.path.dirname(os.path.abspath(simbot)), "..", "python")
     if os.path.isdir(module):
         os.symlink(os.path.abspath(module), os.path.join(main, "build", "python"))
-    for part in ("programs", "scenarios", "profiles", "tests", "bench", "docs"):
+    for part in ("programs", "scenarios", "profiles", "checks", "tests", "bench", "docs"):
         os.symlink(os.path.join(source, part), os.path.join(main, part))
     os.symlink(os.path.abspath(os.path.join(source, "..", "shared")), os.path.join(work, "shared"))
     return main
