@@ -316,6 +316,7 @@ int main(int argc, char** argv) {
   addWarningOptions(sweep.app);
   const auto check = simbot::cli::addCheckCommand(app);
   addWarningOptions(check.app);
+  const auto serve = simbot::cli::addServeCommand(app);
 
   files::removeTemporariesOnSignals();
   try {
@@ -355,6 +356,7 @@ int main(int argc, char** argv) {
     if (*explain.app) return explain.run();
     if (*sweep.app) return sweep.run();
     if (*check.app) return check.run();
+    if (*serve.app) return serve.run();
   } catch (const sinks::UserError& e) {
     std::cerr << e.what();
     return kExitBadInput;

@@ -30,6 +30,9 @@ packages=(
   python3-pandas python3-matplotlib  # traces as DataFrames; docs/ plots a bench
   python3-statsmodels          # test oracle for the survival and interval statistics
   python3-junitparser          # reads simbot check's JUnit XML in its test
+  python3-fastapi python3-uvicorn python3-multipart python3-httpx  # simbot serve, and its tests' client
+  python3-sqlalchemy python3-alembic python3-psycopg2             # its database and migrations
+  curl                         # docs/serve.md's example
   python3-distributed          # sweeps on a Dask cluster
 )
 if [ "${1:-}" = --quickstart ]; then

@@ -1,0 +1,85 @@
+// simbot serve [--db URL] [--host H] [--port P] [--data DIR] [--checks
+// FILE] [--house DIR] [--workers N]: a course's competition over HTTP (server/simbot_server,
+// Python: FastAPI on uvicorn, SQLAlchemy, Alembic). This command hands over to it, with this
+// executable as the simbot it compiles and checks with.
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "cli/commands.h"
+#include "sinks/user_error.h"
+
+namespace simbot::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ServeOptions {
+  std::string db, host = "127.0.0.1", data = "simbot-data", checks, house;
+  int port = 8000, workers = 2;
+};
+
+[[noreturn]] void execServer(const ServeOptions& o) {
+#ifdef SIMBOT_PYTHON
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw sinks::UserError("simbot: serve: cannot find this executable's path\n");
+  std::string path = SIMBOT_SERVER_DIR;
+  if (const char* old = std::getenv("PYTHONPATH"); old && *old) path += std::string(":") + old;
+  setenv("PYTHONPATH", path.c_str(), 1);
+  std::vector<std::string> args = {SIMBOT_PYTHON,          "-m",     "simbot_server", "--simbot",
+                                   self.string(),          "--host", o.host,          "--port",
+                                   std::to_string(o.port), "--data", o.data};
+  if (!o.db.empty()) args.insert(args.end(), {"--db", o.db});
+  if (!o.checks.empty()) args.insert(args.end(), {"--checks", o.checks});
+  if (!o.house.empty()) args.insert(args.end(), {"--house", o.house});
+  args.insert(args.end(), {"--workers", std::to_string(o.workers)});
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::cout.flush();
+  execv(SIMBOT_PYTHON, argv.data());
+  throw sinks::UserError(
+      fmt::format("simbot: serve: cannot run {}: {}\n", SIMBOT_PYTHON, std::strerror(errno)));
+#else
+  (void)o;
+  throw sinks::UserError(
+      "simbot: serve needs the Python server, which this build does not have (sanitizer builds "
+      "leave it out)\n");
+#endif
+}
+
+}  // namespace
+
+Subcommand addServeCommand(CLI::App& app) {
+  auto o = std::make_shared<ServeOptions>();
+  auto* cmd = app.add_subcommand(
+      "serve",
+      "host a course's competition over HTTP: teams, submissions compiled and checked at once "
+      "(docs/serve.md)");
+  cmd->add_option("--db", o->db,
+                  "database URL (default: SQLite, DATA/simbot.sqlite3; PostgreSQL: "
+                  "postgresql://USER@HOST/NAME)");
+  cmd->add_option("--host", o->host, "address to listen on (default 127.0.0.1)");
+  cmd->add_option("--port", o->port, "port (default 8000)")->check(CLI::Range(1, 65535));
+  cmd->add_option("--data", o->data,
+                  "the server's folder: the database file and the instructor token (default "
+                  "simbot-data)");
+  cmd->add_option("--checks", o->checks,
+                  "the course's expectations file (simbot check), run on every submission")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--house", o->house,
+                  "house robots: the folder's NAME.dc plays as \"house:NAME\" (e.g. programs)")
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--workers", o->workers, "matches run at once, each a process (default 2)")
+      ->check(CLI::Range(1, 64));
+  return {cmd, [o]() -> int { execServer(*o); }};
+}
+
+}  // namespace simbot::cli

@@ -1,0 +1,48 @@
+"""A submission compiled by the simbot executable (`simbot compile`), in a
+folder of its own under a name the server chooses: no text a team sends
+becomes a path. The compiler's diagnostics name the file as the team named
+it (its base name, letters, digits, '.', '_', '-' only; else program.dc)."""
+import os
+import re
+import subprocess
+import tempfile
+
+DISK_NAME = "program.dc"
+COMPILE_SECONDS = 30  # the compiler's own limits bound its work; this bounds a stuck process
+_DIAGNOSTIC = re.compile(r"^(?P<file>.*?):(?P<line>\d+):(?P<col>\d+): (?P<kind>error|warning): ")
+_SAFE_NAME = re.compile(r"^[A-Za-z0-9._-]{1,128}$")
+
+
+def display_name(file_name):
+    base = os.path.basename((file_name or "").replace("\\", "/"))
+    return base if _SAFE_NAME.match(base) and base not in (".", "..") else DISK_NAME
+
+
+class Compiled:
+    def __init__(self, ok, errors, warnings):
+        self.ok, self.errors, self.warnings = ok, errors, warnings
+
+
+def compile_source(simbot, source, shown_name):
+    """Compiles `source` (bytes); its errors and warnings are one line
+    each, "NAME:LINE:COL: error: ..." with NAME `shown_name`."""
+    with tempfile.TemporaryDirectory(prefix="simbot-submission-") as folder:
+        path = os.path.join(folder, DISK_NAME)
+        with open(path, "wb") as f:
+            f.write(source)
+        try:
+            p = subprocess.run([simbot, "compile", path], capture_output=True, timeout=COMPILE_SECONDS,
+                               cwd=folder)
+        except subprocess.TimeoutExpired:
+            return Compiled(False, [f"{shown_name}:1:1: error: the compiler took more than "
+                                    f"{COMPILE_SECONDS} s"], [])
+    errors, warnings = [], []
+    for line in p.stderr.decode("utf-8", "replace").splitlines():
+        m = _DIAGNOSTIC.match(line)
+        if not m:
+            continue
+        text = shown_name + line[len(m.group("file")):]
+        (errors if m.group("kind") == "error" else warnings).append(text)
+    if p.returncode != 0 and not errors:
+        errors.append(f"{shown_name}:1:1: error: the compiler failed (exit status {p.returncode})")
+    return Compiled(p.returncode == 0, errors, warnings)
