@@ -1,9 +1,13 @@
 #include "cli/commands.h"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -22,6 +26,23 @@
 #include "timebase/tick.h"
 
 namespace simbot::cli {
+
+#ifdef SIMBOT_PYTHON
+void execPython(const std::string& pythonPath, std::vector<std::string> args,
+                const std::string& what) {
+  std::string path = pythonPath;
+  if (const char* old = std::getenv("PYTHONPATH"); old && *old) path += std::string(":") + old;
+  setenv("PYTHONPATH", path.c_str(), 1);
+  args.insert(args.begin(), SIMBOT_PYTHON);
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::cout.flush();
+  execv(SIMBOT_PYTHON, argv.data());
+  throw sinks::UserError(
+      fmt::format("simbot: {}: cannot run {}: {}\n", what, SIMBOT_PYTHON, std::strerror(errno)));
+}
+#endif
 
 int guarded(const std::function<int()>& body) {
   try {

@@ -20,6 +20,13 @@ struct Subcommand {
 // printed on stderr and gives exit status 1.
 int guarded(const std::function<int()>& body);
 
+// Replaces this process with the build's Python (SIMBOT_PYTHON, where the
+// build has the Python module) running `args`, with `pythonPath` put before
+// PYTHONPATH's entries: simbot sweep --dask and simbot serve. UserError
+// "simbot: WHAT: cannot run ..." when it cannot start.
+[[noreturn]] void execPython(const std::string& pythonPath, std::vector<std::string> args,
+                             const std::string& what);
+
 // A seed: a decimal integer from 0 to 2^64 - 1 (not wrapped, not signed).
 CLI::Validator seedValidator();
 

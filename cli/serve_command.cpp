@@ -2,13 +2,7 @@
 // FILE] [--house DIR] [--workers N]: a course's competition over HTTP (server/simbot_server,
 // Python: FastAPI on uvicorn, SQLAlchemy, Alembic). This command hands over to it, with this
 // executable as the simbot it compiles and checks with.
-#include <fmt/format.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
 #include <filesystem>
-#include <iostream>
 #include <memory>
 
 #include "cli/commands.h"
@@ -30,23 +24,14 @@ struct ServeOptions {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   if (ec) throw sinks::UserError("simbot: serve: cannot find this executable's path\n");
-  std::string path = SIMBOT_SERVER_DIR;
-  if (const char* old = std::getenv("PYTHONPATH"); old && *old) path += std::string(":") + old;
-  setenv("PYTHONPATH", path.c_str(), 1);
-  std::vector<std::string> args = {SIMBOT_PYTHON,          "-m",     "simbot_server", "--simbot",
-                                   self.string(),          "--host", o.host,          "--port",
-                                   std::to_string(o.port), "--data", o.data};
+  std::vector<std::string> args = {"-m",     "simbot_server", "--simbot", self.string(),
+                                   "--host", o.host,          "--port",   std::to_string(o.port),
+                                   "--data", o.data};
   if (!o.db.empty()) args.insert(args.end(), {"--db", o.db});
   if (!o.checks.empty()) args.insert(args.end(), {"--checks", o.checks});
   if (!o.house.empty()) args.insert(args.end(), {"--house", o.house});
   args.insert(args.end(), {"--workers", std::to_string(o.workers)});
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  std::cout.flush();
-  execv(SIMBOT_PYTHON, argv.data());
-  throw sinks::UserError(
-      fmt::format("simbot: serve: cannot run {}: {}\n", SIMBOT_PYTHON, std::strerror(errno)));
+  execPython(SIMBOT_SERVER_DIR, std::move(args), "serve");
 #else
   (void)o;
   throw sinks::UserError(

@@ -50,19 +50,11 @@ std::string defaultOut(const SweepOptions& o) {
     const fs::path installed = self.parent_path().parent_path() / SIMBOT_PYTHON_INSTALL_DIR;
     if (fs::exists(installed / "simbot" / "sweep.py", ec)) path = installed.string();
   }
-  if (const char* old = std::getenv("PYTHONPATH"); old && *old) path += std::string(":") + old;
-  setenv("PYTHONPATH", path.c_str(), 1);
-  std::vector<std::string> args = {SIMBOT_PYTHON, "-m",      "simbot.sweep", o.file,   "--out",
-                                   o.run.out,     "--shard", o.run.shard,    "--dask", o.run.dask};
+  std::vector<std::string> args = {"-m",      "simbot.sweep", o.file,   "--out",   o.run.out,
+                                   "--shard", o.run.shard,    "--dask", o.run.dask};
   if (o.run.noHeader) args.push_back("--no-header");
   if (o.run.resume) args.push_back("--resume");
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  std::cout.flush();
-  execv(SIMBOT_PYTHON, argv.data());
-  throw sinks::UserError(
-      fmt::format("simbot: --dask: cannot run {}: {}\n", SIMBOT_PYTHON, std::strerror(errno)));
+  execPython(path, std::move(args), "--dask");
 #else
   (void)o;
   throw sinks::UserError(
