@@ -22,7 +22,6 @@ import random
 import re
 import secrets
 import subprocess
-import tempfile
 
 from fastapi import Body, Depends, FastAPI, File, Header, HTTPException, Request, UploadFile
 from fastapi.responses import JSONResponse
@@ -163,13 +162,10 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
         if len(source) > MAX_PROGRAM_BYTES:
             raise HTTPException(413, f"a program has at most {MAX_PROGRAM_BYTES} bytes")
         shown = compiler.display_name(program.filename)
-        result = compiler.compile_source(simbot, source, shown)
-        if not result.ok:
-            return JSONResponse({"errors": result.errors}, status_code=422)
-        with tempfile.TemporaryDirectory(prefix="simbot-check-") as folder:
-            path = os.path.join(folder, compiler.DISK_NAME)
-            with open(path, "wb") as f:
-                f.write(source)
+        with compiler.written(source) as path:
+            result = compiler.compile_file(simbot, path, shown)
+            if not result.ok:
+                return JSONResponse({"errors": result.errors}, status_code=422)
             cases = run_checks(path)
         last = s.execute(select(func.max(Submission.version)).where(
             Submission.team_id == who.id)).scalar() or 0

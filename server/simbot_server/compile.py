@@ -2,6 +2,7 @@
 folder of its own under a name the server chooses: no text a team sends
 becomes a path. The compiler's diagnostics name the file as the team named
 it (its base name, letters, digits, '.', '_', '-' only; else program.dc)."""
+import contextlib
 import os
 import re
 import subprocess
@@ -23,19 +24,26 @@ class Compiled:
         self.ok, self.errors, self.warnings = ok, errors, warnings
 
 
-def compile_source(simbot, source, shown_name):
-    """Compiles `source` (bytes); its errors and warnings are one line
-    each, "NAME:LINE:COL: error: ..." with NAME `shown_name`."""
+@contextlib.contextmanager
+def written(source):
+    """The path of `source` (bytes) written as DISK_NAME in a fresh folder,
+    removed with it afterwards: the compiler and the checks read it there."""
     with tempfile.TemporaryDirectory(prefix="simbot-submission-") as folder:
         path = os.path.join(folder, DISK_NAME)
         with open(path, "wb") as f:
             f.write(source)
-        try:
-            p = subprocess.run([simbot, "compile", path], capture_output=True, timeout=COMPILE_SECONDS,
-                               cwd=folder)
-        except subprocess.TimeoutExpired:
-            return Compiled(False, [f"{shown_name}:1:1: error: the compiler took more than "
-                                    f"{COMPILE_SECONDS} s"], [])
+        yield path
+
+
+def compile_file(simbot, path, shown_name):
+    """Compiles the program at `path` (written()); its errors and warnings
+    are one line each, "NAME:LINE:COL: error: ..." with NAME `shown_name`."""
+    try:
+        p = subprocess.run([simbot, "compile", path], capture_output=True, timeout=COMPILE_SECONDS,
+                           cwd=os.path.dirname(path))
+    except subprocess.TimeoutExpired:
+        return Compiled(False, [f"{shown_name}:1:1: error: the compiler took more than "
+                                f"{COMPILE_SECONDS} s"], [])
     errors, warnings = [], []
     for line in p.stderr.decode("utf-8", "replace").splitlines():
         m = _DIAGNOSTIC.match(line)
