@@ -21,21 +21,20 @@ import os
 import random
 import re
 import secrets
-import subprocess
 
 from fastapi import Body, Depends, FastAPI, File, Header, HTTPException, Request, UploadFile
 from fastapi.responses import JSONResponse
 from sqlalchemy import func, select
 from sqlalchemy.exc import IntegrityError
 
-from . import compile as compiler
-from . import db, tokens
+from . import db, submissions, tokens
 from .models import MAX_PROGRAM_BYTES, MAX_TEAM_NAME, Match, Setting, Submission, Team, Tournament
+from .pages import add_pages
 from .queue import MatchQueue, house_robots
+from .replay import Replays
 from .standings import standings
 
 MAX_BODY_BYTES = MAX_PROGRAM_BYTES + 8 * 1024  # a program and its multipart framing
-CHECK_SECONDS = 300  # the course's checks of one submission
 MAX_WAITING_PER_TEAM = 10  # a team's scrimmages queued or running at once
 MAX_ROUNDS = 100  # of a round robin
 _RULES_NAME = re.compile(r"^[A-Za-z0-9-]{1,64}$")
@@ -69,6 +68,13 @@ def latest(s, team_id):
                      .order_by(Submission.version.desc()).limit(1)).scalar()
 
 
+def team_by_token(s, token):
+    """The team whose token is `token`, or None (tokens are kept as hashes)."""
+    if not token:
+        return None
+    return s.execute(select(Team).where(Team.token_hash == tokens.token_hash(token))).scalar()
+
+
 def _name_problem(name):
     if not isinstance(name, str) or not name.strip():
         return "a team's name is a non-empty string"
@@ -98,6 +104,8 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
     app.state.queue = queue = MatchQueue(session_factory, simbot, house, workers)
     app.add_event_handler("startup", queue.start)
     app.add_event_handler("shutdown", queue.stop)
+    add_pages(app, session_factory, simbot, checks, Replays(session_factory, simbot, house, data_dir),
+              team_by_token)
 
     @app.middleware("http")
     async def bounded_bodies(request: Request, call_next):
@@ -123,7 +131,8 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
             raise HTTPException(403, "the instructor's token is needed")
 
     def team(authorization: str = Header(None), s=Depends(session)):
-        found = s.execute(select(Team).where(Team.token_hash == bearer(authorization))).scalar()
+        bearer(authorization)  # 401 without one
+        found = team_by_token(s, authorization[len("Bearer "):].strip())
         if found is None:
             raise HTTPException(403, "a team's token is needed")
         return found
@@ -144,36 +153,15 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
             raise HTTPException(409, "a team of that name exists")
         return {"id": t.id, "token": token}
 
-    def run_checks(source_path):
-        if not checks:
-            return []
-        p = subprocess.run([simbot, "check", source_path, "--expect", checks, "--json"],
-                           capture_output=True, timeout=CHECK_SECONDS)
-        if p.returncode not in (0, 1):
-            return [{"check": "(the checks did not run)", "status": "failed",
-                     "message": p.stderr.decode("utf-8", "replace").strip()[-500:]}]
-        return json.loads(p.stdout)["cases"]
-
     @app.post("/api/submissions", status_code=201)
     def submit(program: UploadFile = File(...), who: Team = Depends(team), s=Depends(session)):
-        # Synchronous: FastAPI runs it on its thread pool, so the compiler and
-        # the checks do not hold up the event loop.
         source = program.file.read(MAX_PROGRAM_BYTES + 1)
-        if len(source) > MAX_PROGRAM_BYTES:
+        if submissions.too_big(source):
             raise HTTPException(413, f"a program has at most {MAX_PROGRAM_BYTES} bytes")
-        shown = compiler.display_name(program.filename)
-        with compiler.written(source) as path:
-            result = compiler.compile_file(simbot, path, shown)
-            if not result.ok:
-                return JSONResponse({"errors": result.errors}, status_code=422)
-            cases = run_checks(path)
-        last = s.execute(select(func.max(Submission.version)).where(
-            Submission.team_id == who.id)).scalar() or 0
-        sub = Submission(team_id=who.id, version=last + 1, file_name=shown,
-                         source=source.decode("latin-1"), warnings="\n".join(result.warnings))
-        s.add(sub)
-        s.commit()
-        return {"version": sub.version, "warnings": result.warnings, "checks": cases}
+        out = submissions.submit(s, simbot, checks, who.id, program.filename, source)
+        if out.errors:
+            return JSONResponse({"errors": out.errors}, status_code=422)
+        return {"version": out.submission.version, "warnings": out.warnings, "checks": out.cases}
 
     @app.post("/api/scrimmages", status_code=201)
     def scrimmage(body: dict = Body(...), who: Team = Depends(team), s=Depends(session)):

@@ -24,6 +24,9 @@ class Team(Base):
     id = Column(Integer, primary_key=True)
     name = Column(String(MAX_TEAM_NAME), nullable=False, unique=True)
     token_hash = Column(String(64), nullable=False, unique=True)
+    # The team's robot: a hardware file (TOML) from its /teams/ID/robot form,
+    # checked by simbot's loader; None: the course's profile as it is.
+    hardware = Column(Text)
     created = Column(DateTime, nullable=False, server_default=func.now())
     submissions = relationship("Submission", back_populates="team", order_by="Submission.version")
 
@@ -38,6 +41,7 @@ class Submission(Base):
     file_name = Column(String(MAX_FILE_NAME), nullable=False)  # as the team named it: shown, never a path
     source = Column(Text, nullable=False)
     warnings = Column(Text, nullable=False)  # the compiler's warning lines, one per line
+    checks = Column(Text)  # the course's checks on it: simbot check's cases (JSON), None if none
     created = Column(DateTime, nullable=False, server_default=func.now())
     team = relationship("Team", back_populates="submissions")
 
@@ -53,6 +57,7 @@ class Tournament(Base):
     rounds = Column(Integer, nullable=False)
     reload_on_fault = Column(Integer, nullable=False)  # 0 or 1
     seed = Column(BigInteger, nullable=False)
+    team_hardware = Column(Integer, nullable=False, server_default="0")  # 1: each team's robot
     created = Column(DateTime, nullable=False, server_default=func.now())
 
 
@@ -69,6 +74,10 @@ class Match(Base):
     a_submission_id = Column(Integer, ForeignKey("submissions.id"), nullable=False)
     b_submission_id = Column(Integer, ForeignKey("submissions.id"))
     b_house = Column(String(64))
+    # The hardware files the robots played with (copied from the teams' at
+    # queueing, so the match can be played again as it was); None: none.
+    a_hardware = Column(Text)
+    b_hardware = Column(Text)
     seed = Column(BigInteger, nullable=False)
     seconds = Column(Integer, nullable=False)
     status = Column(String(16), nullable=False, index=True)  # queued, running, done, failed

@@ -36,6 +36,43 @@ def house_robots(folder):
     return out
 
 
+def match_inputs(s, m):
+    """What a match is, read from the database: its programs' sources, the
+    house robot's name, the robots' hardware files and the options."""
+    return {
+        "a": s.get(Submission, m.a_submission_id).source,
+        "b": s.get(Submission, m.b_submission_id).source if m.b_submission_id else None,
+        "house": m.b_house, "a_hardware": m.a_hardware, "b_hardware": m.b_hardware,
+        "options": ["--seed", str(m.seed), "--seconds", str(m.seconds)]
+        + (["--rules", m.rules] if m.rules else [])
+        + (["--reload-on-fault"] if m.reload_on_fault else []),
+    }
+
+
+def write_inputs(inputs, house_folder, folder):
+    """Writes a match's programs (A.dc, B.dc) and hardware files (A.toml,
+    B.toml) into `folder` and returns simbot match's arguments for them."""
+    def written(name, text):
+        path = os.path.join(folder, name)
+        with open(path, "wb") as f:
+            f.write(text.encode("latin-1") if name.endswith(".dc") else text.encode("utf-8"))
+        return path
+
+    args = [written("A.dc", inputs["a"])]
+    if inputs["b"] is not None:
+        args.append(written("B.dc", inputs["b"]))
+    if inputs["house"] is not None:
+        robots = house_robots(house_folder)
+        if inputs["house"] not in robots:
+            raise RuntimeError(f"no house robot '{inputs['house']}'")
+        args.append(robots[inputs["house"]])
+    for robot in ("a", "b"):
+        if inputs[robot + "_hardware"]:
+            args += ["--hw", f"{robot.upper()}=" + written(robot.upper() + ".toml",
+                                                            inputs[robot + "_hardware"])]
+    return args + inputs["options"]
+
+
 class MatchQueue:
     def __init__(self, session_factory, simbot, house, workers):
         self.sessions, self.simbot, self.house = session_factory, simbot, house
@@ -104,27 +141,11 @@ class MatchQueue:
         try:
             with self.sessions() as s:
                 m = s.get(Match, match_id)
-                a = s.get(Submission, m.a_submission_id).source
-                b = s.get(Submission, m.b_submission_id).source if m.b_submission_id else None
-                house, seed, seconds = m.b_house, m.seed, m.seconds
-                options = (["--rules", m.rules] if m.rules else []) + \
-                    (["--reload-on-fault"] if m.reload_on_fault else [])
+                house = m.b_house
+                inputs = match_inputs(s, m)
             with tempfile.TemporaryDirectory(prefix="simbot-match-") as folder:
-                paths = []
-                for name, source in (("A.dc", a), ("B.dc", b)):
-                    if source is None:
-                        continue
-                    paths.append(os.path.join(folder, name))
-                    with open(paths[-1], "wb") as f:
-                        f.write(source.encode("latin-1"))
-                if house is not None:
-                    robots = house_robots(self.house)
-                    if house not in robots:
-                        raise RuntimeError(f"no house robot '{house}'")
-                    paths.append(robots[house])
-                p = subprocess.run([self.simbot, "match", *paths, "--seed", str(seed),
-                                    "--seconds", str(seconds), "--json", *options],
-                                   capture_output=True,
+                p = subprocess.run([self.simbot, "match", *write_inputs(inputs, self.house, folder),
+                                    "--json"], capture_output=True,
                                    timeout=MATCH_SECONDS_LIMIT, cwd=folder)
             # 3: a robot faulted, which is a result (its fault is in the JSON).
             if p.returncode not in (0, 3):

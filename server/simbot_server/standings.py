@@ -68,6 +68,8 @@ def standings(s, tournament_id=None):
         x[column[p]] = 1
         xs += [x, x.copy()]
         ys += [1, 0]
+    if not players:
+        return []
     fit = sm.Logit(np.array(ys, dtype=float), np.array(xs)).fit(disp=0, maxiter=200)
     interval = fit.conf_int(0.05)
     for tid, entry in row.items():
