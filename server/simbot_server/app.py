@@ -29,6 +29,7 @@ from sqlalchemy.exc import IntegrityError
 
 from . import db, submissions, tokens
 from .models import MAX_PROGRAM_BYTES, MAX_TEAM_NAME, Match, Setting, Submission, Team, Tournament
+from .limits import RATES, RateLimits
 from .pages import add_pages
 from .queue import MatchQueue, house_robots
 from .replay import Replays
@@ -104,12 +105,25 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
     app.state.queue = queue = MatchQueue(session_factory, simbot, house, workers)
     app.add_event_handler("startup", queue.start)
     app.add_event_handler("shutdown", queue.stop)
+    rates = RateLimits()
+
+    def limited(who, kind):
+        """429 when team `who` has made too many `kind` requests of late."""
+        wait = rates.take(who.id, kind)
+        if wait is not None:
+            raise HTTPException(429, f"at most {RATES[kind][0]} {kind}s a minute; try again in "
+                                     f"{wait:.0f} s", {"Retry-After": str(max(1, round(wait)))})
+
     add_pages(app, session_factory, simbot, checks, Replays(session_factory, simbot, house, data_dir),
-              team_by_token)
+              team_by_token, limited)
 
     @app.middleware("http")
     async def bounded_bodies(request: Request, call_next):
         length = request.headers.get("content-length")
+        if length is None and request.method not in ("GET", "HEAD", "OPTIONS"):
+            # A body sent in chunks could be of any length: only a declared one is read.
+            return JSONResponse({"detail": "a request body needs its Content-Length"},
+                                status_code=411)
         if length is not None and (not length.isdigit() or int(length) > MAX_BODY_BYTES):
             return JSONResponse({"detail": f"a request body has at most {MAX_BODY_BYTES} bytes"},
                                 status_code=413)
@@ -155,6 +169,7 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
 
     @app.post("/api/submissions", status_code=201)
     def submit(program: UploadFile = File(...), who: Team = Depends(team), s=Depends(session)):
+        limited(who, "submission")
         source = program.file.read(MAX_PROGRAM_BYTES + 1)
         if submissions.too_big(source):
             raise HTTPException(413, f"a program has at most {MAX_PROGRAM_BYTES} bytes")
@@ -165,6 +180,7 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
 
     @app.post("/api/scrimmages", status_code=201)
     def scrimmage(body: dict = Body(...), who: Team = Depends(team), s=Depends(session)):
+        limited(who, "scrimmage")
         opponent, seed = body.get("opponent"), body.get("seed", 1)
         if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 2**63:
             raise HTTPException(422, "'seed' is an integer from 0 to 2^63 - 1")

@@ -65,7 +65,7 @@ def _marked_source(source, diagnostics):
             for n, text in enumerate(source.splitlines(), start=1)]
 
 
-def add_pages(app, sessions, simbot, checks, replays, team_by_token):
+def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
     def page(request, name, status_code=200, **context):
         return templates.TemplateResponse(name, {"request": request, **context},
                                           status_code=status_code)
@@ -152,6 +152,11 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token):
             if who is None:
                 return page(request, "submit.html", status_code=403, outcome=None,
                             problem="That is not a team's token.")
+            try:
+                limited(who, "submission")
+            except HTTPException as e:
+                return page(request, "submit.html", status_code=e.status_code, outcome=None,
+                            problem=e.detail + ".")
             source = program.file.read(MAX_PROGRAM_BYTES + 1)
             if submissions.too_big(source):
                 return page(request, "submit.html", status_code=413, outcome=None,
