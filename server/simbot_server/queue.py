@@ -4,22 +4,19 @@ at once. A match taken is marked "running"; at start, a queue left by a
 killed server has its running matches queued again, so none is lost. A
 match whose process fails is "failed" with its error, never dropped.
 
-The programs are written to a fresh temporary folder as A.dc and B.dc (a
-house robot is read from the house folder by a name that must be one of
-its files' stems): no text a team sends becomes a path."""
-import json
+Each runs match_run.run_match on the two programs' sources (a house
+robot is read from the house folder by a name that must be one of its
+files' stems)."""
 import os
 import re
-import subprocess
-import tempfile
 import threading
 from concurrent.futures import ThreadPoolExecutor
 
 from sqlalchemy import select, update
 
+from . import match_run
 from .models import Match, Submission
 
-MATCH_SECONDS_LIMIT = 600  # wall time of one match's process
 _HOUSE_NAME = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 
 
@@ -104,39 +101,22 @@ class MatchQueue:
         try:
             with self.sessions() as s:
                 m = s.get(Match, match_id)
-                a = s.get(Submission, m.a_submission_id).source
-                b = s.get(Submission, m.b_submission_id).source if m.b_submission_id else None
+                sources = [s.get(Submission, m.a_submission_id).source.encode("latin-1")]
+                if m.b_submission_id:
+                    sources.append(s.get(Submission, m.b_submission_id).source.encode("latin-1"))
                 house, seed, seconds = m.b_house, m.seed, m.seconds
                 options = (["--rules", m.rules] if m.rules else []) + \
                     (["--reload-on-fault"] if m.reload_on_fault else [])
-            with tempfile.TemporaryDirectory(prefix="simbot-match-") as folder:
-                paths = []
-                for name, source in (("A.dc", a), ("B.dc", b)):
-                    if source is None:
-                        continue
-                    paths.append(os.path.join(folder, name))
-                    with open(paths[-1], "wb") as f:
-                        f.write(source.encode("latin-1"))
-                if house is not None:
-                    robots = house_robots(self.house)
-                    if house not in robots:
-                        raise RuntimeError(f"no house robot '{house}'")
-                    paths.append(robots[house])
-                p = subprocess.run([self.simbot, "match", *paths, "--seed", str(seed),
-                                    "--seconds", str(seconds), "--json", *options],
-                                   capture_output=True,
-                                   timeout=MATCH_SECONDS_LIMIT, cwd=folder)
-            # 3: a robot faulted, which is a result (its fault is in the JSON).
-            if p.returncode not in (0, 3):
-                raise RuntimeError(f"simbot match exited {p.returncode}: "
-                                   f"{p.stderr.decode('utf-8', 'replace').strip()[-500:]}")
-            result = json.loads(p.stdout)
+            if house is not None:
+                robots = house_robots(self.house)
+                if house not in robots:
+                    raise RuntimeError(f"no house robot '{house}'")
+                with open(robots[house], "rb") as f:
+                    sources.append(f.read())
             # The programs by what they are, not by the temporary folder's
             # paths: the same match gives the same result, byte for byte.
             names = ["submission", "house:" + house if house is not None else "submission"]
-            for robot, name in zip(result.get("robots", []), names):
-                robot["program"] = name
-            result.pop("wall_seconds", None)  # the host's time, not the match's
-            self._finish(match_id, "done", result=json.dumps(result, sort_keys=True))
+            result = match_run.run_match(self.simbot, sources, names, seed, seconds, options)
+            self._finish(match_id, "done", result=result)
         except Exception as e:  # a match that fails is recorded, never lost
             self._finish(match_id, "failed", error=f"{type(e).__name__}: {e}"[:2000])
