@@ -1,9 +1,12 @@
-"""One match from its two programs' sources: what a queue worker runs.
+"""One match from its two programs' sources: what a queue worker runs, in
+a thread of the server (--workers) or as a task on a Dask worker (--dask).
 
-The sources come with the call and are written to a fresh temporary
-folder as A.dc and B.dc, so no text a team sends becomes a path, and the
-call needs no file of the server's. This module imports nothing but the
-standard library, so that it can run where the server's package is not."""
+The sources travel with the call and are written to a fresh temporary
+folder as A.dc and B.dc, so no text a team sends becomes a path and a Dask
+worker needs no file of the server's. This module imports nothing but the
+standard library: on Dask it is pickled by value (queue.py registers it),
+so a worker needs Dask and the simbot executable at the server's path,
+not the server's package."""
 import json
 import os
 import subprocess
