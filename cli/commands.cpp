@@ -28,6 +28,16 @@
 namespace simbot::cli {
 
 #ifdef SIMBOT_PYTHON
+std::string pythonModuleDir() {
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const auto installed = self.parent_path().parent_path() / SIMBOT_PYTHON_INSTALL_DIR;
+    if (std::filesystem::exists(installed / "simbot" / "sweep.py", ec)) return installed.string();
+  }
+  return SIMBOT_PYTHON_BUILD_DIR;
+}
+
 void execPython(const std::string& pythonPath, std::vector<std::string> args,
                 const std::string& what) {
   std::string path = pythonPath;

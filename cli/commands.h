@@ -27,6 +27,10 @@ int guarded(const std::function<int()>& body);
 [[noreturn]] void execPython(const std::string& pythonPath, std::vector<std::string> args,
                              const std::string& what);
 
+// Where the Python module `simbot` is: beside an installed simbot
+// (PREFIX/bin/../SITE), else the build tree's (SIMBOT_PYTHON builds only).
+std::string pythonModuleDir();
+
 // A seed: a decimal integer from 0 to 2^64 - 1 (not wrapped, not signed).
 CLI::Validator seedValidator();
 

@@ -1,7 +1,7 @@
 // simbot serve [--db URL] [--host H] [--port P] [--data DIR] [--checks
-// FILE] [--house DIR] [--workers N]: a course's competition over HTTP (server/simbot_server,
-// Python: FastAPI on uvicorn, SQLAlchemy, Alembic). This command hands over to it, with this
-// executable as the simbot it compiles and checks with.
+// FILE] [--house DIR] [--workers N | --dask ADDRESS]: a course's competition over HTTP
+// (server/simbot_server, Python: FastAPI on uvicorn, SQLAlchemy, Alembic). This command hands
+// over to it, with this executable as the simbot it compiles, checks and plays matches with.
 #include <filesystem>
 #include <memory>
 
@@ -15,7 +15,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct ServeOptions {
-  std::string db, host = "127.0.0.1", data = "simbot-data", checks, house;
+  std::string db, host = "127.0.0.1", data = "simbot-data", checks, house, dask;
   int port = 8000, workers = 2;
 };
 
@@ -30,8 +30,12 @@ struct ServeOptions {
   if (!o.db.empty()) args.insert(args.end(), {"--db", o.db});
   if (!o.checks.empty()) args.insert(args.end(), {"--checks", o.checks});
   if (!o.house.empty()) args.insert(args.end(), {"--house", o.house});
-  args.insert(args.end(), {"--workers", std::to_string(o.workers)});
-  execPython(SIMBOT_SERVER_DIR, std::move(args), "serve");
+  if (o.dask.empty())
+    args.insert(args.end(), {"--workers", std::to_string(o.workers)});
+  else
+    args.insert(args.end(), {"--dask", o.dask});
+  // The module beside the server: --dask connects by simbot sweep's code.
+  execPython(std::string(SIMBOT_SERVER_DIR) + ":" + pythonModuleDir(), std::move(args), "serve");
 #else
   (void)o;
   throw sinks::UserError(
@@ -62,8 +66,15 @@ Subcommand addServeCommand(CLI::App& app) {
   cmd->add_option("--house", o->house,
                   "house robots: the folder's NAME.dc plays as \"house:NAME\" (e.g. programs)")
       ->check(CLI::ExistingDirectory);
-  cmd->add_option("--workers", o->workers, "matches run at once, each a process (default 2)")
-      ->check(CLI::Range(1, 64));
+  auto* workers =
+      cmd->add_option("--workers", o->workers, "matches run at once, each a process (default 2)")
+          ->check(CLI::Range(1, 64));
+  cmd->add_option("--dask", o->dask,
+                  "run the matches on a Dask cluster instead: tcp://HOST:PORT of a running "
+                  "`dask scheduler`, or local:N for N local worker processes; as many at once as "
+                  "it has worker threads; the workers run this simbot at this path, so they need "
+                  "it there (the same machine or a shared path)")
+      ->excludes(workers);
   return {cmd, [o]() -> int { execServer(*o); }};
 }
 

@@ -41,20 +41,11 @@ std::string defaultOut(const SweepOptions& o) {
 // sweep on the cluster, with the same writer and the same rows.
 [[noreturn]] void execDaskDriver(const SweepOptions& o) {
 #ifdef SIMBOT_PYTHON
-  // The module beside an installed simbot (PREFIX/bin/../SITE), else the
-  // build tree's.
-  std::string path = SIMBOT_PYTHON_BUILD_DIR;
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const fs::path installed = self.parent_path().parent_path() / SIMBOT_PYTHON_INSTALL_DIR;
-    if (fs::exists(installed / "simbot" / "sweep.py", ec)) path = installed.string();
-  }
   std::vector<std::string> args = {"-m",      "simbot.sweep", o.file,   "--out",   o.run.out,
                                    "--shard", o.run.shard,    "--dask", o.run.dask};
   if (o.run.noHeader) args.push_back("--no-header");
   if (o.run.resume) args.push_back("--resume");
-  execPython(path, std::move(args), "--dask");
+  execPython(pythonModuleDir(), std::move(args), "--dask");
 #else
   (void)o;
   throw sinks::UserError(

@@ -68,7 +68,11 @@ def _probe(address):
         raise DaskError(f"cannot connect to {address}: {reason}") from None
 
 
-def _client(address):
+def connect(address):
+    """(client, cluster): a Client of the scheduler at tcp://HOST:PORT
+    (cluster None), or of a new LocalCluster of N one-thread worker
+    processes for local:N (closed after the client). simbot serve --dask
+    connects by it too. Fails with DaskError."""
     from dask.distributed import Client, LocalCluster
     if address.startswith("local:"):
         try:
@@ -101,7 +105,7 @@ def run(path, out, dask, shard="1/1", header=True, resume=False, progress=True):
     sweep = _simbot.Sweep(path)
     # Connected first: a cluster that cannot be reached leaves `out` as it
     # was, and is the one line said.
-    client, cluster = _client(dask)
+    client, cluster = connect(dask)
     try:
         # The CLI's own checks, fingerprint and table (batch::SweepOutput),
         # with the sweep file named as given, as a local sweep names it:

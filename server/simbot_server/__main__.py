@@ -6,7 +6,9 @@
     --simbot PATH   the simbot executable (simbot serve passes its own)
     --checks FILE   the course's expectations file, run on every submission
     --house DIR     house robots: DIR/NAME.dc is "house:NAME"
-    --workers N     matches run at once (default 2)
+    --workers N     matches run at once, each a process here (default 2)
+    --dask ADDRESS  the matches on a Dask cluster instead (tcp://HOST:PORT
+                    or local:N): as many at once as it has worker threads
     --seconds S     a match's length (default 180)
 """
 import argparse
@@ -16,6 +18,7 @@ import uvicorn
 
 from . import db
 from .app import TOKEN_FILE, create_app
+from .queue import ClusterError
 
 
 def main(argv=None):
@@ -27,11 +30,17 @@ def main(argv=None):
     p.add_argument("--simbot", required=True)
     p.add_argument("--checks")
     p.add_argument("--house")
-    p.add_argument("--workers", type=int, default=2)
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, default=2)
+    where.add_argument("--dask")
     p.add_argument("--seconds", type=int, default=180)
     a = p.parse_args(argv)
-    app = create_app(a.db or db.default_url(a.data), a.data, a.simbot, a.checks, a.house,
-                     a.workers, a.seconds)
+    try:
+        app = create_app(a.db or db.default_url(a.data), a.data, a.simbot, a.checks, a.house,
+                         a.workers, a.seconds, a.dask)
+    except ClusterError as e:  # one line, as simbot sweep --dask says it
+        print(f"simbot: --dask: {e}", file=sys.stderr)
+        return 1
     if app.state.new_instructor_token:
         print(f"simbot serve: the instructor's token (also in {a.data}/{TOKEN_FILE}): "
               f"{app.state.new_instructor_token}", flush=True)

@@ -86,12 +86,14 @@ def _name_problem(name):
     return None
 
 
-def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, seconds=180):
+def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, seconds=180,
+               dask=None):
     """The application over the database at `db_url` (migrated to the newest
     revision), with `data_dir` for the instructor token, the simbot
     executable `simbot`, the course's expectations file `checks` (run on
     every submission; None: no checks), the folder of house robots
-    `house`, `workers` matches at once, each `seconds` long. The match
+    `house`, `workers` matches at once, each `seconds` long, or with
+    `dask` (an address) the matches on that Dask cluster. The match
     queue runs while the application does (its startup and shutdown)."""
     os.makedirs(data_dir, exist_ok=True)
     if os.sep in simbot:  # the compiler and matches run in folders of their own
@@ -100,9 +102,10 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
     db.migrate(engine)
     session_factory = db.sessions(engine)
     app = FastAPI(title="simbot serve", docs_url=None, redoc_url=None, openapi_url=None)
+    # The cluster first: a server that cannot reach it makes no token.
+    app.state.queue = queue = MatchQueue(session_factory, simbot, house, workers, dask)
     app.state.new_instructor_token = _instructor_token(session_factory, data_dir)
     app.state.engine = engine
-    app.state.queue = queue = MatchQueue(session_factory, simbot, house, workers)
     app.add_event_handler("startup", queue.start)
     app.add_event_handler("shutdown", queue.stop)
     rates = RateLimits()

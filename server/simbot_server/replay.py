@@ -12,7 +12,8 @@ import tempfile
 import threading
 
 from .models import Match
-from .queue import MATCH_SECONDS_LIMIT, match_inputs, write_inputs
+from .match_run import MATCH_SECONDS_LIMIT, failed, write_match
+from .queue import match_spec
 
 MAX_KEPT = 50  # matches whose replay page and report are kept
 AT_ONCE = 2  # replays made at the same time
@@ -48,40 +49,33 @@ class Replays:
                     m = s.get(Match, match_id)
                     if m is None or m.status != "done":
                         return False
-                    inputs = match_inputs(s, m)
-                self._make(match_id, inputs)
+                    spec = match_spec(s, m, self.house)
+                self._make(match_id, spec)
         finally:
             with self.lock:
                 self.making.pop(match_id, None)
         self._trim()
         return True
 
-    def _make(self, match_id, inputs):
+    def _make(self, match_id, spec):
         with tempfile.TemporaryDirectory(prefix="simbot-replay-") as folder:
             trace, page = os.path.join(folder, "trace.jsonl"), os.path.join(folder, "replay.html")
-            args = write_inputs(inputs, self.house, folder)
+            args = write_match(spec, folder)
             p = subprocess.run([self.simbot, "match", *args, "--trace", trace, "--replay", page],
                                capture_output=True, timeout=MATCH_SECONDS_LIMIT, cwd=folder)
             if p.returncode not in (0, 3):
-                raise RuntimeError(f"simbot match exited {p.returncode}: "
-                                   f"{p.stderr.decode('utf-8', 'replace').strip()[-500:]}")
+                raise failed("match", p)
             e = subprocess.run([self.simbot, "explain", trace], capture_output=True,
                                timeout=MATCH_SECONDS_LIMIT, cwd=folder)
             if e.returncode != 0:
-                raise RuntimeError(f"simbot explain exited {e.returncode}: "
-                                   f"{e.stderr.decode('utf-8', 'replace').strip()[-500:]}")
-            # The programs by their names in the match (A.dc, B.dc, house/NAME.dc),
-            # not by the host's folders.
-            hidden = [(folder.encode() + b"/", b"")]
-            if self.house:
-                hidden.append((os.path.abspath(self.house).encode() + b"/", b"house/"))
+                raise failed("explain", e)
+            # The programs by their names in the match (A.dc, B.dc), not by
+            # the temporary folder's paths.
             with open(page, "rb") as f:
                 texts = {page: f.read(), trace + ".report": e.stdout}
             for path, text in texts.items():
-                for host, shown in hidden:
-                    text = text.replace(host, shown)
                 with open(path, "wb") as f:
-                    f.write(text)
+                    f.write(text.replace(folder.encode() + b"/", b""))
             # The page first, the report last: the report's presence says both are whole.
             os.replace(page, self.page(match_id))
             os.replace(trace + ".report", self.report(match_id))
