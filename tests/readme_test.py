@@ -11,7 +11,10 @@ and build/python,
 beside WORKDIR/shared), so that
 the files a command writes land in WORKDIR and a later block can read them.
 The Quickstart block is the exception: `.ci/run` runs `scripts/test.sh` and
-`scripts/quickstart.sh` themselves on a clean clone. A desktop program
+`scripts/quickstart.sh` themselves on a clean clone; its third line, a
+server (`simbot serve`), runs here like any other. A server, a command
+that does not end by itself, passes when it answers its front page
+(HTTP 200) within SERVER_SECONDS; it is then stopped. A desktop program
 (GTKWave) runs under Xvfb and passes when it is still showing the file
 after a few seconds; anything else must exit with status 0. A block
 that already ran (the README shows some of the manual's) runs once.
@@ -24,10 +27,12 @@ import shutil
 import subprocess
 import sys
 import time
+import urllib.request
 
 CI_RUNS_THESE = {"./scripts/quickstart.sh", "./scripts/test.sh"}
 DESKTOP_PROGRAMS = {"gtkwave"}
 DESKTOP_SECONDS = 8
+SERVER_SECONDS = 60
 
 
 def blocks(readme_text):
@@ -93,6 +98,36 @@ def run_desktop(line, cwd):
         return None
 
 
+def is_server(line):
+    words = line.split("#")[0].split()
+    return len(words) > 1 and words[0].endswith("bin/simbot") and words[1] == "serve"
+
+
+def run_server(line, cwd):
+    """Starts `simbot serve ...`; it passes if its front page answers 200."""
+    words = line.split("#")[0].split()
+    port = words[words.index("--port") + 1] if "--port" in words else "8000"
+    proc = subprocess.Popen(["bash", "-c", "exec " + line.split("#")[0]], cwd=cwd,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+    problem = f"its front page did not answer within {SERVER_SECONDS} s"
+    deadline = time.monotonic() + SERVER_SECONDS
+    try:
+        while time.monotonic() < deadline and proc.poll() is None:
+            try:
+                with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=5) as r:
+                    problem = None if r.status == 200 else f"its front page answered {r.status}"
+                    break
+            except OSError:
+                time.sleep(0.3)
+        if proc.poll() is not None:
+            problem = f"exited with status {proc.returncode}: {proc.stderr.read().decode()[-400:]}"
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, 15)
+            proc.wait()
+    return problem
+
+
 def main():
     simbot, work, readme = sys.argv[1:4]
     pages = [readme] + sys.argv[4:]
@@ -105,14 +140,15 @@ def main():
     seen = set()
     every = [b for page in pages for b in blocks(open(page, encoding="utf-8").read())]
     for block in every:
-        if set(line.split("#")[0].strip() for line in block) <= CI_RUNS_THESE:
+        block = [line for line in block if line.split("#")[0].strip() not in CI_RUNS_THESE]
+        if not block:
             continue
         if tuple(block) in seen:
             continue
         seen.add(tuple(block))
         script = []
         for line in block:
-            if line.split()[0] in DESKTOP_PROGRAMS:
+            if line.split()[0] in DESKTOP_PROGRAMS or is_server(line):
                 problem = None
                 if script:  # what comes before it runs first
                     done = subprocess.run(["bash", "-e", "-c", "\n".join(script)], cwd=cwd,
@@ -121,7 +157,7 @@ def main():
                     script = []
                     if done.returncode != 0:
                         problem = f"status {done.returncode}: {done.stderr[-600:]}"
-                problem = problem or run_desktop(line, cwd)
+                problem = problem or (run_server if is_server(line) else run_desktop)(line, cwd)
                 ran += 1
                 if problem:
                     failures.append(f"{line}\n  {problem}")
