@@ -32,6 +32,7 @@ packages=(
   python3-junitparser          # reads simbot check's JUnit XML in its test
   python3-fastapi python3-uvicorn python3-multipart python3-httpx  # simbot serve, and its tests' client
   python3-sqlalchemy python3-alembic python3-psycopg2             # its database and migrations
+  postgresql                   # a throwaway server for its tests on PostgreSQL (scripts/postgres.sh)
   curl                         # docs/serve.md's example
   python3-distributed          # sweeps on a Dask cluster
 )
