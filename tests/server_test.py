@@ -1,12 +1,22 @@
 #!/usr/bin/env python3
-"""simbot serve's HTTP API on SQLite (server/simbot_server), through
-FastAPI's test client.
+"""simbot serve's HTTP API (server/simbot_server) end to end, on SQLite or
+on PostgreSQL: through FastAPI's test client, then the real server over
+the loopback.
 
-Usage: server_test.py SIMBOT SOURCE_DIR SHARED_DIR OUTDIR
+Usage: server_test.py SIMBOT SOURCE_DIR SHARED_DIR OUTDIR [--db sqlite|postgres]
+
+With --db postgres (ctest's server.api.postgres) every check runs on the
+PostgreSQL server at $SIMBOT_TEST_POSTGRES_URL (scripts/postgres.sh starts
+a throwaway one), each part of the test on a database of its own, dropped
+and made again (so every run starts empty), named after the URL's
+database: NAME_api, NAME_queue, NAME_killed, NAME_whole. Without that
+variable it exits with SKIPPED (77), which ctest reports as skipped, not
+passed.
 
 - First start: the instructor token is written to DATA/instructor-token,
-  mode 0600; the database holds only its SHA-256 (the token's bytes appear
-  nowhere in the database file); a second start makes no new token.
+  mode 0600; the database holds only its SHA-256 (the token's text appears
+  in no row of any table, and on SQLite nowhere in the database file); a
+  second start makes no new token.
 - The schema is the Alembic head, and it has exactly the models' tables
   and columns.
 - Teams: no token 401, a team's token 403, the instructor's 201 with a
@@ -19,21 +29,34 @@ Usage: server_test.py SIMBOT SOURCE_DIR SHARED_DIR OUTDIR
   byte is 413 and stores nothing; a path as a file name is shown by its
   base name only, and no file of that name appears anywhere.
 """
+import argparse
 import hashlib
 import os
 import shutil
-import sqlite3
 import stat
 import sys
 from pathlib import Path
 
-SIMBOT, SOURCE, SHARED, OUT = sys.argv[1:5]
-SOURCE, SHARED, OUT = Path(SOURCE), Path(SHARED), Path(OUT)
+arguments = argparse.ArgumentParser()
+for name in ("simbot", "source", "shared", "out"):
+    arguments.add_argument(name)
+arguments.add_argument("--db", choices=("sqlite", "postgres"), default="sqlite")
+arguments = arguments.parse_args()
+SIMBOT, SOURCE, SHARED, OUT = (arguments.simbot, Path(arguments.source), Path(arguments.shared),
+                               Path(arguments.out))
+SKIPPED = 77  # ctest's SKIP_RETURN_CODE for server.api.postgres
+POSTGRES = os.environ.get("SIMBOT_TEST_POSTGRES_URL") if arguments.db == "postgres" else None
+if arguments.db == "postgres" and not POSTGRES:
+    print("server_test: SKIPPED: no PostgreSQL server (SIMBOT_TEST_POSTGRES_URL is not set; "
+          "scripts/postgres.sh sets it)")
+    sys.exit(SKIPPED)
 sys.path.insert(0, str(SOURCE / "server"))
 
 from alembic.script import ScriptDirectory  # noqa: E402
 from fastapi.testclient import TestClient  # noqa: E402
-from sqlalchemy import inspect  # noqa: E402
+from sqlalchemy import create_engine, inspect, text  # noqa: E402
+from sqlalchemy.engine import make_url  # noqa: E402
+from sqlalchemy.pool import NullPool  # noqa: E402
 
 from simbot_server import db, models  # noqa: E402
 from simbot_server.app import create_app  # noqa: E402
@@ -41,9 +64,48 @@ from simbot_server.models import Submission  # noqa: E402
 
 shutil.rmtree(OUT, ignore_errors=True)
 OUT.mkdir(parents=True)
-DATA = OUT / "data"
-URL = db.default_url(DATA)
 failures = []
+
+
+def fresh_database(label, data):
+    """The URL of an empty database for one part of the test: on SQLite
+    the default file in `data` (a new folder), on PostgreSQL NAME_label,
+    dropped and made again."""
+    if not POSTGRES:
+        return db.default_url(data)
+    base = make_url(POSTGRES)
+    name = f"{base.database}_{label}"
+    admin = create_engine(base, isolation_level="AUTOCOMMIT", poolclass=NullPool)
+    with admin.connect() as c:
+        c.execute(text(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)'))
+        c.execute(text(f'CREATE DATABASE "{name}"'))
+    admin.dispose()
+    return base.set(database=name).render_as_string(hide_password=False)
+
+
+def rows(url, query, **params):
+    """The rows of `query` on the database at `url`, read outside the server."""
+    engine = create_engine(url, poolclass=NullPool)
+    try:
+        with engine.connect() as c:
+            return [tuple(r) for r in c.execute(text(query), params)]
+    finally:
+        engine.dispose()
+
+
+def stored_text(url):
+    """Every value of every row of every table, as text."""
+    engine = create_engine(url, poolclass=NullPool)
+    try:
+        with engine.connect() as c:
+            return "\n".join(str(v) for table in inspect(c).get_table_names()
+                             for row in c.execute(text(f'select * from "{table}"')) for v in row)
+    finally:
+        engine.dispose()
+
+
+DATA = OUT / "data"
+URL = fresh_database("api", DATA)
 
 
 def check(ok, message):
@@ -64,19 +126,20 @@ instructor = token_file.read_text().strip()
 check(app.state.new_instructor_token == instructor, "the printed token is the file's")
 check(stat.S_IMODE(token_file.stat().st_mode) == 0o600,
       f"instructor-token mode {oct(stat.S_IMODE(token_file.stat().st_mode))}")
-database = (DATA / "simbot.sqlite3").read_bytes()
-check(instructor.encode() not in database, "the instructor token is not stored")
-check(hashlib.sha256(instructor.encode()).hexdigest().encode() in database,
-      "its SHA-256 is stored")
+stored = stored_text(URL)
+check(instructor not in stored, "the instructor token is in no row")
+check(hashlib.sha256(instructor.encode()).hexdigest() in stored, "its SHA-256 is stored")
+if not POSTGRES:
+    database = (DATA / "simbot.sqlite3").read_bytes()
+    check(instructor.encode() not in database, "the instructor token is not in the file")
 again = create_app(URL, str(DATA), SIMBOT)
 check(again.state.new_instructor_token is None and token_file.read_text().strip() == instructor,
       "a second start makes no new token")
 
 # ---- the schema: Alembic's head, the models' tables and columns
 heads = ScriptDirectory(db.MIGRATIONS).get_heads()
-with sqlite3.connect(DATA / "simbot.sqlite3") as c:
-    got = c.execute("select version_num from alembic_version").fetchall()
-    check(len(heads) == 1 and got == [(heads[0],)], f"alembic_version {got}, the head {heads}")
+got = rows(URL, "select version_num from alembic_version")
+check(len(heads) == 1 and got == [(heads[0],)], f"alembic_version {got}, the head {heads}")
 found = inspect(app.state.engine)
 for table in models.Base.metadata.sorted_tables:
     columns = {col["name"] for col in found.get_columns(table.name)}
@@ -103,8 +166,7 @@ for name in ["<script>alert(1)</script>", "x'); DROP TABLE teams; --", "\u00e9qu
 for bad in ["", " ", "a" * 65, "tab\there", None, 7]:
     r = client.post("/api/teams", json={"name": bad}, headers=auth(instructor))
     check(r.status_code == 422, f"name {bad!r}: {r.status_code}")
-with sqlite3.connect(DATA / "simbot.sqlite3") as c:
-    check(c.execute("select count(*) from teams").fetchone() == (4,), "four teams stored")
+check(rows(URL, "select count(*) from teams") == [(4,)], "four teams stored")
 
 # ---- submissions
 fig92 = (SHARED / "programs/fig92.dc").read_bytes()
@@ -135,9 +197,8 @@ r = client.post("/api/submissions", files={"program": ("fig92.dc", fig92)},
 check(r.status_code == 403, f"the instructor is not a team: {r.status_code}")
 versions = client.get(f"/api/teams/{alpha['id']}").json()["versions"]
 check([v["version"] for v in versions] == [1, 2], f"two versions stored: {versions}")
-with sqlite3.connect(DATA / "simbot.sqlite3") as c:
-    stored = c.execute("select source from submissions where version = 1").fetchone()[0]
-    check(stored.encode("latin-1") == fig92, "the source is stored byte for byte")
+stored = rows(URL, "select source from submissions where version = 1")[0][0]
+check(stored.encode("latin-1") == fig92, "the source is stored byte for byte")
 
 # ---- scrimmages: the queue runs them off the request path
 import json  # noqa: E402
@@ -169,7 +230,8 @@ def score(result):
 
 
 QDATA = OUT / "queue"
-queued = create_app(db.default_url(QDATA), str(QDATA), SIMBOT, house=str(SOURCE / "programs"),
+QURL = fresh_database("queue", QDATA)
+queued = create_app(QURL, str(QDATA), SIMBOT, house=str(SOURCE / "programs"),
                     workers=2, seconds=10)
 qtoken = (QDATA / "instructor-token").read_text().strip()
 with TestClient(queued) as c:
@@ -218,15 +280,14 @@ with TestClient(queued) as c:
     # The oracle: each game played again by simbot match from the stored
     # programs and seed; wins and hits counted here.
     programs = {"fig": SHARED / "programs/fig92.dc", "ice": SHARED / "programs/iceman.dc"}
-    with sqlite3.connect(QDATA / "simbot.sqlite3") as q:
-        rows = q.execute("select ta.name, tb.name, m.seed, m.seconds from matches m "
-                         "join submissions sa on sa.id = m.a_submission_id join teams ta on ta.id = sa.team_id "
-                         "join submissions sb on sb.id = m.b_submission_id join teams tb on tb.id = sb.team_id "
-                         "where m.tournament_id = ? order by m.id", (tid,)).fetchall()
-    check(sorted((a, b) for a, b, _, _ in rows) == [("fig", "ice"), ("ice", "fig")],
-          f"each side once: {rows}")
+    games = rows(QURL, "select ta.name, tb.name, m.seed, m.seconds from matches m "
+                 "join submissions sa on sa.id = m.a_submission_id join teams ta on ta.id = sa.team_id "
+                 "join submissions sb on sb.id = m.b_submission_id join teams tb on tb.id = sb.team_id "
+                 "where m.tournament_id = :tid order by m.id", tid=tid)
+    check(sorted((a, b) for a, b, _, _ in games) == [("fig", "ice"), ("ice", "fig")],
+          f"each side once: {games}")
     expect = {"fig": [0, 0, 0, 0], "ice": [0, 0, 0, 0]}  # played, wins, losses, hits
-    for a, b, seed, _ in rows:
+    for a, b, seed, _ in games:
         res = direct(programs[a], programs[b], seed)
         for name, robot in zip((a, b), res["robots"]):
             expect[name][0] += 1
@@ -274,7 +335,7 @@ with sessions() as s:
     s.add_all(left + [gone])
     s.commit()
     ids = [m.id for m in left] + [gone.id]
-restarted = create_app(db.default_url(QDATA), str(QDATA), SIMBOT, house=str(SOURCE / "programs"),
+restarted = create_app(QURL, str(QDATA), SIMBOT, house=str(SOURCE / "programs"),
                        workers=2, seconds=10)
 with TestClient(restarted) as c:
     got = [wait_done(c, i) for i in ids]
@@ -299,11 +360,13 @@ def free_port():
 
 
 class Live:
-    def __init__(self, data):
+    def __init__(self, data, url):
         self.data, self.port = data, free_port()
         self.base = f"http://127.0.0.1:{self.port}"
+        # SQLite: the default database (no --db), DATA/simbot.sqlite3.
         self.process = subprocess.Popen(
-            [SIMBOT, "serve", "--data", str(data), "--port", str(self.port), "--workers", "2"],
+            [SIMBOT, "serve", "--data", str(data), "--port", str(self.port), "--workers", "2",
+             *(["--db", url] if POSTGRES else [])],
             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
         # Its first line the instructor's token (first start only), then
         # "simbot serve: listening on ...".
@@ -344,11 +407,11 @@ class Live:
         self.process.wait(timeout=30)
 
 
-def league(data):
-    """A server with three teams (fig92, ICEMAN, turret) and a 30-game
-    round robin of 180-s matches, seed 99; returns the server and the
-    tournament's id."""
-    live = Live(data)
+def league(data, url):
+    """A server on the empty database at `url` with three teams (fig92,
+    ICEMAN, turret) and a 30-game round robin of 180-s matches, seed 99;
+    returns the server and the tournament's id."""
+    live = Live(data, url)
     token = (data / "instructor-token").read_text().strip()
     check(live.first.rstrip().endswith(token), f"simbot serve prints the token: {live.first!r}")
     for name, program in [("fig", SHARED / "programs/fig92.dc"), ("ice", SHARED / "programs/iceman.dc"),
@@ -373,7 +436,8 @@ def finish(live, tid):
     return tour
 
 
-killed, tid = league(OUT / "killed")
+killed_url = fresh_database("killed", OUT / "killed")
+killed, tid = league(OUT / "killed", killed_url)
 done = 0
 deadline = time.monotonic() + 120
 while done < 2 and time.monotonic() < deadline:
@@ -381,11 +445,11 @@ while done < 2 and time.monotonic() < deadline:
     time.sleep(0.01)
 killed.kill(signal.SIGKILL)
 check(2 <= done < 30, f"killed with {done} of 30 games done")
-again = Live(OUT / "killed")
+again = Live(OUT / "killed", killed_url)
 check(again.first == "", f"no new token at a restart: {again.first!r}")
 after = finish(again, tid)
 again.kill(signal.SIGTERM)
-whole, tid2 = league(OUT / "whole")
+whole, tid2 = league(OUT / "whole", fresh_database("whole", OUT / "whole"))
 uninterrupted = finish(whole, tid2)
 whole.kill(signal.SIGTERM)
 check(after["games"] == {"total": 30, "done": 30, "failed": 0}, f"after the restart: {after['games']}")
@@ -394,4 +458,4 @@ check(strip == [{k: v for k, v in e.items() if k != "team_id"} for e in uninterr
       f"the same table: {after['table']} and {uninterrupted['table']}")
 if failures:
     sys.exit(f"{len(failures)} check(s) failed")
-print("server_test: all checks passed")
+print(f"server_test: all checks passed on {arguments.db}")
