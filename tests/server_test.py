@@ -27,9 +27,13 @@ passed.
   file's base name; a second is version 2; a program with an error on its
   line 3 is 422 with "NAME:3:" and stores nothing; a program of 64 KiB + 1
   byte is 413 and stores nothing; a path as a file name is shown by its
-  base name only, and no file of that name appears anywhere.
+  base name only, and no file of that name appears anywhere. A version's
+  time is UTC, between the test's clock before and after its request
+  (on PostgreSQL the database's time zone is set to America/Los_Angeles,
+  so a time taken in the database's zone would be 7 or 8 hours off).
 """
 import argparse
+import datetime
 import hashlib
 import os
 import shutil
@@ -79,6 +83,9 @@ def fresh_database(label, data):
     with admin.connect() as c:
         c.execute(text(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)'))
         c.execute(text(f'CREATE DATABASE "{name}"'))
+        # Not UTC (the throwaway server's is the machine's, often UTC): a
+        # time the server stores in the database's own zone shows.
+        c.execute(text(f"ALTER DATABASE \"{name}\" SET timezone TO 'America/Los_Angeles'"))
     admin.dispose()
     return base.set(database=name).render_as_string(hide_password=False)
 
@@ -170,8 +177,10 @@ check(rows(URL, "select count(*) from teams") == [(4,)], "four teams stored")
 
 # ---- submissions
 fig92 = (SHARED / "programs/fig92.dc").read_bytes()
+before = datetime.datetime.utcnow().replace(microsecond=0)  # SQLite keeps whole seconds
 r = client.post("/api/submissions", files={"program": ("fig92.dc", fig92)},
                 headers=auth(alpha["token"]))
+after = datetime.datetime.utcnow()
 check(r.status_code == 201, f"fig92 submitted: {r.status_code} {r.text}")
 body = r.json()
 check(body.get("version") == 1, f"version 1: {body}")
@@ -197,6 +206,8 @@ r = client.post("/api/submissions", files={"program": ("fig92.dc", fig92)},
 check(r.status_code == 403, f"the instructor is not a team: {r.status_code}")
 versions = client.get(f"/api/teams/{alpha['id']}").json()["versions"]
 check([v["version"] for v in versions] == [1, 2], f"two versions stored: {versions}")
+created = datetime.datetime.fromisoformat(versions[0]["created"])
+check(before <= created <= after, f"version 1 made at {created}, UTC, between {before} and {after}")
 stored = rows(URL, "select source from submissions where version = 1")[0][0]
 check(stored.encode("latin-1") == fig92, "the source is stored byte for byte")
 
