@@ -25,7 +25,8 @@ passed.
 - Submissions: fig92 is version 1 with its warning at 57:9 (the line of
   its first platform() call, counted in the file), named by the uploaded
   file's base name; a second is version 2; a program with an error on its
-  line 3 is 422 with "NAME:3:" and stores nothing; a program of 64 KiB + 1
+  line 3 is 422 with "NAME:3:" and stores nothing, and so is one with a
+  NUL byte in a comment, at its line and column; a program of 64 KiB + 1
   byte is 413 and stores nothing; a path as a file name is shown by its
   base name only, and no file of that name appears anywhere. A version's
   time is UTC, between the test's clock before and after its request
@@ -197,6 +198,12 @@ bad = b"main()\n{\n    int x\n    x = 1;\n}\n"
 r = client.post("/api/submissions", files={"program": ("bad.dc", bad)}, headers=auth(alpha["token"]))
 check(r.status_code == 422 and r.json()["errors"][0].startswith("bad.dc:3:"),
       f"an error at its line: {r.status_code} {r.text}")
+# simbot compile passes a NUL byte in a comment (this program compiles),
+# but PostgreSQL's text cannot hold one: refused, with its place.
+r = client.post("/api/submissions", files={"program": ("nul.dc", b"main()\n{\n}\n// \0 a NUL\n")},
+                headers=auth(alpha["token"]))
+check(r.status_code == 422 and r.json()["errors"] == ["nul.dc:4:4: error: a NUL byte (a program is text)"],
+      f"a NUL byte at 4:4: {r.status_code} {r.text}")
 huge = b"/*" + b"x" * (64 * 1024 - 3) + b"*/"
 r = client.post("/api/submissions", files={"program": ("huge.dc", huge)},
                 headers=auth(alpha["token"]))
