@@ -32,6 +32,8 @@ passed.
   time is UTC, between the test's clock before and after its request
   (on PostgreSQL the database's time zone is set to America/Los_Angeles,
   so a time taken in the database's zone would be 7 or 8 hours off).
+  16 submissions of one team at once, compiling at the same moment, are
+  versions 1 to 16.
 """
 import argparse
 import datetime
@@ -217,6 +219,45 @@ created = datetime.datetime.fromisoformat(versions[0]["created"])
 check(before <= created <= after, f"version 1 made at {created}, UTC, between {before} and {after}")
 stored = rows(URL, "select source from submissions where version = 1")[0][0]
 check(stored.encode("latin-1") == fig92, "the source is stored byte for byte")
+
+# 16 submissions of one team at once, all compiling at the same moment (a
+# barrier in the compiler's call): more than SQLAlchemy's pool for
+# PostgreSQL lends (5 connections and 10 more), so a request that kept its
+# connection while it compiled would leave the 16th waiting at the pool
+# and break the barrier; and all 16 then ask for the next version together.
+import threading  # noqa: E402
+
+from simbot_server import compile as compiler  # noqa: E402
+
+crowd = client.post("/api/teams", json={"name": "crowd"}, headers=auth(instructor)).json()
+AT_ONCE = 16
+barrier = threading.Barrier(AT_ONCE, timeout=20)
+compile_file = compiler.compile_file
+
+
+def compile_together(*args):
+    barrier.wait()
+    return compile_file(*args)
+
+
+def submit_one(answers):
+    r = TestClient(app, raise_server_exceptions=False).post(
+        "/api/submissions", files={"program": ("fig92.dc", fig92)}, headers=auth(crowd["token"]))
+    answers.append((r.status_code, r.json().get("version") if r.status_code == 201 else r.text[:200]))
+
+
+compiler.compile_file = compile_together
+answers = []
+threads = [threading.Thread(target=submit_one, args=(answers,)) for _ in range(AT_ONCE)]
+for t in threads:
+    t.start()
+for t in threads:
+    t.join()
+compiler.compile_file = compile_file
+check(sorted(answers) == [(201, v) for v in range(1, AT_ONCE + 1)],
+      f"16 submissions at once are versions 1 to 16: {sorted(answers, key=str)[:3]}...")
+versions = [v["version"] for v in client.get(f"/api/teams/{crowd['id']}").json()["versions"]]
+check(versions == list(range(1, AT_ONCE + 1)), f"16 versions stored: {versions}")
 
 # ---- scrimmages: the queue runs them off the request path
 import json  # noqa: E402
