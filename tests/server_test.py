@@ -21,7 +21,9 @@ passed.
   and columns.
 - Teams: no token 401, a team's token 403, the instructor's 201 with a
   token that works; a name with markup or SQL is stored and returned as
-  the very text sent, and creates one row; a duplicate name 409.
+  the very text sent, and creates one row; a duplicate name 409; a name
+  empty, too long, with a control character or a lone surrogate
+  ("\\ud800" in the JSON, which neither database can encode) 422.
 - Submissions: fig92 is version 1 with its warning at 57:9 (the line of
   its first platform() call, counted in the file), named by the uploaded
   file's base name; a second is version 2; a program with an error on its
@@ -173,7 +175,7 @@ for name in ["<script>alert(1)</script>", "x'); DROP TABLE teams; --", "\u00e9qu
     check(r.status_code == 201, f"name {name!r}: {r.status_code}")
     got = client.get(f"/api/teams/{r.json()['id']}").json()
     check(got["name"] == name, f"name {name!r} comes back as {got['name']!r}")
-for bad in ["", " ", "a" * 65, "tab\there", None, 7]:
+for bad in ["", " ", "a" * 65, "tab\there", None, 7, "\ud800 lone"]:
     r = client.post("/api/teams", json={"name": bad}, headers=auth(instructor))
     check(r.status_code == 422, f"name {bad!r}: {r.status_code}")
 check(rows(URL, "select count(*) from teams") == [(4,)], "four teams stored")

@@ -76,6 +76,8 @@ def _name_problem(name):
         return f"a team's name has at most {MAX_TEAM_NAME} characters"
     if any(ord(c) < 0x20 or ord(c) == 0x7F for c in name):
         return "a team's name has no control characters"
+    if any(0xD800 <= ord(c) <= 0xDFFF for c in name):  # JSON's "\ud800" alone: no UTF-8 for it
+        return "a team's name has no lone surrogates"
     return None
 
 
