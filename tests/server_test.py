@@ -36,6 +36,11 @@ passed.
   so a time taken in the database's zone would be 7 or 8 hours off).
   16 submissions of one team at once, compiling at the same moment, are
   versions 1 to 16.
+- The queue: scrimmages and a round robin give simbot match's own
+  results; the largest seed, 2^63 - 1, is stored, given back and played
+  (2^63 is 422); a queue left by a killed server runs at the next start.
+- The real server (simbot serve) killed with SIGKILL mid-tournament and
+  restarted ends with the table of a run without the kill.
 """
 import argparse
 import datetime
@@ -309,13 +314,18 @@ with TestClient(queued) as c:
     check(r.status_code == 422, f"an unknown house robot: {r.status_code}")
     r = c.post("/api/scrimmages", json={"opponent": "house:../../etc/passwd"}, headers=auth(fig["token"]))
     check(r.status_code == 422, f"a path as a house robot: {r.status_code}")
-    r = c.post("/api/scrimmages", json={"opponent": "house:turret", "seed": 3},
+    r = c.post("/api/scrimmages", json={"opponent": "house:turret", "seed": 2**63},
+               headers=auth(fig["token"]))
+    check(r.status_code == 422, f"a seed of 2^63: {r.status_code}")
+    # The largest seed (a BIGINT on PostgreSQL, SQLite's 8-byte INTEGER).
+    r = c.post("/api/scrimmages", json={"opponent": "house:turret", "seed": 2**63 - 1},
                headers=auth(fig["token"]))
     check(r.status_code == 201, f"a scrimmage against a house robot: {r.status_code} {r.text}")
     m = wait_done(c, r.json()["match_id"])
-    check(m["status"] == "done", f"it ran: {m['status']} {m.get('error')}")
+    check(m["status"] == "done" and m["seed"] == 2**63 - 1,
+          f"it ran: {m['status']} {m.get('error')} {m['seed']}")
     if m["status"] == "done":
-        want = direct(SHARED / "programs/fig92.dc", SOURCE / "programs/turret.dc", 3)
+        want = direct(SHARED / "programs/fig92.dc", SOURCE / "programs/turret.dc", 2**63 - 1)
         check(score(m["result"]) == score(want), f"its result is simbot match's: {score(m['result'])} {score(want)}")
     r = c.post("/api/scrimmages", json={"opponent": ice["id"], "seed": 5}, headers=auth(fig["token"]))
     m = wait_done(c, r.json()["match_id"])
@@ -325,13 +335,15 @@ with TestClient(queued) as c:
     else:
         check(False, f"team against team ran: {m}")
 
-    # A round robin of the two teams, two rounds (sides swapped), seed 42.
-    r = c.post("/api/tournaments", json={"rounds": 2, "seconds": 10, "seed": 42},
+    # A round robin of the two teams, two rounds (sides swapped), the
+    # largest seed.
+    r = c.post("/api/tournaments", json={"rounds": 2, "seconds": 10, "seed": 2**63 - 1},
                headers=auth(fig["token"]))
     check(r.status_code == 403, f"a team cannot start a tournament: {r.status_code}")
-    r = c.post("/api/tournaments", json={"rounds": 2, "seconds": 10, "seed": 42},
+    r = c.post("/api/tournaments", json={"rounds": 2, "seconds": 10, "seed": 2**63 - 1},
                headers=auth(qtoken))
     check(r.status_code == 201 and r.json()["games"] == 2, f"a tournament: {r.status_code} {r.text}")
+    check(c.get(f"/api/tournaments/{r.json()['id']}").json()["seed"] == 2**63 - 1, "its seed kept")
     tid = r.json()["id"]
     deadline = time.monotonic() + 120
     while c.get(f"/api/tournaments/{tid}").json()["status"] != "done" and time.monotonic() < deadline:
