@@ -40,6 +40,8 @@ passed.
 - The queue: scrimmages and a round robin give simbot match's own
   results; the largest seed, 2^63 - 1, is stored, given back and played
   (2^63 is 422); a queue left by a killed server runs at the next start.
+- Two servers' queues on one database, 4 workers each, run each of 120
+  matches queued at once exactly once.
 - The real server (simbot serve) killed with SIGKILL mid-tournament and
   restarted ends with the table of a run without the kill.
 """
@@ -428,6 +430,34 @@ check([g["status"] for g in got] == ["done", "done", "failed"],
       f"after a restart: {[(g['status'], g['error']) for g in got]}")
 check(got[0]["result"] == got[1]["result"], "the same seed gives the same result")
 check("no house robot 'gone'" in (got[2]["error"] or ""), f"the failure says why: {got[2]['error']}")
+
+# Two servers' queues on one database (what PostgreSQL allows), 4
+# workers each, take 120 matches queued at once: each match is run once.
+# Their simbot is a script that logs the seed it is given (each match has
+# its own) and answers a match without a winner.
+fake = OUT / "fake-simbot"
+runs = OUT / "runs.log"
+fake.write_text(f"""#!/bin/sh
+while [ $# -gt 0 ]; do [ "$1" = --seed ] && echo "$2" >> '{runs}'; shift; done
+echo '{{"robots": [], "winner": null}}'
+""")
+fake.chmod(0o755)
+twins = [create_app(QURL, str(QDATA), str(fake), house=str(SOURCE / "programs"), workers=4, seconds=10)
+         for _ in range(2)]
+with TestClient(twins[0]) as c, TestClient(twins[1]):
+    with sessions() as s:
+        crowd = [Match(kind="scrimmage", a_submission_id=sub.id, b_house="turret", seed=1000 + k,
+                       seconds=10, status="queued") for k in range(120)]
+        s.add_all(crowd)
+        s.commit()
+        ids = [m.id for m in crowd]
+    for twin in twins:
+        twin.state.queue.notify()
+    got = [wait_done(c, i) for i in ids]
+check(all(g["status"] == "done" for g in got), f"all 120 done: {[g['status'] for g in got][:5]}...")
+seeds = sorted(int(line) for line in runs.read_text().split())
+check(seeds == list(range(1000, 1120)),
+      f"each match run once: {len(seeds)} runs, {len(set(seeds))} matches")
 
 # ---- simbot serve: the real server over the loopback; a tournament
 # killed with SIGKILL mid-way and restarted ends with the table of one run
