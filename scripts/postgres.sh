@@ -13,9 +13,11 @@
 # Usage: scripts/postgres.sh COMMAND [ARG...]
 set -euo pipefail
 [ $# -ge 1 ] || { echo "usage: scripts/postgres.sh COMMAND [ARG...]" >&2; exit 2; }
-bin=$(ls -d /usr/lib/postgresql/*/bin 2> /dev/null | sort -V | tail -n 1)
-[ -n "$bin" ] && [ -x "$bin/initdb" ] ||
-  { echo "postgres.sh: no PostgreSQL server in /usr/lib/postgresql/*/bin (scripts/setup.sh installs it)" >&2; exit 1; }
+bin=$(printf '%s\n' /usr/lib/postgresql/*/bin | sort -V | tail -n 1)  # the newest
+if [ ! -x "$bin/initdb" ]; then
+  echo "postgres.sh: no PostgreSQL server in /usr/lib/postgresql/*/bin (scripts/setup.sh installs it)" >&2
+  exit 1
+fi
 folder=$(mktemp -d /tmp/simbot-postgres.XXXXXX)
 owner=()
 user=$(id -un)
@@ -29,7 +31,7 @@ fi
 as_owner() { (cd "$folder" && "${owner[@]}" "$@"); }
 finish() {
   local status=$?
-  [ -e "$folder/data/postmaster.pid" ] && as_owner "$bin/pg_ctl" -D "$folder/data" -m immediate stop > /dev/null 2>&1
+  [ ! -e "$folder/data/postmaster.pid" ] || as_owner "$bin/pg_ctl" -D "$folder/data" -m immediate stop > /dev/null 2>&1 || true
   rm -rf "$folder"
   exit "$status"
 }
