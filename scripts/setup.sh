@@ -33,6 +33,7 @@ packages=(
   python3-fastapi python3-uvicorn python3-multipart python3-httpx  # simbot serve, and its tests' client
   python3-jinja2                # simbot serve's pages
   python3-sqlalchemy python3-alembic python3-psycopg2             # its database and migrations
+  postgresql                   # a throwaway server for its tests on PostgreSQL (scripts/postgres.sh)
   curl                         # docs/serve.md's example
   python3-distributed          # sweeps on a Dask cluster
 )

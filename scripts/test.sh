@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Sets everything up and runs the whole test suite: the layout check
-# (clang-format, no source file over 1,000 lines), the normal build with warnings as errors, the plant
+# (clang-format, no source file over 1,000 lines), the normal build with warnings as errors
+# (its tests beside a throwaway PostgreSQL server, scripts/postgres.sh), the plant
 # built against SUNDIALS 7 and its tests, the same suite
 # built with AddressSanitizer and UndefinedBehaviorSanitizer, the threaded
 # bench and tournament built with ThreadSanitizer, and a short campaign
@@ -43,7 +44,10 @@ phase "set-up and layout check"
 # optimisation is the one users run (-O2).
 ./scripts/build.sh build -DSIMBOT_WERROR=ON -DSIMBOT_CLI_ONLY=OFF "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG"
 phase "normal build"
-ctest --test-dir build --output-on-failure --parallel "$jobs" --timeout 900
+# Beside a throwaway PostgreSQL server (scripts/postgres.sh), which
+# server.api.postgres runs simbot serve's tests on; the sanitizer builds
+# have no server.
+./scripts/postgres.sh ctest --test-dir build --output-on-failure --parallel "$jobs" --timeout 900
 phase "normal tests"
 # The sanitizer builds keep line tables only (-g1): their reports still give
 # FILE:LINE, and compiling takes less time (ThreadSanitizer at -O1 -g1: 14 s

@@ -83,6 +83,8 @@ def _name_problem(name):
         return f"a team's name has at most {MAX_TEAM_NAME} characters"
     if any(ord(c) < 0x20 or ord(c) == 0x7F for c in name):
         return "a team's name has no control characters"
+    if any(0xD800 <= ord(c) <= 0xDFFF for c in name):  # JSON's "\ud800" alone: no UTF-8 for it
+        return "a team's name has no lone surrogates"
     return None
 
 
@@ -176,7 +178,10 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
         source = program.file.read(MAX_PROGRAM_BYTES + 1)
         if submissions.too_big(source):
             raise HTTPException(413, f"a program has at most {MAX_PROGRAM_BYTES} bytes")
-        out = submissions.submit(s, simbot, checks, who.id, program.filename, source)
+        try:
+            out = submissions.submit(s, simbot, checks, who.id, program.filename, source)
+        except submissions.Busy as e:
+            raise HTTPException(503, str(e))
         if out.errors:
             return JSONResponse({"errors": out.errors}, status_code=422)
         return {"version": out.submission.version, "warnings": out.warnings, "checks": out.cases}

@@ -35,9 +35,26 @@ def written(source):
         yield path
 
 
+def _nul_byte(path, shown_name):
+    """The error for a program's first NUL byte, or None. The compiler
+    passes one in a comment, but PostgreSQL's text (where the source is
+    kept) cannot hold it, and a program is text."""
+    with open(path, "rb") as f:
+        source = f.read()
+    at = source.find(b"\0")
+    if at < 0:
+        return None
+    line, column = source.count(b"\n", 0, at) + 1, at - source.rfind(b"\n", 0, at)
+    return f"{shown_name}:{line}:{column}: error: a NUL byte (a program is text)"
+
+
 def compile_file(simbot, path, shown_name):
     """Compiles the program at `path` (written()); its errors and warnings
-    are one line each, "NAME:LINE:COL: error: ..." with NAME `shown_name`."""
+    are one line each, "NAME:LINE:COL: error: ..." with NAME `shown_name`.
+    A program with a NUL byte is refused before the compiler runs."""
+    nul = _nul_byte(path, shown_name)
+    if nul:
+        return Compiled(False, [nul], [])
     try:
         p = subprocess.run([simbot, "compile", path], capture_output=True, timeout=COMPILE_SECONDS,
                            cwd=os.path.dirname(path))

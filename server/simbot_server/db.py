@@ -25,7 +25,20 @@ def make_engine(url):
             connection.execute("PRAGMA foreign_keys=ON")
 
         return engine
-    return create_engine(url, pool_pre_ping=True)
+    engine = create_engine(url, pool_pre_ping=True)
+    if engine.dialect.name == "postgresql":
+        # The tables' times (server_default now()) are UTC, as SQLite's
+        # CURRENT_TIMESTAMP is: PostgreSQL gives a timestamp without a zone
+        # in the session's time zone, which is the database's or the
+        # server's setting unless set here.
+        @event.listens_for(engine, "connect")
+        def _utc(connection, _record):
+            cursor = connection.cursor()
+            cursor.execute("SET TIME ZONE 'UTC'")
+            cursor.close()
+            connection.commit()
+
+    return engine
 
 
 def migrate(engine):

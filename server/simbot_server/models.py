@@ -70,7 +70,7 @@ class Match(Base):
     kind = Column(String(16), nullable=False)  # "scrimmage" or "tournament"
     tournament_id = Column(Integer, ForeignKey("tournaments.id"))
     rules = Column(String(64))
-    reload_on_fault = Column(Integer, nullable=False, default=0)
+    reload_on_fault = Column(Integer, nullable=False, default=0, server_default="0")
     a_submission_id = Column(Integer, ForeignKey("submissions.id"), nullable=False)
     b_submission_id = Column(Integer, ForeignKey("submissions.id"))
     b_house = Column(String(64))

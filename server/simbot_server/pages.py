@@ -161,7 +161,11 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
             if submissions.too_big(source):
                 return page(request, "submit.html", status_code=413, outcome=None,
                             problem=f"A program has at most {MAX_PROGRAM_BYTES} bytes.")
-            out = submissions.submit(s, simbot, checks, who.id, program.filename, source)
+            try:
+                out = submissions.submit(s, simbot, checks, who.id, program.filename, source)
+            except submissions.Busy as e:
+                return page(request, "submit.html", status_code=503, outcome=None,
+                            problem=str(e) + "; try again.")
             text = source.decode("latin-1")
             return page(request, "submit.html", status_code=422 if out.errors else 200,
                         outcome=out, team=who,
