@@ -6,7 +6,7 @@ Usage: readme_test.py SIMBOT WORKDIR README [PAGE...]
 Each ```sh block of the README, then of each manual page (docs/*.md) in
 the order given, runs with bash -e, in a sandbox
 laid out like the project's checkout (WORKDIR/main holding build/bin/simbot,
-programs/, scenarios/, profiles/, checks/, tests/, bench/, docs/, the bench binaries
+programs/, scenarios/, profiles/, checks/, tests/, bench/, docs/, scripts/, the bench binaries
 and build/python,
 beside WORKDIR/shared), so that
 the files a command writes land in WORKDIR and a later block can read them.
@@ -79,7 +79,7 @@ def sandbox(source, simbot, work):
     module = os.path.join(os.path.dirname(os.path.abspath(simbot)), "..", "python")
     if os.path.isdir(module):
         os.symlink(os.path.abspath(module), os.path.join(main, "build", "python"))
-    for part in ("programs", "scenarios", "profiles", "checks", "tests", "bench", "docs"):
+    for part in ("programs", "scenarios", "profiles", "checks", "tests", "bench", "docs", "scripts"):
         os.symlink(os.path.join(source, part), os.path.join(main, part))
     os.symlink(os.path.abspath(os.path.join(source, "..", "shared")), os.path.join(work, "shared"))
     return main
@@ -99,8 +99,12 @@ def run_desktop(line, cwd):
 
 
 def is_server(line):
-    words = line.split("#")[0].split()
-    return len(words) > 1 and words[0].endswith("bin/simbot") and words[1] == "serve"
+    """A `simbot serve` line left to run (one put in the background with `&`
+    runs in its block, which stops it)."""
+    command = line.split("#")[0]
+    words = command.split()
+    return len(words) > 1 and words[0].endswith("bin/simbot") and words[1] == "serve" \
+        and "&" not in command
 
 
 def run_server(line, cwd):
