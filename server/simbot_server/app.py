@@ -7,7 +7,8 @@
     POST /api/scrimmages   (team) {"opponent": TEAM_ID | "house:NAME", "seed"}
                            -> 201 {"match_id"}: the two latest versions, queued
     GET  /api/matches/ID   -> {"status": queued|running|done|failed, "result", ...}
-    POST /api/tournaments  (instructor) {"rules", "seconds", "rounds", "reload_on_fault", "seed"}
+    POST /api/tournaments  (instructor) {"rules", "seconds", "rounds", "reload_on_fault", "seed",
+                           "team_hardware"}
                            -> 201 {"id", "seed", "games"}: a round robin, queued
     GET  /api/tournaments/ID -> status, games done, its table
     GET  /api/standings    -> every team's games, wins, hits, rating (standings.py)
@@ -195,8 +196,10 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
         a = latest(s, who.id)
         if a is None:
             raise HTTPException(409, "submit a program first")
+        # Each team's robot as it is now (its /teams/ID/robot form), kept
+        # with the match: the match is played, and replayed, with it.
         m = Match(kind="scrimmage", a_submission_id=a.id, seed=seed, seconds=seconds,
-                  status="queued")
+                  status="queued", a_hardware=who.hardware)
         if isinstance(opponent, str) and opponent.startswith("house:"):
             if opponent[len("house:"):] not in house_robots(house):
                 raise HTTPException(422, f"no such house robot (there are: "
@@ -207,6 +210,7 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
             if b is None:
                 raise HTTPException(422, "that team has no program")
             m.b_submission_id = b.id
+            m.b_hardware = s.get(Team, opponent).hardware
         else:
             raise HTTPException(422, "'opponent' is a team's id or \"house:NAME\"")
         waiting = s.execute(select(func.count(Match.id)).join(
@@ -223,6 +227,7 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
     def create_tournament(body: dict = Body(...), s=Depends(session)):
         rules, rounds = body.get("rules"), body.get("rounds", 1)
         length, reload = body.get("seconds", seconds), body.get("reload_on_fault", False)
+        team_hardware = body.get("team_hardware", False)
         seed = body.get("seed", secrets.randbits(63))
         if rules is not None and (not isinstance(rules, str) or not _RULES_NAME.match(rules)):
             raise HTTPException(422, "'rules' is a rule set's name (letters, digits, '-')")
@@ -230,14 +235,18 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
                                  ("seed", seed, 2**63 - 1)):
             if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value <= top:
                 raise HTTPException(422, f"'{name}' is an integer from 0 to {top}")
-        if not isinstance(reload, bool):
-            raise HTTPException(422, "'reload_on_fault' is true or false")
+        for name, value in (("reload_on_fault", reload), ("team_hardware", team_hardware)):
+            if not isinstance(value, bool):
+                raise HTTPException(422, f"'{name}' is true or false")
         entrants = [t.id for t in s.execute(select(Team).order_by(Team.id)).scalars()
                     if latest(s, t.id) is not None]
         if len(entrants) < 2 or rounds < 1 or length < 1:
             raise HTTPException(422, "a round robin needs two teams with programs, a round and a length")
         t = Tournament(rules=rules, seconds=length, rounds=rounds, reload_on_fault=int(reload),
-                       seed=seed)
+                       seed=seed, team_hardware=int(team_hardware))
+        # The teams' robots (their forms' hardware files) if the instructor
+        # asks for them, else every robot the course's.
+        robot_of = {tid: s.get(Team, tid).hardware if team_hardware else None for tid in entrants}
         s.add(t)
         s.flush()
         # The brackets: every pair `rounds` times, sides swapped each round,
@@ -250,7 +259,7 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
             s.add(Match(kind="tournament", tournament_id=t.id, a_submission_id=latest(s, a).id,
                         b_submission_id=latest(s, b).id, seed=draw.getrandbits(63),
                         seconds=length, rules=rules, reload_on_fault=int(reload),
-                        status="queued"))
+                        a_hardware=robot_of[a], b_hardware=robot_of[b], status="queued"))
         s.commit()
         queue.notify()
         return {"id": t.id, "seed": seed, "games": len(games)}
@@ -266,6 +275,7 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
         finished = counts.get("done", 0) + counts.get("failed", 0)
         return {"id": t.id, "seed": t.seed, "rules": t.rules, "rounds": t.rounds,
                 "seconds": t.seconds, "reload_on_fault": bool(t.reload_on_fault),
+                "team_hardware": bool(t.team_hardware),
                 "status": "done" if finished == total else "running",
                 "games": {"total": total, "done": counts.get("done", 0),
                           "failed": counts.get("failed", 0)},

@@ -11,6 +11,10 @@ file name, program text and message a team sent is shown as text).
                         program that does not compile is shown with each
                         error at its line
     /tournaments/ID     a round robin: its status, its table, its games
+    /teams/ID/robot     the team's robot: every value a hardware file may
+                        set, with its unit, range and source; the team's
+                        token saves its answers as its hardware file
+                        (robot.py), checked by simbot's own loader
 
 The forms carry the team's token in their body, not in a cookie: no
 other site can post one on a visitor's behalf."""
@@ -19,11 +23,12 @@ import os
 import re
 
 from fastapi import File, Form, HTTPException, Request, UploadFile
+from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import FileResponse, HTMLResponse, Response
 from fastapi.templating import Jinja2Templates
 from sqlalchemy import or_, select
 
-from . import submissions
+from . import robot, submissions
 from .models import MAX_PROGRAM_BYTES, Match, Submission, Team, Tournament
 from .standings import standings
 
@@ -126,6 +131,58 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
         if not replays.ensure(match_id):
             raise HTTPException(404, "no replay: the match is not done")
         return FileResponse(replays.page(match_id), media_type="text/html")
+
+    def robot_page(request, t, status_code=200, **context):
+        found = robot.listing(simbot, t.hardware)
+        sections = {}
+        for key in found.keys:
+            sections.setdefault(key["section"], []).append(key)
+        return page(request, "robot.html", status_code=status_code, team=t, sections=sections,
+                    listing_error=found.error, field=robot.field, shown=robot.shown, **context)
+
+    @app.get("/teams/{team_id}/robot", response_class=HTMLResponse)
+    def robot_form(request: Request, team_id: int):
+        with sessions() as s:
+            t = s.get(Team, team_id)
+            if t is None:
+                raise HTTPException(404, "no such team")
+        return robot_page(request, t, sent={})
+
+    @app.post("/teams/{team_id}/robot", response_class=HTMLResponse)
+    async def robot_posted(request: Request, team_id: int):
+        form = await request.form()
+        sent = {k: v for k, v in form.items() if isinstance(v, str)}
+        return await run_in_threadpool(save_robot, request, team_id, sent)
+
+    def save_robot(request, team_id, sent):
+        with sessions() as s:
+            t = s.get(Team, team_id)
+            if t is None:
+                raise HTTPException(404, "no such team")
+            who = team_by_token(s, sent.get("token", ""))
+            if who is None or who.id != t.id:
+                return robot_page(request, t, 403, sent=sent, problem="That is not this team's token.")
+            try:
+                limited(who, "robot edit")
+            except HTTPException as e:
+                return robot_page(request, t, e.status_code, sent=sent, problem=e.detail + ".")
+            if sent.get("action") == "reset":
+                text, problems = None, {}
+            else:
+                text, problems = robot.hardware_file(robot.listing(simbot, None).keys, sent)
+            if problems:
+                return robot_page(request, t, 422, sent=sent, problems=problems,
+                                  problem="Some values are not what their keys take; nothing was kept.")
+            text = text or None
+            if text is not None:
+                checked = robot.listing(simbot, text)
+                if checked.error:
+                    return robot_page(request, t, 422, sent=sent, made=text,
+                                      problem="simbot's loader refuses the robot; nothing was kept: "
+                                              + checked.error)
+            t.hardware = text
+            s.commit()
+            return robot_page(request, t, sent={}, saved=True)
 
     @app.get("/tournaments/{tournament_id}", response_class=HTMLResponse)
     def tournament_page(request: Request, tournament_id: int):

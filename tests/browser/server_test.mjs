@@ -14,6 +14,12 @@
 //   own oracle);
 // - the match page shows `simbot explain`'s report, and its replay link
 //   opens the replay viewer, which draws without an error.
+// - the team's robot form shows each value with its unit, range and
+//   source; a mass of 900 lb is refused with simbot's loader's own
+//   FILE:LINE:COL error, 15 kg and a 95 ft/s gun are kept as a hardware
+//   file of those two values, and the team's scrimmages are played with
+//   it: each ends where `simbot match --hw A=that file` ends, not where the
+//   course's robot does.
 // Team names with markup are shown as text (no element made of them).
 // Screenshots go to OUTDIR (the ones in docs/serve-*.png come from here).
 //
@@ -125,6 +131,34 @@ try {
   check(failed.length === 1 && /\b3\b/.test(failed[0]),
     `the course's checks shown, ICEMAN's overwritten send on seed 3 among them: ${failed}`);
 
+  // ---- the team's robot: a value out of its range refused by simbot's
+  // loader at its line and column (robot.toml line 2: "[robot]" then
+  // "mass = { value = 900, ..."; column 18 is the value's, as simbot
+  // match --hw says it), then a lighter robot with a slower gun kept
+  await page.goto(`${base}/teams/${ice.id}/robot`);
+  const massRow = await page.locator('tr#key-robot\\.mass').textContent();
+  check(massRow.includes('35') && massRow.includes('0.5 to 500 lb') && massRow.includes("the competition limit"),
+    `mass shown with its value, range and source: ${massRow.replace(/\s+/g, ' ')}`);
+  await page.fill('[id="v.robot.mass"]', '900');
+  await page.fill('#token', ice.token);
+  await Promise.all([page.waitForNavigation(), page.click('button[value=save]')]);
+  const refused = await page.locator('#problem').textContent();
+  check(refused.includes("robot.toml:2:18: error: 'robot.mass' must be between 0.5 and 500 lb, got 900 lb"),
+    `the loader's error: ${refused}`);
+  await page.fill('[id="v.robot.mass"]', '15');
+  await page.selectOption('[name="u.robot.mass"]', 'kg');
+  await page.fill('[id="v.gun.muzzle_speed"]', '95');
+  await page.fill('#token', ice.token);
+  await Promise.all([page.waitForNavigation(), page.click('button[value=save]')]);
+  check(await page.locator('#saved').count() === 1, 'the robot is saved');
+  const hardware = await page.locator('#hardware').textContent();
+  check(/mass = \{ value = 15\.0, unit = "kg"/.test(hardware) && /muzzle_speed = \{ value = 95\.0, unit = "ft\/s"/.test(hardware),
+    `the hardware file holds what was changed, and only that: ${hardware}`);
+  check(!/body_diameter/.test(hardware), 'values left as the course has them are not in it');
+  await page.screenshot({ path: join(out, 'serve-robot.png') });
+  const robotFile = join(out, 'robot.toml');
+  writeFileSync(robotFile, hardware);
+
   // ---- fig92 by the API, a scrimmage and a round robin
   const form = new FormData();
   form.append('program', new Blob([readFileSync(join(sharedDir, 'programs/fig92.dc'))]), 'fig92.dc');
@@ -158,8 +192,16 @@ try {
   for (const id of [scrimmage, house]) {
     const m = (await api('GET', `/api/matches/${id}`, instructor)).body;
     const b = id === house ? join(sourceDir, 'programs/turret.dc') : join(sharedDir, 'programs/fig92.dc');
+    // ICEMAN's robot is its team's: the scrimmages are played with its file.
     const direct = JSON.parse(execFileSync(simbot, ['match', join(sharedDir, 'programs/iceman.dc'), b,
+      '--seed', String(m.seed), '--seconds', String(m.seconds), '--hw', `A=${robotFile}`, '--json'],
+    { stdio: ['ignore', 'pipe', 'ignore'] }));
+    const plain = JSON.parse(execFileSync(simbot, ['match', join(sharedDir, 'programs/iceman.dc'), b,
       '--seed', String(m.seed), '--seconds', String(m.seconds), '--json'], { stdio: ['ignore', 'pipe', 'ignore'] }));
+    check(JSON.stringify(direct.robots[0].final_pose) !== JSON.stringify(plain.robots[0].final_pose),
+      `the tailored robot plays another match than the course's (match ${id})`);
+    check(JSON.stringify(m.result.robots[0].final_pose) === JSON.stringify(direct.robots[0].final_pose),
+      `match ${id} ends where simbot match --hw puts ICEMAN: ${JSON.stringify(m.result.robots[0].final_pose)}`);
     const shown = (await page.locator(`table.matches tr:has(a[href="/matches/${id}"])`).textContent());
     const hits = direct.robots.map((r) => `${r.hits} hits`).join(' / ');
     check(shown.includes(hits) && shown.includes(direct.winner),
