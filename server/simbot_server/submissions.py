@@ -46,6 +46,10 @@ def submit(s, simbot, checks, team_id, file_name, source):
     `file_name`, and keeps it as team `team_id`'s next version if it
     compiles. Synchronous: the callers run it on FastAPI's thread pool."""
     shown = compiler.display_name(file_name)
+    if b"\0" in source:  # PostgreSQL keeps no NUL in text, and no program needs one
+        at = source.index(b"\0")
+        line, column = source.count(b"\n", 0, at) + 1, at - source.rfind(b"\n", 0, at)
+        return Outcome(errors=[f"{shown}:{line}:{column}: error: a NUL byte: a program is text"])
     with compiler.written(source) as path:
         result = compiler.compile_file(simbot, path, shown)
         if not result.ok:
