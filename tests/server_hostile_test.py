@@ -32,6 +32,7 @@ import contextlib
 import json
 import os
 import re
+import shutil
 import signal
 import socket
 import sqlite3
@@ -49,8 +50,6 @@ from fastapi.testclient import TestClient  # noqa: E402
 from simbot_server import db  # noqa: E402
 from simbot_server.app import create_app  # noqa: E402
 from simbot_server.limits import RateLimits  # noqa: E402
-
-import shutil  # noqa: E402
 
 shutil.rmtree(OUT, ignore_errors=True)
 OUT.mkdir(parents=True)
