@@ -20,6 +20,8 @@ from . import db
 from .app import TOKEN_FILE, create_app
 from .queue import ClusterError
 
+KEEP_ALIVE_SECONDS = 75  # an idle connection's life (uvicorn's default: 5)
+
 
 def main(argv=None):
     p = argparse.ArgumentParser(prog="simbot serve", description=__doc__.splitlines()[0])
@@ -45,7 +47,14 @@ def main(argv=None):
         print(f"simbot serve: the instructor's token (also in {a.data}/{TOKEN_FILE}): "
               f"{app.state.new_instructor_token}", flush=True)
     print(f"simbot serve: listening on http://{a.host}:{a.port}/ (data: {a.data})", flush=True)
-    uvicorn.run(app, host=a.host, port=a.port, log_level="warning")
+    # uvicorn 0.17 (Debian's) arms its keep-alive timer after a response
+    # even when the connection's next request is already being handled, and
+    # the timer then closes it mid-request, unanswered (encode/uvicorn#1637,
+    # fixed upstream by #2243): its 5-s default dropped round-robin pages
+    # under load.
+    # The timer is therefore longer than any request takes.
+    uvicorn.run(app, host=a.host, port=a.port, log_level="warning",
+                timeout_keep_alive=KEEP_ALIVE_SECONDS)
 
 
 if __name__ == "__main__":

@@ -22,14 +22,15 @@ import os
 import random
 import re
 import secrets
+import unicodedata
 
-from fastapi import Body, Depends, FastAPI, File, Header, HTTPException, Request, UploadFile
+from fastapi import Body, Depends, FastAPI, File, Header, HTTPException, Path, Request, UploadFile
 from fastapi.responses import JSONResponse
 from sqlalchemy import func, select
 from sqlalchemy.exc import IntegrityError
 
 from . import db, submissions, tokens
-from .models import MAX_PROGRAM_BYTES, MAX_TEAM_NAME, Match, Setting, Submission, Team, Tournament
+from .models import MAX_ID, MAX_PROGRAM_BYTES, MAX_TEAM_NAME, Match, Setting, Submission, Team, Tournament
 from .limits import RATES, RateLimits
 from .pages import add_pages
 from .queue import MatchQueue, house_robots
@@ -82,10 +83,10 @@ def _name_problem(name):
         return "a team's name is a non-empty string"
     if len(name) > MAX_TEAM_NAME:
         return f"a team's name has at most {MAX_TEAM_NAME} characters"
-    if any(ord(c) < 0x20 or ord(c) == 0x7F for c in name):
-        return "a team's name has no control characters"
-    if any(0xD800 <= ord(c) <= 0xDFFF for c in name):  # JSON's "\ud800" alone: no UTF-8 for it
-        return "a team's name has no lone surrogates"
+    # Cc: C0, DEL and C1 (U+0085 is a line break to Python); Cs: a lone
+    # surrogate (JSON's "\ud800"), which no database can store as text.
+    if any(unicodedata.category(c) in ("Cc", "Cs") for c in name):
+        return "a team's name has no control characters or lone surrogates"
     return None
 
 
@@ -126,8 +127,11 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
     @app.middleware("http")
     async def bounded_bodies(request: Request, call_next):
         length = request.headers.get("content-length")
-        if length is None and request.method not in ("GET", "HEAD", "OPTIONS"):
-            # A body sent in chunks could be of any length: only a declared one is read.
+        # A body sent in chunks could be of any length: only a declared one
+        # is read. With both headers the server reads the chunks (RFC 9112
+        # 6.3), so a small Content-Length would not bound them.
+        chunked = "transfer-encoding" in request.headers
+        if (length is None or chunked) and request.method not in ("GET", "HEAD", "OPTIONS"):
             return JSONResponse({"detail": "a request body needs its Content-Length"},
                                 status_code=411)
         if length is not None and (not length.isdigit() or int(length) > MAX_BODY_BYTES):
@@ -206,7 +210,7 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
                                          f"{', '.join(sorted(house_robots(house))) or 'none'})")
             m.b_house = opponent[len("house:"):]
         elif isinstance(opponent, int) and not isinstance(opponent, bool):
-            b = latest(s, opponent)
+            b = latest(s, opponent) if 0 <= opponent <= MAX_ID else None
             if b is None:
                 raise HTTPException(422, "that team has no program")
             m.b_submission_id = b.id
@@ -229,7 +233,7 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
         length, reload = body.get("seconds", seconds), body.get("reload_on_fault", False)
         team_hardware = body.get("team_hardware", False)
         seed = body.get("seed", secrets.randbits(63))
-        if rules is not None and (not isinstance(rules, str) or not _RULES_NAME.match(rules)):
+        if rules is not None and (not isinstance(rules, str) or not _RULES_NAME.fullmatch(rules)):
             raise HTTPException(422, "'rules' is a rule set's name (letters, digits, '-')")
         for name, value, top in (("rounds", rounds, MAX_ROUNDS), ("seconds", length, 1000),
                                  ("seed", seed, 2**63 - 1)):
@@ -265,7 +269,7 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
         return {"id": t.id, "seed": seed, "games": len(games)}
 
     @app.get("/api/tournaments/{tournament_id}")
-    def get_tournament(tournament_id: int, s=Depends(session)):
+    def get_tournament(tournament_id: int = Path(..., ge=0, le=MAX_ID), s=Depends(session)):
         t = s.get(Tournament, tournament_id)
         if t is None:
             raise HTTPException(404, "no such tournament")
@@ -286,7 +290,7 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
         return standings(s)
 
     @app.get("/api/matches/{match_id}")
-    def get_match(match_id: int, s=Depends(session)):
+    def get_match(match_id: int = Path(..., ge=0, le=MAX_ID), s=Depends(session)):
         m = s.get(Match, match_id)
         if m is None:
             raise HTTPException(404, "no such match")
@@ -295,7 +299,7 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
                 "error": m.error}
 
     @app.get("/api/teams/{team_id}")
-    def get_team(team_id: int, s=Depends(session)):
+    def get_team(team_id: int = Path(..., ge=0, le=MAX_ID), s=Depends(session)):
         t = s.get(Team, team_id)
         if t is None:
             raise HTTPException(404, "no such team")

@@ -16,7 +16,7 @@ _SAFE_NAME = re.compile(r"^[A-Za-z0-9._-]{1,128}$")
 
 def display_name(file_name):
     base = os.path.basename((file_name or "").replace("\\", "/"))
-    return base if _SAFE_NAME.match(base) and base not in (".", "..") else DISK_NAME
+    return base if _SAFE_NAME.fullmatch(base) and base not in (".", "..") else DISK_NAME
 
 
 class Compiled:

@@ -10,6 +10,7 @@ Base = declarative_base()
 MAX_TEAM_NAME = 64
 MAX_PROGRAM_BYTES = 64 * 1024
 MAX_FILE_NAME = 128
+MAX_ID = 2**63 - 1  # a row id: SQLite's INTEGER is 64-bit, and a larger int overflows its driver
 
 
 class Setting(Base):

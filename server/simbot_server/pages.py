@@ -22,14 +22,14 @@ import json
 import os
 import re
 
-from fastapi import File, Form, HTTPException, Request, UploadFile
+from fastapi import File, Form, HTTPException, Path, Request, UploadFile
 from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import FileResponse, HTMLResponse, Response
 from fastapi.templating import Jinja2Templates
 from sqlalchemy import or_, select
 
 from . import robot, submissions
-from .models import MAX_PROGRAM_BYTES, Match, Submission, Team, Tournament
+from .models import MAX_ID, MAX_PROGRAM_BYTES, Match, Submission, Team, Tournament
 from .standings import standings
 
 LATEST_MATCHES = 30  # listed on the front page and a team's page
@@ -71,9 +71,9 @@ def _marked_source(source, diagnostics):
 
 
 def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
-    def page(request, name, status_code=200, **context):
+    def page(request, name, status_code=200, headers=None, **context):
         return templates.TemplateResponse(name, {"request": request, **context},
-                                          status_code=status_code)
+                                          status_code=status_code, headers=headers)
 
     @app.get("/", response_class=HTMLResponse)
     def front(request: Request):
@@ -86,7 +86,7 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
                         .scalars().all())
 
     @app.get("/teams/{team_id}", response_class=HTMLResponse)
-    def team_page(request: Request, team_id: int):
+    def team_page(request: Request, team_id: int = Path(..., ge=0, le=MAX_ID)):
         with sessions() as s:
             t = s.get(Team, team_id)
             if t is None:
@@ -103,7 +103,7 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
                         matches=[_match_row(s, m) for m in matches])
 
     @app.get("/matches/{match_id}", response_class=HTMLResponse)
-    def match_page(request: Request, match_id: int):
+    def match_page(request: Request, match_id: int = Path(..., ge=0, le=MAX_ID)):
         with sessions() as s:
             m = s.get(Match, match_id)
             if m is None:
@@ -127,7 +127,7 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
         return Response(status_code=204)
 
     @app.get("/matches/{match_id}/replay")
-    def replay_page(match_id: int):
+    def replay_page(match_id: int = Path(..., ge=0, le=MAX_ID)):
         if not replays.ensure(match_id):
             raise HTTPException(404, "no replay: the match is not done")
         return FileResponse(replays.page(match_id), media_type="text/html")
@@ -141,7 +141,7 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
                     listing_error=found.error, field=robot.field, shown=robot.shown, **context)
 
     @app.get("/teams/{team_id}/robot", response_class=HTMLResponse)
-    def robot_form(request: Request, team_id: int):
+    def robot_form(request: Request, team_id: int = Path(..., ge=0, le=MAX_ID)):
         with sessions() as s:
             t = s.get(Team, team_id)
             if t is None:
@@ -149,7 +149,7 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
         return robot_page(request, t, sent={})
 
     @app.post("/teams/{team_id}/robot", response_class=HTMLResponse)
-    async def robot_posted(request: Request, team_id: int):
+    async def robot_posted(request: Request, team_id: int = Path(..., ge=0, le=MAX_ID)):
         form = await request.form()
         sent = {k: v for k, v in form.items() if isinstance(v, str)}
         return await run_in_threadpool(save_robot, request, team_id, sent)
@@ -185,7 +185,7 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
             return robot_page(request, t, sent={}, saved=True)
 
     @app.get("/tournaments/{tournament_id}", response_class=HTMLResponse)
-    def tournament_page(request: Request, tournament_id: int):
+    def tournament_page(request: Request, tournament_id: int = Path(..., ge=0, le=MAX_ID)):
         with sessions() as s:
             t = s.get(Tournament, tournament_id)
             if t is None:
@@ -212,8 +212,8 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
             try:
                 limited(who, "submission")
             except HTTPException as e:
-                return page(request, "submit.html", status_code=e.status_code, outcome=None,
-                            problem=e.detail + ".")
+                return page(request, "submit.html", status_code=e.status_code, headers=e.headers,
+                            outcome=None, problem=e.detail + ".")
             source = program.file.read(MAX_PROGRAM_BYTES + 1)
             if submissions.too_big(source):
                 return page(request, "submit.html", status_code=413, outcome=None,

@@ -25,14 +25,17 @@ def _participants_and_games(s, tournament_id):
     teams = {t.id: t.name for t in s.execute(select(Team)).scalars()}
     team_of = {sub.id: sub.team_id for sub in s.execute(select(Submission)).scalars()}
     games = []
-    done = select(Match).where(Match.status == "done").order_by(Match.id)
+    # Columns, not Match objects: a match the session loaded earlier (a
+    # page lists the games first) would come back as it was then, say
+    # running without its result, though its row is done now.
+    done = select(Match.a_submission_id, Match.b_submission_id, Match.b_house, Match.result).where(
+        Match.status == "done").order_by(Match.id)
     if tournament_id is not None:
         done = done.where(Match.tournament_id == tournament_id)
-    for m in s.execute(done).scalars():
-        r = json.loads(m.result)
-        a = ("team", team_of[m.a_submission_id])
-        b = ("team", team_of[m.b_submission_id]) if m.b_submission_id else ("house", m.b_house)
-        games.append((a, b, r))
+    for a_submission, b_submission, b_house, result in s.execute(done):
+        a = ("team", team_of[a_submission])
+        b = ("team", team_of[b_submission]) if b_submission else ("house", b_house)
+        games.append((a, b, json.loads(result)))
     return teams, games
 
 
