@@ -47,6 +47,9 @@ Subcommand addExplainCommand(CLI::App& app);  // cli/explain_command.cpp
 Subcommand addSweepCommand(CLI::App& app);    // cli/sweep_command.cpp
 Subcommand addCheckCommand(CLI::App& app);    // cli/check_command.cpp
 Subcommand addServeCommand(CLI::App& app);    // cli/serve_command.cpp
+// simbot hardware (cli/hardware_command.cpp): the values a hardware file
+// may set for one robot, and a hardware file checked.
+Subcommand addHardwareCommand(CLI::App& app);
 // simbot debug (cli/debug_command.cpp): commands from --batch FILE, the
 // terminal or stdin; --robot the one held first ("A" or "B").
 int debugCommand(const std::vector<std::string>& programs, const runs::RunOptions& o);

@@ -317,6 +317,7 @@ int main(int argc, char** argv) {
   const auto check = simbot::cli::addCheckCommand(app);
   addWarningOptions(check.app);
   const auto serve = simbot::cli::addServeCommand(app);
+  const auto hardware = simbot::cli::addHardwareCommand(app);
 
   files::removeTemporariesOnSignals();
   try {
@@ -357,6 +358,7 @@ int main(int argc, char** argv) {
     if (*sweep.app) return sweep.run();
     if (*check.app) return check.run();
     if (*serve.app) return serve.run();
+    if (*hardware.app) return hardware.run();
   } catch (const sinks::UserError& e) {
     std::cerr << e.what();
     return kExitBadInput;

@@ -495,6 +495,48 @@ const char* internalUnit(Kind k) {
   }
 }
 
-// A TOML number as a double. toml++ gives no double for an integer it
+const char* kindName(Kind k) {
+  switch (k) {
+    case Kind::Length:
+      return "length";
+    case Kind::Speed:
+      return "speed";
+    case Kind::Time:
+      return "time";
+    case Kind::Angle:
+      return "angle";
+    case Kind::Accel:
+      return "acceleration";
+    case Kind::Mass:
+      return "mass";
+    case Kind::Ratio:
+      return "ratio";
+    case Kind::Probability:
+      return "probability";
+    case Kind::Reading:
+      return "reading";
+    case Kind::Count:
+      return "count";
+    case Kind::Step:
+      return "step";
+    case Kind::Bit:
+      return "bit";
+    case Kind::Bool:
+      return "bool";
+    case Kind::Choice:
+      return "choice";
+    case Kind::SpeedTable:
+      return "speed_table";
+    case Kind::Charge:
+      return "charge";
+    case Kind::Voltage:
+      return "voltage";
+    case Kind::Current:
+      return "current";
+    case Kind::Resistance:
+      return "resistance";
+  }
+  return "";
+}
 
 }  // namespace simbot::config::keys

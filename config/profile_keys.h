@@ -119,5 +119,8 @@ double unitFactor(Kind k, std::string_view u);
 const char* allowedUnits(Kind k);
 // The internal unit of a kind, for messages about its range.
 const char* internalUnit(Kind k);
+// The kind's name for a reader ("length", "speed_table", "bool", ...):
+// simbot hardware's listing.
+const char* kindName(Kind k);
 
 }  // namespace simbot::config::keys

@@ -63,6 +63,7 @@ enum RunOptionUse : unsigned {
   kTournament = 1 << 7,
   kSweep = 1 << 8,
   kPythonBench = 1 << 9,
+  kHardware = 1 << 10,
 };
 
 // What a run option's value must be beyond its type: anything, an integer
