@@ -95,8 +95,9 @@ try {
   const page = await browser.newPage({ viewport: { width: 1200, height: 900 } });
   const problems = [];
   const readPixelsNote = /GL Driver Message \(OpenGL, Performance.*ReadPixels|willReadFrequently/;
-  // The form's answer to a program that does not compile is a 422, as the API's.
-  const expected422 = /status of 422 .*\/submit\)$/;
+  // The forms' answers to a program that does not compile and to a robot
+  // the loader refuses are 422s, as the API's are.
+  const expected422 = /status of 422 .*\/(submit|teams\/\d+\/robot)\)$/;
   page.on('console', (m) => {
     if (expected422.test(`${m.text()} (${page.url()})`)) return;
     if (m.type() === 'error' || (m.type() === 'warning' && !readPixelsNote.test(m.text())))
@@ -155,6 +156,7 @@ try {
   check(/mass = \{ value = 15\.0, unit = "kg"/.test(hardware) && /muzzle_speed = \{ value = 95\.0, unit = "ft\/s"/.test(hardware),
     `the hardware file holds what was changed, and only that: ${hardware}`);
   check(!/body_diameter/.test(hardware), 'values left as the course has them are not in it');
+  await page.evaluate(() => document.getElementById('key-robot.motor_lag').scrollIntoView());
   await page.screenshot({ path: join(out, 'serve-robot.png') });
   const robotFile = join(out, 'robot.toml');
   writeFileSync(robotFile, hardware);
