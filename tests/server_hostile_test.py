@@ -500,6 +500,34 @@ check(got == [None] * 20 + [1.0], f"scrimmages: 20 then 1 s: {got[-2:]}")
 now[0] = 70.25
 check(limits.take(1, "scrimmage") == 0.75, "a quarter token later: 0.75 s")
 
+# ---- the database's growth: a team keeps at most MAX_VERSIONS_PER_TEAM
+# versions (409 after, through the API and the form) and asks at most
+# MAX_SCRIMMAGES_PER_DAY scrimmages in 24 hours (429 after); both set low
+# here: 2 versions, 2 scrimmages.
+from simbot_server import app as app_module  # noqa: E402
+from simbot_server import submissions as submissions_module  # noqa: E402
+
+grower = c.post("/api/teams", json={"name": "grower"}, headers=auth(instructor)).json()
+kept_versions, kept_scrimmages = submissions_module.MAX_VERSIONS_PER_TEAM, app_module.MAX_SCRIMMAGES_PER_DAY
+submissions_module.MAX_VERSIONS_PER_TEAM, app_module.MAX_SCRIMMAGES_PER_DAY = 2, 2
+with adds("two versions", submissions=2):
+    for k in range(2):
+        check(api_submit(c, grower["token"], b"tiny.dc", TINY).status_code == 201, f"version {k + 1}")
+with adds("a third version stores nothing"):
+    r = api_submit(c, grower["token"], b"tiny.dc", TINY)
+    check(r.status_code == 409 and "at most 2 versions" in r.text, f"a third version: {r.status_code} {r.text}")
+    r = form_submit(c, grower["token"], b"tiny.dc", TINY)
+    check(r.status_code == 409 and "at most 2 versions" in r.text, f"the form: {r.status_code}")
+with adds("two scrimmages", matches=2):
+    for k in range(2):
+        r = c.post("/api/scrimmages", json={"opponent": "house:turret", "seed": k}, headers=auth(grower["token"]))
+        check(r.status_code == 201, f"scrimmage {k + 1}: {r.status_code} {r.text}")
+with adds("a third scrimmage in a day stores nothing"):
+    r = c.post("/api/scrimmages", json={"opponent": "house:turret", "seed": 2}, headers=auth(grower["token"]))
+    check(r.status_code == 429 and "at most 2 scrimmages a day" in r.text
+          and r.headers.get("retry-after") == "3600", f"a third scrimmage: {r.status_code} {r.text}")
+submissions_module.MAX_VERSIONS_PER_TEAM, app_module.MAX_SCRIMMAGES_PER_DAY = kept_versions, kept_scrimmages
+
 # ---- the queue runs: every match done; the pages show every name and
 # program escaped; the replay page carries the program and its console
 # only as JSON with '<' as \u003c.
@@ -621,7 +649,7 @@ with contextlib.closing(sqlite3.connect(DATABASE)) as q:
     tables = {r[0] for r in q.execute("select name from sqlite_master where type = 'table'")}
     check(set(TABLES) | {"alembic_version"} <= tables, f"every table there: {sorted(tables)}")
     check(q.execute("pragma integrity_check").fetchone() == ("ok",), "the database is whole")
-    check(q.execute("select count(*) from teams").fetchone()[0] == 8 + len(kept_names) + 1 + 2,
+    check(q.execute("select count(*) from teams").fetchone()[0] == 8 + len(kept_names) + 1 + 2 + 1,
           "the teams made, and only those")
 bad = [s for s in statuses if s[0] >= 500]
 check(bad == [], f"5xx answers: {bad[:10]}")

@@ -17,6 +17,7 @@
 Tokens come as `Authorization: Bearer TOKEN`. Every body is bounded
 (MAX_BODY_BYTES, a program MAX_PROGRAM_BYTES); names are checked and kept
 as text, shown only as JSON strings (and, in pages, escaped)."""
+import datetime
 import json
 import os
 import random
@@ -39,6 +40,7 @@ from .standings import standings
 
 MAX_BODY_BYTES = MAX_PROGRAM_BYTES + 8 * 1024  # a program and its multipart framing
 MAX_WAITING_PER_TEAM = 10  # a team's scrimmages queued or running at once
+MAX_SCRIMMAGES_PER_DAY = 500  # a team's scrimmages asked in the last 24 hours
 MAX_ROUNDS = 100  # of a round robin
 _RULES_NAME = re.compile(r"^[A-Za-z0-9-]{1,64}$")
 INSTRUCTOR_KEY = "instructor_token_hash"
@@ -187,6 +189,8 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
             out = submissions.submit(s, simbot, checks, who.id, program.filename, source)
         except submissions.Busy as e:
             raise HTTPException(503, str(e))
+        except submissions.Full as e:
+            raise HTTPException(409, str(e))
         if out.errors:
             return JSONResponse({"errors": out.errors}, status_code=422)
         return {"version": out.submission.version, "warnings": out.warnings, "checks": out.cases}
@@ -222,6 +226,15 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
             Submission.team_id == who.id, Match.status.in_(("queued", "running")))).scalar()
         if waiting >= MAX_WAITING_PER_TEAM:
             raise HTTPException(429, f"a team has at most {MAX_WAITING_PER_TEAM} matches waiting")
+        # The database's growth: a day's scrimmages of a team are bounded
+        # (a match's row holds its result, a few KB).
+        today = s.execute(select(func.count(Match.id)).join(
+            Submission, Match.a_submission_id == Submission.id).where(
+            Submission.team_id == who.id, Match.kind == "scrimmage",
+            Match.created >= datetime.datetime.utcnow() - datetime.timedelta(days=1))).scalar()
+        if today >= MAX_SCRIMMAGES_PER_DAY:
+            raise HTTPException(429, f"a team plays at most {MAX_SCRIMMAGES_PER_DAY} scrimmages "
+                                     f"a day", {"Retry-After": "3600"})
         s.add(m)
         s.commit()
         queue.notify()

@@ -223,6 +223,9 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
             except submissions.Busy as e:
                 return page(request, "submit.html", status_code=503, outcome=None,
                             problem=str(e) + "; try again.")
+            except submissions.Full as e:
+                return page(request, "submit.html", status_code=409, outcome=None,
+                            problem=str(e) + ".")
             text = source.decode("latin-1")
             return page(request, "submit.html", status_code=422 if out.errors else 200,
                         outcome=out, team=who,

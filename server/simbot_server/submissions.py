@@ -12,6 +12,13 @@ from .models import MAX_PROGRAM_BYTES, Submission
 
 CHECK_SECONDS = 300  # wall time of the course's checks on one submission
 MAX_VERSION_TRIES = 100  # submissions of one team stored at the same moment
+# The database's growth: a team keeps at most this many versions (each at
+# most MAX_PROGRAM_BYTES: 12.8 MB a team at most).
+MAX_VERSIONS_PER_TEAM = 200
+
+
+class Full(Exception):
+    """The team has kept MAX_VERSIONS_PER_TEAM versions (409)."""
 
 
 class Busy(Exception):
@@ -54,6 +61,10 @@ def submit(s, simbot, checks, team_id, file_name, source):
     the compiler and the checks do not hold up the event loop; nor do they
     hold a database connection (PostgreSQL's pool lends 15): session `s`
     gives its back until the version is stored."""
+    kept = s.execute(select(func.count(Submission.id)).where(
+        Submission.team_id == team_id)).scalar()
+    if kept >= MAX_VERSIONS_PER_TEAM:
+        raise Full(f"a team keeps at most {MAX_VERSIONS_PER_TEAM} versions; ask the instructor")
     s.close()
     shown = compiler.display_name(file_name)
     with compiler.written(source) as path:
