@@ -38,6 +38,14 @@ _DIAGNOSTIC_LINE = re.compile(r"^[^:]*:(\d+):(\d+): (error|warning): (.*)$")
 templates = Jinja2Templates(directory=os.path.join(os.path.dirname(__file__), "templates"))
 
 
+def _found(s, model, row_id, what):
+    """Row `row_id` of `model`, or 404 "no such WHAT"."""
+    row = s.get(model, row_id)
+    if row is None:
+        raise HTTPException(404, f"no such {what}")
+    return row
+
+
 def _side(s, m, robot):
     """(label, team id or None) of a match's robot A or B."""
     if robot == "B" and m.b_house is not None:
@@ -88,9 +96,7 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
     @app.get("/teams/{team_id}", response_class=HTMLResponse)
     def team_page(request: Request, team_id: int = Path(..., ge=0, le=MAX_ID)):
         with sessions() as s:
-            t = s.get(Team, team_id)
-            if t is None:
-                raise HTTPException(404, "no such team")
+            t = _found(s, Team, team_id, "team")
             mine = [sub.id for sub in t.submissions]
             matches = s.execute(select(Match).where(or_(
                 Match.a_submission_id.in_(mine), Match.b_submission_id.in_(mine)))
@@ -105,9 +111,7 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
     @app.get("/matches/{match_id}", response_class=HTMLResponse)
     def match_page(request: Request, match_id: int = Path(..., ge=0, le=MAX_ID)):
         with sessions() as s:
-            m = s.get(Match, match_id)
-            if m is None:
-                raise HTTPException(404, "no such match")
+            m = _found(s, Match, match_id, "match")
             row, result, error = _match_row(s, m), json.loads(m.result) if m.result else None, m.error
             options = {"seconds": m.seconds, "rules": m.rules,
                        "reload_on_fault": bool(m.reload_on_fault),
@@ -143,9 +147,7 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
     @app.get("/teams/{team_id}/robot", response_class=HTMLResponse)
     def robot_form(request: Request, team_id: int = Path(..., ge=0, le=MAX_ID)):
         with sessions() as s:
-            t = s.get(Team, team_id)
-            if t is None:
-                raise HTTPException(404, "no such team")
+            t = _found(s, Team, team_id, "team")
         return robot_page(request, t, sent={})
 
     @app.post("/teams/{team_id}/robot", response_class=HTMLResponse)
@@ -156,9 +158,7 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
 
     def save_robot(request, team_id, sent):
         with sessions() as s:
-            t = s.get(Team, team_id)
-            if t is None:
-                raise HTTPException(404, "no such team")
+            t = _found(s, Team, team_id, "team")
             who = team_by_token(s, sent.get("token", ""))
             if who is None or who.id != t.id:
                 return robot_page(request, t, 403, sent=sent, problem="That is not this team's token.")
@@ -187,9 +187,7 @@ def add_pages(app, sessions, simbot, checks, replays, team_by_token, limited):
     @app.get("/tournaments/{tournament_id}", response_class=HTMLResponse)
     def tournament_page(request: Request, tournament_id: int = Path(..., ge=0, le=MAX_ID)):
         with sessions() as s:
-            t = s.get(Tournament, tournament_id)
-            if t is None:
-                raise HTTPException(404, "no such tournament")
+            t = _found(s, Tournament, tournament_id, "tournament")
             games = s.execute(select(Match).where(Match.tournament_id == t.id)
                               .order_by(Match.id)).scalars().all()
             rows = [_match_row(s, m) for m in games]
