@@ -14,6 +14,7 @@
 
 #include "cli/commands.h"
 #include "config/config.h"
+#include "config/hardware_keys.h"
 #include "runs/play.h"
 #include "sinks/json_text.h"
 

@@ -4,6 +4,8 @@
 // as the profile or the hardware file writes it, and the value the loader
 // leaves. The files are checked by their loaders first (loadProfile,
 // loadHardware), so what is read here again is known to be well formed.
+#include "config/hardware_keys.h"
+
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
