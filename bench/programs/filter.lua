@@ -2,7 +2,7 @@
 -- times, a moving average over 8 readings and the times it rises through
 -- 500 (above 500 after being at or below it). Prints the crossings, the
 -- last average and the repetitions. Same algorithm as filter.dc.
-local N, WINDOW, REPS = 256, 8, 500
+local N, WINDOW, REPS = 256, 8, 5000
 local readings = {}
 local seed = 5
 for i = 0, N - 1 do

@@ -2,7 +2,7 @@
 -- 17, then the interior cells whose four neighbours sum to more than 32
 -- are counted. Prints the count and the repetitions. Same algorithm as
 -- grid.dc.
-local SIDE, REPS = 32, 60
+local SIDE, REPS = 32, 600
 local g = {}
 for r = 0, SIDE - 1 do g[r] = {} end
 local count, rep = 0, 0

@@ -1,7 +1,7 @@
 -- Insertion sort of 200 integers drawn from a linear congruential
 -- generator, REPS times; prints the smallest, the middle and the largest
 -- value and the repetitions. Same algorithm as sort.dc (bench/vs_lua.py).
-local N, REPS = 200, 20
+local N, REPS = 200, 200
 local a = {}
 local seed, rep = 1, 0
 while rep < REPS do

@@ -2,7 +2,7 @@
 -- (a letter after a space or at the start) and the places where "robot"
 -- begins, found by comparing character by character. Prints the three
 -- counts and the repetitions. Same algorithm as strscan.dc.
-local LEN, REPS = 640, 300
+local LEN, REPS = 640, 1200
 local source = "the robot sees the other robot and fires "
 local text, word = {}, {string.byte("robot", 1, 5)}
 for i = 0, LEN - 1 do text[i] = source:byte(i % 41 + 1) end

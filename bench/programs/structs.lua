@@ -2,7 +2,7 @@
 -- a linear congruential generator; REPS times, the nearest sighting seen,
 -- how many were seen and the sum of their bearings modulo 1000. Prints the
 -- three and the repetitions. Same algorithm as structs.dc.
-local N, REPS = 100, 1500
+local N, REPS = 100, 15000
 local tbl = {}
 local seed = 3
 for i = 0, N - 1 do
