@@ -255,15 +255,17 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
         for name, value in (("reload_on_fault", reload), ("team_hardware", team_hardware)):
             if not isinstance(value, bool):
                 raise HTTPException(422, f"'{name}' is true or false")
-        entrants = [t.id for t in s.execute(select(Team).order_by(Team.id)).scalars()
-                    if latest(s, t.id) is not None]
+        # Each team's latest version and robot, read once for all its games.
+        teams = s.execute(select(Team).order_by(Team.id)).scalars().all()
+        version = {t.id: latest(s, t.id) for t in teams}
+        entrants = [t.id for t in teams if version[t.id] is not None]
         if len(entrants) < 2 or rounds < 1 or length < 1:
             raise HTTPException(422, "a round robin needs two teams with programs, a round and a length")
         t = Tournament(rules=rules, seconds=length, rounds=rounds, reload_on_fault=int(reload),
                        seed=seed, team_hardware=int(team_hardware))
         # The teams' robots (their forms' hardware files) if the instructor
         # asks for them, else every robot the course's.
-        robot_of = {tid: s.get(Team, tid).hardware if team_hardware else None for tid in entrants}
+        robot_of = {t.id: t.hardware if team_hardware else None for t in teams}
         s.add(t)
         s.flush()
         # The brackets: every pair `rounds` times, sides swapped each round,
@@ -273,8 +275,8 @@ def create_app(db_url, data_dir, simbot, checks=None, house=None, workers=2, sec
                  for i, a in enumerate(entrants) for b in entrants[i + 1:]]
         draw.shuffle(games)
         for a, b in games:
-            s.add(Match(kind="tournament", tournament_id=t.id, a_submission_id=latest(s, a).id,
-                        b_submission_id=latest(s, b).id, seed=draw.getrandbits(63),
+            s.add(Match(kind="tournament", tournament_id=t.id, a_submission_id=version[a].id,
+                        b_submission_id=version[b].id, seed=draw.getrandbits(63),
                         seconds=length, rules=rules, reload_on_fault=int(reload),
                         a_hardware=robot_of[a], b_hardware=robot_of[b], status="queued"))
         s.commit()
