@@ -31,9 +31,25 @@ class Listing:
         self.keys, self.error = keys or [], error
 
 
+_course = {}  # simbot executable -> its listing of the course's profile alone
+
+
 def listing(simbot, hardware=None):
     """The keys over the course's profile, with `hardware` (a file's text,
-    or None) loaded over it."""
+    or None) loaded over it. The course's alone is the same for every team
+    and form: it is made once (the profile is read when the server first
+    shows a form)."""
+    if hardware is None:
+        if simbot not in _course:
+            found = _listing(simbot, None)
+            if found.error:
+                return found
+            _course[simbot] = found
+        return _course[simbot]
+    return _listing(simbot, hardware)
+
+
+def _listing(simbot, hardware):
     with tempfile.TemporaryDirectory(prefix="simbot-robot-") as folder:
         args = [simbot, "hardware", "--json"]
         if hardware is not None:
