@@ -17,13 +17,8 @@ import { mkdirSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 
-let chromium;
-try {
-  ({ chromium } = await import('playwright-core'));
-} catch {
-  console.error('playwright-core is not installed: run scripts/setup.sh (npm ci in tests/browser)');
-  process.exit(1);
-}
+import { launchChromium, watchConsole } from './chromium.mjs';
+
 
 const [simbot, iceman, fig92, sourceDir, outArg] = process.argv.slice(2);
 const out = resolve(outArg);
@@ -55,22 +50,13 @@ const pushes = runPair('pushes', join(sourceDir, 'programs/backer.dc'), fig92,
 const discs = run('discs', ['--rules', 'se3015-1997w', '--hw', 'A=profiles/hardware/disc-launcher.toml',
   '--seconds', '60']);
 
-const browser = await chromium.launch({
-  executablePath: '/usr/bin/chromium',
-  headless: true,
-  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
-});
+const browser = await launchChromium();
 const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
 const problems = [];
 // The test's own read-backs (view3dStats, the probes' getImageData) make
 // Chromium note their cost: the test's doing, not the page's.
 const readPixelsNote = /GL Driver Message \(OpenGL, Performance.*ReadPixels|willReadFrequently/;
-page.on('console', (m) => {
-  if (m.type() === 'error' || (m.type() === 'warning' && !readPixelsNote.test(m.text())))
-    problems.push(`${m.type()}: ${m.text()}`);
-});
-page.on('pageerror', (e) => problems.push(`pageerror: ${e.message}`));
+watchConsole(page, problems, (type, text) => type === 'warning' && readPixelsNote.test(text));
 
 async function open(path) {
   await page.goto(pathToFileURL(path).href);

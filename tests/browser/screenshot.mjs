@@ -3,15 +3,11 @@
 // Usage: node screenshot.mjs PAGE.html OUT.png [SECONDS] [CAMERA]
 import { resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
-import { chromium } from 'playwright-core';
+
+import { launchChromium } from './chromium.mjs';
 
 const [pagePath, out, seconds = '60', camera = 'corner SW'] = process.argv.slice(2);
-const browser = await chromium.launch({
-  executablePath: '/usr/bin/chromium',
-  headless: true,
-  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
-});
+const browser = await launchChromium();
 const page = await browser.newPage({ viewport: { width: 1400, height: 940 } });
 await page.goto(pathToFileURL(resolve(pagePath)).href);
 await page.waitForFunction(() => window.simbotViewer && window.simbotViewer.ready === true);

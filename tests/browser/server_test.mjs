@@ -29,13 +29,8 @@ import { mkdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { createServer } from 'node:net';
 import { join, resolve } from 'node:path';
 
-let chromium;
-try {
-  ({ chromium } = await import('playwright-core'));
-} catch {
-  console.error('playwright-core is not installed: run scripts/setup.sh (npm ci in tests/browser)');
-  process.exit(1);
-}
+import { launchChromium, watchConsole } from './chromium.mjs';
+
 
 const [simbot, sourceDir, sharedDir, outArg] = process.argv.slice(2);
 const out = resolve(outArg);
@@ -86,24 +81,15 @@ try {
   const ice = (await api('POST', '/api/teams', instructor, { name: 'Ice<i>man</i>' })).body;
   const fig = (await api('POST', '/api/teams', instructor, { name: 'Fig 92' })).body;
 
-  browser = await chromium.launch({
-    executablePath: '/usr/bin/chromium',
-    headless: true,
-    args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
-  });
+  browser = await launchChromium();
   const page = await browser.newPage({ viewport: { width: 1200, height: 900 } });
   const problems = [];
   const readPixelsNote = /GL Driver Message \(OpenGL, Performance.*ReadPixels|willReadFrequently/;
   // The forms' answers to a program that does not compile and to a robot
   // the loader refuses are 422s, as the API's are.
   const expected422 = /status of 422 .*\/(submit|teams\/\d+\/robot)\)$/;
-  page.on('console', (m) => {
-    if (expected422.test(`${m.text()} (${page.url()})`)) return;
-    if (m.type() === 'error' || (m.type() === 'warning' && !readPixelsNote.test(m.text())))
-      problems.push(`${m.type()}: ${m.text()} (${page.url()})`);
-  });
-  page.on('pageerror', (e) => problems.push(`pageerror: ${e.message} (${page.url()})`));
+  watchConsole(page, problems, (type, text, url) => expected422.test(`${text} (${url})`) ||
+    (type === 'warning' && readPixelsNote.test(text)));
 
   // ---- a program that does not compile, through the form
   const bad = join(out, 'bad.dc');

@@ -16,13 +16,8 @@ import { mkdirSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 
-let chromium;
-try {
-  ({ chromium } = await import('playwright-core'));
-} catch {
-  console.error('playwright-core is not installed: run scripts/setup.sh (npm ci in tests/browser)');
-  process.exit(1);
-}
+import { launchChromium, watchConsole } from './chromium.mjs';
+
 
 const [simbot, iceman, fig92, outArg] = process.argv.slice(2);
 const out = resolve(outArg);
@@ -59,22 +54,13 @@ function sampleAt(robot, t) {
 }
 
 // ---- the browser: no network, software WebGL
-const browser = await chromium.launch({
-  executablePath: '/usr/bin/chromium',
-  headless: true,
-  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
-});
+const browser = await launchChromium();
 const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
 const consoleProblems = [];
 // Chromium's software GL reports a "GPU stall due to ReadPixels" when the
 // test reads the 3-D canvas back (view3dStats): the test's doing, not the page's.
 const readPixelsNote = /GL Driver Message \(OpenGL, Performance.*ReadPixels/;
-page.on('console', (m) => {
-  if (m.type() === 'error' || (m.type() === 'warning' && !readPixelsNote.test(m.text())))
-    consoleProblems.push(`${m.type()}: ${m.text()}`);
-});
-page.on('pageerror', (e) => consoleProblems.push(`pageerror: ${e.message}`));
+watchConsole(page, consoleProblems, (type, text) => type === 'warning' && readPixelsNote.test(text));
 const requests = [];
 page.on('request', (r) => { if (!r.url().startsWith('file:') && !r.url().startsWith('data:')) requests.push(r.url()); });
 
