@@ -563,7 +563,10 @@ SIMBOT_INSTRUCTION(CALLI) {
   const uint32_t target = r.pop() & 0xFFFF;
   const uint32_t argc = r.code[r.opPc + 1];
   const Image::Entry* entry = image().entryAt(target);
-  if (!entry || entry->params != argc) return badCallThrough(r, target, argc);
+  if (!entry || entry->params != argc) {
+    const Regs held = r;  // r's address stays in run(), so its fields stay in registers
+    return badCallThrough(held, target, argc);
+  }
   return callTo(r, target);
 }
 SIMBOT_INSTRUCTION(ENTER) {
@@ -596,8 +599,12 @@ SIMBOT_INSTRUCTION(RET) {
   const uint32_t target = r.rd16(readAt);
   // SP wraps at 16 bits; kMemorySize is the empty stack.
   msp = (readAt + kReturnAddressBytes - 1) % kMemorySize + 1;
-  if (__builtin_expect(target != call.retPc || readAt != call.saved, 0))
-    return divertedReturn(r, call, target, readAt, frame, fp);
+  if (__builtin_expect(target != call.retPc || readAt != call.saved, 0)) {
+    Regs held = r;  // as in CALLI
+    const bool runsOn = divertedReturn(held, call, target, readAt, frame, fp);
+    r = held;
+    return runsOn;
+  }
   r.ip = target;
   return true;
 }
