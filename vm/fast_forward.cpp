@@ -45,14 +45,15 @@ bool inRegime(const Loop& loop, uint32_t v) {
 bool Vm::State::fastForward(Tick until) {
   const int index = program->loopAtTop[pc];
   const Loop& loop = program->loops[static_cast<size_t>(index)];
-  const bool breakpointInside = dispatch->breakpointInLoop(static_cast<size_t>(index));
   uint32_t v = loop.wide ? rd32(loop.counter) : rd16(loop.counter);
   bool applied = false;
   const uint32_t mask = loop.wide ? 0xFFFFFFFFu : 0xFFFFu;
-  const bool regime = inRegime(loop, v);
+  // The cheap tests first: most arrivals are the first of a pass to
+  // measure (the counter is not the measured one's successor).
   if (measure.loop == index && measure.accepted == acceptances &&
-      v == ((measure.counter + 1) & mask) && regime && !breakpointInside &&
-      inRegime(loop, measure.counter)) {
+      v == ((measure.counter + 1) & mask) && inRegime(loop, v) &&
+      inRegime(loop, measure.counter) &&
+      !dispatch->breakpointInLoop(static_cast<size_t>(index))) {
     const Tick pass = now - measure.start;
     loopPass[static_cast<size_t>(index)] = pass;
     const Tick bound = std::min(until, nextTimer);
