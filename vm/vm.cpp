@@ -525,13 +525,13 @@ boundary:
   // The profiling run never fuses (its table has no superinstruction's
   // label): its copies of these handlers are left empty, which halves
   // their compile time.
-#define SUPER(name, ...)                                    \
-  S_##name : if constexpr (!kProfile) {                     \
-    using enum Op;                                          \
-    if (superinstruction<kSuper##name, __VA_ARGS__>(r)) {   \
-      NEXT;                                                 \
-    }                                                       \
-  }                                                         \
+#define SUPER(name, ...)                                  \
+  S_##name : if constexpr (!kProfile) {                   \
+    using enum Op;                                        \
+    if (superinstruction<kSuper##name, __VA_ARGS__>(r)) { \
+      NEXT;                                               \
+    }                                                     \
+  }                                                       \
   goto boundary;
 #include "vm/superinstructions.def"
 #undef SUPER
