@@ -51,8 +51,7 @@ bool Vm::State::fastForward(Tick until) {
   // The cheap tests first: most arrivals are the first of a pass to
   // measure (the counter is not the measured one's successor).
   if (measure.loop == index && measure.accepted == acceptances &&
-      v == ((measure.counter + 1) & mask) && inRegime(loop, v) &&
-      inRegime(loop, measure.counter) &&
+      v == ((measure.counter + 1) & mask) && inRegime(loop, v) && inRegime(loop, measure.counter) &&
       !dispatch->breakpointInLoop(static_cast<size_t>(index))) {
     const Tick pass = now - measure.start;
     loopPass[static_cast<size_t>(index)] = pass;
