@@ -211,6 +211,10 @@ struct RobotDisc {
 struct Discrete {
   std::array<RobotDisc, 2> r{};
   bool robotContact = false;
+  // Balls and discs whose `active` is set: kept wherever one is set or
+  // cleared, so that asking whether any flies (every round) does not scan
+  // both tables.
+  int inFlight = 0;
   std::array<Ball, kMaxBalls> balls{};
   std::array<Disc, kMaxDiscs> discs{};
   int blockCount = 0;  // blocks set down; 0: none of their rules run

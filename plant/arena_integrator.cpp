@@ -188,10 +188,7 @@ double Arena::Impl::stepBound(const double* y, double ahead) const {
 // changes the right-hand side without one), so no crossing can hide inside
 // a step and only kRestStep bounds it.
 bool Arena::Impl::atRest() const {
-  for (const Ball& b : D.balls)
-    if (b.active) return false;
-  for (const Disc& c : D.discs)
-    if (c.active) return false;
+  if (D.inFlight > 0) return false;
   for (int i = 0; i < nR; ++i) {
     const Motion& m = motion[static_cast<std::size_t>(i)];
     if (m.vl0 != 0 || m.vr0 != 0 || m.tl != 0 || m.tr != 0) return false;

@@ -214,6 +214,10 @@ TEST(Motion, ProjectileFlightTimeAndRange) {
   EXPECT_NEAR(balls[0].x_ft, muzzleX + 10.0 * tf, 1e-4);
   EXPECT_EQ(a.shots(0), 1);
   EXPECT_EQ(a.ballsLeft(0, 0), 14);
+  // In flight up to the floor, not once that tick has been passed.
+  EXPECT_TRUE(a.ballsInFlight());
+  a.advance(miss->tick + 1);
+  EXPECT_FALSE(a.ballsInFlight());
 }
 
 // Words chosen so that drawDispersion's Box-Muller pair gives a radius r
@@ -339,8 +343,10 @@ TEST(Motion, HitTickMatchesClosedForm) {
   EXPECT_NEAR(static_cast<double>(hit->tick), want, 10.0);
   EXPECT_EQ(hit->event.robot, 0);
   EXPECT_EQ(hit->event.other, 1);
+  EXPECT_TRUE(a.ballsInFlight());
   a.advance(hit->tick + 1);
   EXPECT_EQ(a.hits(0), 1);
+  EXPECT_FALSE(a.ballsInFlight());
 }
 
 TEST(Motion, FloorSkipsCountOnlyWithTheOption) {
@@ -389,6 +395,9 @@ TEST(Motion, DividerStopsLowBall) {
   ASSERT_TRUE(miss.has_value());
   EXPECT_EQ(miss->event.miss, MissReason::Divider);
   EXPECT_EQ(a.hits(0), 0);
+  EXPECT_TRUE(a.ballsInFlight());
+  a.advance(miss->tick + 1);
+  EXPECT_FALSE(a.ballsInFlight());
 }
 
 TEST(Motion, BumperReflexBacksOffProfileDistance) {
