@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -221,6 +222,57 @@ struct Discrete {
   std::array<Block, kMaxBlocks> blocks{};
 };
 
+// The last argument and value of a pure function of one double: the same
+// argument, bit for bit, gives back the same value without the call (the
+// value is the one the call made; -0 and +0 are different arguments). A
+// step evaluates the motion at its end several times (ARKODE's last stage,
+// the dense output, the root functions, the step bound), both robots share
+// the wheels' lag term when their lags are equal, and the eyes ask for
+// both robots at one tick.
+template <double (*F)(double)>
+class LastCall {
+ public:
+  double operator()(double x) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    if (!valid_ || bits != arg_) {
+      arg_ = bits;
+      value_ = F(x);
+      valid_ = true;
+    }
+    return value_;
+  }
+
+ private:
+  std::uint64_t arg_ = 0;
+  double value_ = 0;
+  bool valid_ = false;
+};
+inline double expm1Of(double x) { return std::expm1(x); }
+inline double expOf(double x) { return std::exp(x); }
+using Expm1Memo = LastCall<&expm1Of>;
+using ExpMemo = LastCall<&expOf>;
+
+// The last heading whose unit vector (sin h, cos h) was computed, and it.
+class HeadingMemo {
+ public:
+  Vec2 dir(double h) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &h, sizeof bits);
+    if (!valid_ || bits != arg_) {
+      arg_ = bits;
+      dir_ = geom::headingDir(h);
+      valid_ = true;
+    }
+    return dir_;
+  }
+
+ private:
+  std::uint64_t arg_ = 0;
+  Vec2 dir_ = Vec2::Zero();
+  bool valid_ = false;
+};
+
 // One robot's closed-form motion within a segment (DESIGN.md "Continuous
 // motion"): each wheel's ground speed follows a first-order lag toward its
 // target, v(t) = vt + (v0 - vt) e^{-dt/tau}, so its path length is
@@ -241,11 +293,11 @@ struct Motion {
     double s;       // odometer, ft
     double dv;      // d/dt of the mean wheel speed, ft/s^2
   };
-  At at(double t) const {
+  At at(double t, Expm1Memo& expm1) const {
     const double dt = t - t0;
     At a{};
     if (tau > 0) {
-      const double em1 = std::expm1(-dt / tau);
+      const double em1 = expm1(-dt / tau);
       const double e = 1.0 + em1;
       a.vl = tl + (vl0 - tl) * e;
       a.vr = tr + (vr0 - tr) * e;
@@ -263,10 +315,10 @@ struct Motion {
     }
     return a;
   }
-  double gun(int g, double t) const {
+  double gun(int g, double t, ExpMemo& exp) const {
     const auto k = static_cast<std::size_t>(g);
     if (gtau[k] <= 0) return g0[k];
-    return gt[k] + (g0[k] - gt[k]) * std::exp(-(t - t0) / gtau[k]);
+    return gt[k] + (g0[k] - gt[k]) * exp(-(t - t0) / gtau[k]);
   }
 };
 
@@ -426,6 +478,14 @@ struct Arena::Impl : ArenaState {
   void restore(const Checkpoint& cp);
 
   // ---- scratch
+  // The lag terms and headings last evaluated (see LastCall): a robot's
+  // heading memo is its own, as both robots' alternate.
+  mutable Expm1Memo wheelLag;
+  mutable ExpMemo gunLag;
+  mutable std::array<HeadingMemo, 2> headingMemo;
+  Vec2 headingDirOf(int robot, double h) const {
+    return headingMemo[static_cast<std::size_t>(robot)].dir(h);
+  }
   std::vector<double> tmp;
   mutable std::vector<double> qtmp;    // for const queries
   mutable std::vector<double> rootY;   // the full state inside the root function

@@ -199,9 +199,10 @@ bool Arena::Impl::atRest() const {
 void Arena::Impl::freeVelocities(double t, double* v, double* a) const {
   for (int i = 0; i < nR; ++i) {
     const Motion& m = motion[static_cast<std::size_t>(i)];
-    const Motion::At w = m.at(t);
+    const Motion::At w = m.at(t, wheelLag);
     const double sp = 0.5 * (w.vl + w.vr);
-    const double sh = std::sin(w.h), ch = std::cos(w.h);
+    const Vec2 dir = headingDirOf(i, w.h);
+    const double sh = dir.x(), ch = dir.y();
     v[kXY * i + X] = sp * sh;
     v[kXY * i + Y] = sp * ch;
     if (a) {
@@ -241,7 +242,7 @@ void Arena::Impl::rhs(double t, const double* xy, double* f, double* accel) cons
 void Arena::Impl::fullState(double t, const double* xy, double* out) const {
   for (int i = 0; i < nR; ++i) {
     const Motion& m = motion[static_cast<std::size_t>(i)];
-    const Motion::At w = m.at(t);
+    const Motion::At w = m.at(t, wheelLag);
     double* r = out + i * kPerRobot;
     r[X] = xy[kXY * i + X];
     r[Y] = xy[kXY * i + Y];
@@ -249,8 +250,8 @@ void Arena::Impl::fullState(double t, const double* xy, double* out) const {
     r[VL] = w.vl;
     r[VR] = w.vr;
     r[S] = w.s;
-    r[G1] = m.gun(0, t);
-    r[G2] = m.gun(1, t);
+    r[G1] = m.gun(0, t, gunLag);
+    r[G2] = m.gun(1, t, gunLag);
   }
 }
 
@@ -603,7 +604,7 @@ std::array<double, 3> Arena::Impl::poseAt(int robot, std::int64_t tick) const {
   const double t = timeOfTick(tick);
   const Rec& r = recordAt(t);
   return {component(r, t, kXY * robot + X), component(r, t, kXY * robot + Y),
-          motion[static_cast<std::size_t>(robot)].at(t).h};
+          motion[static_cast<std::size_t>(robot)].at(t, wheelLag).h};
 }
 
 // State at a tick (after the events of that tick).

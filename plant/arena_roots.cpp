@@ -18,7 +18,7 @@ constexpr double kMinSide = 1e-150;
 
 Vec2 Arena::Impl::detector(const double* y, int i, int k) const {
   const double off = radius(i) - P(i).edge_detector_inset_ft;
-  const Vec2 dir = geom::headingDir(heading(y, i));
+  const Vec2 dir = headingDirOf(i, heading(y, i));
   return k == 0 ? Vec2(centre(y, i) + off * dir) : Vec2(centre(y, i) - off * dir);
 }
 
