@@ -3,7 +3,9 @@
 // a hit's tick, the bumper reflex, the referee, rewinds and determinism.
 #include <cmath>
 #include <cstring>
+#include <vector>
 
+#include "plant/geometry.h"
 #include "plant_support.h"
 
 using namespace plant_test;
@@ -15,6 +17,22 @@ constexpr double kPi = 3.14159265358979323846;
 void expectRel(double actual, double expected, double rel, const char* what) {
   const double tol = rel * std::max(1.0, std::abs(expected));
   EXPECT_NEAR(actual, expected, tol) << what;
+}
+
+// Headings in degrees as poses and events report them: fmod(deg, 360),
+// exact, moved into [0, 360). By hand: below 360 in magnitude fmod gives
+// deg back (-0 too, which is not below 0); 725.5 - 2 x 360 = 5.5;
+// -1e-300 + 360 rounds to 360, which wraps to 0.
+TEST(Geometry, Wrap360IsTheExactRemainderInZeroTo360) {
+  using simbot::plant::geom::wrap360;
+  EXPECT_EQ(wrap360(359.75), 359.75);
+  EXPECT_EQ(wrap360(-90.0), 270.0);
+  EXPECT_EQ(wrap360(-359.75), 0.25);
+  EXPECT_TRUE(std::signbit(wrap360(-0.0)));
+  EXPECT_EQ(wrap360(360.0), 0.0);
+  EXPECT_EQ(wrap360(725.5), 5.5);
+  EXPECT_EQ(wrap360(-725.5), 354.5);
+  EXPECT_EQ(wrap360(-1e-300), 0.0);
 }
 
 TEST(Time, EventTickIsCeilingOfExactProduct) {
