@@ -652,6 +652,7 @@ struct Arena::Impl : ArenaState {
   double timeOfTick(std::int64_t tick) const { return std::max(secondsFromTick(tick), segT0); }
 
   const Rec& recordAt(double t) const;
+  mutable std::size_t recordHint = 0;  // the record recordAt() found last
   double component(const Rec& r, double t, int i) const;
   void evalAt(double t, std::vector<double>& out) const;
   std::array<double, 3> poseAt(int robot, std::int64_t tick) const;

@@ -571,10 +571,16 @@ void Arena::Impl::recordStep(double tn, const double* ynew) {
 // First record whose interval reaches t; past the end, the last one
 // (advance() steps until ARKODE has returned a time at or past now(), so
 // at most a rounding of the tick's time).
+// The record found last is tried first (the eyes' poses and the trace's
+// samples come in time order, mostly within one step): it is the answer
+// exactly when it reaches t and the one before it does not.
 const Arena::Impl::Rec& Arena::Impl::recordAt(double t) const {
+  const std::size_t h = recordHint;
+  if (h < recs.size() && recs[h].thi >= t && (h == 0 || recs[h - 1].thi < t)) return recs[h];
   auto it = std::lower_bound(recs.begin(), recs.end(), t,
                              [](const Rec& r, double tt) { return r.thi < tt; });
   if (it == recs.end()) --it;
+  recordHint = static_cast<std::size_t>(it - recs.begin());
   return *it;
 }
 

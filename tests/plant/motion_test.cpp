@@ -576,6 +576,37 @@ TEST(Queries, PoseIsTheStatesPoseBitForBit) {
   EXPECT_GT(checked, 10);
 }
 
+// The dense output's record for a tick is found from the one found last
+// (recordAt): the poses of ticks asked in rising, falling and alternating
+// order are the same bits, each from the step that holds its tick.
+TEST(Queries, APoseDoesNotDependOnTheTicksAskedBefore) {
+  const Profile p = defaults();
+  Arena a(config(p, {Pose{-6.5, -6.5, 30}, Pose{6, 6, 200}}));
+  a.setWheels(0, frame("cfg0afg0"), 0);
+  a.setWheels(1, frame("ffg0ffg0"), 0);
+  int checked = 0;
+  while (a.now() < ticks(12)) {
+    const AdvanceResult r = a.advance(ticks(12));
+    const std::int64_t from = a.lastReinitTick();
+    if (r.tick - from < 16) continue;
+    std::vector<std::int64_t> at;
+    for (int k = 0; k <= 16; ++k) at.push_back(from + (r.tick - from) * k / 16);
+    std::vector<Pose> rising, falling(at.size()), alternating(at.size());
+    for (std::int64_t t : at) rising.push_back(a.pose(0, t));
+    for (std::size_t k = at.size(); k-- > 0;) falling[k] = a.pose(0, at[k]);
+    for (std::size_t k = 0; k < at.size(); ++k) {
+      const std::size_t j = k % 2 == 0 ? k / 2 : at.size() - 1 - k / 2;
+      alternating[j] = a.pose(0, at[j]);
+    }
+    for (std::size_t k = 0; k < at.size(); ++k) {
+      EXPECT_EQ(std::memcmp(&rising[k], &falling[k], sizeof(Pose)), 0) << at[k];
+      EXPECT_EQ(std::memcmp(&rising[k], &alternating[k], sizeof(Pose)), 0) << at[k];
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 50);
+}
+
 TEST(Queries, OutsideTheWindowThrow) {
   const Profile p = thesis();
   Arena a(config(p, {Pose{0, 0, 0}}));
