@@ -385,6 +385,13 @@ struct ArenaState {
   int nRoots = 0;
   int nRootsRegistered = -1;
   std::array<double, kMaxRoots> rootShift{};
+  // Where buildRoots() put the root functions stepBound() reads.
+  struct BoundRoots {
+    std::array<int, 2> edge{}, wall{};
+    int out = -1, divider = -1, obstacle0 = -1;
+  };
+  std::array<BoundRoots, 2> boundRoots{};
+  int robotPairRoot = -1;
   // A push's end function is >= 0 as the segment starts (a wheel command
   // stopped or reversed its robot at once, without motor lag): no root
   // can cross, so the push ends at the segment's first tick.
@@ -498,7 +505,17 @@ struct Arena::Impl : ArenaState {
   double radius(int i) const { return P(i).body_diameter_ft / 2; }
 
   double pointSpeed() const;
-  double stepBound(const double* y, double ahead) const;
+  // `raw`, if given, holds this segment's root functions (unshifted) at
+  // y: the distances are read from it instead of computed again.
+  double stepBound(const double* y, double ahead, const double* raw = nullptr) const;
+  // The root functions' last evaluation by ARKODE (rootThunk), unshifted,
+  // and the time and centres it was made at: at the end of a step, where
+  // stepBound() is evaluated next on the same state. Cleared by reinit()
+  // and restore().
+  mutable bool rootRawValid = false;
+  mutable double rootRawT = 0;
+  mutable std::array<double, 2 * kXY> rootRawXY{};
+  mutable std::array<double, kMaxRoots> rootRaw{};
   bool atRest() const;
 
   // ------------------------------------------------------------ geometry on a
