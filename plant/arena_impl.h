@@ -22,6 +22,7 @@
 #include "plant/arkode.h"
 #include "plant/contact.h"
 #include "plant/geometry.h"
+#include "plant/last_call.h"
 #include "plant/plant.h"
 
 namespace simbot::plant {
@@ -222,32 +223,6 @@ struct Discrete {
   std::array<Block, kMaxBlocks> blocks{};
 };
 
-// The last argument and value of a pure function of one double: the same
-// argument, bit for bit, gives back the same value without the call (the
-// value is the one the call made; -0 and +0 are different arguments). A
-// step evaluates the motion at its end several times (ARKODE's last stage,
-// the dense output, the root functions, the step bound), both robots share
-// the wheels' lag term when their lags are equal, and the eyes ask for
-// both robots at one tick.
-template <double (*F)(double)>
-class LastCall {
- public:
-  double operator()(double x) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &x, sizeof bits);
-    if (!valid_ || bits != arg_) {
-      arg_ = bits;
-      value_ = F(x);
-      valid_ = true;
-    }
-    return value_;
-  }
-
- private:
-  std::uint64_t arg_ = 0;
-  double value_ = 0;
-  bool valid_ = false;
-};
 inline double expm1Of(double x) { return std::expm1(x); }
 inline double expOf(double x) { return std::exp(x); }
 using Expm1Memo = LastCall<&expm1Of>;
