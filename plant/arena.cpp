@@ -399,11 +399,7 @@ bool Arena::ballsInFlight() const {
   const Impl& m = *impl_;
   for (const Discrete* d : {&m.D, &m.pendingD}) {
     if (d == &m.pendingD && !m.pending) break;
-    for (const Ball& b : d->balls)
-      if (b.active) return true;
-    for (const Disc& c : d->discs)
-      if (c.active) return true;
-    if (m.nextLaunchIn(*d) >= 0) return true;
+    if (d->inFlight > 0 || m.nextLaunchIn(*d) >= 0) return true;
   }
   return false;
 }

@@ -107,6 +107,7 @@ void Arena::Impl::launchDisc(Discrete& d, const std::vector<double>& y, int i, d
   Disc& c = d.discs[static_cast<std::size_t>(slot)];
   c = Disc{};
   c.active = true;
+  ++d.inFlight;
   c.shooter = i;
   c.t0 = te;
   c.x0 = rim.x();
@@ -170,6 +171,7 @@ void Arena::Impl::discOutcome(int k, double te, Discrete& d, const double* ys, c
     e.obstacle = c.obstacle;
     ev.push(e);
     c.active = false;
+    --d.inFlight;
     return;
   }
   if (nR < 2) return;
@@ -185,6 +187,7 @@ void Arena::Impl::discOutcome(int k, double te, Discrete& d, const double* ys, c
     ev.push(e);
     d.r[static_cast<std::size_t>(c.shooter)].discHits++;
     c.active = false;
+    --d.inFlight;
   }
 }
 

@@ -89,6 +89,7 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
                across * flight.x(),
                across * flight.y(),
                speed * std::sin(elevation)};
+      ++d.inFlight;
       if (bodies.obstacleCount > 0 || d.blockCount > 0) ballMeetings(b, d, ys, te);
       Event e{EventKind::BallLaunch};
       e.robot = static_cast<std::int8_t>(i);
@@ -145,6 +146,7 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
         e.miss = MissReason::Floor;
         ev.push(e);
         b.active = false;
+        --d.inFlight;
         continue;
       }
     }
@@ -156,6 +158,7 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
       e.miss = MissReason::Divider;
       ev.push(e);
       b.active = false;
+      --d.inFlight;
       continue;
     }
     if (b.meetObstacle >= 0 && (reported(found, RootKind::BallObstacle, s) < 0 || te >= b.meetT)) {
@@ -165,6 +168,7 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
           static_cast<std::int8_t>(block ? b.meetObstacle - kMaxObstacles : b.meetObstacle);
       ev.push(e);
       b.active = false;
+      --d.inFlight;
       continue;
     }
     if (nR == 2) {
@@ -182,6 +186,7 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
         ev.push(h);
         d.r[static_cast<std::size_t>(b.shooter)].hits++;
         b.active = false;
+        --d.inFlight;
         continue;
       }
     }
@@ -189,6 +194,7 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
       e.miss = MissReason::LeftField;
       ev.push(e);
       b.active = false;
+      --d.inFlight;
     }
   }
   // -- discs

@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "plant/arkode.h"
 #include "plant/contact.h"
 #include "plant/geometry.h"
+#include "plant/last_call.h"
 #include "plant/plant.h"
 
 namespace simbot::plant {
@@ -211,10 +213,39 @@ struct RobotDisc {
 struct Discrete {
   std::array<RobotDisc, 2> r{};
   bool robotContact = false;
+  // Balls and discs whose `active` is set: kept wherever one is set or
+  // cleared, so that asking whether any flies (every round) does not scan
+  // both tables.
+  int inFlight = 0;
   std::array<Ball, kMaxBalls> balls{};
   std::array<Disc, kMaxDiscs> discs{};
   int blockCount = 0;  // blocks set down; 0: none of their rules run
   std::array<Block, kMaxBlocks> blocks{};
+};
+
+inline double expm1Of(double x) { return std::expm1(x); }
+inline double expOf(double x) { return std::exp(x); }
+using Expm1Memo = LastCall<&expm1Of>;
+using ExpMemo = LastCall<&expOf>;
+
+// The last heading whose unit vector (sin h, cos h) was computed, and it.
+class HeadingMemo {
+ public:
+  Vec2 dir(double h) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &h, sizeof bits);
+    if (!valid_ || bits != arg_) {
+      arg_ = bits;
+      dir_ = geom::headingDir(h);
+      valid_ = true;
+    }
+    return dir_;
+  }
+
+ private:
+  std::uint64_t arg_ = 0;
+  Vec2 dir_ = Vec2::Zero();
+  bool valid_ = false;
 };
 
 // One robot's closed-form motion within a segment (DESIGN.md "Continuous
@@ -237,11 +268,11 @@ struct Motion {
     double s;       // odometer, ft
     double dv;      // d/dt of the mean wheel speed, ft/s^2
   };
-  At at(double t) const {
+  At at(double t, Expm1Memo& expm1) const {
     const double dt = t - t0;
     At a{};
     if (tau > 0) {
-      const double em1 = std::expm1(-dt / tau);
+      const double em1 = expm1(-dt / tau);
       const double e = 1.0 + em1;
       a.vl = tl + (vl0 - tl) * e;
       a.vr = tr + (vr0 - tr) * e;
@@ -259,10 +290,10 @@ struct Motion {
     }
     return a;
   }
-  double gun(int g, double t) const {
+  double gun(int g, double t, ExpMemo& exp) const {
     const auto k = static_cast<std::size_t>(g);
     if (gtau[k] <= 0) return g0[k];
-    return gt[k] + (g0[k] - gt[k]) * std::exp(-(t - t0) / gtau[k]);
+    return gt[k] + (g0[k] - gt[k]) * exp(-(t - t0) / gtau[k]);
   }
 };
 
@@ -329,6 +360,13 @@ struct ArenaState {
   int nRoots = 0;
   int nRootsRegistered = -1;
   std::array<double, kMaxRoots> rootShift{};
+  // Where buildRoots() put the root functions stepBound() reads.
+  struct BoundRoots {
+    std::array<int, 2> edge{}, wall{};
+    int out = -1, divider = -1, obstacle0 = -1;
+  };
+  std::array<BoundRoots, 2> boundRoots{};
+  int robotPairRoot = -1;
   // A push's end function is >= 0 as the segment starts (a wheel command
   // stopped or reversed its robot at once, without motor lag): no root
   // can cross, so the push ends at the segment's first tick.
@@ -422,6 +460,14 @@ struct Arena::Impl : ArenaState {
   void restore(const Checkpoint& cp);
 
   // ---- scratch
+  // The lag terms and headings last evaluated (see LastCall): a robot's
+  // heading memo is its own, as both robots' alternate.
+  mutable Expm1Memo wheelLag;
+  mutable ExpMemo gunLag;
+  mutable std::array<HeadingMemo, 2> headingMemo;
+  Vec2 headingDirOf(int robot, double h) const {
+    return headingMemo[static_cast<std::size_t>(robot)].dir(h);
+  }
   std::vector<double> tmp;
   mutable std::vector<double> qtmp;    // for const queries
   mutable std::vector<double> rootY;   // the full state inside the root function
@@ -434,7 +480,17 @@ struct Arena::Impl : ArenaState {
   double radius(int i) const { return P(i).body_diameter_ft / 2; }
 
   double pointSpeed() const;
-  double stepBound(const double* y, double ahead) const;
+  // `raw`, if given, holds this segment's root functions (unshifted) at
+  // y: the distances are read from it instead of computed again.
+  double stepBound(const double* y, double ahead, const double* raw = nullptr) const;
+  // The root functions' last evaluation by ARKODE (rootThunk), unshifted,
+  // and the time and centres it was made at: at the end of a step, where
+  // stepBound() is evaluated next on the same state. Cleared by reinit()
+  // and restore().
+  mutable bool rootRawValid = false;
+  mutable double rootRawT = 0;
+  mutable std::array<double, 2 * kXY> rootRawXY{};
+  mutable std::array<double, kMaxRoots> rootRaw{};
   bool atRest() const;
 
   // ------------------------------------------------------------ geometry on a
@@ -588,6 +644,7 @@ struct Arena::Impl : ArenaState {
   double timeOfTick(std::int64_t tick) const { return std::max(secondsFromTick(tick), segT0); }
 
   const Rec& recordAt(double t) const;
+  mutable std::size_t recordHint = 0;  // the record recordAt() found last
   double component(const Rec& r, double t, int i) const;
   void evalAt(double t, std::vector<double>& out) const;
   std::array<double, 3> poseAt(int robot, std::int64_t tick) const;

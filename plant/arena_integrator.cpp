@@ -162,24 +162,45 @@ double Arena::Impl::pointSpeed() const {
 // step's size at the end of the step before it, so a bound set after step
 // k applies from step k + 2: it is the distance at the end of step k less
 // what step k + 1, already planned (`ahead`), can move.
-double Arena::Impl::stepBound(const double* y, double ahead) const {
+// With no contact active the contacts' root functions are their gaps, so
+// a root evaluation at y (`raw`) already holds every distance; each is
+// read where buildRoots() put it, checked against the list.
+double Arena::Impl::stepBound(const double* y, double ahead, const double* raw) const {
   const double v = segSpeed;
   if (v <= 0) return kRestStep;  // nothing can move
   const double floor = (1.0 / 12.0) / (nR * v);
   if (active.count > 0) return floor;
+  const auto dist = [&](int j, RootKind k, int who, auto compute) {
+    if (!raw) return std::abs(compute());
+    if (j < 0 || j >= nRoots || roots[static_cast<std::size_t>(j)].kind != k ||
+        roots[static_cast<std::size_t>(j)].robot != who)
+      throw std::logic_error("plant: stepBound read the wrong root function");
+    return std::abs(raw[j]);
+  };
   double d = HUGE_VAL;
   for (int i = 0; i < nR; ++i) {
-    d = std::min({d, std::abs(edgeG(y, i, 0)), std::abs(edgeG(y, i, 1))});
-    if (cfg.field.divider) d = std::min(d, std::abs(gapOf(contact::Kind::Divider, i, y)));
+    const BoundRoots& at = boundRoots[static_cast<std::size_t>(i)];
+    d = std::min({d, dist(at.edge[0], RootKind::EdgeFore, i, [&] { return edgeG(y, i, 0); }),
+                  dist(at.edge[1], RootKind::EdgeAft, i, [&] { return edgeG(y, i, 1); })});
+    if (cfg.field.divider)
+      d = std::min(d, dist(at.divider, RootKind::Divider, i,
+                           [&] { return gapOf(contact::Kind::Divider, i, y); }));
     for (int k = 0; k < bodies.obstacleCount; ++k)
-      d = std::min(d, std::abs(gapOf(contact::Kind::Obstacle, i, y, k)));
+      d = std::min(d, dist(at.obstacle0 + k, RootKind::Obstacle, obstacleRoot(i, k),
+                           [&] { return gapOf(contact::Kind::Obstacle, i, y, k); }));
     if (cfg.field.field_walls)
-      d = std::min({d, std::abs(gapOf(contact::Kind::WallX, i, y)),
-                    std::abs(gapOf(contact::Kind::WallY, i, y))});
+      d = std::min(
+          {d,
+           dist(at.wall[0], RootKind::WallX, i, [&] { return gapOf(contact::Kind::WallX, i, y); }),
+           dist(at.wall[1], RootKind::WallY, i,
+                [&] { return gapOf(contact::Kind::WallY, i, y); })});
     else
-      d = std::min(d, std::abs(outG(y, i)));
+      d = std::min(d, dist(at.out, RootKind::OutOfField, i, [&] { return outG(y, i); }));
   }
-  if (nR == 2) d = std::min(d, std::abs(gapOf(contact::Kind::Robot, 0, y)) / 2);
+  if (nR == 2)
+    d = std::min(d, dist(robotPairRoot, RootKind::RobotRobot, 0, [&] {
+                      return gapOf(contact::Kind::Robot, 0, y);
+                    }) / 2);
   return std::max(floor, d / v - ahead);
 }
 
@@ -188,10 +209,7 @@ double Arena::Impl::stepBound(const double* y, double ahead) const {
 // changes the right-hand side without one), so no crossing can hide inside
 // a step and only kRestStep bounds it.
 bool Arena::Impl::atRest() const {
-  for (const Ball& b : D.balls)
-    if (b.active) return false;
-  for (const Disc& c : D.discs)
-    if (c.active) return false;
+  if (D.inFlight > 0) return false;
   for (int i = 0; i < nR; ++i) {
     const Motion& m = motion[static_cast<std::size_t>(i)];
     if (m.vl0 != 0 || m.vr0 != 0 || m.tl != 0 || m.tr != 0) return false;
@@ -202,9 +220,10 @@ bool Arena::Impl::atRest() const {
 void Arena::Impl::freeVelocities(double t, double* v, double* a) const {
   for (int i = 0; i < nR; ++i) {
     const Motion& m = motion[static_cast<std::size_t>(i)];
-    const Motion::At w = m.at(t);
+    const Motion::At w = m.at(t, wheelLag);
     const double sp = 0.5 * (w.vl + w.vr);
-    const double sh = std::sin(w.h), ch = std::cos(w.h);
+    const Vec2 dir = headingDirOf(i, w.h);
+    const double sh = dir.x(), ch = dir.y();
     v[kXY * i + X] = sp * sh;
     v[kXY * i + Y] = sp * ch;
     if (a) {
@@ -244,7 +263,7 @@ void Arena::Impl::rhs(double t, const double* xy, double* f, double* accel) cons
 void Arena::Impl::fullState(double t, const double* xy, double* out) const {
   for (int i = 0; i < nR; ++i) {
     const Motion& m = motion[static_cast<std::size_t>(i)];
-    const Motion::At w = m.at(t);
+    const Motion::At w = m.at(t, wheelLag);
     double* r = out + i * kPerRobot;
     r[X] = xy[kXY * i + X];
     r[Y] = xy[kXY * i + Y];
@@ -252,8 +271,8 @@ void Arena::Impl::fullState(double t, const double* xy, double* out) const {
     r[VL] = w.vl;
     r[VR] = w.vr;
     r[S] = w.s;
-    r[G1] = m.gun(0, t);
-    r[G2] = m.gun(1, t);
+    r[G1] = m.gun(0, t, gunLag);
+    r[G2] = m.gun(1, t, gunLag);
   }
 }
 
@@ -425,6 +444,7 @@ void Arena::Impl::setMaxStep(double h) {
 // (Re)starts the integration at tick `tick`, time t0, from state y, under
 // the dynamics the discrete state D now selects.
 void Arena::Impl::reinit(std::int64_t tick, double t0, std::vector<double>& y, bool first) {
+  rootRawValid = false;
   computeTargets(D);
   applyJumps(y);
   // A reset at the tick of the last one, before any step, that leaves the
@@ -573,10 +593,16 @@ void Arena::Impl::recordStep(double tn, const double* ynew) {
 // First record whose interval reaches t; past the end, the last one
 // (advance() steps until ARKODE has returned a time at or past now(), so
 // at most a rounding of the tick's time).
+// The record found last is tried first (the eyes' poses and the trace's
+// samples come in time order, mostly within one step): it is the answer
+// exactly when it reaches t and the one before it does not.
 const Arena::Impl::Rec& Arena::Impl::recordAt(double t) const {
+  const std::size_t h = recordHint;
+  if (h < recs.size() && recs[h].thi >= t && (h == 0 || recs[h - 1].thi < t)) return recs[h];
   auto it = std::lower_bound(recs.begin(), recs.end(), t,
                              [](const Rec& r, double tt) { return r.thi < tt; });
   if (it == recs.end()) --it;
+  recordHint = static_cast<std::size_t>(it - recs.begin());
   return *it;
 }
 
@@ -606,7 +632,7 @@ std::array<double, 3> Arena::Impl::poseAt(int robot, std::int64_t tick) const {
   const double t = timeOfTick(tick);
   const Rec& r = recordAt(t);
   return {component(r, t, kXY * robot + X), component(r, t, kXY * robot + Y),
-          motion[static_cast<std::size_t>(robot)].at(t).h};
+          motion[static_cast<std::size_t>(robot)].at(t, wheelLag).h};
 }
 
 // State at a tick (after the events of that tick).
@@ -754,7 +780,11 @@ AdvanceResult Arena::Impl::advance(std::int64_t stopTick) {
       fullState(tn, yn, qtmp.data());
       const double ahead = ode.currentStep();
       recs.back().next = ahead;
-      setMaxStep(segRest ? kRestStep : stepBound(qtmp.data(), ahead));
+      // ARKODE's root check at the step's end saw this very state.
+      const bool rawHere = rootRawValid && std::memcmp(&rootRawT, &tn, sizeof tn) == 0 &&
+                           std::memcmp(rootRawXY.data(), yn, sizeof(double) * nx) == 0;
+      setMaxStep(segRest ? kRestStep
+                         : stepBound(qtmp.data(), ahead, rawHere ? rootRaw.data() : nullptr));
     } else if (tret > recs.back().thi) {
       recs.back().thi = tret;
     }

@@ -124,6 +124,7 @@ void Arena::Impl::restore(const Checkpoint& cp) {
   double tr = 0;
   ode.step(kFirstStepHorizon, ark::Buffer::Scratch, tr);
   static_cast<ArenaState&>(*this) = cp.state;
+  rootRawValid = false;  // (the step above evaluated the new integrator's roots)
   centresOf(segY.data(), ode.data(ark::Buffer::State));
   ode.reset(segT0);
   ode.setInitStep(recs.front().next);

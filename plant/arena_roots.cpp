@@ -18,7 +18,7 @@ constexpr double kMinSide = 1e-150;
 
 Vec2 Arena::Impl::detector(const double* y, int i, int k) const {
   const double off = radius(i) - P(i).edge_detector_inset_ft;
-  const Vec2 dir = geom::headingDir(heading(y, i));
+  const Vec2 dir = headingDirOf(i, heading(y, i));
   return k == 0 ? Vec2(centre(y, i) + off * dir) : Vec2(centre(y, i) - off * dir);
 }
 
@@ -230,12 +230,21 @@ double Arena::Impl::rootValue(const RootDesc& rd, double t, const double* y) con
 void Arena::Impl::rootThunk(double t, const double* y, double* g, void* user) {
   const Impl* self = static_cast<const Impl*>(user);
   if (self->rootsMuted) {
+    self->rootRawValid = false;
     for (int i = 0; i < self->nRoots; ++i) g[i] = 1.0;
     return;
   }
   double* full = self->rootY.data();
   self->fullState(t, y, full);
-  for (int i = 0; i < self->nRoots; ++i) g[i] = self->sidedValue(i, t, full);
+  // sidedValue(), keeping the unshifted values for stepBound().
+  for (int i = 0; i < self->nRoots; ++i) {
+    const auto j = static_cast<std::size_t>(i);
+    self->rootRaw[j] = self->rootValue(self->roots[j], t, full);
+    g[i] = self->rootRaw[j] - self->rootShift[j];
+  }
+  self->rootRawValid = true;
+  self->rootRawT = t;
+  std::copy(y, y + self->nx, self->rootRawXY.begin());
 }
 
 // Sided roots. A contact or edge function's sign is the discrete state
@@ -330,20 +339,27 @@ void Arena::Impl::buildRoots() {
     roots[static_cast<std::size_t>(nRoots++)] = RootDesc{k, who};
   };
   for (int i = 0; i < nR; ++i) {
+    BoundRoots& at = boundRoots[static_cast<std::size_t>(i)];
+    at.edge = {nRoots, nRoots + 1};
     add(RootKind::EdgeFore, i);
     add(RootKind::EdgeAft, i);
+    at.out = nRoots;
     add(RootKind::OutOfField, i);
     if (cfg.field.field_walls) {
+      at.wall = {nRoots, nRoots + 1};
       add(RootKind::WallX, i);
       add(RootKind::WallY, i);
     }
+    at.divider = nRoots;
     if (cfg.field.divider) add(RootKind::Divider, i);
     if (D.r[static_cast<std::size_t>(i)].reflex) add(RootKind::ReflexEnd, i);
+    at.obstacle0 = nRoots;
     for (int k = 0; k < bodies.obstacleCount; ++k) add(RootKind::Obstacle, obstacleRoot(i, k));
     for (int k = 0; k < D.blockCount; ++k) add(RootKind::Block, blockRoot(i, k));
   }
   for (int k = 0; k < D.blockCount; ++k)
     if (D.blocks[static_cast<std::size_t>(k)].pusher >= 0) add(RootKind::BlockStop, k);
+  robotPairRoot = nRoots;
   if (nR == 2) add(RootKind::RobotRobot, 0);
   for (int b = 0; b < kMaxBalls; ++b) {
     const Ball& ball = D.balls[static_cast<std::size_t>(b)];

@@ -30,10 +30,16 @@ enum class StepEnd { Step, StopTime, Root };
 // and step() returns into, and a second one for interpolation.
 enum class Buffer { State, Scratch };
 
+// The serial vector operations ARKODE works with: arkode.cpp's own for
+// the hot ones (the same arithmetic as SUNDIALS' serial vector, compiled
+// with optimisation, which distributions' SUNDIALS is not), or SUNDIALS'
+// throughout, to check those against (tests/plant/arkode_test.cpp).
+enum class VectorOps { Own, Sundials };
+
 class Integrator {
  public:
   // n values, starting at t = 0 from state() as it is (zeros).
-  Integrator(int n, RhsFn rhs, void* user);
+  Integrator(int n, RhsFn rhs, void* user, VectorOps ops = VectorOps::Own);
   ~Integrator();
   Integrator(const Integrator&) = delete;
   Integrator& operator=(const Integrator&) = delete;

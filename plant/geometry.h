@@ -31,7 +31,9 @@ inline Vec2 headingDir(double headingRad) {
 
 // Degrees in [0, 360).
 inline double wrap360(double deg) {
-  double w = std::fmod(deg, 360.0);
+  // fmod is exact and gives back a deg of magnitude below 360 unchanged
+  // (its sign, -0 too): the call is needed only beyond.
+  double w = std::abs(deg) < 360.0 ? deg : std::fmod(deg, 360.0);
   if (w < 0) w += 360.0;
   if (w >= 360.0) w = 0.0;  // fmod of a tiny negative number plus 360
   return w;

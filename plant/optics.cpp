@@ -25,10 +25,13 @@
 #include <cmath>
 
 #include "plant/geometry.h"
+#include "plant/last_call.h"
 #include "plant/plant.h"
 
 namespace simbot::plant {
 namespace {
+
+double atanOf(double x) { return std::atan(x); }
 
 int quantise(double s, const RobotParams& p) {
   double q = 16.0 * std::floor(s / 16.0);
@@ -107,7 +110,10 @@ EyeGeometry eyeGeometry(const Pose& self, const Pose& opp, const RobotParams& p,
   }
   // The far eye is the right one when the opponent is to the left.
   const double farWidth = g.gamma_deg < 0 ? p.right_eye_width : p.left_eye_width;
-  const double phi = geom::radToDeg(std::atan(farWidth / p.eye_nose));
+  // The same one or two widths on every read: atan once per profile (a
+  // pure function's last value, per thread: LastCall).
+  thread_local LastCall<&atanOf> farEyeAtan;
+  const double phi = geom::radToDeg(farEyeAtan(farWidth / p.eye_nose));
   g.far_fraction = std::max(0.0, 1.0 - std::abs(g.gamma_deg) / phi);
   return g;
 }

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <string>
 
@@ -150,6 +151,88 @@ TEST(Arkode, CountersAreTheStepsTakenAndTheRightHandSidesCalled) {
   EXPECT_EQ(f.ode.steps(), steps);
   EXPECT_GT(steps, 10);
   EXPECT_EQ(f.ode.rhsEvals(), f.osc.rhsCalls);
+}
+
+// One or two oscillators of different frequencies (two or four values;
+// four as the arena's two robots' x and y): y0' = y1, y1' = -y0,
+// y2' = 3 y3, y3' = -3 y2. `user` points to the count.
+void oscillators(double, const double* y, double* ydot, void* user) {
+  ydot[0] = y[1];
+  ydot[1] = -y[0];
+  if (*static_cast<const int*>(user) == 4) {
+    ydot[2] = 3 * y[3];
+    ydot[3] = -3 * y[2];
+  }
+}
+void oscillatorRoots(double, const double* y, double* g, void*) {
+  g[0] = y[1];
+  g[1] = y[0] - 0.25;
+}
+
+// arkode.cpp's own vector operations against SUNDIALS' serial ones, which
+// they replace, for n values: the same steps, roots, stop time, reset and
+// interpolation give the same numbers, bit for bit.
+void compareWithSundials(int n) {
+  using simbot::plant::ark::VectorOps;
+  Integrator own{n, &oscillators, &n, VectorOps::Own};
+  Integrator ref{n, &oscillators, &n, VectorOps::Sundials};
+  for (Integrator* ode : {&own, &ref}) {
+    ode->useDormandPrince745();
+    ode->setTolerances(3e-11, 1e-10);
+    ode->setMaxNumSteps(100000);
+    const double start[4] = {0.0, 1.0, 1.0, -0.5};
+    std::copy(start, start + n, ode->data(Buffer::State));
+    ode->reset(0.0);
+    ode->setRoots(2, &oscillatorRoots);
+    ode->setStopTime(2.5);
+  }
+  const auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  double tOwn = 0, tRef = 0;
+  int roots = 0, stops = 0;
+  while (tOwn < 6.0) {
+    const double tPrev = tOwn;
+    const StepEnd endOwn = own.step(tOwn + 1.0, Buffer::State, tOwn);
+    const StepEnd endRef = ref.step(tRef + 1.0, Buffer::State, tRef);
+    ASSERT_EQ(endOwn, endRef);
+    ASSERT_TRUE(same(tOwn, tRef)) << tOwn << " " << tRef;
+    ASSERT_TRUE(same(own.currentStep(), ref.currentStep()));
+    for (int j = 0; j < n; ++j)
+      ASSERT_TRUE(same(own.data(Buffer::State)[j], ref.data(Buffer::State)[j])) << tOwn;
+    if (endOwn == StepEnd::Root) {
+      ++roots;
+      int foundOwn[2], foundRef[2];
+      own.rootsFound(foundOwn);
+      ref.rootsFound(foundRef);
+      EXPECT_EQ(foundOwn[0], foundRef[0]);
+      EXPECT_EQ(foundOwn[1], foundRef[1]);
+    }
+    // Between the last two returns (within the last step), ARKODE's
+    // interpolant.
+    own.interpolate(0.5 * (tPrev + tOwn), Buffer::Scratch);
+    ref.interpolate(0.5 * (tPrev + tOwn), Buffer::Scratch);
+    for (int j = 0; j < n; ++j)
+      ASSERT_TRUE(same(own.data(Buffer::Scratch)[j], ref.data(Buffer::Scratch)[j]));
+    if (endOwn == StepEnd::StopTime) {
+      // A reset there with an initial step, as the arena makes them.
+      ++stops;
+      for (Integrator* ode : {&own, &ref}) {
+        ode->data(Buffer::State)[1] += 0.125;
+        ode->reset(tOwn);
+        ode->setInitStep(0.01);
+      }
+    }
+  }
+  EXPECT_GE(roots, 3);
+  EXPECT_EQ(stops, 1);
+  EXPECT_EQ(own.steps(), ref.steps());
+  EXPECT_EQ(own.rhsEvals(), ref.rhsEvals());
+}
+
+// Four values (the arena's two robots) take arkode.cpp's four-value path,
+// two (one robot) the general one.
+TEST(Arkode, OwnVectorOperationsGiveSundialsBitsExactly) {
+  compareWithSundials(4);
+  compareWithSundials(2);
 }
 
 // A call ARKODE refuses (a negative tolerance is ARK_ILL_INPUT) throws

@@ -3,7 +3,9 @@
 // a hit's tick, the bumper reflex, the referee, rewinds and determinism.
 #include <cmath>
 #include <cstring>
+#include <vector>
 
+#include "plant/geometry.h"
 #include "plant_support.h"
 
 using namespace plant_test;
@@ -15,6 +17,22 @@ constexpr double kPi = 3.14159265358979323846;
 void expectRel(double actual, double expected, double rel, const char* what) {
   const double tol = rel * std::max(1.0, std::abs(expected));
   EXPECT_NEAR(actual, expected, tol) << what;
+}
+
+// Headings in degrees as poses and events report them: fmod(deg, 360),
+// exact, moved into [0, 360). By hand: below 360 in magnitude fmod gives
+// deg back (-0 too, which is not below 0); 725.5 - 2 x 360 = 5.5;
+// -1e-300 + 360 rounds to 360, which wraps to 0.
+TEST(Geometry, Wrap360IsTheExactRemainderInZeroTo360) {
+  using simbot::plant::geom::wrap360;
+  EXPECT_EQ(wrap360(359.75), 359.75);
+  EXPECT_EQ(wrap360(-90.0), 270.0);
+  EXPECT_EQ(wrap360(-359.75), 0.25);
+  EXPECT_TRUE(std::signbit(wrap360(-0.0)));
+  EXPECT_EQ(wrap360(360.0), 0.0);
+  EXPECT_EQ(wrap360(725.5), 5.5);
+  EXPECT_EQ(wrap360(-725.5), 354.5);
+  EXPECT_EQ(wrap360(-1e-300), 0.0);
 }
 
 TEST(Time, EventTickIsCeilingOfExactProduct) {
@@ -214,6 +232,10 @@ TEST(Motion, ProjectileFlightTimeAndRange) {
   EXPECT_NEAR(balls[0].x_ft, muzzleX + 10.0 * tf, 1e-4);
   EXPECT_EQ(a.shots(0), 1);
   EXPECT_EQ(a.ballsLeft(0, 0), 14);
+  // In flight up to the floor, not once that tick has been passed.
+  EXPECT_TRUE(a.ballsInFlight());
+  a.advance(miss->tick + 1);
+  EXPECT_FALSE(a.ballsInFlight());
 }
 
 // Words chosen so that drawDispersion's Box-Muller pair gives a radius r
@@ -339,8 +361,10 @@ TEST(Motion, HitTickMatchesClosedForm) {
   EXPECT_NEAR(static_cast<double>(hit->tick), want, 10.0);
   EXPECT_EQ(hit->event.robot, 0);
   EXPECT_EQ(hit->event.other, 1);
+  EXPECT_TRUE(a.ballsInFlight());
   a.advance(hit->tick + 1);
   EXPECT_EQ(a.hits(0), 1);
+  EXPECT_FALSE(a.ballsInFlight());
 }
 
 TEST(Motion, FloorSkipsCountOnlyWithTheOption) {
@@ -389,6 +413,9 @@ TEST(Motion, DividerStopsLowBall) {
   ASSERT_TRUE(miss.has_value());
   EXPECT_EQ(miss->event.miss, MissReason::Divider);
   EXPECT_EQ(a.hits(0), 0);
+  EXPECT_TRUE(a.ballsInFlight());
+  a.advance(miss->tick + 1);
+  EXPECT_FALSE(a.ballsInFlight());
 }
 
 TEST(Motion, BumperReflexBacksOffProfileDistance) {
@@ -547,6 +574,37 @@ TEST(Queries, PoseIsTheStatesPoseBitForBit) {
       }
   }
   EXPECT_GT(checked, 10);
+}
+
+// The dense output's record for a tick is found from the one found last
+// (recordAt): the poses of ticks asked in rising, falling and alternating
+// order are the same bits, each from the step that holds its tick.
+TEST(Queries, APoseDoesNotDependOnTheTicksAskedBefore) {
+  const Profile p = defaults();
+  Arena a(config(p, {Pose{-6.5, -6.5, 30}, Pose{6, 6, 200}}));
+  a.setWheels(0, frame("cfg0afg0"), 0);
+  a.setWheels(1, frame("ffg0ffg0"), 0);
+  int checked = 0;
+  while (a.now() < ticks(12)) {
+    const AdvanceResult r = a.advance(ticks(12));
+    const std::int64_t from = a.lastReinitTick();
+    if (r.tick - from < 16) continue;
+    std::vector<std::int64_t> at;
+    for (int k = 0; k <= 16; ++k) at.push_back(from + (r.tick - from) * k / 16);
+    std::vector<Pose> rising, falling(at.size()), alternating(at.size());
+    for (std::int64_t t : at) rising.push_back(a.pose(0, t));
+    for (std::size_t k = at.size(); k-- > 0;) falling[k] = a.pose(0, at[k]);
+    for (std::size_t k = 0; k < at.size(); ++k) {
+      const std::size_t j = k % 2 == 0 ? k / 2 : at.size() - 1 - k / 2;
+      alternating[j] = a.pose(0, at[j]);
+    }
+    for (std::size_t k = 0; k < at.size(); ++k) {
+      EXPECT_EQ(std::memcmp(&rising[k], &falling[k], sizeof(Pose)), 0) << at[k];
+      EXPECT_EQ(std::memcmp(&rising[k], &alternating[k], sizeof(Pose)), 0) << at[k];
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 50);
 }
 
 TEST(Queries, OutsideTheWindowThrow) {

@@ -47,6 +47,28 @@ TEST(Optics, GridOfBearingsAndRanges) {
   EXPECT_NEAR(phi, 33.69, 0.01);  // thesis III.B: "limiting angle 33 deg"
 }
 
+// Eyes of different widths, the opponent alternating sides: the far eye's
+// limiting angle is atan(its width / nose) for the eye that is far each
+// time (the right one for an opponent on the left): with widths 0.2 and
+// 0.4 and nose 0.3, phi = 33.69 deg on the left, 53.13 deg on the right.
+TEST(Optics, EachSideUsesItsFarEyesWidthWhenTheyDiffer) {
+  Profile p = thesis();
+  p.robot.left_eye_width = 0.4;
+  p.robot.right_eye_width = 0.2;
+  p.robot.eye_nose = 0.3;
+  const double phiRightEye = std::atan(0.2 / 0.3) * 180 / kPi;
+  const double phiLeftEye = std::atan(0.4 / 0.3) * 180 / kPi;
+  EXPECT_NEAR(phiRightEye, 33.69, 0.01);
+  EXPECT_NEAR(phiLeftEye, 53.13, 0.01);
+  const Pose self{2, 3, 30};
+  for (int k = 0; k < 6; ++k) {
+    const double g = (k % 2 == 0 ? -1 : 1) * (10.0 + 3 * k);
+    const EyeGeometry got = eyeGeometry(self, place(self, 4.0, g), p.robot, p.field);
+    const double phi = g < 0 ? phiRightEye : phiLeftEye;
+    EXPECT_NEAR(got.far_fraction, 1 - std::abs(g) / phi, 1e-12) << g;
+  }
+}
+
 TEST(Optics, OpponentOnTheLeftMakesTheLeftEyeBrighter) {
   const Profile p = thesis();
   const Pose self{0, 2, 0};
