@@ -490,8 +490,6 @@ struct Vm::State {
   bool exec(Regs& r);
   template <Op O>
   bool step(Regs& r);
-  template <Op O>
-  bool piece(Regs& r);
   template <int kKind, Op First, Op... Rest>
   bool superinstruction(Regs& r);
   template <int kKind, int kPiece, Op O>

@@ -286,38 +286,6 @@ void Vm::State::unwindSuperinstruction(int kind, int k) {
   }
 }
 
-// A superinstruction's piece after the first: the boundary before it, as
-// NEXT tests it, then the piece as NEXT would dispatch it. A piece longer
-// than kMaxStepTstates runs as L_Long_ and slowNext run it: its first
-// step, its effect, then its tail's steps, each after a boundary.
-template <Op O>
-[[gnu::always_inline]] inline bool Vm::State::piece(Regs& r) {
-  if (__builtin_expect(r.clk >= r.limit, 0)) {
-    save(r);
-    return false;
-  }
-  r.opPc = r.ip;
-  ++r.count;
-  const uint32_t cost = costs().op[static_cast<int>(O)];
-  if (cost <= kMaxStepTstates) {
-    r.clk += cost;
-    return step<O>(r);
-  }
-  r.clk += kMaxStepTstates;
-  burn = cost - kMaxStepTstates;
-  burnPc = r.pc();
-  const Tick limit = r.limit;
-  if (!step<O>(r)) return false;
-  // As slowNext: the step's own limit = 0 is forgotten for the tail.
-  r.limit = limit;
-  burnTail(r);
-  if (burn) {
-    save(r);
-    return false;
-  }
-  return true;
-}
-
 // An unchecked run's piece (State::superinstruction): charged and counted
 // in advance with the pieces after it, which a fault takes back.
 template <int kKind, int kPiece, Op O>
@@ -365,6 +333,9 @@ template <int kKind, Op First, Op... Rest, size_t... kPieces>
 // also has room for the most the pieces hold above a call's headroom, no
 // check on its depth inside can fail: the pieces run unchecked, their time
 // and count charged at once, on a copy of the stack's top (unchecked()).
+// Otherwise the first piece runs alone, and the ones after it are
+// dispatched from the table one by one, each after NEXT's test, as they
+// are unfused (a long one as L_Long_).
 template <int kKind, Op First, Op... Rest>
 [[gnu::always_inline]] inline bool Vm::State::superinstruction(Regs& r) {
   constexpr StackReach kReach = stackReach({First, Rest...});
@@ -372,7 +343,7 @@ template <int kKind, Op First, Op... Rest>
                            r.esp <= kEvalSlots - kEvalHeadroom - kReach.above,
                        1))
     return unchecked<kKind, First, Rest...>(r, std::make_index_sequence<sizeof...(Rest)>{});
-  return step<First>(r) && (piece<Rest>(r) && ...);
+  return step<First>(r);
 }
 
 template <bool kProfile>
