@@ -554,13 +554,20 @@ TEST(Determinism, SameCallsGiveBitIdenticalPosesWhetherQueriedOrNot) {
   EXPECT_GT(s1.reinits, 0);
 }
 
+// Two robots driving from opposite corners, one of them turning: the
+// arena the query tests ask poses of.
+Arena turningPair(const Profile& p) {
+  Arena a(config(p, {Pose{-6.5, -6.5, 30}, Pose{6, 6, 200}}));
+  a.setWheels(0, frame("cfg0afg0"), 0);
+  a.setWheels(1, frame("ffg0ffg0"), 0);
+  return a;
+}
+
 // pose() evaluates only x, y and heading; it must give the very bits of
 // state().pose, inside a segment and at a tick with pending events.
 TEST(Queries, PoseIsTheStatesPoseBitForBit) {
   const Profile p = defaults();
-  Arena a(config(p, {Pose{-6.5, -6.5, 30}, Pose{6, 6, 200}}));
-  a.setWheels(0, frame("cfg0afg0"), 0);
-  a.setWheels(1, frame("ffg0ffg0"), 0);
+  Arena a = turningPair(p);
   int checked = 0;
   while (a.now() < ticks(12)) {
     const std::int64_t from = a.lastReinitTick();
@@ -581,9 +588,7 @@ TEST(Queries, PoseIsTheStatesPoseBitForBit) {
 // order are the same bits, each from the step that holds its tick.
 TEST(Queries, APoseDoesNotDependOnTheTicksAskedBefore) {
   const Profile p = defaults();
-  Arena a(config(p, {Pose{-6.5, -6.5, 30}, Pose{6, 6, 200}}));
-  a.setWheels(0, frame("cfg0afg0"), 0);
-  a.setWheels(1, frame("ffg0ffg0"), 0);
+  Arena a = turningPair(p);
   int checked = 0;
   while (a.now() < ticks(12)) {
     const AdvanceResult r = a.advance(ticks(12));
