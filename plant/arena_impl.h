@@ -14,7 +14,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -229,24 +228,7 @@ using Expm1Memo = LastCall<&expm1Of>;
 using ExpMemo = LastCall<&expOf>;
 
 // The last heading whose unit vector (sin h, cos h) was computed, and it.
-class HeadingMemo {
- public:
-  Vec2 dir(double h) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &h, sizeof bits);
-    if (!valid_ || bits != arg_) {
-      arg_ = bits;
-      dir_ = geom::headingDir(h);
-      valid_ = true;
-    }
-    return dir_;
-  }
-
- private:
-  std::uint64_t arg_ = 0;
-  Vec2 dir_ = Vec2::Zero();
-  bool valid_ = false;
-};
+using HeadingMemo = LastCall<&geom::headingDir>;
 
 // One robot's closed-form motion within a segment (DESIGN.md "Continuous
 // motion"): each wheel's ground speed follows a first-order lag toward its
@@ -466,7 +448,7 @@ struct Arena::Impl : ArenaState {
   mutable ExpMemo gunLag;
   mutable std::array<HeadingMemo, 2> headingMemo;
   Vec2 headingDirOf(int robot, double h) const {
-    return headingMemo[static_cast<std::size_t>(robot)].dir(h);
+    return headingMemo[static_cast<std::size_t>(robot)](h);
   }
   std::vector<double> tmp;
   mutable std::vector<double> qtmp;    // for const queries
