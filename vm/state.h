@@ -491,11 +491,11 @@ struct Vm::State {
   template <Op O>
   bool step(Regs& r);
   template <int kKind, Op First, Op... Rest>
-  bool superinstruction(Regs& r);
+  bool superinstruction(Regs& r, const Program& prog);
   template <int kKind, int kPiece, Op O>
   bool uncheckedPiece(Regs& r);
   template <int kKind, Op First, Op... Rest, size_t... kPieces>
-  bool unchecked(Regs& r, std::index_sequence<kPieces...>);
+  bool unchecked(Regs& r, const Program& prog, std::index_sequence<kPieces...>);
   void save(const Regs& r);
   void burnTail(Regs& r);
   bool fail(const Regs& r, const char* message);

@@ -303,7 +303,8 @@ template <int kKind, int kPiece, Op O>
 // (the guard, CALL's headroom) passes: superinstruction() checked the
 // deepest they can reach.
 template <int kKind, Op First, Op... Rest, size_t... kPieces>
-[[gnu::always_inline]] inline bool Vm::State::unchecked(Regs& r, std::index_sequence<kPieces...>) {
+[[gnu::always_inline]] inline bool Vm::State::unchecked(Regs& r, const Program& prog,
+                                                        std::index_sequence<kPieces...>) {
   constexpr StackReach kReach = stackReach({First, Rest...});
   uint32_t window[kReach.below + kReach.above + 1];
   uint32_t* const stack = r.e;
@@ -312,7 +313,7 @@ template <int kKind, Op First, Op... Rest, size_t... kPieces>
   for (int k = 0; k < kReach.below; ++k) window[k] = base[k];
   r.e = window;
   r.esp = kReach.below;
-  r.clk += program->superAfter[kKind][0];
+  r.clk += prog.superAfter[kKind][0];
   r.count += sizeof...(Rest);
   const bool ran = uncheckedPiece<kKind, 0, First>(r) &&
                    (uncheckedPiece<kKind, static_cast<int>(kPieces) + 1, Rest>(r) && ...);
@@ -335,14 +336,17 @@ template <int kKind, Op First, Op... Rest, size_t... kPieces>
 // and count charged at once, on a copy of the stack's top (unchecked()).
 // Otherwise the first piece runs alone, and the ones after it are
 // dispatched from the table one by one, each after NEXT's test, as they
-// are unfused (a long one as L_Long_).
+// are unfused (a long one as L_Long_). `prog` is run()'s: read through
+// the `program` member, the pointer is loaded again after every store to
+// the robot's memory (bytes, which may alias it), 1 % of the host's
+// instructions (cachegrind, the Lua comparison programs).
 template <int kKind, Op First, Op... Rest>
-[[gnu::always_inline]] inline bool Vm::State::superinstruction(Regs& r) {
+[[gnu::always_inline]] inline bool Vm::State::superinstruction(Regs& r, const Program& prog) {
   constexpr StackReach kReach = stackReach({First, Rest...});
-  if (__builtin_expect(r.clk + program->superSpan[kKind] < r.limit &&
+  if (__builtin_expect(r.clk + prog.superSpan[kKind] < r.limit &&
                            r.esp <= kEvalSlots - kEvalHeadroom - kReach.above,
                        1))
-    return unchecked<kKind, First, Rest...>(r, std::make_index_sequence<sizeof...(Rest)>{});
+    return unchecked<kKind, First, Rest...>(r, prog, std::make_index_sequence<sizeof...(Rest)>{});
   return step<First>(r);
 }
 
@@ -496,13 +500,13 @@ boundary:
   // The profiling run never fuses (its table has no superinstruction's
   // label): its copies of these handlers are left empty, which halves
   // their compile time.
-#define SUPER(name, ...)                                  \
-  S_##name : if constexpr (!kProfile) {                   \
-    using enum Op;                                        \
-    if (superinstruction<kSuper##name, __VA_ARGS__>(r)) { \
-      NEXT;                                               \
-    }                                                     \
-  }                                                       \
+#define SUPER(name, ...)                                        \
+  S_##name : if constexpr (!kProfile) {                         \
+    using enum Op;                                              \
+    if (superinstruction<kSuper##name, __VA_ARGS__>(r, prog)) { \
+      NEXT;                                                     \
+    }                                                           \
+  }                                                             \
   goto boundary;
 #include "vm/superinstructions.def"
 #undef SUPER
