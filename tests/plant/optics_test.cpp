@@ -179,6 +179,43 @@ TEST(Optics, OneChannelReadMatchesBothAndDrawsTheSameWords) {
   EXPECT_EQ(right.next(), next);
 }
 
+// Every noisy reading is the documented formula's, evaluated in full
+// here for every draw: Box-Muller from the two words (u1 = (w >> 11) + 1
+// over 2^53, u2 = (w >> 11) over 2^53), s + sigma z quantised. The eyes
+// skip that arithmetic where it cannot change the reading (a signal that
+// already reads 16 and a draw whose cosine is certainly negative): signals
+// on both sides of 32, the lowest that can read above 16, must agree on
+// every read, and the skip must have been possible on many of them.
+TEST(Optics, NoisyReadingsAreTheFullFormulasOnEveryDraw) {
+  Profile p = defaults();
+  p.robot.bad_reading_probability = 0;
+  const Pose self{0, 0, 0};
+  for (const double sigma : {16.0, 40.0}) {
+    p.robot.noise_sigma = sigma;
+    for (const double background : {16.0, 24.0, 31.0, 31.999999, 32.0, 33.0, 48.0}) {
+      p.robot.eye_background = background;
+      SplitMix64 eyes(11), words(11);
+      int skippable = 0;
+      for (int i = 0; i < 20000; ++i) {
+        const EyeReadings r = computeEyes(self, nullptr, p.robot, p.field, &eyes);
+        int expected[2];
+        for (int& e : expected) {
+          const double u1 = static_cast<double>((words.next() >> 11) + 1) / 9007199254740992.0;
+          const double u2 = static_cast<double>(words.next() >> 11) / 9007199254740992.0;
+          const double z = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+          e = expectedReading(background + sigma * z, p.robot.eye_max);
+          skippable += background < 32 && u2 > 0.26 && u2 < 0.74;
+        }
+        ASSERT_EQ(r.left, expected[0]) << "sigma " << sigma << " background " << background;
+        ASSERT_EQ(r.right, expected[1]) << "sigma " << sigma << " background " << background;
+      }
+      if (background < 32) {
+        EXPECT_GT(skippable, 15000);
+      }
+    }
+  }
+}
+
 TEST(Optics, ArenaEyesFollowThePoses) {
   const Profile p = thesis();
   Arena a(makeArenaConfig(p, 2));
