@@ -30,10 +30,33 @@ inline Vec2 headingDir(double headingRad) {
 }
 
 // Degrees in [0, 360).
+//
+// fmod(deg, 360), which is exact, without the call below 2^52 degrees (a
+// robot turning for a whole match is far below; glibc's fmod takes about
+// 90 host instructions there, a quarter of a pose). k = trunc(deg / 360)
+// is the exact quotient's integer part or one off it; 360 k is exact, and
+// so is deg - 360 k: both are multiples of ulp(deg) (360 k of 8, and
+// ulp(deg) <= 1/2) and the difference is smaller than |deg|. One step of
+// 360 (exact for the same reason) brings it into (-360, 360) with deg's
+// sign; a zero takes deg's sign, as fmod's does. That is fmod's result:
+// the only value there congruent to deg modulo 360.
+inline double remainder360(double deg) {
+  const double k = std::trunc(deg / 360.0);
+  double r = deg - k * 360.0;
+  if (deg > 0) {
+    if (r < 0) r += 360.0;
+    if (r >= 360.0) r -= 360.0;
+  } else {
+    if (r > 0) r -= 360.0;
+    if (r <= -360.0) r += 360.0;
+  }
+  return r == 0 ? std::copysign(0.0, deg) : r;
+}
 inline double wrap360(double deg) {
-  // fmod is exact and gives back a deg of magnitude below 360 unchanged
-  // (its sign, -0 too): the call is needed only beyond.
-  double w = std::abs(deg) < 360.0 ? deg : std::fmod(deg, 360.0);
+  // fmod gives back a deg of magnitude below 360 unchanged (its sign, -0
+  // too): the remainder is needed only beyond.
+  const double size = std::abs(deg);
+  double w = size < 360.0 ? deg : size < 0x1p52 ? remainder360(deg) : std::fmod(deg, 360.0);
   if (w < 0) w += 360.0;
   if (w >= 360.0) w = 0.0;  // fmod of a tiny negative number plus 360
   return w;

@@ -1,6 +1,7 @@
 // Continuous motion against closed forms: straight runs, spins, the motor
 // lag's step response, the wire-detector crossing tick, projectile flight,
 // a hit's tick, the bumper reflex, the referee, rewinds and determinism.
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -33,6 +34,36 @@ TEST(Geometry, Wrap360IsTheExactRemainderInZeroTo360) {
   EXPECT_EQ(wrap360(725.5), 5.5);
   EXPECT_EQ(wrap360(-725.5), 354.5);
   EXPECT_EQ(wrap360(-1e-300), 0.0);
+}
+
+// remainder360 against the C library's fmod, which is exact: bit for bit
+// (a zero's sign too) on random magnitudes from 360 to 2^52 degrees of
+// both signs, and on multiples of 360 and their neighbours (where the
+// quotient's integer part changes).
+TEST(Geometry, Remainder360IsFmodBitForBit) {
+  using simbot::plant::geom::remainder360;
+  const auto same = [](double deg) {
+    const double want = std::fmod(deg, 360.0);
+    const double got = remainder360(deg);
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(got), std::bit_cast<std::uint64_t>(want))
+        << std::hexfloat << deg << " -> " << got << ", fmod " << want;
+  };
+  SplitMix64 bits(360);
+  for (int i = 0; i < 200000; ++i) {
+    const std::uint64_t w = bits.next();
+    // Exponents 8 to 51, any mantissa, either sign.
+    const double size = std::ldexp(1.0 + unit53(w), 8 + static_cast<int>(w % 44));
+    if (size < 360.0) continue;
+    same(size);
+    same(-size);
+  }
+  for (double k : {1.0, 2.0, 3.0, 1e3, 12345.0, 1e9, 4503599627370495.0 / 360.0}) {
+    const double m = std::trunc(k) * 360.0;
+    for (double d : {m, std::nextafter(m, 0.0), std::nextafter(m, 1e300)}) {
+      same(d);
+      same(-d);
+    }
+  }
 }
 
 TEST(Time, EventTickIsCeilingOfExactProduct) {
