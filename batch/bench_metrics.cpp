@@ -14,7 +14,7 @@ void MetricsObserver::onEyeRead(int robot, Tick t, int channel, int value) {
   if (robot != robot_ || (channel != 0 && channel != 1)) return;
   if (value != lastEye_[channel]) {
     lastEye_[channel] = value;
-    stallInputs_.push_back({StallInput::Kind::Eye, t, channel, value});
+    addStallInput(kFromVm, {StallInput::Kind::Eye, t, channel, value});
   }
   if (channel == 0) {
     pairOpen_ = true;
@@ -41,22 +41,22 @@ void MetricsObserver::onFrame(int robot, Tick t, bool latched) {
     ++framesRejected;
     return;
   }
-  stallInputs_.push_back({StallInput::Kind::Latch, t});
+  addStallInput(kFromEvents, {StallInput::Kind::Latch, t});
   latches_.push_back(t);
 }
 
 void MetricsObserver::onPose(int robot, Tick t, double x_ft, double y_ft) {
-  if (robot == robot_) stallInputs_.push_back({StallInput::Kind::Pose, t, 0, 0, x_ft, y_ft});
+  if (robot == robot_) addStallInput(kFromSamples, {StallInput::Kind::Pose, t, 0, 0, x_ft, y_ft});
 }
 
 void MetricsObserver::onHalt(int robot, Tick t) {
-  if (robot == robot_) stallInputs_.push_back({StallInput::Kind::Halt, t});
+  if (robot == robot_) addStallInput(kFromVm, {StallInput::Kind::Halt, t});
 }
 
 void MetricsObserver::onReload(int robot, Tick t) {
   if (robot != robot_) return;
   lastEye_[0] = lastEye_[1] = -1;
-  stallInputs_.push_back({StallInput::Kind::Reload, t});
+  addStallInput(kFromEvents, {StallInput::Kind::Reload, t});
 }
 
 void MetricsObserver::onPlantEvent(Tick t, const plant::Event& e) {
@@ -83,12 +83,35 @@ void MetricsObserver::onPlantEvent(Tick t, const plant::Event& e) {
   }
 }
 
+void MetricsObserver::addStallInput(StallSource source, StallInput input) {
+  input.call = stallCalls_++;
+  stallInputs_[source].push_back(input);
+}
+
 void MetricsObserver::finish(Tick endTick) {
-  // Stable: within a tick, the order of the calls, which is the trace's.
-  std::stable_sort(stallInputs_.begin(), stallInputs_.end(),
-                   [](const StallInput& a, const StallInput& b) { return a.t < b.t; });
+  // By tick, and within a tick in the order of the calls, which is the
+  // trace's: each source's list by tick (stable: its calls are in order),
+  // then the lists merged by (tick, call).
+  const auto byTick = [](const StallInput& a, const StallInput& b) { return a.t < b.t; };
+  for (auto& list : stallInputs_)
+    if (!std::is_sorted(list.begin(), list.end(), byTick))
+      std::stable_sort(list.begin(), list.end(), byTick);
+  std::array<size_t, kStallSources> next{};
   reports::StallWatch stall = stall_;
-  for (const StallInput& in : stallInputs_) {
+  for (;;) {
+    const StallInput* first = nullptr;
+    size_t from = 0;
+    for (size_t s = 0; s < kStallSources; ++s) {
+      if (next[s] == stallInputs_[s].size()) continue;
+      const StallInput& in = stallInputs_[s][next[s]];
+      if (!first || in.t < first->t || (in.t == first->t && in.call < first->call)) {
+        first = &in;
+        from = s;
+      }
+    }
+    if (!first) break;
+    ++next[from];
+    const StallInput& in = *first;
     switch (in.kind) {
       case StallInput::Kind::Eye:
         stall.eyeRead(in.t, in.channel, in.value);

@@ -3,6 +3,7 @@
 // stats/). What they measure is the bench's, not the match's: ICEMAN's own
 // tests of acquiring and aiming, the edge legs, the stall time.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -66,8 +67,16 @@ class MetricsObserver final : public scheduler::MatchObserver {
     Tick t;
     int channel = 0, value = 0;
     double x = 0, y = 0;
+    uint64_t call = 0;  // its place among all the calls
   };
-  std::vector<StallInput> stallInputs_;
+  // One list per source, each in tick order but for rare cases, so that
+  // finish() merges them instead of sorting them all: the robot's VM (eye
+  // readings, halts), the plant's samples (poses), the events between
+  // rounds (latches, reloads).
+  enum StallSource : uint8_t { kFromVm, kFromSamples, kFromEvents, kStallSources };
+  void addStallInput(StallSource source, StallInput input);
+  std::array<std::vector<StallInput>, kStallSources> stallInputs_;
+  uint64_t stallCalls_ = 0;
   int lastEye_[2] = {-1, -1};
   // edge legs, kept raw and resolved in finish()
   std::optional<plant::Detector> edgeDetector_;
