@@ -457,6 +457,23 @@ boundary:
   }
   if (loopTop && loopTop[pc] >= 0 && fastForward(until)) goto boundary;
   resumeAtBreakpoint = false;
+  // An ordinary instruction (the table's, not a trap) runs on the fast
+  // path, as after NEXT: a long one's tail, a superinstruction and the
+  // limit are then the fast path's, and the checks below pass.
+  if (ops[pc] != kTrap && !diverted) {
+    eiShadow = false;
+    r = Regs{now,
+             anyPending && iff1 ? 0 : std::min(until, nextTimer),
+             stats.instructions,
+             pc,
+             pc,
+             eval.sp,
+             eval.data(),
+             mem.data(),
+             code,
+             kProfile ? profile.data() : nullptr};
+    DISPATCH_NEXT;
+  }
   op = code[pc];
   if (op >= kOpCount) {
     raiseFault(fmt::format("invalid opcode {}", op), pc);
