@@ -1,6 +1,7 @@
 // One match: the round loop described in match.h, the robots' VMs and the
 // trace. The robots' buses (ports, A/D, serial library hooks, interrupt
-// notifications) are in robot_bus.cpp; the classes in match_impl.h.
+// notifications) are in robot_bus.cpp, the plant events' records in
+// plant_records.cpp; the classes in match_impl.h.
 //
 // Larger rounds. A round is a run of sub-rounds, each exactly one round of
 // the one-character protocol of match.h: every VM runs to h_k = min(next
@@ -68,6 +69,21 @@
 // every trace snapshot, and JSON with and without --trace is the same), so
 // only the split of instructions between fast-forwarded and dispatched can
 // differ.
+// (6) A robot quiet past a sub-round's horizon (Vm::quietUntil: inside a
+// measured delay loop, no bus access, acceptance or PRT0 tick before its
+// arrival where the compare fails) sits the sub-round out when no trace
+// or debugger looks at it between sub-rounds: its run to the horizon
+// would make no record, no bus access and no input, and nothing between
+// the sub-rounds reads it but its own serial byte, before which it runs
+// to the horizon (all of them do before a NUL, which may latch a frame).
+// It runs at the next sub-round it is not quiet past, or at the round's
+// end, where every robot is at the horizon before anything else: one run
+// where there were several, the same instructions by (5). Its
+// quietUntil, and so every later horizon, is the same as if it had run:
+// fast-forward moves the measured pass's start and counter together, and
+// the arrival they give stays where it was. A trace and --no-fast-forward
+// (quietUntil is then the clock) never sit out, and the JSON must be
+// theirs (tests/fast_forward_test.py).
 #include "scheduler/match.h"
 
 #include <fmt/format.h>
@@ -455,124 +471,6 @@ void Match::applyInputs() {
   inputs_.clear();
 }
 
-// A plant event's record at t, with `watch` (robot `watchRobot`'s values at
-// t, taken when it was there) for that robot's records.
-void Match::emitPlant(Tick t, const plant::Event& e, const trace::Watch* watch, int watchRobot) {
-  if (!trace_.on()) return;
-  if (watch && e.robot == watchRobot)
-    emit(t, plantRecord(e), *watch);
-  else
-    emit(t, plantRecord(e));
-}
-
-// The trace record of a plant event.
-trace::Record Match::plantRecord(const plant::Event& e) const {
-  namespace rec = trace::rec;
-  const int r = e.robot;
-  const auto side = [](plant::Bumper b) { return b == plant::Bumper::Front ? "front" : "back"; };
-  const auto obstacle = [&](int index) { return plant::obstacleLabel(arenaConfig_->field, index); };
-  const auto with = [&](plant::ContactWith w, int index) -> std::string {
-    return w == plant::ContactWith::Robot      ? "robot"
-           : w == plant::ContactWith::Divider  ? "divider"
-           : w == plant::ContactWith::Obstacle ? obstacle(index)
-           : w == plant::ContactWith::Block    ? fmt::format("block {}", index + 1)
-                                               : "wall";
-  };
-  const auto missed = [&](plant::MissReason m, int index) -> std::string {
-    return m == plant::MissReason::Floor      ? "floor"
-           : m == plant::MissReason::Divider  ? "divider"
-           : m == plant::MissReason::Stopped  ? "stopped"
-           : m == plant::MissReason::Obstacle ? obstacle(index)
-           : m == plant::MissReason::Block    ? fmt::format("block {}", index + 1)
-                                              : "wall";
-  };
-  switch (e.kind) {
-    case plant::EventKind::EdgeEnter:
-      return rec::EdgeEnter{r, e.detector == plant::Detector::Fore ? "fore" : "aft"};
-    case plant::EventKind::EdgeLeave:
-      return rec::EdgeLeave{r, e.detector == plant::Detector::Fore ? "fore" : "aft"};
-    case plant::EventKind::Contact:
-      return rec::Contact{r, side(e.bumper), with(e.with, e.obstacle)};
-    case plant::EventKind::ContactEnd:
-      return rec::ContactEnd{r, with(e.with, e.obstacle)};
-    case plant::EventKind::ReflexStart:
-      return rec::ReflexStart{r, side(e.bumper)};
-    case plant::EventKind::ReflexEnd:
-      return rec::ReflexEnd{r, side(e.bumper)};
-    case plant::EventKind::BallLaunch:
-      return rec::BallLaunch{r, e.gun, e.ball, e.x, e.y, e.z, e.vx, e.vy, e.vz, e.heading_deg};
-    case plant::EventKind::BallSkip:
-      return rec::BallSkip{r, e.gun, e.ball, e.x, e.y};
-    case plant::EventKind::BallHit:
-      return rec::BallHit{r, e.gun, e.other, e.ball, "robot", e.x, e.y, e.z};
-    case plant::EventKind::BallMiss:
-      return rec::BallMiss{
-          r,      e.gun,
-          e.ball, missed(e.miss, e.obstacle),
-          e.x,    e.y,
-          e.z,    e.closest_ft >= 0 ? std::optional<double>(e.closest_ft) : std::nullopt};
-    case plant::EventKind::RefereePutBack:
-      return rec::RefereePutBack{r};
-    case plant::EventKind::RefereeTurn:
-      return rec::RefereeTurn{r};
-    case plant::EventKind::SolenoidStroke:
-      return rec::SolenoidStroke{r, e.gun};
-    case plant::EventKind::GunEmpty:
-      return rec::GunEmpty{r, e.gun};
-    case plant::EventKind::GunMisfire:
-      return rec::GunMisfire{r, e.gun};
-    case plant::EventKind::GunJammed:
-      return rec::GunJammed{r, e.gun};
-    case plant::EventKind::DiscShooter:
-      return rec::DiscShooter{r, -1};
-    case plant::EventKind::DiscFire:
-      return rec::DiscFire{
-          r,
-          e.ball,
-          e.x,
-          e.y,
-          e.z,
-          e.vx,
-          e.vy,
-          arenaConfig_->robots[static_cast<size_t>(r)].hardware.secondary.drag_time_s,
-          e.heading_deg};
-    case plant::EventKind::DiscEmpty:
-      return rec::DiscEmpty{r};
-    case plant::EventKind::Deploy:
-    case plant::EventKind::DeployEmpty:
-    case plant::EventKind::DeployBlocked: {
-      const plant::Deployable& d = arenaConfig_->robots[static_cast<size_t>(r)]
-                                       .hardware.deployables[static_cast<size_t>(e.gun)];
-      if (e.kind == plant::EventKind::DeployEmpty)
-        return rec::DeployEmpty{r, plant::deployKindName(d.kind), d.bit};
-      if (e.kind == plant::EventKind::DeployBlocked)
-        return rec::DeployBlocked{r, plant::deployKindName(d.kind), d.bit, e.x, e.y};
-      return rec::Deploy{r, plant::deployKindName(d.kind), e.ball, d.bit, e.x, e.y, e.heading_deg};
-    }
-    case plant::EventKind::DiscHit:
-      return rec::DiscHit{r, e.other, e.ball, e.x, e.y, e.z};
-    case plant::EventKind::PushStart:
-      return rec::PushStart{r, e.ball + 1, e.x, e.y, e.vx, e.vy};
-    case plant::EventKind::PushEnd:
-      return rec::PushEnd{
-          r,
-          e.ball + 1,
-          e.x,
-          e.y,
-          e.z,
-          e.with == plant::ContactWith::None ? std::string("drive") : with(e.with, e.obstacle)};
-    case plant::EventKind::DiscMiss:
-      return rec::DiscMiss{r,
-                           e.ball,
-                           missed(e.miss, e.obstacle),
-                           e.x,
-                           e.y,
-                           e.z,
-                           e.closest_ft >= 0 ? std::optional<double>(e.closest_ft) : std::nullopt};
-  }
-  throw std::logic_error("plant event without a trace record");
-}
-
 void Match::handlePlantEvents(Tick t, const plant::EventList& events, const trace::Watch* watch,
                               int watchRobot) {
   for (const auto& e : events) {
@@ -725,7 +623,14 @@ void Match::rounds(Tick pause) {
       horizon = std::min(horizon, step.tick);
       {
         const PartScope vms(clock_, PartClock::Vm);
-        for (Robot* r : runOrder_) r->runTo(horizon);
+        for (Robot* r : runOrder_) {
+          if (sitsOut(*r, horizon)) {
+            r->behind = true;
+          } else {
+            r->behind = false;
+            r->runTo(horizon);
+          }
+        }
       }
       if (horizon == step.tick || !inputs_.empty() || (config_.stopWhenAllExited && allExited()))
         break;
@@ -734,6 +639,7 @@ void Match::rounds(Tick pause) {
       ++subRounds_;
       horizon = std::min(queue_.nextTick(), earliestAction() + kLookahead);
     }
+    for (Robot* r : runOrder_) catchUp(*r, horizon);
     if (config_.stopWhenAllExited && allExited()) {
       // The run ends where the last robot stopped, not at the round's
       // horizon: where that falls depends on how long the rounds were
@@ -813,7 +719,14 @@ bool Match::serialBytesInRound(Tick horizon) {
   while (!queue_.empty() && queue_.nextTick() == horizon &&
          queue_.top().payload.kind == QueuedEvent::Kind::SerialByte) {
     const auto entry = queue_.pop();
-    robots_[static_cast<size_t>(entry.payload.robot)]->byteDone(horizon);
+    Robot& r = *robots_[static_cast<size_t>(entry.payload.robot)];
+    // Rule (6): the byte's robot at the horizon, where its interrupt
+    // request is raised; every robot there for a NUL, which may latch a
+    // frame (and then, as at any input, all of them are).
+    if (r.board.serial.nulDone() == horizon)
+      for (Robot* other : runOrder_) catchUp(*other, horizon);
+    catchUp(r, horizon);
+    r.byteDone(horizon);
   }
   return arena_.now() > horizon && (queue_.empty() || queue_.nextTick() != horizon);
 }

@@ -113,6 +113,9 @@ class Robot : public vm::Bus {
   bool running() const { return !board.cpu.fault() && !powerOff; }
   bool reloadPending = false;
   bool faultSeen = false;  // this VM's fault is recorded
+  // Sat out a sub-round, quiet past its horizon (match.cpp "Larger
+  // rounds", (6)): its clock is behind until it next runs.
+  bool behind = false;
 
   // vm::Bus
   void out(Tick t, uint16_t port, uint8_t value) override;
@@ -383,6 +386,20 @@ class Match : public MatchView, private MatchState {
   // The earliest tick at which a robot that has not faulted can act:
   // the least of their Vm::quietUntil (match ticks).
   Tick earliestAction() const;
+  // Rule (6) of "Larger rounds": whether robot r, quiet past the
+  // sub-round's horizon, sits it out.
+  bool sitsOut(const Robot& r, Tick horizon) const {
+    // Not with a trace (its samples say where each program is) or a
+    // debugger (it looks at any robot between rounds).
+    return !config_.debugger && !trace_.on() && r.running() && r.now() < horizon &&
+           r.quietUntil() >= horizon;
+  }
+  // Robot r at the horizon again after sitting sub-rounds out.
+  void catchUp(Robot& r, Tick horizon) {
+    if (!r.behind) return;
+    r.behind = false;
+    r.runTo(horizon);
+  }
   bool allExited() const {
     return std::all_of(robots_.begin(), robots_.end(), [](const auto& r) {
       return (r->result.exited || r->vm().fault()) && !r->reloadPending && !r->powerOff;
