@@ -233,10 +233,15 @@ Tick MatchState::earliestClock() const {
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 
-Tick Match::earliestAction() const {
+Tick Match::earliestAction() {
   Tick t = INT64_MAX;
-  for (const auto& r : robots_)
-    if (r->running()) t = std::min(t, r->quietUntil());
+  quiet_.assign(robots_.size(), INT64_MIN);
+  for (const auto& r : robots_) {
+    if (!r->running()) continue;
+    const Tick q = r->quietUntil();
+    quiet_[static_cast<size_t>(r->index)] = q;
+    t = std::min(t, q);
+  }
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 

@@ -384,15 +384,16 @@ class Match : public MatchView, private MatchState {
   // Each robot's match and its VM's bus, and the order they run in.
   void link();
   // The earliest tick at which a robot that has not faulted can act:
-  // the least of their Vm::quietUntil (match ticks).
-  Tick earliestAction() const;
+  // the least of their Vm::quietUntil (match ticks), each kept in quiet_
+  // for the sub-round the horizon it gives starts (nothing runs between).
+  Tick earliestAction();
   // Rule (6) of "Larger rounds": whether robot r, quiet past the
   // sub-round's horizon, sits it out.
   bool sitsOut(const Robot& r, Tick horizon) const {
     // Not with a trace (its samples say where each program is) or a
     // debugger (it looks at any robot between rounds).
     return !config_.debugger && !trace_.on() && r.running() && r.now() < horizon &&
-           r.quietUntil() >= horizon;
+           quiet_[static_cast<size_t>(r.index)] >= horizon;
   }
   // Robot r at the horizon again after sitting sub-rounds out.
   void catchUp(Robot& r, Tick horizon) {
@@ -424,6 +425,7 @@ class Match : public MatchView, private MatchState {
   plant::Arena arena_;
   // The order robots run in a round: the one a debugger holds first.
   std::vector<Robot*> runOrder_;
+  std::vector<Tick> quiet_;  // per robot, at the last earliestAction()
   void orderRobots();
   int hitsAt(const Injection& in, uint32_t address) const {
     const auto& hits = robots_[static_cast<size_t>(in.robot)]->lineHits;
