@@ -14,7 +14,7 @@ void MetricsObserver::onEyeRead(int robot, Tick t, int channel, int value) {
   if (robot != robot_ || (channel != 0 && channel != 1)) return;
   if (value != lastEye_[channel]) {
     lastEye_[channel] = value;
-    addStallInput(kFromVm, {StallInput::Kind::Eye, t, channel, value});
+    addStallInput(kFromVm, {t, 0, value, StallInput::Kind::Eye, static_cast<uint8_t>(channel)});
   }
   if (channel == 0) {
     pairOpen_ = true;
@@ -41,22 +41,24 @@ void MetricsObserver::onFrame(int robot, Tick t, bool latched) {
     ++framesRejected;
     return;
   }
-  addStallInput(kFromEvents, {StallInput::Kind::Latch, t});
+  addStallInput(kFromEvents, {t, 0, 0, StallInput::Kind::Latch});
   latches_.push_back(t);
 }
 
 void MetricsObserver::onPose(int robot, Tick t, double x_ft, double y_ft) {
-  if (robot == robot_) addStallInput(kFromSamples, {StallInput::Kind::Pose, t, 0, 0, x_ft, y_ft});
+  if (robot != robot_) return;
+  addStallInput(kFromSamples, {t, 0, static_cast<int32_t>(poses_.size()), StallInput::Kind::Pose});
+  poses_.push_back({x_ft, y_ft});
 }
 
 void MetricsObserver::onHalt(int robot, Tick t) {
-  if (robot == robot_) addStallInput(kFromVm, {StallInput::Kind::Halt, t});
+  if (robot == robot_) addStallInput(kFromVm, {t, 0, 0, StallInput::Kind::Halt});
 }
 
 void MetricsObserver::onReload(int robot, Tick t) {
   if (robot != robot_) return;
   lastEye_[0] = lastEye_[1] = -1;
-  addStallInput(kFromEvents, {StallInput::Kind::Reload, t});
+  addStallInput(kFromEvents, {t, 0, 0, StallInput::Kind::Reload});
 }
 
 void MetricsObserver::onPlantEvent(Tick t, const plant::Event& e) {
@@ -119,9 +121,11 @@ void MetricsObserver::finish(Tick endTick) {
       case StallInput::Kind::Latch:
         stall.frameLatched(in.t);
         break;
-      case StallInput::Kind::Pose:
-        stall.pose(in.t, in.x, in.y);
+      case StallInput::Kind::Pose: {
+        const auto& [x, y] = poses_[static_cast<size_t>(in.value)];
+        stall.pose(in.t, x, y);
         break;
+      }
       case StallInput::Kind::Halt:
         stall.halted(in.t);
         break;

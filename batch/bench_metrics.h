@@ -62,12 +62,13 @@ class MetricsObserver final : public scheduler::MatchObserver {
   // What the StallWatch is fed, kept until finish() feeds it in tick order
   // (the observer's calls are not: a pose sample comes after the VM ran
   // past it). Eye readings only where they change, as the trace's ad_read.
+  // 24 bytes: an edge run keeps a quarter of a million of them.
   struct StallInput {
-    enum class Kind : uint8_t { Eye, Latch, Pose, Halt, Reload } kind;
     Tick t;
-    int channel = 0, value = 0;
-    double x = 0, y = 0;
     uint64_t call = 0;  // its place among all the calls
+    int32_t value = 0;  // an eye's reading; a pose's index in poses_
+    enum class Kind : uint8_t { Eye, Latch, Pose, Halt, Reload } kind;
+    uint8_t channel = 0;
   };
   // One list per source, each in tick order but for rare cases, so that
   // finish() merges them instead of sorting them all: the robot's VM (eye
@@ -76,6 +77,7 @@ class MetricsObserver final : public scheduler::MatchObserver {
   enum StallSource : uint8_t { kFromVm, kFromSamples, kFromEvents, kStallSources };
   void addStallInput(StallSource source, StallInput input);
   std::array<std::vector<StallInput>, kStallSources> stallInputs_;
+  std::vector<std::array<double, 2>> poses_;  // x, y (ft) of each Pose input
   uint64_t stallCalls_ = 0;
   int lastEye_[2] = {-1, -1};
   // edge legs, kept raw and resolved in finish()
