@@ -210,6 +210,7 @@ void Match::link() {
 }
 
 void Match::orderRobots() {
+  quiet_.assign(robots_.size(), INT64_MIN);
   runOrder_.clear();
   if (config_.debugger)
     runOrder_.push_back(robots_.at(static_cast<size_t>(config_.debugRobot)).get());
@@ -235,12 +236,10 @@ Tick MatchState::earliestClock() const {
 
 Tick Match::earliestAction() {
   Tick t = INT64_MAX;
-  quiet_.assign(robots_.size(), INT64_MIN);
   for (const auto& r : robots_) {
-    if (!r->running()) continue;
-    const Tick q = r->quietUntil();
-    quiet_[static_cast<size_t>(r->index)] = q;
-    t = std::min(t, q);
+    Tick& q = quiet_[static_cast<size_t>(r->index)];
+    q = r->running() ? r->quietUntil() : INT64_MIN;
+    if (q != INT64_MIN) t = std::min(t, q);
   }
   return t == INT64_MAX ? queue_.nextTick() : t;
 }

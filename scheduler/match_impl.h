@@ -392,8 +392,9 @@ class Match : public MatchView, private MatchState {
   bool sitsOut(const Robot& r, Tick horizon) const {
     // Not with a trace (its samples say where each program is) or a
     // debugger (it looks at any robot between rounds).
-    return !config_.debugger && !trace_.on() && r.running() && r.now() < horizon &&
-           quiet_[static_cast<size_t>(r.index)] >= horizon;
+    // (quiet_ holds INT64_MIN for a robot that does not run.)
+    return quiet_[static_cast<size_t>(r.index)] >= horizon && !config_.debugger && !trace_.on() &&
+           r.now() < horizon;
   }
   // Robot r at the horizon again after sitting sub-rounds out.
   void catchUp(Robot& r, Tick horizon) {
