@@ -32,9 +32,12 @@ PROGRAMS = os.path.join(HERE, "programs")
 # were then left out on measurements that included them; fletcher and
 # ring were written after every choice of the first part, and nothing was
 # measured on them before; the second part's forms were chosen on all
-# thirteen, and insertion and checksum were written after that choice.
+# thirteen, insertion and checksum were written after that choice, the
+# auto-index forms were then chosen on insertion, and smooth was written
+# after them.
 ALGORITHMS = ("sieve", "nested", "fib", "sort", "strscan", "structs", "grid", "filter",
-              "bubble", "histogram", "matrix", "fletcher", "ring", "insertion", "checksum")
+              "bubble", "histogram", "matrix", "fletcher", "ring", "insertion", "checksum",
+              "smooth")
 
 
 def child_cpu():
