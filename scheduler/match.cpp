@@ -71,7 +71,10 @@
 // differ.
 // (6) A robot quiet past a sub-round's horizon (Vm::quietUntil: inside a
 // measured delay loop, no bus access, acceptance or PRT0 tick before its
-// arrival where the compare fails) sits the sub-round out when no trace
+// arrival where the compare fails), and past the most a run overshoots
+// its horizon (vm::kMaxRunOvershoot: PRT0's tick, not an instruction
+// boundary, could otherwise fall inside the run's last instruction and
+// be requested at its end), sits the sub-round out when no trace
 // or debugger looks at it between sub-rounds: its run to the horizon
 // would make no record, no bus access and no input, and nothing between
 // the sub-rounds reads it but its own serial byte, before which it runs
@@ -234,13 +237,15 @@ Tick MatchState::earliestClock() const {
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 
-Tick Match::earliestAction() {
+void Match::noteQuiet() {
+  for (const auto& r : robots_)
+    quiet_[static_cast<size_t>(r->index)] = r->running() ? r->quietUntil() : INT64_MIN;
+}
+
+Tick Match::earliestAction() const {
   Tick t = INT64_MAX;
-  for (const auto& r : robots_) {
-    Tick& q = quiet_[static_cast<size_t>(r->index)];
-    q = r->running() ? r->quietUntil() : INT64_MIN;
+  for (const Tick q : quiet_)
     if (q != INT64_MIN) t = std::min(t, q);
-  }
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 
@@ -607,6 +612,7 @@ void Match::rounds(Tick pause) {
     if (config_.stop && config_.stop->load(std::memory_order_relaxed)) throw Stopped();
     roundStart_ = t;
     if (trace_.on()) trace_.flushBefore(std::min(t, arena_.now()));
+    noteQuiet();
     Tick horizon = std::min(queue_.nextTick(), earliestAction() + kLookahead);
     // The plant goes further than the first sub-round when no ball is in
     // flight, past serial bytes (header comment: "Larger rounds", (d)).
@@ -641,6 +647,7 @@ void Match::rounds(Tick pause) {
       sampleUpTo(horizon);  // before the next sub-round's records, as between rounds
       if (queue_.nextTick() == horizon && !serialBytesInRound(horizon)) break;
       ++subRounds_;
+      noteQuiet();
       horizon = std::min(queue_.nextTick(), earliestAction() + kLookahead);
     }
     for (Robot* r : runOrder_) catchUp(*r, horizon);

@@ -383,18 +383,23 @@ class Match : public MatchView, private MatchState {
  private:
   // Each robot's match and its VM's bus, and the order they run in.
   void link();
-  // The earliest tick at which a robot that has not faulted can act:
-  // the least of their Vm::quietUntil (match ticks), each kept in quiet_
-  // for the sub-round the horizon it gives starts (nothing runs between).
-  Tick earliestAction();
+  // Each robot's Vm::quietUntil (match ticks; INT64_MIN for one that has
+  // faulted or is held in reset), kept in quiet_ for the horizon it gives
+  // (earliestAction) and the sub-round that starts there (sitsOut):
+  // nothing runs in between.
+  void noteQuiet();
+  // The earliest tick at which a robot that has not faulted can act: the
+  // least of quiet_.
+  Tick earliestAction() const;
   // Rule (6) of "Larger rounds": whether robot r, quiet past the
   // sub-round's horizon, sits it out.
   bool sitsOut(const Robot& r, Tick horizon) const {
     // Not with a trace (its samples say where each program is) or a
     // debugger (it looks at any robot between rounds).
-    // (quiet_ holds INT64_MIN for a robot that does not run.)
-    return quiet_[static_cast<size_t>(r.index)] >= horizon && !config_.debugger && !trace_.on() &&
-           r.now() < horizon;
+    // Quiet past a run's overshoot of the horizon too: PRT0's next tick,
+    // one bound of quietUntil, may fall inside the run's last instruction.
+    return quiet_[static_cast<size_t>(r.index)] >= horizon + vm::kMaxRunOvershoot &&
+           !config_.debugger && !trace_.on() && r.now() < horizon;
   }
   // Robot r at the horizon again after sitting sub-rounds out.
   void catchUp(Robot& r, Tick horizon) {

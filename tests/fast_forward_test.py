@@ -10,11 +10,13 @@ for its wall-clock field and the integrator's step and right-hand-side
 counts) and a byte-identical trace. Each also runs without a trace, where
 a robot quiet past a sub-round's horizon sits it out (scheduler/match.cpp,
 "Larger rounds", (6)): its JSON must be the traced run's but for the
-wall-clock field. Under the sanitizers (slow) only programs/ and the
-reference programs run.
+wall-clock field. programs/ and the reference programs run again with
+PRT0 ticking in each (a profile with timer_service = "always"). Under the
+sanitizers (slow) only programs/ and the reference programs run.
 """
 import json
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -61,6 +63,15 @@ def main():
     if not sanitized:
         runs.append(("match-iceman-fig92-180s",
                      ["match", str(shared / "programs" / "iceman.dc"), str(fig92)]))
+    # PRT0 ticking in every program (the profile's timer_service = "always"):
+    # its ticks bound quietUntil and land inside delay loops' passes.
+    always = work / "timer-always.toml"
+    always.write_text(re.sub(r'timer_service *= *\{ *value *= *"auto"', 'timer_service = { value = "always"',
+                             (source / "profiles" / "default.toml").read_text()))
+    for p in [shared / "programs" / "iceman.dc", fig92, *sorted((source / "programs").glob("*.dc"))]:
+        timed = ["--profile", str(always), "--seconds", seconds]
+        runs.append((f"timer-solo-{p.stem}", ["solo", str(p), *timed]))
+        runs.append((f"timer-match-{p.stem}", ["match", str(p), str(fig92), *timed]))
     failures = 0
     for name, args in runs:
         fast_trace, slow_trace = work / f"{name}.ff.jsonl", work / f"{name}.step.jsonl"

@@ -37,6 +37,7 @@ static_assert(kEvalHeadroom > kMaxLibArgs + kEvalGuard,
               "a call's headroom must hold a library call's arguments");
 inline constexpr int kMaxInterruptNesting = 16;
 inline constexpr uint32_t kMaxStepTstates = 100;  // long library calls: boundary spacing
+static_assert(Tick{kMaxStepTstates} <= kMaxRunOvershoot, "vm.h promises runs overshoot less");
 // printf's largest field width and precision (assumption: Dynamic C's
 // printf formatted each field into a buffer of this size).
 inline constexpr long kMaxPrintfField = 127;

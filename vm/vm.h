@@ -50,6 +50,9 @@ using timebase::Tick;
 // PIO), PRT0 (the timer), ASCI (the serial port).
 enum class Irq : uint8_t { Pio = 0, Timer = 1, SerialTx = 2 };
 inline constexpr int kIrqCount = 3;
+// The most a run ends after its `until` (Vm::run): an instruction, or a
+// step of a long one, is at most this long.
+inline constexpr Tick kMaxRunOvershoot = 100;
 std::string_view irqName(Irq irq);  // "pio_a", "timer", "serial_tx"
 
 class Vm;
@@ -150,7 +153,9 @@ class Vm {
   // requests and clock, and goes on the same.
   bool sameProgramState(const Vm& other) const;
 
-  // Executes every instruction that starts before `until`. A bus access
+  // Executes every instruction that starts before `until` (so it stops
+  // less than kMaxRunOvershoot ticks after it: no step of an instruction
+  // is longer). A bus access
   // does not end the run: what the host does on one (a port B write, a
   // send) takes effect in the plant or the queue at the end of the host's
   // round, not inside it, so stopping there bought nothing (160,000 of
