@@ -376,8 +376,13 @@ Stop Vm::State::run(Tick until) {
       prog.costs.knobs.fastForward && !prog.loopAtTop.empty() ? prog.loopAtTop.data() : nullptr;
   const uint8_t* const ops = dispatch->ops().data();
   ready();
-  Regs r{now,     0,           stats.instructions, pc,   pc,
-         eval.sp, eval.data(), mem.data(),         code, kProfile ? profile.data() : nullptr};
+  // The fast path's registers, from the machine at a boundary.
+  const auto registers = [&](Tick limit) {
+    return Regs{
+        now,     limit,       stats.instructions, pc,   pc,
+        eval.sp, eval.data(), mem.data(),         code, kProfile ? profile.data() : nullptr};
+  };
+  Regs r = registers(0);
   Tick longLimit = -1;  // L_Long_: the limit its instruction's tail runs to
   uint8_t op = 0;
   hostStop = false;
@@ -462,16 +467,7 @@ boundary:
   // limit are then the fast path's, and the checks below pass.
   if (ops[pc] != kTrap && !diverted) {
     eiShadow = false;
-    r = Regs{now,
-             anyPending && iff1 ? 0 : std::min(until, nextTimer),
-             stats.instructions,
-             pc,
-             pc,
-             eval.sp,
-             eval.data(),
-             mem.data(),
-             code,
-             kProfile ? profile.data() : nullptr};
+    r = registers(anyPending && iff1 ? 0 : std::min(until, nextTimer));
     DISPATCH_NEXT;
   }
   op = code[pc];
@@ -495,17 +491,9 @@ boundary:
   eiShadow = false;
   // The boundary after this instruction is slow too when anything rare is
   // due there (see "Fast path").
-  r = Regs{
-      now,
-      ops[pc] == kTrap || burn || (anyPending && iff1) || diverted ? 0 : std::min(until, nextTimer),
-      stats.instructions,
-      pc,
-      pc,
-      eval.sp,
-      eval.data(),
-      mem.data(),
-      code,
-      kProfile ? profile.data() : nullptr};
+  r = registers(ops[pc] == kTrap || burn || (anyPending && iff1) || diverted
+                    ? 0
+                    : std::min(until, nextTimer));
   goto* kLabels[op];
 
   // One handler per opcode, and one per superinstruction.
