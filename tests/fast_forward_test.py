@@ -14,6 +14,7 @@ wall-clock field. programs/ and the reference programs run again with
 PRT0 ticking in each (a profile with timer_service = "always"). Under the
 sanitizers (slow) only programs/ and the reference programs run.
 """
+import copy
 import json
 import pathlib
 import re
@@ -31,8 +32,9 @@ def summary_of(simbot, args):
 
 
 def run(simbot, args, trace):
+    """The traced run's summary without the integrator's work counts, and whole."""
     summary = summary_of(simbot, [*args, "--trace", str(trace)])
-    traced = json.loads(json.dumps(summary))
+    traced = copy.deepcopy(summary)
     # The integrator's steps, right-hand sides and roots count work, not
     # results: steps past an input's tick (and the roots found in them) are
     # thrown away at its re-initialisation, and fast-forward lets the
