@@ -17,27 +17,17 @@ namespace {
 
 using Loop = Program::Loop;
 
-// A counter value as a signed or unsigned number of the counter's width.
-int64_t counterNumber(const Loop& loop, uint32_t x) {
-  if (!loop.isSigned) return loop.wide ? int64_t{x} : int64_t{x & 0xFFFFu};
-  return loop.wide ? static_cast<int32_t>(x) : static_cast<int16_t>(x);
-}
-
 // Passes still to run from `from` while the compare holds, the counter
 // staying below the top of its range (it never wraps here).
 int64_t passesLeft(const Loop& loop, uint32_t from) {
-  const int64_t top = loop.isSigned ? (loop.wide ? INT32_MAX : INT16_MAX)
-                                    : (loop.wide ? int64_t{UINT32_MAX} : int64_t{UINT16_MAX});
-  const int64_t n = counterNumber(loop, loop.limit);
-  const int64_t last = std::min(loop.inclusive ? n : n - 1, top - 1);
-  const int64_t v = counterNumber(loop, from);
-  return last >= v ? last - v + 1 : 0;
+  const int64_t v = loop.number(from);
+  return loop.last >= v ? loop.last - v + 1 : 0;
 }
 
 // The regime in which every pass costs the same: a signed compare's
 // overflow branch is never taken when both sides are non-negative.
 bool inRegime(const Loop& loop, uint32_t v) {
-  return !loop.isSigned || (counterNumber(loop, v) >= 0 && counterNumber(loop, loop.limit) >= 0);
+  return !loop.isSigned || (loop.limitInRegime && loop.number(v) >= 0);
 }
 
 }  // namespace

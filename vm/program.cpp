@@ -94,7 +94,13 @@ void Program::findLoops() {
     if (loopAtTop.empty()) loopAtTop.assign(code.size() + 1, -1);
     if (loopAtTop[mark.top] >= 0) continue;
     loopAtTop[mark.top] = static_cast<int16_t>(loops.size());
-    loops.push_back(Loop{mark.top, mark.exit, counter, limit, wide, isSigned, inclusive});
+    Loop loop{mark.top, mark.exit, counter, limit, wide, isSigned, inclusive};
+    const int64_t top = isSigned ? (wide ? INT32_MAX : INT16_MAX)
+                                 : (wide ? int64_t{UINT32_MAX} : int64_t{UINT16_MAX});
+    const int64_t n = loop.number(limit);
+    loop.last = std::min(inclusive ? n : n - 1, top - 1);
+    loop.limitInRegime = !isSigned || n >= 0;
+    loops.push_back(loop);
   }
 }
 

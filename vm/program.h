@@ -65,6 +65,17 @@ struct Program {
     bool wide;       // a long counter
     bool isSigned;   // LTW, LEW, LTL, LEL
     bool inclusive;  // <=
+    // Worked out once from the above (findLoops), not at every arrival:
+    // the last counter number the compare holds for, below the top of the
+    // counter's range (it never wraps in fast-forward), and whether the
+    // limit is non-negative or unsigned (a signed compare's regime).
+    int64_t last = 0;
+    bool limitInRegime = false;
+    // A counter value as a signed or unsigned number of the counter's width.
+    int64_t number(uint32_t x) const {
+      if (!isSigned) return wide ? int64_t{x} : int64_t{x & 0xFFFFu};
+      return wide ? static_cast<int32_t>(x) : static_cast<int16_t>(x);
+    }
   };
   std::vector<Loop> loops;
   std::vector<int16_t> loopAtTop;
