@@ -238,8 +238,11 @@ Tick MatchState::earliestClock() const {
 }
 
 void Match::noteQuiet() {
+  // A robot still behind has not run, nor taken a byte, since its value
+  // was noted (nothing else reaches a VM inside a round): it is the same.
   for (const auto& r : robots_)
-    quiet_[static_cast<size_t>(r->index)] = r->running() ? r->quietUntil() : INT64_MIN;
+    if (!r->behind)
+      quiet_[static_cast<size_t>(r->index)] = r->running() ? r->quietUntil() : INT64_MIN;
 }
 
 Tick Match::earliestAction() const {

@@ -386,7 +386,8 @@ class Match : public MatchView, private MatchState {
   // Each robot's Vm::quietUntil (match ticks; INT64_MIN for one that has
   // faulted or is held in reset), kept in quiet_ for the horizon it gives
   // (earliestAction) and the sub-round that starts there (sitsOut):
-  // nothing runs in between.
+  // nothing runs in between. A robot sitting sub-rounds out keeps its
+  // value.
   void noteQuiet();
   // The earliest tick at which a robot that has not faulted can act: the
   // least of quiet_.
