@@ -97,6 +97,7 @@ void Arena::Impl::launchDisc(Discrete& d, const std::vector<double>& y, int i, d
   for (int k = 0; k < kMaxDiscs && slot < 0; ++k)
     if (!d.discs[static_cast<std::size_t>(k)].active) slot = k;
   if (slot < 0) throw std::logic_error("plant: the disc table is full (see kMaxDiscs)");
+  d.discSlots = std::max(d.discSlots, slot + 1);
   RobotDisc& r = d.r[static_cast<std::size_t>(i)];
   r.discsLeft--;
   r.discShots++;

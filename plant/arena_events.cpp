@@ -61,6 +61,7 @@ void Arena::Impl::process(std::int64_t T, double te, Discrete& d, std::vector<do
       for (int b = 0; b < kMaxBalls && slot < 0; ++b)
         if (!d.balls[static_cast<std::size_t>(b)].active) slot = b;
       if (slot < 0) throw std::logic_error("plant: the ball table is full (see kMaxBalls)");
+      d.ballSlots = std::max(d.ballSlots, slot + 1);
       r.ballsLeft[static_cast<std::size_t>(g)]--;
       r.shots++;
       const RobotParams& p = P(i);

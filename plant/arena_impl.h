@@ -220,6 +220,30 @@ struct Discrete {
   std::array<Disc, kMaxDiscs> discs{};
   int blockCount = 0;  // blocks set down; 0: none of their rules run
   std::array<Block, kMaxBlocks> blocks{};
+  // One past the highest ball and disc slot ever launched into (a launch
+  // takes the lowest free slot): every slot from there on still holds its
+  // default value, as does every block past blockCount (blocks are only
+  // ever appended).
+  int ballSlots = 0, discSlots = 0;
+
+  Discrete() = default;
+  Discrete(const Discrete&) = default;
+  // Everything but the slots past both sides' high-water marks, which
+  // hold the default value on both: copied at every plant event (pendingD
+  // = D, then D = pendingD), where the tables are most of its 14.6 kB.
+  Discrete& operator=(const Discrete& o) {
+    r = o.r;
+    robotContact = o.robotContact;
+    inFlight = o.inFlight;
+    const int balls_ = std::max(ballSlots, o.ballSlots), discs_ = std::max(discSlots, o.discSlots);
+    std::copy_n(o.balls.begin(), balls_, balls.begin());
+    std::copy_n(o.discs.begin(), discs_, discs.begin());
+    ballSlots = o.ballSlots;
+    discSlots = o.discSlots;
+    std::copy_n(o.blocks.begin(), std::max(blockCount, o.blockCount), blocks.begin());
+    blockCount = o.blockCount;
+    return *this;
+  }
 };
 
 inline double expm1Of(double x) { return std::expm1(x); }
