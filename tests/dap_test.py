@@ -682,15 +682,17 @@ LONG = {"program": ICEMAN, "opponent": FIG92, "seed": 3, "seconds": 600, "stopOn
 
 def run_long():
     """A continue that runs for a minute or more in any build: a data
-    breakpoint on ICEMAN's global i, which it declares and never writes,
-    makes the session step every instruction (the 600-s match alone runs in
-    about a second here: too short to stop for sure in its middle)."""
+    breakpoint on ICEMAN's global s, which it declares and never writes,
+    makes the session step every instruction (the 600-s match alone runs
+    in about a second here: too short to stop for sure in its middle).
+    Not i: fire() writes it, and seed 3 reaches fire() at 21.03 s, which
+    a fast host stepped to before the pause came."""
     client = Client()
     start(client, LONG)
     client.request("configurationDone")
     client.stopped("entry")
-    r = client.request("setDataBreakpoints", {"breakpoints": [{"dataId": "i", "accessType": "write"}]})
-    check(r["body"]["breakpoints"][0].get("verified") is True, f"a data breakpoint on i: {r['body']}")
+    r = client.request("setDataBreakpoints", {"breakpoints": [{"dataId": "s", "accessType": "write"}]})
+    check(r["body"]["breakpoints"][0].get("verified") is True, f"a data breakpoint on s: {r['body']}")
     client.request("continue", {"threadId": 1})
     time.sleep(0.5)
     check(not any(e["event"] == "stopped" for e in client.events), "the long match runs")
