@@ -32,38 +32,57 @@ bool inRegime(const Loop& loop, uint32_t v) {
 
 }  // namespace
 
+// n more passes of `loop` from counter value v at once, n as many as stay
+// below the loop's exit and land at or before min(until, PRT0's tick);
+// `measured`: the pass just stepped is the measure (the profile's deltas
+// are taken from it).
+bool Vm::State::applyPasses(const Program::Loop& loop, uint32_t& v, Tick until, bool measured) {
+  const auto k = static_cast<size_t>(program->loopAtTop[pc]);
+  const Tick pass = loopPass[k];
+  const Tick bound = std::min(until, nextTimer);
+  const int64_t n =
+      pass > 0 && bound > now ? std::min<int64_t>(passesLeft(loop, v), (bound - now) / pass) : 0;
+  if (n <= 0) return false;
+  v += static_cast<uint32_t>(n);
+  if (loop.wide)
+    wr32(loop.counter, v);
+  else
+    wr16(loop.counter, v);
+  now += n * pass;
+  const uint64_t skipped = static_cast<uint64_t>(n) * loopInstructions[k];
+  stats.instructions += skipped;
+  stats.fastForwarded += skipped;
+  if (profiling && measured)
+    for (uint32_t a = loop.top; a < loop.exit; ++a)
+      profile[a] += static_cast<uint64_t>(n) * (profile[a] - measure.profile[a - loop.top]);
+  return true;
+}
+
 bool Vm::State::fastForward(Tick until) {
   const int index = program->loopAtTop[pc];
   const Loop& loop = program->loops[static_cast<size_t>(index)];
   uint32_t v = loop.wide ? rd32(loop.counter) : rd16(loop.counter);
   bool applied = false;
   const uint32_t mask = loop.wide ? 0xFFFFFFFFu : 0xFFFFu;
-  // The cheap tests first: most arrivals are the first of a pass to
-  // measure (the counter is not the measured one's successor).
-  if (measure.loop == index && measure.accepted == acceptances &&
-      v == ((measure.counter + 1) & mask) && inRegime(loop, v) && inRegime(loop, measure.counter) &&
-      !dispatch->breakpointInLoop(static_cast<size_t>(index))) {
-    const Tick pass = now - measure.start;
-    loopPass[static_cast<size_t>(index)] = pass;
-    const Tick bound = std::min(until, nextTimer);
-    const int64_t n =
-        pass > 0 && bound > now ? std::min<int64_t>(passesLeft(loop, v), (bound - now) / pass) : 0;
-    if (n > 0) {
-      v += static_cast<uint32_t>(n);
-      if (loop.wide)
-        wr32(loop.counter, v);
-      else
-        wr16(loop.counter, v);
-      now += n * pass;
-      const uint64_t skipped =
-          static_cast<uint64_t>(n) * (stats.instructions - measure.instructions);
-      stats.instructions += skipped;
-      stats.fastForwarded += skipped;
-      if (profiling)
-        for (uint32_t a = loop.top; a < loop.exit; ++a)
-          profile[a] += static_cast<uint64_t>(n) * (profile[a] - measure.profile[a - loop.top]);
-      applied = true;
-    }
+  const auto k = static_cast<size_t>(index);
+  if (dispatch->breakpointInLoop(k) || !inRegime(loop, v)) {
+    // Stepped: nothing is applied, the pass is measured all the same.
+  } else if (measure.loop == index && measure.accepted == acceptances &&
+             v == ((measure.counter + 1) & mask) && inRegime(loop, measure.counter)) {
+    // The pass just stepped was one: its cost and count, the same for
+    // every pass of the regime.
+    loopPass[k] = now - measure.start;
+    loopInstructions[k] = stats.instructions - measure.instructions;
+    applied = applyPasses(loop, v, until, true);
+  } else if (loopPass[k] > 0 && !profiling) {
+    // A pass of this loop was measured before (at an earlier entry or
+    // run): it costs what every pass does, so the passes are applied at
+    // this first arrival, where the measured one would have been stepped
+    // first. They land where stepping one pass and applying the rest
+    // would: n' = floor((B - t) / p) = 1 + floor((B - t - p) / p). The
+    // profiling run keeps measuring (its profile takes the pass's
+    // per-instruction deltas).
+    applied = applyPasses(loop, v, until, false);
   }
   // The pass that starts here is measured (after passes applied, the VM has
   // landed at the top: quietUntil needs the measure there too).

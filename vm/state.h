@@ -364,6 +364,8 @@ struct Vm::State {
   // Per loop, the cost of a pass in the constant-cost regime, once
   // measured (0 until then): every pass there costs the same.
   std::vector<Tick> loopPass = std::vector<Tick>(program->loops.size(), 0);
+  // and the instructions a pass runs.
+  std::vector<uint64_t> loopInstructions = std::vector<uint64_t>(program->loops.size(), 0);
   // The pass being measured: from one arrival at a loop's top to the next.
   struct Measure {
     int loop = -1;
@@ -376,6 +378,7 @@ struct Vm::State {
   } measure;
   uint64_t acceptances = 0;  // interrupts accepted so far (a pass with one is no measure)
   bool fastForward(Tick until);
+  bool applyPasses(const Program::Loop& loop, uint32_t& v, Tick until, bool measured);
   Tick quietUntil() const;
   std::string consoleLine;
   // The machine at power-on at tick `start` (the constructor's and a

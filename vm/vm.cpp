@@ -657,6 +657,7 @@ bool Vm::sameProgramState(const Vm& other) const {
   mine.copyCounters(*other.s_);
   mine.measure = other.s_->measure;
   mine.loopPass = other.s_->loopPass;
+  mine.loopInstructions = other.s_->loopInstructions;
   mine.resumeAtBreakpoint = other.s_->resumeAtBreakpoint;
   return mine == *other.s_;
 }
