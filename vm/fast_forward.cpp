@@ -2,7 +2,8 @@
 // expected shape runs many passes in one step. Every pass from the same counter regime costs the
 // same and touches nothing but its counter, so the VM measures one pass as stepped (arrival at the
 // top to the next arrival, with no interrupt accepted in between) and then applies n more at once:
-// the counter +n, the clock +n x the pass, the instruction count and the profile likewise. n stops
+// the counter +n, the clock +n x the pass, the instruction count and the profile likewise. Once a
+// loop's pass is measured, later arrivals (another run, another entry) apply at once. n stops
 // short of the loop's exit and lands at or before the earliest tick at which anything can happen to
 // this robot: the horizon of run() (the host stops a robot at every tick it raises a request or a
 // device acts) and PRT0's next tick. The boundaries it skips are all before those, so nothing could
