@@ -37,7 +37,8 @@ bool inRegime(const Loop& loop, uint32_t v) {
 // below the loop's exit and land at or before min(until, PRT0's tick);
 // `measured`: the pass just stepped is the measure (the profile's deltas
 // are taken from it).
-bool Vm::State::applyPasses(const Program::Loop& loop, uint32_t& v, Tick until, bool measured) {
+[[gnu::always_inline]] inline bool Vm::State::applyPasses(const Program::Loop& loop, uint32_t& v,
+                                                          Tick until, bool measured) {
   const auto k = static_cast<size_t>(program->loopAtTop[pc]);
   const Tick pass = loopPass[k];
   const Tick bound = std::min(until, nextTimer);
