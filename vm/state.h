@@ -388,6 +388,7 @@ struct Vm::State {
   // nesting, so that no push on the hot path allocates (a copy holds what
   // is in use only).
   void ready();
+  [[gnu::noinline, gnu::cold]] void prepare();
   // The run's counters (stats, profile, interrupt service cycles): they
   // carry on over a reset.
   void copyCounters(const State& from);

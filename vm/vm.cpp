@@ -589,9 +589,18 @@ void Vm::attach(Bus& bus) {
   s_->costateEvents = bus.wantCostateEvents();
 }
 
+// Every run's first call: the tests inline, the work (after a copy, which
+// keeps no capacity) out of line.
 void Vm::State::ready() {
-  if (!bus) throw std::logic_error("a copied VM runs only once attached to a bus (Vm::attach)");
+  if (__builtin_expect(!bus || calls.capacity() < kMemorySize / kReturnAddressBytes ||
+                           ints.capacity() < static_cast<size_t>(kMaxInterruptNesting),
+                       0))
+    prepare();
   eval.ready();
+}
+
+void Vm::State::prepare() {
+  if (!bus) throw std::logic_error("a copied VM runs only once attached to a bus (Vm::attach)");
   calls.reserve(kMemorySize / kReturnAddressBytes);
   ints.reserve(kMaxInterruptNesting);
 }
