@@ -6,7 +6,7 @@
 //   2. event class, in the order of the EventClass enum below;
 //   3. insertion sequence, first inserted first.
 // The key is total, so the same insertions give the same order on every run,
-// whatever the heap does with equal elements. Causality is asserted: an
+// whatever the container does with equal elements. Causality is asserted: an
 // event may not be scheduled before the tick of the last event taken.
 #pragma once
 #include <algorithm>
@@ -67,17 +67,20 @@ class EventQueue {
     if (tick < now_)
       throw CausalityError("event scheduled at tick " + std::to_string(tick) + " before now (" +
                            std::to_string(now_) + ")");
-    heap_.push_back(Entry{EventKey{tick, cls, nextSeq_++}, std::move(payload)});
-    std::push_heap(heap_.begin(), heap_.end(), Later{});
+    const EventKey key{tick, cls, nextSeq_++};
+    // Where it goes: after every later event. A scan from the earliest:
+    // most new events (a byte's end, a reload) are among the earliest.
+    auto at = events_.end();
+    while (at != events_.begin() && (at - 1)->key < key) --at;
+    events_.insert(at, Entry{key, std::move(payload)});
   }
-  bool empty() const { return heap_.empty(); }
-  size_t size() const { return heap_.size(); }
-  Tick nextTick() const { return heap_.front().key.tick; }
-  const Entry& top() const { return heap_.front(); }
+  bool empty() const { return events_.empty(); }
+  size_t size() const { return events_.size(); }
+  Tick nextTick() const { return events_.back().key.tick; }
+  const Entry& top() const { return events_.back(); }
   Entry pop() {
-    std::pop_heap(heap_.begin(), heap_.end(), Later{});
-    Entry e = std::move(heap_.back());
-    heap_.pop_back();
+    Entry e = std::move(events_.back());
+    events_.pop_back();
     now_ = e.key.tick;
     return e;
   }
@@ -85,17 +88,17 @@ class EventQueue {
   // there is none. A scan: the queue holds a handful of events.
   Tick nextTickExcept(EventClass cls, Tick none) const {
     Tick best = none;
-    for (const Entry& e : heap_)
+    for (const Entry& e : events_)
       if (e.key.cls != cls && e.key.tick < best) best = e.key.tick;
     return best;
   }
   Tick now() const { return now_; }
 
  private:
-  struct Later {
-    bool operator()(const Entry& a, const Entry& b) const { return b.key < a.key; }
-  };
-  std::vector<Entry> heap_;  // a binary heap under Later: top at front()
+  // Sorted by key, the latest first: the next event is the last. The
+  // queue holds a handful of events, so an insertion's shift is short and
+  // cheaper than a heap's sifting (and the order is the key's alone).
+  std::vector<Entry> events_;
   uint64_t nextSeq_ = 0;
   Tick now_ = 0;
 };

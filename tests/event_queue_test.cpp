@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <tuple>
+#include <vector>
+
 using namespace simbot::scheduler;
 
 TEST(EventQueue, OrdersByTickThenClassThenInsertion) {
@@ -24,4 +28,41 @@ TEST(EventQueue, RejectsAnEventBeforeNow) {
   EXPECT_EQ(q.now(), 100);
   EXPECT_THROW(q.schedule(99, EventClass::Plant, 2), CausalityError);
   EXPECT_NO_THROW(q.schedule(100, EventClass::Plant, 3));
+}
+
+// Schedules and pops interleaved, as the match does, against the rule
+// taken literally: each pop is the least (tick, class, insertion number)
+// of the events still held, found by a scan of a plain list.
+TEST(EventQueue, InterleavedAgreesWithTheRuleByScan) {
+  EventQueue<int> q;
+  struct Held {
+    Tick tick;
+    EventClass cls;
+    int number;
+  };
+  std::vector<Held> held;
+  uint64_t x = 12345;
+  const auto next = [&x] {
+    x = x * 6364136223846793005ull + 1442695040888963407ull;
+    return x >> 33;
+  };
+  int number = 0;
+  Tick now = 0;
+  for (int step = 0; step < 5000; ++step) {
+    if (held.empty() || next() % 3 != 0) {
+      const Tick tick = now + static_cast<Tick>(next() % 20);
+      const auto cls = static_cast<EventClass>(next() % 9);
+      q.schedule(tick, cls, number);
+      held.push_back({tick, cls, number++});
+      continue;
+    }
+    const auto least = std::min_element(held.begin(), held.end(), [](const Held& a, const Held& b) {
+      return std::tie(a.tick, a.cls, a.number) < std::tie(b.tick, b.cls, b.number);
+    });
+    ASSERT_EQ(q.nextTick(), least->tick);
+    const auto e = q.pop();
+    ASSERT_EQ(e.payload, least->number) << "at step " << step;
+    now = least->tick;
+    held.erase(least);
+  }
 }
