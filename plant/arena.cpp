@@ -435,7 +435,19 @@ bool Arena::edgeDetectorLow(int robot, Detector d, std::int64_t tick) const {
 EyeReadings Arena::eyeReadings(int robot, std::int64_t tick, RandomBits* noise,
                                EyeChannels channels) const {
   const Impl& m = *impl_;
-  const Pose self = pose(robot, tick);
+  m.checkRobot(robot);
+  // Both poses at once when there are two robots (pose()'s arithmetic).
+  Pose poses[2];
+  if (m.nR < 2) {
+    poses[0] = pose(robot, tick);
+  } else {
+    const auto both = m.posesAt(tick);
+    for (int i = 0; i < 2; ++i) {
+      const auto [x, y, h] = both[static_cast<std::size_t>(i)];
+      poses[i] = Pose{x, y, geom::wrap360(geom::radToDeg(h))};
+    }
+  }
+  const Pose self = m.nR < 2 ? poses[0] : poses[robot];
   // The items set down by `tick` (deployed is in tick order).
   EyeScene scene{m.deployed.data(), 0};
   while (scene.count < static_cast<int>(m.deployed.size()) &&
@@ -457,8 +469,8 @@ EyeReadings Arena::eyeReadings(int robot, std::int64_t tick, RandomBits* noise,
   }
   if (m.nR < 2)
     return computeEyes(self, nullptr, m.P(robot), m.cfg.field, noise, channels, &scene, robot);
-  const Pose other = pose(1 - robot, tick);
-  return computeEyes(self, &other, m.P(robot), m.cfg.field, noise, channels, &scene, robot);
+  return computeEyes(self, &poses[1 - robot], m.P(robot), m.cfg.field, noise, channels, &scene,
+                     robot);
 }
 
 std::vector<BallView> Arena::balls(std::int64_t tick) const {

@@ -654,6 +654,9 @@ struct Arena::Impl : ArenaState {
   double component(const Rec& r, double t, int i) const;
   void evalAt(double t, std::vector<double>& out) const;
   std::array<double, 3> poseAt(int robot, std::int64_t tick) const;
+  // Both robots' poses at one tick (an eye read's): poseAt's arithmetic,
+  // the tick's time and dense-output record found once.
+  std::array<std::array<double, 3>, 2> posesAt(std::int64_t tick) const;
 
   void checkRobot(int robot) const {
     if (robot < 0 || robot >= nR) throw std::out_of_range("plant: robot index");

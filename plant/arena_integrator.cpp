@@ -635,6 +635,27 @@ std::array<double, 3> Arena::Impl::poseAt(int robot, std::int64_t tick) const {
           motion[static_cast<std::size_t>(robot)].at(t, wheelLag).h};
 }
 
+std::array<std::array<double, 3>, 2> Arena::Impl::posesAt(std::int64_t tick) const {
+  checkQueryTick(tick);
+  std::array<std::array<double, 3>, 2> out{};
+  if (pending && tick == pendingTick) {
+    for (int robot = 0; robot < 2; ++robot) {
+      const int base = robot * kPerRobot;
+      out[static_cast<std::size_t>(robot)] = {pendingY[static_cast<std::size_t>(base + X)],
+                                              pendingY[static_cast<std::size_t>(base + Y)],
+                                              pendingY[static_cast<std::size_t>(base + H)]};
+    }
+    return out;
+  }
+  const double t = timeOfTick(tick);
+  const Rec& r = recordAt(t);
+  for (int robot = 0; robot < 2; ++robot)
+    out[static_cast<std::size_t>(robot)] = {
+        component(r, t, kXY * robot + X), component(r, t, kXY * robot + Y),
+        motion[static_cast<std::size_t>(robot)].at(t, wheelLag).h};
+  return out;
+}
+
 // State at a tick (after the events of that tick).
 void Arena::Impl::stateAt(std::int64_t tick, std::vector<double>& out) const {
   checkQueryTick(tick);
