@@ -550,7 +550,8 @@ L_Trap_ : {  // the slow boundary looks first (see "Fast path")
 // ---- public interface ---------------------------------------------------
 
 Vm::Vm(const Image& image, Bus& bus, const CostTable& costs, Tick start)
-    : s_(std::make_unique<State>(std::make_shared<const Program>(image, costs), &bus)) {
+    : s_(std::make_unique<State>(std::make_shared<const Program>(image, costs), &bus)),
+      clock_(&s_->now) {
   s_->self = this;
   s_->costateEvents = bus.wantCostateEvents();
   s_->powerOn(start);
@@ -566,7 +567,7 @@ void Vm::State::powerOn(Tick start) {
     nextTimer = start + kPrtTicks;
 }
 
-Vm::Vm(const Vm& other) : s_(std::make_unique<State>(*other.s_)) {
+Vm::Vm(const Vm& other) : s_(std::make_unique<State>(*other.s_)), clock_(&s_->now) {
   s_->bus = nullptr;
   s_->self = this;
 }
@@ -708,7 +709,6 @@ void Vm::cancelRequest(Irq irq) {
 }
 
 bool Vm::pending(Irq irq) const { return s_->pend[static_cast<int>(irq)]; }
-Tick Vm::now() const { return s_->now; }
 Tick Vm::quietUntil() const { return s_->quietUntil(); }
 bool Vm::halted() const { return s_->halted; }
 const Fault* Vm::fault() const { return s_->fault ? &*s_->fault : nullptr; }

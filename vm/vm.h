@@ -179,7 +179,7 @@ class Vm {
   void cancelRequest(Irq irq);
   bool pending(Irq irq) const;
 
-  Tick now() const;
+  Tick now() const { return *clock_; }  // inline: the round loop asks at every sub-round
   bool halted() const;
   const Fault* fault() const;  // null unless faulted
   bool interruptsEnabled() const;
@@ -268,6 +268,7 @@ class Vm {
 
  private:
   std::unique_ptr<State> s_;
+  const Tick* clock_;  // the State's clock: s_ lives as long as this VM
 };
 
 // Disassembly of an image, interleaving source lines (vm/disasm.cpp).
