@@ -117,4 +117,6 @@ Tick Vm::State::quietUntil() const {
   return std::max(now, std::min(measure.start + passes * pass, nextTimer));
 }
 
+Tick Vm::quietUntil() const { return s_->quietUntil(); }
+
 }  // namespace simbot::vm

@@ -551,7 +551,8 @@ L_Trap_ : {  // the slow boundary looks first (see "Fast path")
 
 Vm::Vm(const Image& image, Bus& bus, const CostTable& costs, Tick start)
     : s_(std::make_unique<State>(std::make_shared<const Program>(image, costs), &bus)),
-      clock_(&s_->now) {
+      clock_(&s_->now),
+      fault_(&s_->fault) {
   s_->self = this;
   s_->costateEvents = bus.wantCostateEvents();
   s_->powerOn(start);
@@ -567,7 +568,8 @@ void Vm::State::powerOn(Tick start) {
     nextTimer = start + kPrtTicks;
 }
 
-Vm::Vm(const Vm& other) : s_(std::make_unique<State>(*other.s_)), clock_(&s_->now) {
+Vm::Vm(const Vm& other)
+    : s_(std::make_unique<State>(*other.s_)), clock_(&s_->now), fault_(&s_->fault) {
   s_->bus = nullptr;
   s_->self = this;
 }
@@ -709,9 +711,7 @@ void Vm::cancelRequest(Irq irq) {
 }
 
 bool Vm::pending(Irq irq) const { return s_->pend[static_cast<int>(irq)]; }
-Tick Vm::quietUntil() const { return s_->quietUntil(); }
 bool Vm::halted() const { return s_->halted; }
-const Fault* Vm::fault() const { return s_->fault ? &*s_->fault : nullptr; }
 bool Vm::interruptsEnabled() const { return s_->iff1; }
 uint32_t Vm::pc() const { return s_->currentPc(); }
 int Vm::line() const { return s_->image().lineAt(pc()); }

@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -179,9 +180,9 @@ class Vm {
   void cancelRequest(Irq irq);
   bool pending(Irq irq) const;
 
-  Tick now() const { return *clock_; }  // inline: the round loop asks at every sub-round
+  Tick now() const { return *clock_; }
   bool halted() const;
-  const Fault* fault() const;  // null unless faulted
+  const Fault* fault() const { return *fault_ ? &**fault_ : nullptr; }  // null unless faulted
   bool interruptsEnabled() const;
   // The instruction, library call or interrupt acceptance under way at the
   // current boundary: a long library call's own address while it runs.
@@ -268,7 +269,10 @@ class Vm {
 
  private:
   std::unique_ptr<State> s_;
-  const Tick* clock_;  // the State's clock: s_ lives as long as this VM
+  // The State's clock and fault, read inline (the round loop asks at every
+  // sub-round): s_ lives as long as this VM.
+  const Tick* clock_;
+  const std::optional<Fault>* fault_;
 };
 
 // Disassembly of an image, interleaving source lines (vm/disasm.cpp).
