@@ -190,3 +190,127 @@ main()
 }
 
 }  // namespace
+
+namespace {
+
+// A loop entered right after EI with a request already pending (raised
+// while interrupts were disabled): the request waits only for EI's shadow
+// and is accepted inside the loop's first pass (nodebug: no DBG between EI
+// and the loop's top). From the second entry on,
+// the loop's pass is known, and fast-forward must not apply passes before
+// that acceptance. Oracle: every pass stepped (--no-fast-forward), for a
+// request at each tick around the third entry's DI section.
+TEST(FastForward, ARequestPendingAtEntryAfterEiIsAcceptedInTheFirstPass) {
+  const auto img = testkit::compileOrDie(R"(#INT_VEC PIOA_VEC edge
+int i, x, seen, seenX;
+interrupt reti edge() { seen = i; seenX = x; }
+nodebug main()
+{
+    while (x < 4) {
+        i = 0;
+        DI();
+        x++;
+        EI();
+        for (; i < 500; i++) ;
+    }
+}
+)");
+  ASSERT_EQ(img.delayLoops.size(), 1u);
+  const auto& x = testkit::symbol(img, "x");
+  const auto& seen = testkit::symbol(img, "seen");
+  const auto& seenX = testkit::symbol(img, "seenX");
+  // Where the third entry's x++ has run: stepped tick by tick.
+  vm::CostTable off = testkit::calibratedCosts();
+  off.knobs.fastForward = false;
+  TestHost probeHost;
+  vm::Vm probe(img, probeHost, off);
+  Tick t = 0;
+  while (probe.read16(static_cast<uint16_t>(x.address)) < 3) probe.run(++t);
+  const Tick third = probe.now();
+  int insideWindow = 0;
+  for (Tick at = third - 150; at < third + 150; ++at) {
+    Tick accepted[2] = {-1, -1}, end[2] = {0, 0};
+    int seenI[2] = {0, 0}, seenEntry[2] = {0, 0};
+    for (int mode = 0; mode < 2; ++mode) {
+      vm::CostTable table = testkit::calibratedCosts();
+      table.knobs.fastForward = mode == 0;
+      TestHost host;
+      host.schedule(at, Irq::Pio);
+      vm::Vm v(img, host, table);
+      host.runUntil(v, vm::kTicksPerSecond);
+      for (const auto& e : host.events)
+        if (e.accepted && e.irq == Irq::Pio) accepted[mode] = e.tick;
+      seenI[mode] = static_cast<int16_t>(v.read16(static_cast<uint16_t>(seen.address)));
+      seenEntry[mode] = static_cast<int16_t>(v.read16(static_cast<uint16_t>(seenX.address)));
+      end[mode] = v.now();
+    }
+    EXPECT_EQ(accepted[0], accepted[1]) << "request at " << at;
+    EXPECT_EQ(seenI[0], seenI[1]) << "request at " << at;
+    EXPECT_EQ(end[0], end[1]) << "request at " << at;
+    if (seenEntry[1] == 3 && seenI[1] == 0) ++insideWindow;  // accepted at the loop's top
+  }
+  // Some of the requests fell inside DI ... EI and waited for the shadow.
+  EXPECT_GT(insideWindow, 0);
+}
+
+}  // namespace
+
+namespace {
+
+// An unsigned counter that leaves its loop at 0xFFFF and enters it again
+// at 0: the arrival at the top is the successor of the exit's (0xFFFF + 1
+// wraps to 0), but what came between is no pass, and its time must not be
+// taken for one. Oracle: every pass stepped.
+TEST(FastForward, AWrappedCounterAtReentryIsNoMeasuredPass) {
+  const auto img = testkit::compileOrDie(R"(unsigned int u;
+int n;
+main()
+{
+    while (n < 3) {
+        for (u = 0; u < 0xFFFF; u++) ;
+        n++;
+    }
+}
+)");
+  ASSERT_EQ(img.delayLoops.size(), 1u);
+  vm::CostTable off = testkit::calibratedCosts();
+  off.knobs.fastForward = false;
+  TestHost h1, h2;
+  vm::Vm fast(img, h1, testkit::calibratedCosts());
+  vm::Vm stepped(img, h2, off);
+  h1.runUntil(fast, 10 * vm::kTicksPerSecond);
+  h2.runUntil(stepped, 10 * vm::kTicksPerSecond);
+  EXPECT_EQ(fast.now(), stepped.now());
+  EXPECT_EQ(fast.stats().instructions, stepped.stats().instructions);
+  EXPECT_GT(fast.stats().fastForwarded, 3u * 65000u * 6u);
+}
+
+}  // namespace
+
+namespace {
+
+// A robot stopped at a breakpoint on a delay loop's top, the breakpoint
+// removed and the robot run on exactly to a pass's landing (passes applied
+// at that first arrival), stands at the top again: a breakpoint set there
+// now stops it at once, as stepping would, not one pass later.
+TEST(FastForward, ABreakpointSetAgainAfterAppliedPassesStopsAtOnce) {
+  const auto img = testkit::compileOrDie("int z; main() { for (z = 0; z < 700; z++) ; }");
+  ASSERT_EQ(img.delayLoops.size(), 1u);
+  const uint32_t top = img.delayLoops[0].top;
+  TestHost host;
+  vm::Vm v(img, host, testkit::calibratedCosts());
+  v.run(100 * 252);  // the pass is measured
+  v.setBreakpoint(top);
+  ASSERT_EQ(v.run(vm::kTicksPerSecond), vm::Stop::Breakpoint);
+  ASSERT_EQ(v.pc(), top);
+  v.setBreakpoint(top, false);
+  const Tick landing = v.now() + 10 * 252;  // a pass is 252 T-states
+  v.run(landing);
+  ASSERT_EQ(v.now(), landing);
+  ASSERT_EQ(v.pc(), top);
+  v.setBreakpoint(top);
+  EXPECT_EQ(v.run(vm::kTicksPerSecond), vm::Stop::Breakpoint);
+  EXPECT_EQ(v.now(), landing);
+}
+
+}  // namespace

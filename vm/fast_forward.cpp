@@ -70,20 +70,23 @@ bool Vm::State::fastForward(Tick until) {
   if (dispatch->breakpointInLoop(k) || !inRegime(loop, v)) {
     // Stepped: nothing is applied, the pass is measured all the same.
   } else if (measure.loop == index && measure.accepted == acceptances &&
-             v == ((measure.counter + 1) & mask) && inRegime(loop, measure.counter)) {
-    // The pass just stepped was one: its cost and count, the same for
-    // every pass of the regime.
+             v == ((measure.counter + 1) & mask) && inRegime(loop, measure.counter) &&
+             passesLeft(loop, measure.counter) > 0) {
+    // The pass just stepped was one (the compare held at its start: not
+    // an exit at the top of an unsigned counter's range and a re-entry
+    // at 0): its cost and count, the same for every pass of the regime.
     loopPass[k] = now - measure.start;
     loopInstructions[k] = stats.instructions - measure.instructions;
     applied = applyPasses(loop, v, until, true);
-  } else if (loopPass[k] > 0 && !profiling) {
+  } else if (loopPass[k] > 0 && !profiling && !(anyPending && iff1)) {
     // A pass of this loop was measured before (at an earlier entry or
     // run): it costs what every pass does, so the passes are applied at
     // this first arrival, where the measured one would have been stepped
     // first. They land where stepping one pass and applying the rest
     // would: n' = floor((B - t) / p) = 1 + floor((B - t - p) / p). The
     // profiling run keeps measuring (its profile takes the pass's
-    // per-instruction deltas).
+    // per-instruction deltas). Not while a request IFF1 lets in waits for
+    // EI's shadow: it is accepted inside the pass that would be stepped.
     applied = applyPasses(loop, v, until, false);
   }
   // The pass that starts here is measured (after passes applied, the VM has

@@ -460,7 +460,13 @@ boundary:
     resumeAtBreakpoint = true;
     return Stop::Breakpoint;
   }
-  if (loopTop && loopTop[pc] >= 0 && fastForward(until)) goto boundary;
+  if (loopTop && loopTop[pc] >= 0 && fastForward(until)) {
+    // Passes ran: a breakpoint the robot resumed from is behind it (a
+    // measured pass applied at the first arrival after one must not
+    // leave the flag for the landing).
+    resumeAtBreakpoint = false;
+    goto boundary;
+  }
   resumeAtBreakpoint = false;
   // An ordinary instruction (the table's, not a trap) runs on the fast
   // path, as after NEXT: a long one's tail, a superinstruction and the
