@@ -231,7 +231,9 @@ struct Discrete {
   // Everything but the slots past both sides' high-water marks, which
   // hold the default value on both: copied at every plant event (pendingD
   // = D, then D = pendingD), where the tables are most of its 14.6 kB.
+  // A member added to Discrete must be copied here too.
   Discrete& operator=(const Discrete& o) {
+    if (this == &o) return *this;
     r = o.r;
     robotContact = o.robotContact;
     inFlight = o.inFlight;
