@@ -419,11 +419,18 @@ RobotState Arena::state(int robot, std::int64_t tick) const {
   return s;
 }
 
+namespace {
+// x, y and the heading in radians as a Pose (heading in degrees, [0, 360)).
+Pose poseOf(const std::array<double, 3>& xyh) {
+  const auto [x, y, h] = xyh;
+  return Pose{x, y, geom::wrap360(geom::radToDeg(h))};
+}
+}  // namespace
+
 Pose Arena::pose(int robot, std::int64_t tick) const {
   const Impl& m = *impl_;
   m.checkRobot(robot);
-  const auto [x, y, h] = m.poseAt(robot, tick);
-  return Pose{x, y, geom::wrap360(geom::radToDeg(h))};
+  return poseOf(m.poseAt(robot, tick));
 }
 
 bool Arena::edgeDetectorLow(int robot, Detector d, std::int64_t tick) const {
@@ -436,18 +443,17 @@ EyeReadings Arena::eyeReadings(int robot, std::int64_t tick, RandomBits* noise,
                                EyeChannels channels) const {
   const Impl& m = *impl_;
   m.checkRobot(robot);
-  // Both poses at once when there are two robots (pose()'s arithmetic).
+  // Both poses at once when there are two robots (the tick's record found
+  // once).
   Pose poses[2];
   if (m.nR < 2) {
-    poses[0] = pose(robot, tick);
+    poses[robot] = poseOf(m.poseAt(robot, tick));
   } else {
     const auto both = m.posesAt(tick);
-    for (int i = 0; i < 2; ++i) {
-      const auto [x, y, h] = both[static_cast<std::size_t>(i)];
-      poses[i] = Pose{x, y, geom::wrap360(geom::radToDeg(h))};
-    }
+    poses[0] = poseOf(both[0]);
+    poses[1] = poseOf(both[1]);
   }
-  const Pose self = m.nR < 2 ? poses[0] : poses[robot];
+  const Pose& self = poses[robot];
   // The items set down by `tick` (deployed is in tick order).
   EyeScene scene{m.deployed.data(), 0};
   while (scene.count < static_cast<int>(m.deployed.size()) &&

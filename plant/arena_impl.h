@@ -659,6 +659,10 @@ struct Arena::Impl : ArenaState {
   // Both robots' poses at one tick (an eye read's): poseAt's arithmetic,
   // the tick's time and dense-output record found once.
   std::array<std::array<double, 3>, 2> posesAt(std::int64_t tick) const;
+  // One robot's pose in the pending state (at pendingTick), and from
+  // record r's dense output at time t.
+  std::array<double, 3> pendingPose(int robot) const;
+  std::array<double, 3> poseIn(const Rec& r, double t, int robot) const;
 
   void checkRobot(int robot) const {
     if (robot < 0 || robot >= nR) throw std::out_of_range("plant: robot index");

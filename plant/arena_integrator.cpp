@@ -620,40 +620,34 @@ void Arena::Impl::evalAt(double t, std::vector<double>& out) const {
   fullState(t, xy.data(), out.data());
 }
 
-// One robot's x, y and heading (rad) at a tick: what the eyes need, at a
-// fraction of evaluating the whole state. Same arithmetic, same bits.
-std::array<double, 3> Arena::Impl::poseAt(int robot, std::int64_t tick) const {
-  checkQueryTick(tick);
+[[gnu::always_inline]] inline std::array<double, 3> Arena::Impl::pendingPose(int robot) const {
   const int base = robot * kPerRobot;
-  if (pending && tick == pendingTick)
-    return {pendingY[static_cast<std::size_t>(base + X)],
-            pendingY[static_cast<std::size_t>(base + Y)],
-            pendingY[static_cast<std::size_t>(base + H)]};
-  const double t = timeOfTick(tick);
-  const Rec& r = recordAt(t);
+  return {pendingY[static_cast<std::size_t>(base + X)],
+          pendingY[static_cast<std::size_t>(base + Y)],
+          pendingY[static_cast<std::size_t>(base + H)]};
+}
+
+[[gnu::always_inline]] inline std::array<double, 3> Arena::Impl::poseIn(const Rec& r, double t,
+                                                                        int robot) const {
   return {component(r, t, kXY * robot + X), component(r, t, kXY * robot + Y),
           motion[static_cast<std::size_t>(robot)].at(t, wheelLag).h};
 }
 
+// One robot's x, y and heading (rad) at a tick: what the eyes need, at a
+// fraction of evaluating the whole state. Same arithmetic, same bits.
+std::array<double, 3> Arena::Impl::poseAt(int robot, std::int64_t tick) const {
+  checkQueryTick(tick);
+  if (pending && tick == pendingTick) return pendingPose(robot);
+  const double t = timeOfTick(tick);
+  return poseIn(recordAt(t), t, robot);
+}
+
 std::array<std::array<double, 3>, 2> Arena::Impl::posesAt(std::int64_t tick) const {
   checkQueryTick(tick);
-  std::array<std::array<double, 3>, 2> out{};
-  if (pending && tick == pendingTick) {
-    for (int robot = 0; robot < 2; ++robot) {
-      const int base = robot * kPerRobot;
-      out[static_cast<std::size_t>(robot)] = {pendingY[static_cast<std::size_t>(base + X)],
-                                              pendingY[static_cast<std::size_t>(base + Y)],
-                                              pendingY[static_cast<std::size_t>(base + H)]};
-    }
-    return out;
-  }
+  if (pending && tick == pendingTick) return {pendingPose(0), pendingPose(1)};
   const double t = timeOfTick(tick);
   const Rec& r = recordAt(t);
-  for (int robot = 0; robot < 2; ++robot)
-    out[static_cast<std::size_t>(robot)] = {
-        component(r, t, kXY * robot + X), component(r, t, kXY * robot + Y),
-        motion[static_cast<std::size_t>(robot)].at(t, wheelLag).h};
-  return out;
+  return {poseIn(r, t, 0), poseIn(r, t, 1)};
 }
 
 // State at a tick (after the events of that tick).
