@@ -33,13 +33,13 @@ bool inRegime(const Loop& loop, uint32_t v) {
 
 }  // namespace
 
-// n more passes of `loop` from counter value v at once, n as many as stay
+// n more passes of loop k from counter value v at once, n as many as stay
 // below the loop's exit and land at or before min(until, PRT0's tick);
 // `measured`: the pass just stepped is the measure (the profile's deltas
 // are taken from it).
-[[gnu::always_inline]] inline bool Vm::State::applyPasses(const Program::Loop& loop, uint32_t& v,
-                                                          Tick until, bool measured) {
-  const auto k = static_cast<size_t>(program->loopAtTop[pc]);
+[[gnu::always_inline]] inline bool Vm::State::applyPasses(size_t k, uint32_t& v, Tick until,
+                                                          bool measured) {
+  const Loop& loop = program->loops[k];
   const Tick pass = loopPass[k];
   const Tick bound = std::min(until, nextTimer);
   const int64_t n =
@@ -77,7 +77,7 @@ bool Vm::State::fastForward(Tick until) {
     // at 0): its cost and count, the same for every pass of the regime.
     loopPass[k] = now - measure.start;
     loopInstructions[k] = stats.instructions - measure.instructions;
-    applied = applyPasses(loop, v, until, true);
+    applied = applyPasses(k, v, until, true);
   } else if (loopPass[k] > 0 && !profiling && !(anyPending && iff1)) {
     // A pass of this loop was measured before (at an earlier entry or
     // run): it costs what every pass does, so the passes are applied at
@@ -87,7 +87,7 @@ bool Vm::State::fastForward(Tick until) {
     // profiling run keeps measuring (its profile takes the pass's
     // per-instruction deltas). Not while a request IFF1 lets in waits for
     // EI's shadow: it is accepted inside the pass that would be stepped.
-    applied = applyPasses(loop, v, until, false);
+    applied = applyPasses(k, v, until, false);
   }
   // The pass that starts here is measured (after passes applied, the VM has
   // landed at the top: quietUntil needs the measure there too).

@@ -378,7 +378,7 @@ struct Vm::State {
   } measure;
   uint64_t acceptances = 0;  // interrupts accepted so far (a pass with one is no measure)
   bool fastForward(Tick until);
-  bool applyPasses(const Program::Loop& loop, uint32_t& v, Tick until, bool measured);
+  bool applyPasses(size_t loop, uint32_t& v, Tick until, bool measured);
   Tick quietUntil() const;
   std::string consoleLine;
   // The machine at power-on at tick `start` (the constructor's and a
