@@ -133,6 +133,10 @@ class Robot : public vm::Bus {
 
   // Runs the VM to `horizon` (its clock ends at or after it).
   void runTo(Tick horizon);
+  // The same for a robot that runs alone with no trace and no debugger,
+  // going on through the sub-rounds after `horizon` that `more` gives
+  // (match.cpp, "Chained sub-rounds"); `horizon` follows them.
+  void runChained(const Tick& horizon, vm::Continuation& more);
   // The same for the robot a debugger holds (MatchConfig::debugger).
   void debugRunTo(Tick horizon);
   void noteFault();                        // the VM faulted: record it once
@@ -402,6 +406,13 @@ class Match : public MatchView, private MatchState {
     return quiet_[static_cast<size_t>(r.index)] >= horizon + vm::kMaxRunOvershoot &&
            !config_.debugger && !trace_.on() && r.now() < horizon;
   }
+  // Rule (7) of "Larger rounds": the robot that runs alone this
+  // sub-round, when its sub-rounds may chain; null otherwise.
+  Robot* runsAlone() const;
+  // The next sub-round's horizon, taken by robot r's VM as it reaches
+  // `horizon` (which it sets), or `horizon` where the round loop has
+  // more to do.
+  Tick chainedHorizon(const Robot& r, Tick& horizon, Tick plantTick);
   // Robot r at the horizon again after sitting sub-rounds out.
   void catchUp(Robot& r, Tick horizon) {
     if (!r.behind) return;

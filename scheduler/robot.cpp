@@ -93,6 +93,15 @@ void Robot::runTo(Tick horizon) {
   }
 }
 
+void Robot::runChained(const Tick& horizon, vm::Continuation& more) {
+  if (powerOff) return;
+  while (now() < horizon) {
+    const vm::Stop stop = board.cpu.run(horizon, more);
+    if (stop == vm::Stop::Fault) return noteFault();
+    if (stop == vm::Stop::Breakpoint) noteBreakpoint();
+  }
+}
+
 void Robot::noteFault() {
   if (faultSeen) return;
   faultSeen = true;

@@ -489,7 +489,7 @@ struct Vm::State {
   void printfSent();
 
   template <bool kProfile>
-  Stop run(Tick until);
+  Stop run(Tick until, Continuation* more);
   // ---- instructions (instructions.h) and superinstructions (vm.cpp) ----
   template <Op O>
   bool exec(Regs& r);

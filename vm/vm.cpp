@@ -351,7 +351,7 @@ template <int kKind, Op First, Op... Rest>
 }
 
 template <bool kProfile>
-Stop Vm::State::run(Tick until) {
+Stop Vm::State::run(Tick until, Continuation* more) {
   if (fault) return Stop::Fault;
   static const void* const kLabels[] = {
 #define OP(name, shape, pop, push, seq) &&L_##name,
@@ -415,7 +415,13 @@ boundary:
     return Stop::Host;
   }
   if (now >= nextTimer) timerTick();
-  if (now >= until) return halted ? Stop::Halted : Stop::Horizon;
+  if (now >= until) {
+    // Going on from here is what a new run() would do: its entry checks
+    // (fault, stack guard, stop, PRT0) are the ones above.
+    if (!more || halted) return halted ? Stop::Halted : Stop::Horizon;
+    until = more->nextHorizon(until);
+    if (now >= until) return Stop::Horizon;
+  }
   if (lib.awaitingBegin) {  // the end of a library call's sequence: no boundary
     // (for an atomic call this also keeps interrupts out until its effect)
     libBegin();
@@ -700,7 +706,13 @@ void Vm::fillMemory(const std::function<uint64_t()>& next) {
   }
 }
 
-Stop Vm::run(Tick until) { return s_->profiling ? s_->run<true>(until) : s_->run<false>(until); }
+Stop Vm::run(Tick until) {
+  return s_->profiling ? s_->run<true>(until, nullptr) : s_->run<false>(until, nullptr);
+}
+
+Stop Vm::run(Tick until, Continuation& more) {
+  return s_->profiling ? s_->run<true>(until, &more) : s_->run<false>(until, &more);
+}
 
 void Vm::request(Irq irq, uint8_t vector) {
   const int i = static_cast<int>(irq);

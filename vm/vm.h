@@ -58,6 +58,21 @@ std::string_view irqName(Irq irq);  // "pio_a", "timer", "serial_tx"
 
 class Vm;
 
+// A host that knows, when a run reaches its horizon, where the next one
+// would be with nothing happening in between (the scheduler's next
+// sub-round of a robot that runs alone): the run goes on to it at once,
+// exactly as a new run() from there would.
+class Continuation {
+ public:
+  // Called at the boundary where the run reached `reached` (the VM's
+  // now() and quietUntil() are its own there): the next horizon, or one
+  // at or before now() to end the run.
+  virtual Tick nextHorizon(Tick reached) = 0;
+
+ protected:
+  ~Continuation() = default;
+};
+
 // What the host provides. Every call carries the exact tick of the access.
 class Bus {
  public:
@@ -162,6 +177,9 @@ class Vm {
   // round, not inside it, so stopping there bought nothing (160,000 of
   // the 412,000 runs of the 180-s ICEMAN vs fig92 match did).
   Stop run(Tick until);
+  // The same, going on past `until` as long as `more` gives a later
+  // horizon (not while halted: a halted robot's run ends at its horizon).
+  Stop run(Tick until, Continuation& more);
   // From inside a bus call: end the run at the next instruction boundary
   // (Stop::Host), for a host that must look at what the call did before
   // the VM goes on, such as a test host with no lookahead of its own.
