@@ -17,7 +17,8 @@
 //   2. The plant integrates ahead to h; its first root, if earlier, caps h.
 //      (Several such rounds share one plant advance when nothing happens
 //      between them: match.cpp, "Larger rounds"; MatchResult::rounds counts
-//      the plant's rounds.)
+//      the plant's rounds. A robot that runs alone takes such sub-rounds
+//      in one run of its VM: rule (7) there.)
 //   3. Each VM runs to h (every instruction starting before h; bus accesses
 //      happen at boundaries before h). Port reads see device state as of the
 //      last processed event; eye readings come from dense output at their
