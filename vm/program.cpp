@@ -152,7 +152,11 @@ std::shared_ptr<const Dispatch> Dispatch::withBreakpoint(const Program& program,
 
 int Dispatch::superinstructionAt(const Program& program, uint32_t address) const {
   const auto end = static_cast<uint32_t>(ops_.size());
-  for (int i = 0; i < kSuperCount; ++i) {
+  if (address >= end || ops_[address] >= kOpCount) return -1;
+  const int first = ops_[address];
+  for (int j = kSuperByFirst.begin[static_cast<size_t>(first)];
+       j < kSuperByFirst.begin[static_cast<size_t>(first) + 1]; ++j) {
+    const int i = kSuperByFirst.entry[static_cast<size_t>(j)];
     const SuperShape& shape = kSuperShapes[i];
     uint32_t a = address;
     int k = 0;

@@ -45,6 +45,38 @@ enum SuperKind : int {
 #undef SUPER
 };
 
+// The entries by their first piece, each opcode's in the table's order
+// (the decoder tries only those that can match at an address):
+// kSuperByFirst.entry[begin[op] .. begin[op + 1]).
+struct SuperIndex {
+  std::array<int, kOpCount + 1> begin{};
+  std::array<int, kSuperCount> entry{};
+};
+inline constexpr SuperIndex kSuperByFirst = [] {
+  SuperIndex index;
+  int next = 0;
+  for (int op = 0; op < kOpCount; ++op) {
+    index.begin[static_cast<size_t>(op)] = next;
+    for (int i = 0; i < kSuperCount; ++i)
+      if (static_cast<int>(kSuperShapes[i].pieces[0]) == op)
+        index.entry[static_cast<size_t>(next++)] = i;
+  }
+  index.begin[kOpCount] = next;
+  return index;
+}();
+static_assert(
+    [] {
+      // Every entry once, each opcode's in the table's order.
+      for (int op = 0; op < kOpCount; ++op)
+        for (int j = kSuperByFirst.begin[static_cast<size_t>(op)] + 1;
+             j < kSuperByFirst.begin[static_cast<size_t>(op) + 1]; ++j)
+          if (kSuperByFirst.entry[static_cast<size_t>(j)] <=
+              kSuperByFirst.entry[static_cast<size_t>(j) - 1])
+            return false;
+      return kSuperByFirst.begin[kOpCount] == kSuperCount;
+    }(),
+    "the first-piece index holds every superinstruction once, in order");
+
 // Where a piece leads (the next piece's address is decided at decode time,
 // so a run may not go on after a piece whose successor depends on data).
 constexpr bool endsRun(Op op) {
