@@ -90,13 +90,13 @@
 // (7) Chained sub-rounds. While one robot runs alone (every other has
 // faulted or is held in reset) with no trace, observer or debugger, its VM
 // takes the next sub-round's horizon as it reaches one (vm::Continuation,
-// chainedHorizon) instead of returning to this loop and being run again:
+// SubRoundChain) instead of returning to this loop and being run again:
 // 548,000 VM entries become 68,500 in bench/programs/histogram.dc. It does
 // so only where the loop would do nothing but take that horizon: no input
 // made, no queued event and not the plant's stop at the horizon, not every
 // robot exited, and the robot not sitting the next sub-round out; the
-// horizon is the loop's min(queue, quietUntil + 9,600, plant stop), since
-// the others' quiet_ is INT64_MIN. Samples are taken only with a trace or
+// horizon is the loop's own (noteQuiet, subRoundHorizon, capped by the
+// plant's stop). Samples are taken only with a trace or
 // an observer, and the robots not running do nothing when run. So the same
 // horizons are taken in the same order, the VM's run goes on from its
 // boundary as a new run() would (vm.h), and every record is the same.
@@ -629,7 +629,7 @@ void Match::rounds(Tick pause) {
     roundStart_ = t;
     if (trace_.on()) trace_.flushBefore(std::min(t, arena_.now()));
     noteQuiet();
-    Tick horizon = std::min(queue_.nextTick(), earliestAction() + kLookahead);
+    Tick horizon = subRoundHorizon();
     // The plant goes further than the first sub-round when no ball is in
     // flight, past serial bytes (header comment: "Larger rounds", (d)).
     Tick plantStop = horizon;
@@ -655,18 +655,8 @@ void Match::rounds(Tick pause) {
             r->behind = true;
           } else if (r == alone) {
             r->behind = false;
-            struct Chain final : vm::Continuation {
-              Match& match;
-              const Robot& robot;
-              Tick& horizon;
-              Tick plantTick;
-              Chain(Match& m, const Robot& r, Tick& h, Tick p)
-                  : match(m), robot(r), horizon(h), plantTick(p) {}
-              Tick nextHorizon(Tick) override {
-                return match.chainedHorizon(robot, horizon, plantTick);
-              }
-            } chain(*this, *r, horizon, step.tick);
-            r->runChained(horizon, chain);
+            SubRoundChain chain{*this, *r, horizon, step.tick};
+            r->runTo(horizon, &chain);
           } else {
             r->behind = false;
             r->runTo(horizon);
@@ -679,7 +669,7 @@ void Match::rounds(Tick pause) {
       if (queue_.nextTick() == horizon && !serialBytesInRound(horizon)) break;
       ++subRounds_;
       noteQuiet();
-      horizon = std::min(queue_.nextTick(), earliestAction() + kLookahead);
+      horizon = subRoundHorizon();
     }
     for (Robot* r : runOrder_) catchUp(*r, horizon);
     if (config_.stopWhenAllExited && allExited()) {
@@ -764,19 +754,17 @@ Robot* Match::runsAlone() const {
 
 // The round loop's work after a sub-round's runs (rounds()), where it would
 // only take the next horizon; the horizon itself where it would do more.
-Tick Match::chainedHorizon(const Robot& r, Tick& horizon, Tick plantTick) {
-  // (All have exited only if r has: it is the one running.)
-  const Tick queued = queue_.nextTick();
-  if (horizon == plantTick || !inputs_.empty() ||
-      (config_.stopWhenAllExited && r.result.exited && allExited()) || queued == horizon)
+Tick Match::SubRoundChain::nextHorizon(Tick) {
+  // (All have exited only if the robot has: it is the one running.)
+  if (horizon == plantTick || !match.inputs_.empty() ||
+      (match.config_.stopWhenAllExited && robot.result.exited && match.allExited()) ||
+      match.queue_.nextTick() == horizon)
     return horizon;
-  // noteQuiet and earliestAction for the one robot running (the others'
-  // quiet_ is INT64_MIN).
-  const Tick quiet = r.quietUntil();
-  const Tick next = std::min({queued, quiet + kLookahead, plantTick});
-  quiet_[static_cast<size_t>(r.index)] = quiet;
-  if (sitsOut(r, next)) return horizon;
-  ++subRounds_;
+  // noteQuiet for the one robot that has run (the others' values stand).
+  match.quiet_[static_cast<size_t>(robot.index)] = robot.quietUntil();
+  const Tick next = std::min(match.subRoundHorizon(), plantTick);
+  if (match.sitsOut(robot, next)) return horizon;
+  ++match.subRounds_;
   horizon = next;
   return next;
 }

@@ -131,12 +131,11 @@ class Robot : public vm::Bus {
   bool wantCostateEvents() const override;
   void costate(Tick t, uint16_t coData, CostateEvent e, int line) override;
 
-  // Runs the VM to `horizon` (its clock ends at or after it).
-  void runTo(Tick horizon);
-  // The same for a robot that runs alone with no trace and no debugger,
-  // going on through the sub-rounds after `horizon` that `more` gives
-  // (match.cpp, "Chained sub-rounds"); `horizon` follows them.
-  void runChained(const Tick& horizon, vm::Continuation& more);
+  // Runs the VM to `horizon` (its clock ends at or after it). With `more`
+  // (a robot that runs alone, with no trace and no debugger), through the
+  // sub-rounds after it that `more` gives (match.cpp, rule (7) of "Larger
+  // rounds"), which `horizon` follows.
+  void runTo(const Tick& horizon, vm::Continuation* more = nullptr);
   // The same for the robot a debugger holds (MatchConfig::debugger).
   void debugRunTo(Tick horizon);
   void noteFault();                        // the VM faulted: record it once
@@ -406,13 +405,26 @@ class Match : public MatchView, private MatchState {
     return quiet_[static_cast<size_t>(r.index)] >= horizon + vm::kMaxRunOvershoot &&
            !config_.debugger && !trace_.on() && r.now() < horizon;
   }
+  // The next sub-round's horizon before the plant's stop caps it:
+  // min(next queued event, earliest action + one character time).
+  Tick subRoundHorizon() const {
+    return std::min(queue_.nextTick(), earliestAction() + kLookahead);
+  }
   // Rule (7) of "Larger rounds": the robot that runs alone this
   // sub-round, when its sub-rounds may chain; null otherwise.
   Robot* runsAlone() const;
-  // The next sub-round's horizon, taken by robot r's VM as it reaches
-  // `horizon` (which it sets), or `horizon` where the round loop has
-  // more to do.
-  Tick chainedHorizon(const Robot& r, Tick& horizon, Tick plantTick);
+  // Its VM's continuation: the next sub-round's horizon as it reaches
+  // `horizon` (which it sets), or `horizon` where the round loop has more
+  // to do (the plant's stop is `plantTick`).
+  struct SubRoundChain final : vm::Continuation {
+    Match& match;
+    const Robot& robot;
+    Tick& horizon;
+    Tick plantTick;
+    SubRoundChain(Match& m, const Robot& r, Tick& h, Tick p)
+        : match(m), robot(r), horizon(h), plantTick(p) {}
+    Tick nextHorizon(Tick reached) override;
+  };
   // Robot r at the horizon again after sitting sub-rounds out.
   void catchUp(Robot& r, Tick horizon) {
     if (!r.behind) return;

@@ -65,7 +65,7 @@ void Robot::restartProgram(Tick t) {
   nextSnapshot = (t / interval + 1) * interval;
 }
 
-void Robot::runTo(Tick horizon) {
+void Robot::runTo(const Tick& horizon, vm::Continuation* more) {
   if (powerOff) return;  // held in reset: no instruction runs
   DebugHook* hook = match->debugger();
   if (hook && index == match->debugRobot()) return debugRunTo(horizon);
@@ -83,22 +83,13 @@ void Robot::runTo(Tick horizon) {
     }
     Tick until = tracing ? std::min(horizon, nextSnapshot) : horizon;
     if (watched) until = std::min(until, now() + 1);
-    const vm::Stop stop = board.cpu.run(until);
+    const vm::Stop stop = board.cpu.run(until, more);
     if (stop == vm::Stop::Fault) return noteFault();
     if (stop == vm::Stop::Breakpoint) {
       noteBreakpoint();
       if (hook) hook->otherBreakpoint(*match, index);
     }
     if (watched) hook->otherBoundary(*match, index);
-  }
-}
-
-void Robot::runChained(const Tick& horizon, vm::Continuation& more) {
-  if (powerOff) return;
-  while (now() < horizon) {
-    const vm::Stop stop = board.cpu.run(horizon, more);
-    if (stop == vm::Stop::Fault) return noteFault();
-    if (stop == vm::Stop::Breakpoint) noteBreakpoint();
   }
 }
 

@@ -503,7 +503,7 @@ TEST(Vm, ContinuationCarriesTheRunThroughTheHorizonsItGives) {
   TestHost host;
   vm::Vm v(img, host, costs());
   horizons.v = &v;
-  EXPECT_EQ(v.run(1000, horizons), Stop::Horizon);
+  EXPECT_EQ(v.run(1000, &horizons), Stop::Horizon);
   EXPECT_EQ(horizons.reached, (std::vector<vm::Tick>{1000, 2500, 4000}));
   EXPECT_EQ(horizons.at, (std::vector<vm::Tick>{firstBoundaryFrom(1000), firstBoundaryFrom(2500),
                                                 firstBoundaryFrom(4000)}));
@@ -520,7 +520,7 @@ TEST(Vm, ContinuationCarriesTheRunThroughTheHorizonsItGives) {
   vm::Vm u(halts, host, costs());
   horizons.reached.clear();
   horizons.v = &u;
-  EXPECT_EQ(u.run(1000, horizons), Stop::Halted);
+  EXPECT_EQ(u.run(1000, &horizons), Stop::Halted);
   EXPECT_TRUE(horizons.reached.empty());
 }
 

@@ -706,12 +706,8 @@ void Vm::fillMemory(const std::function<uint64_t()>& next) {
   }
 }
 
-Stop Vm::run(Tick until) {
-  return s_->profiling ? s_->run<true>(until, nullptr) : s_->run<false>(until, nullptr);
-}
-
-Stop Vm::run(Tick until, Continuation& more) {
-  return s_->profiling ? s_->run<true>(until, &more) : s_->run<false>(until, &more);
+Stop Vm::run(Tick until, Continuation* more) {
+  return s_->profiling ? s_->run<true>(until, more) : s_->run<false>(until, more);
 }
 
 void Vm::request(Irq irq, uint8_t vector) {

@@ -176,10 +176,9 @@ class Vm {
   // send) takes effect in the plant or the queue at the end of the host's
   // round, not inside it, so stopping there bought nothing (160,000 of
   // the 412,000 runs of the 180-s ICEMAN vs fig92 match did).
-  Stop run(Tick until);
-  // The same, going on past `until` as long as `more` gives a later
+  // With `more`, the run goes on past `until` as long as it gives a later
   // horizon (not while halted: a halted robot's run ends at its horizon).
-  Stop run(Tick until, Continuation& more);
+  Stop run(Tick until, Continuation* more = nullptr);
   // From inside a bus call: end the run at the next instruction boundary
   // (Stop::Host), for a host that must look at what the call did before
   // the VM goes on, such as a test host with no lookahead of its own.
