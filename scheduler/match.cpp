@@ -100,6 +100,20 @@
 // an observer, and the robots not running do nothing when run. So the same
 // horizons are taken in the same order, the VM's run goes on from its
 // boundary as a new run() would (vm.h), and every record is the same.
+// The VM takes the next horizon itself (vm::Continuation::cap, step)
+// where asking would give the same: it has called nothing here since the
+// last answer, so the queue, the inputs, the exits and every other
+// robot's quiet_ are as they were (nothing else runs meanwhile); it is
+// before min(queue, the plant's stop), so none of the conditions above
+// ends the chain; and it is not quiet past its clock, so it cannot sit
+// the next sub-round out, and the horizon is min(that cap, the others'
+// earliest action + one character, its clock + one character).
+// (8) While one robot runs (the others faulted or held in reset) a round
+// lets the plant run further ahead (kLoneRoundLookahead): by (1) the
+// plant's steps, roots and events do not depend on where its time is cut,
+// and the sub-rounds' horizons are the ones the shorter rounds gave, as
+// nothing happened at the ends of those rounds but taking the next
+// horizon. Only the integration thrown away at an input is longer.
 #include "scheduler/match.h"
 
 #include <fmt/format.h>
@@ -634,7 +648,8 @@ void Match::rounds(Tick pause) {
     // flight, past serial bytes (header comment: "Larger rounds", (d)).
     Tick plantStop = horizon;
     if (!arena_.ballsInFlight()) {
-      plantStop = queue_.nextTickExcept(EventClass::SerialByte, t + kRoundLookahead);
+      const Tick lookahead = onlyRunning() ? kLoneRoundLookahead : kRoundLookahead;
+      plantStop = queue_.nextTickExcept(EventClass::SerialByte, t + lookahead);
       // Not past a NUL that may latch new wheel speeds: the steps beyond it
       // would be thrown away (measured: they cost what the rounds save).
       for (const auto& r : robots_)
@@ -657,6 +672,7 @@ void Match::rounds(Tick pause) {
             r->behind = false;
             SubRoundChain chain{*this, *r, horizon, step.tick};
             r->runTo(horizon, &chain);
+            subRounds_ += chain.taken;
           } else {
             r->behind = false;
             r->runTo(horizon);
@@ -743,6 +759,10 @@ void Match::rounds(Tick pause) {
 
 Robot* Match::runsAlone() const {
   if (trace_.on() || config_.observer || config_.debugger) return nullptr;
+  return onlyRunning();
+}
+
+Robot* Match::onlyRunning() const {
   Robot* alone = nullptr;
   for (const auto& r : robots_) {
     if (!r->running()) continue;
@@ -755,6 +775,7 @@ Robot* Match::runsAlone() const {
 // The round loop's work after a sub-round's runs (rounds()), where it would
 // only take the next horizon; the horizon itself where it would do more.
 Tick Match::SubRoundChain::nextHorizon(Tick) {
+  cap = INT64_MIN;  // the VM asks at the next horizon unless set below
   // (All have exited only if the robot has: it is the one running.)
   if (horizon == plantTick || !match.inputs_.empty() ||
       (match.config_.stopWhenAllExited && robot.result.exited && match.allExited()) ||
@@ -766,6 +787,13 @@ Tick Match::SubRoundChain::nextHorizon(Tick) {
   if (match.sitsOut(robot, next)) return horizon;
   ++match.subRounds_;
   horizon = next;
+  // The ones after it while the VM calls nothing here and is not quiet
+  // past its clock (header comment, (7)): what the lines above give then.
+  cap = std::min(match.queue_.nextTick(), plantTick);
+  for (size_t k = 0; k < match.quiet_.size(); ++k)
+    if (k != static_cast<size_t>(robot.index) && match.quiet_[k] != INT64_MIN)
+      cap = std::min(cap, match.quiet_[k] + kLookahead);
+  step = kLookahead;
   return next;
 }
 

@@ -333,31 +333,39 @@ TEST(Match, CyclesAreTheClockAtMainsReturnOrTheEnd) {
 
 // Larger rounds (match.cpp, "Larger rounds"): with no ball in flight and
 // no queued event before the end, a round lets the plant run eight
-// character times (76,800 ticks) ahead, and ends there unless a robot acts
-// on the plant. A program whose main returns at once idles from then on
-// (its clock stands at each horizon), so the 1-s run (9,216,000 ticks) is
-// 9,216,000 / 76,800 = 120 rounds, where one-character rounds took
+// character times (76,800 ticks) ahead, sixty-four (614,400) while one
+// robot runs alone, and ends there unless a robot acts on the plant. A
+// program whose main returns at once idles from then on (its clock stands
+// at each horizon), so the 1-s run (9,216,000 ticks) is, for two such
+// robots, 9,216,000 / 76,800 = 120 rounds, where one-character rounds took
 // 9,216,000 / 9,600 = 960: each round holds eight sub-rounds, and only the
-// last of the 120 ends at the end-of-run event.
-TEST(Match, AnIdleRobotsSecondIsOneHundredTwentyRounds) {
-  const auto r =
-      scheduler::runMatch(matchConfig({{"A", "idle.dc", compileSource("main()\n{\n}\n")}}, 1.0));
-  ASSERT_TRUE(r.robots[0].exited);
-  EXPECT_EQ(r.endTick, 9'216'000);
-  EXPECT_EQ(r.rounds, 120u);
+// last of the 120 ends at the end-of-run event. For one alone it is
+// 9,216,000 / 614,400 = 15.
+TEST(Match, IdleRobotsSecondIs120RoundsAndOneAlonesIs15) {
+  const auto idle = compileSource("main()\n{\n}\n");
+  const auto two =
+      scheduler::runMatch(matchConfig({{"A", "idle.dc", idle}, {"B", "idle.dc", idle}}, 1.0));
+  ASSERT_TRUE(two.robots[0].exited);
+  ASSERT_TRUE(two.robots[1].exited);
+  EXPECT_EQ(two.endTick, 9'216'000);
+  EXPECT_EQ(two.rounds, 120u);
+  const auto one = scheduler::runMatch(matchConfig({{"A", "idle.dc", idle}}, 1.0));
+  ASSERT_TRUE(one.robots[0].exited);
+  EXPECT_EQ(one.endTick, 9'216'000);
+  EXPECT_EQ(one.rounds, 15u);
 }
 
 // Larger rounds, rule (d) (match.cpp): a frame's bytes are taken inside
-// a round, and only a NUL already in the port (the one byte that can latch
-// new wheel speeds) stops the plant. The robot sends one 9-byte string at
-// T0 (a few hundred ticks in) and returns; byte k finishes at
-// T0 + 9,600 (k + 1), the NUL (k = 8) at the latch L = T0 + 86,400.
-// Round 1 is [0, 76,800): no NUL is in the port at 0, and bytes 0-6 finish
-// inside it without ending it. By 76,800 byte 7 is shifting and the NUL
-// waits in the TDR, so round 2 is [76,800, L]. From L the robot is idle and
-// rounds are 76,800 ticks long again up to the end at 9,216,000:
-// 2 + ceil((9,216,000 - L) / 76,800) rounds (121). Before rule (d), when
-// every byte ended its round, the same run took 128 (at d73b409).
+// a round, and only the latch of new wheel speeds by its NUL ends it. The
+// robot, alone, sends one 9-byte string at T0 (a few hundred ticks in)
+// and returns; byte k finishes at T0 + 9,600 (k + 1), the NUL (k = 8) at
+// the latch L = T0 + 86,400. Round 1 would run to 614,400 (sixty-four
+// characters: the robot runs alone); bytes 0-7 finish inside it without
+// ending it, and the latch ends it at L. From L the robot is idle and
+// rounds are 614,400 ticks long up to the end at 9,216,000:
+// 1 + ceil((9,216,000 - L) / 614,400) rounds (16). Before rule (d), when
+// every byte ended its round, the same run (with eight-character rounds)
+// took 128 (at d73b409), and 121 after it.
 TEST(Match, AFramesBytesDoNotCutRoundsOnlyItsLatchDoes) {
   const char* kSendOnce =
       "char buf[9];\nchar cc;\n"
@@ -369,9 +377,9 @@ TEST(Match, AFramesBytesDoNotCutRoundsOnlyItsLatchDoes) {
   for (const auto& rec : parse(r.trace))
     if (rec.type == "frame_latched") latch = rec.t;
   ASSERT_GT(latch, 86'400);
-  ASSERT_LT(latch, 76'800 + 86'400);  // T0 < 76,800: the NUL finishes in round 2
+  ASSERT_LT(latch, 614'400);
   EXPECT_EQ(r.endTick, 9'216'000);
-  EXPECT_EQ(r.rounds, static_cast<uint64_t>(2 + (9'216'000 - latch + 76'800 - 1) / 76'800));
+  EXPECT_EQ(r.rounds, static_cast<uint64_t>(1 + (9'216'000 - latch + 614'400 - 1) / 614'400));
 }
 
 TEST(Match, AFaultedRobotLosesATiedRound) {

@@ -462,68 +462,6 @@ TEST(Vm, LibraryCallIsChargedOneCall) {
   EXPECT_EQ(host.outs[0].tick, 20 + 20 + 58);
 }
 
-TEST(Vm, RunStopsAtFirstBoundaryAtOrAfterHorizon) {
-  Assembler a;
-  a.bind("loop").op(Op::DBG).jump(Op::JMP, "loop");
-  const auto img = a.finish();
-  TestHost host;
-  vm::Vm v(img, host, costs());
-  const vm::Tick until = 1000;
-  EXPECT_EQ(v.run(until), Stop::Horizon);
-  const vm::Tick pair = cost(Op::DBG) + cost(Op::JMP);
-  // Every instruction starting before `until` ran, and no more.
-  EXPECT_GE(v.now(), until);
-  EXPECT_LT(v.now() - std::max<vm::Tick>(cost(Op::DBG), cost(Op::JMP)), until);
-  EXPECT_EQ(v.now() % pair == 0 || v.now() % pair == cost(Op::DBG), true);
-}
-
-TEST(Vm, ContinuationCarriesTheRunThroughTheHorizonsItGives) {
-  // DBG; JMP loop: boundaries at k x (DBG + JMP) and k x (DBG + JMP) + DBG.
-  // A Continuation asked at horizons 1000 and 2500 gives 2500 and 4000,
-  // then ends the run: it is asked at the first boundary at or after each,
-  // and the run stops at the first at or after 4000, as three runs would.
-  Assembler a;
-  a.bind("loop").op(Op::DBG).jump(Op::JMP, "loop");
-  const auto img = a.finish();
-  const vm::Tick pair = cost(Op::DBG) + cost(Op::JMP);
-  const auto firstBoundaryFrom = [&](vm::Tick h) {
-    const vm::Tick k = h / pair;
-    if (k * pair >= h) return k * pair;
-    return k * pair + cost(Op::DBG) >= h ? k * pair + cost(Op::DBG) : (k + 1) * pair;
-  };
-  struct Horizons final : vm::Continuation {
-    vm::Vm* v = nullptr;
-    std::vector<vm::Tick> reached, at;
-    vm::Tick nextHorizon(vm::Tick h) override {
-      reached.push_back(h);
-      at.push_back(v->now());
-      return h == 1000 ? 2500 : h == 2500 ? 4000 : h;
-    }
-  } horizons;
-  TestHost host;
-  vm::Vm v(img, host, costs());
-  horizons.v = &v;
-  EXPECT_EQ(v.run(1000, &horizons), Stop::Horizon);
-  EXPECT_EQ(horizons.reached, (std::vector<vm::Tick>{1000, 2500, 4000}));
-  EXPECT_EQ(horizons.at, (std::vector<vm::Tick>{firstBoundaryFrom(1000), firstBoundaryFrom(2500),
-                                                firstBoundaryFrom(4000)}));
-  EXPECT_EQ(v.now(), firstBoundaryFrom(4000));
-  TestHost other;
-  vm::Vm w(img, other, costs());
-  for (const vm::Tick h : {1000, 2500, 4000}) EXPECT_EQ(w.run(h), Stop::Horizon);
-  EXPECT_TRUE(v.sameMachine(w));
-
-  // A halted robot's run ends at its horizon: it is not asked.
-  Assembler b;
-  b.op(Op::HALT);
-  const auto halts = b.finish();
-  vm::Vm u(halts, host, costs());
-  horizons.reached.clear();
-  horizons.v = &u;
-  EXPECT_EQ(u.run(1000, &horizons), Stop::Halted);
-  EXPECT_TRUE(horizons.reached.empty());
-}
-
 TEST(Vm, RequestAcceptedAtFirstBoundaryAtOrAfterIt) {
   Assembler a;
   const uint16_t counter = a.data(2);
@@ -790,24 +728,6 @@ TEST(VmFault, InterruptThroughUnboundVector) {
   v.request(Irq::Pio, 0x20);
   EXPECT_EQ(v.run(1000), Stop::Fault);
   EXPECT_NE(v.fault()->message.find("0x20"), std::string::npos);
-}
-
-TEST(Vm, BusAccessNeverHappensAtOrAfterTheHorizon) {
-  Assembler a;
-  a.op(Op::PUSHW, vm::kPortPIODB).op(Op::PUSHW, 0x88).lib(vm::Lib::OUTPORT, 2).op(Op::HALT);
-  const auto img = a.finish();
-  TestHost host;
-  vm::Vm v(img, host, costs());
-  const vm::Tick callEnd =
-      2 * cost(Op::PUSHW) + cost(Op::LIB) + costs().libCall[static_cast<int>(vm::Lib::OUTPORT)];
-  // The horizon falls inside the call sequence: the write waits for the
-  // next run, and happens at the end of the sequence.
-  EXPECT_EQ(v.run(callEnd - 1), Stop::Horizon);
-  EXPECT_TRUE(host.outs.empty());
-  EXPECT_EQ(v.run(callEnd + 1), Stop::Halted);
-  ASSERT_EQ(host.outs.size(), 1u);
-  EXPECT_EQ(host.outs[0].tick, callEnd);
-  EXPECT_EQ(host.outs[0].value, 0x88);
 }
 
 TEST(Vm, BreakpointStopsBeforeAndResumes) {

@@ -644,9 +644,9 @@ SIMBOT_INSTRUCTION(RETI) {
   const Irq irq = f.irq;
   const uint32_t expected = f.retPc;
   ints.pop_back();
-  bus->interruptReturned(now, irq);
+  host().interruptReturned(now, irq);
   // The epilogue's EI: IFF1 is set when the RETI after it ends.
-  if (costs().knobs.epilogueEi && !iff1) bus->iffChanged(now, true);
+  if (costs().knobs.epilogueEi && !iff1) host().iffChanged(now, true);
   if (costs().knobs.epilogueEi) iff1 = iff2 = true;
   if (target != expected) {
     // A smashed frame: the robot goes where it leads, and what it was
@@ -687,14 +687,14 @@ SIMBOT_INSTRUCTION(LIB) {
 }
 SIMBOT_INSTRUCTION(EI) {
   save(r);
-  if (!iff1) bus->iffChanged(now, true);
+  if (!iff1) host().iffChanged(now, true);
   iff1 = iff2 = true;
   eiShadow = true;
   return false;
 }
 SIMBOT_INSTRUCTION(DI) {
   save(r);
-  if (iff1) bus->iffChanged(now, false);
+  if (iff1) host().iffChanged(now, false);
   iff1 = iff2 = false;
   return false;
 }

@@ -204,21 +204,21 @@ void Vm::State::libBegin() {
   switch (id) {
     case Lib::AD_RD8:
       // Sampled at the start of the conversion, which then takes its time.
-      lib.result = w(bus->adSample(now, static_cast<int>(asInt16(a[0]))));
+      lib.result = w(host().adSample(now, static_cast<int>(asInt16(a[0]))));
       lib.remaining = costs().adConversion;
       lib.active = lib.remaining > 0;
       if (!lib.active) eval.push(lib.result);
       return;
     case Lib::OUTPORT:
-      bus->out(now, static_cast<uint16_t>(a[0]), static_cast<uint8_t>(a[1]));
+      host().out(now, static_cast<uint16_t>(a[0]), static_cast<uint8_t>(a[1]));
       return;
     case Lib::INPORT:
-      eval.push(bus->in(now, static_cast<uint16_t>(a[0])));
+      eval.push(host().in(now, static_cast<uint16_t>(a[0])));
       return;
     case Lib::SER_INIT_Z1:
       // The routine restores the caller's interrupt state (JP PO; EI): IFF1
       // is as it was before the call.
-      bus->serialInit(now, asInt16(a[0]), asInt16(a[1]));
+      host().serialInit(now, asInt16(a[0]), asInt16(a[1]));
       return;
     case Lib::SER_SEND_Z1: {
       // The library reads *cc now and buf[0] .. buf[*cc - 1] as it sends:
@@ -227,11 +227,11 @@ void Vm::State::libBegin() {
       if (!checkAccess(a[1], 1, instructionPc)) return;
       const uint8_t count = rd8(a[1]);
       if (count > 0 && !checkAccess(a[0], count, instructionPc)) return;
-      bus->serialSend(now, static_cast<uint16_t>(a[0]), static_cast<uint16_t>(a[1]));
+      host().serialSend(now, static_cast<uint16_t>(a[0]), static_cast<uint16_t>(a[1]));
       return;
     }
     case Lib::HV_ENB:
-      bus->hvEnable(now);
+      host().hvEnable(now);
       return;
     case Lib::ABS: {
       int16_t v = asInt16(a[0]);

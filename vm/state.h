@@ -301,6 +301,14 @@ struct Vm::State {
   // (Vm's copy and assignment set them).
   Bus* bus;
   Vm* self = nullptr;
+  // Every bus call goes through host(): whether one was made since the
+  // continuation last answered (Continuation: the horizons a run takes
+  // without asking hold only while none was).
+  bool touchedHost = true;
+  Bus& host() {
+    touchedHost = true;
+    return *bus;
+  }
 
   std::vector<uint8_t> mem = std::vector<uint8_t>(kMemorySize, 0);
   EvalStack eval;
@@ -431,7 +439,7 @@ struct Vm::State {
   void emitConsole(std::string_view text) {
     for (char c : text) {
       if (c == '\n') {
-        bus->console(now, consoleLine);
+        host().console(now, consoleLine);
         consoleLine.clear();
       } else {
         consoleLine.push_back(c);
@@ -440,7 +448,7 @@ struct Vm::State {
   }
   void flushConsole() {
     if (!consoleLine.empty()) {
-      bus->console(now, consoleLine);
+      host().console(now, consoleLine);
       consoleLine.clear();
     }
   }
@@ -461,7 +469,8 @@ struct Vm::State {
   void timerService(uint32_t interruptedPc);
   // ---- costatements ----
   void costateEvent(uint32_t coData, Bus::CostateEvent kind, uint32_t atPc) {
-    if (costateEvents) bus->costate(now, static_cast<uint16_t>(coData), kind, image().lineAt(atPc));
+    if (costateEvents)
+      host().costate(now, static_cast<uint16_t>(coData), kind, image().lineAt(atPc));
   }
   // CoData's ChkSum: the XOR of the resume address's three bytes.
   static uint8_t coChecksum(uint32_t resume, uint8_t cbr) {
@@ -490,6 +499,7 @@ struct Vm::State {
 
   template <bool kProfile>
   Stop run(Tick until, Continuation* more);
+  Tick nextHorizon(Continuation& more, Tick reached);
   // ---- instructions (instructions.h) and superinstructions (vm.cpp) ----
   template <Op O>
   bool exec(Regs& r);

@@ -64,11 +64,11 @@ void Vm::State::accept() {
   }
   if (irq == Irq::SerialTx) {
     // The serial library's own ISR: short and atomic, leaves IFF1 set.
-    bus->interruptAccepted(now, irq, interruptedPc);
+    host().interruptAccepted(now, irq, interruptedPc);
     now += costs().serialIsr;
     serialIsrCycles += costs().serialIsr;
-    bus->serialTxService(now, *self);
-    bus->interruptReturned(now, irq);
+    host().serialTxService(now, *self);
+    host().interruptReturned(now, irq);
     return;
   }
   const int32_t handler = program->handlerFor[vec[i]];
@@ -99,8 +99,8 @@ void Vm::State::accept() {
   msp -= kInterruptFrameBytes;
   halted = false;
   iff1 = iff2 = false;
-  bus->interruptAccepted(now, irq, interruptedPc);
-  bus->iffChanged(now, false);
+  host().interruptAccepted(now, irq, interruptedPc);
+  host().iffChanged(now, false);
   now += costs().interruptAccept;
   if (profiling) profile[handler] += costs().interruptAccept;
   pc = static_cast<uint32_t>(handler);
@@ -110,7 +110,7 @@ void Vm::State::accept() {
 // library's ISR: interrupts stay disabled inside it and its EI; RETI leaves
 // IFF1 set as it was at acceptance.
 void Vm::State::timerService(uint32_t interruptedPc) {
-  bus->interruptAccepted(now, Irq::Timer, interruptedPc);
+  host().interruptAccepted(now, Irq::Timer, interruptedPc);
   const TimerBlock& tb = image().timer;
   const uint32_t ticks = (tb.used() ? rd32(tb.tick) : biosTicks) + 1;
   const uint32_t fraction = (tb.used() ? rd8(tb.msFraction) : biosMsFraction) + kMsFractionStep;
@@ -129,7 +129,7 @@ void Vm::State::timerService(uint32_t interruptedPc) {
   const uint32_t cost = costs().timerIsr[(msDue ? 0u : 1u) | (secDue ? 0u : 2u)];
   now += cost;
   timerIsrCycles += cost;
-  bus->interruptReturned(now, Irq::Timer);
+  host().interruptReturned(now, Irq::Timer);
 }
 
 // ---- dispatch ---------------------------------------------------------------
@@ -276,6 +276,18 @@ void Vm::State::unwindSuperinstruction(int kind, int k) {
   stats.instructions -= static_cast<uint64_t>(kSuperShapes[kind].n - 1 - k);
 }
 
+// The run's next horizon from its continuation: taken without asking
+// where the continuation says it may (Continuation::cap), else asked.
+Tick Vm::State::nextHorizon(Continuation& more, Tick reached) {
+  if (!touchedHost && reached < more.cap && quietUntil() == now) {
+    ++more.taken;
+    more.horizon = std::min(more.cap, now + more.step);
+    return more.horizon;
+  }
+  touchedHost = false;
+  return more.nextHorizon(reached);
+}
+
 // A long instruction's tail on the fast path: its steps while they start
 // before the limit (nothing else can be due inside it).
 [[gnu::always_inline]] inline void Vm::State::burnTail(Regs& r) {
@@ -419,7 +431,7 @@ boundary:
     // Going on from here is what a new run() would do: its entry checks
     // (fault, stack guard, stop, PRT0) are the ones above.
     if (!more || halted) return halted ? Stop::Halted : Stop::Horizon;
-    until = more->nextHorizon(until);
+    until = nextHorizon(*more, until);
     if (now >= until) return Stop::Horizon;
   }
   if (lib.awaitingBegin) {  // the end of a library call's sequence: no boundary
@@ -534,6 +546,18 @@ slowNext:
     longLimit = -1;
     burnTail(r);
     if (!burn && !copy.left && r.clk < r.limit) DISPATCH_NEXT;
+  }
+  // The horizon reached on the fast path where the slow boundary would
+  // only take the next one unasked (nextHorizon below): the limit is the
+  // horizon, not 0 (something rare due) or PRT0's tick; no long
+  // instruction's steps or copy are left; and with no delay loop under
+  // measure, quietUntil() is the clock.
+  if (more && r.limit == until && r.clk < nextTimer && !burn && !copy.left && measure.loop < 0 &&
+      !touchedHost && until < more->cap) {
+    ++more->taken;
+    until = more->horizon = std::min(more->cap, r.clk + more->step);
+    r.limit = std::min(until, nextTimer);
+    if (r.clk < r.limit) DISPATCH_NEXT;
   }
   save(r);
   goto boundary;
@@ -655,6 +679,7 @@ Vm::State comparable(const Vm::State& mine, const Vm::State& other) {
   copy.bus = other.bus;
   copy.self = other.self;
   copy.costateEvents = other.costateEvents;
+  copy.touchedHost = other.touchedHost;
   if (copy.program->image == other.program->image && copy.program->costs == other.program->costs)
     copy.program = other.program;
   if (copy.program == other.program &&
