@@ -111,10 +111,16 @@ void Program::setSuperSpans() {
   };
   for (int i = 0; i < kSuperCount; ++i) {
     const SuperShape& shape = kSuperShapes[i];
+    // The boundary after the last piece is NEXT's to test, as the
+    // unfused piece's would be; a long last piece's steps have boundaries
+    // before it (L_Long_), the last at most a tick before its end.
     uint32_t span = static_cast<uint32_t>(slowest(shape.pieces[0]));
-    for (int k = 1; k < shape.n; ++k)
+    for (int k = 1; k < shape.n - 1; ++k)
       span += costs.op[static_cast<int>(shape.pieces[k])] +
               static_cast<uint32_t>(slowest(shape.pieces[k]));
+    const auto last = static_cast<int>(shape.pieces[shape.n - 1]);
+    if (costs.op[last] > kMaxStepTstates)
+      span += costs.op[last] - 1 + static_cast<uint32_t>(slowest(shape.pieces[shape.n - 1]));
     superSpan[i] = span;
     superAfter[i] = {};
     for (int k = shape.n - 2; k >= 0; --k)

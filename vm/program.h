@@ -80,9 +80,10 @@ struct Program {
   std::vector<Loop> loops;
   std::vector<int16_t> loopAtTop;
   // Per superinstruction, the most ticks its inner boundaries can lie after
-  // its first piece's dispatch (every piece at its slowest path), under
-  // the cost table: when they all lie before the limit, nothing can happen
-  // at them (vm.cpp State::superinstruction).
+  // its first piece's dispatch (every piece at its slowest path; the
+  // boundary after the last is not inner, but a long last piece's steps
+  // are), under the cost table: when they all lie before the limit,
+  // nothing can happen at them (vm.cpp State::superinstruction).
   std::array<uint32_t, kSuperCount> superSpan{};
   // Per superinstruction and piece k, what the pieces after k cost on their
   // not-taken paths ([0]: all but the first).
