@@ -108,12 +108,15 @@
 // ends the chain; and it is not quiet past its clock, so it cannot sit
 // the next sub-round out, and the horizon is min(that cap, the others'
 // earliest action + one character, its clock + one character).
-// (8) While one robot runs (the others faulted or held in reset) a round
-// lets the plant run further ahead (kLoneRoundLookahead): by (1) the
-// plant's steps, roots and events do not depend on where its time is cut,
-// and the sub-rounds' horizons are the ones the shorter rounds gave, as
-// nothing happened at the ends of those rounds but taking the next
-// horizon. Only the integration thrown away at an input is longer.
+// (8) In a solo run a round lets the plant run further ahead
+// (kSoloRoundLookahead): by (1) the plant's steps, roots and events do not
+// depend on where its time is cut, and the sub-rounds' horizons are the
+// ones the shorter rounds gave, as nothing happened at the ends of those
+// rounds but taking the next horizon. Only the integration thrown away at
+// an input can be longer (by (4)): not in a match, where a robot that
+// faults leaves the other alone (two robots' JSON would then count more
+// integrator steps than before); solo, every program's JSON at 20 s and
+// 180 s is the same, steps included (docs/benchmarks.md).
 #include "scheduler/match.h"
 
 #include <fmt/format.h>
@@ -648,7 +651,7 @@ void Match::rounds(Tick pause) {
     // flight, past serial bytes (header comment: "Larger rounds", (d)).
     Tick plantStop = horizon;
     if (!arena_.ballsInFlight()) {
-      const Tick lookahead = onlyRunning() ? kLoneRoundLookahead : kRoundLookahead;
+      const Tick lookahead = robots_.size() == 1 ? kSoloRoundLookahead : kRoundLookahead;
       plantStop = queue_.nextTickExcept(EventClass::SerialByte, t + lookahead);
       // Not past a NUL that may latch new wheel speeds: the steps beyond it
       // would be thrown away (measured: they cost what the rounds save).
@@ -759,10 +762,6 @@ void Match::rounds(Tick pause) {
 
 Robot* Match::runsAlone() const {
   if (trace_.on() || config_.observer || config_.debugger) return nullptr;
-  return onlyRunning();
-}
-
-Robot* Match::onlyRunning() const {
   Robot* alone = nullptr;
   for (const auto& r : robots_) {
     if (!r->running()) continue;

@@ -35,12 +35,12 @@ constexpr Tick kLookahead = timebase::kTicksPerChar;
 // rounds"): eight character times. Integration past an input's tick is
 // thrown away at the input, so this bounds the work wasted per input.
 constexpr Tick kRoundLookahead = 8 * timebase::kTicksPerChar;
-// The same while one robot runs alone: its sub-rounds chain (rule (7)), so
-// a round's end is most of what a round costs it, and only its own inputs
-// end a round early. Sixty-four characters: the pure-compute comparison
-// programs (bench/vs_lua.py) 4-8 % less CPU time than with eight; the
-// 200-seed benches unchanged.
-constexpr Tick kLoneRoundLookahead = 64 * timebase::kTicksPerChar;
+// The same in a solo run (header comment of match.cpp, (8)): its robot's
+// sub-rounds chain (rule (7)), so a round's end is most of what a round
+// costs, and only its own inputs end a round early. Sixty-four
+// characters: the pure-compute comparison programs (bench/vs_lua.py) 4-8 %
+// less CPU time than with eight.
+constexpr Tick kSoloRoundLookahead = 64 * timebase::kTicksPerChar;
 
 // Queued events; the plant's own events come from Arena::advance.
 struct QueuedEvent {
@@ -419,9 +419,6 @@ class Match : public MatchView, private MatchState {
   // Rule (7) of "Larger rounds": the robot that runs alone this
   // sub-round, when its sub-rounds may chain; null otherwise.
   Robot* runsAlone() const;
-  // The one robot that runs (the others have faulted or are held in
-  // reset), or null.
-  Robot* onlyRunning() const;
   // Its VM's continuation: the next sub-round's horizon as it reaches
   // `horizon` (which it sets), or `horizon` where the round loop has more
   // to do (the plant's stop is `plantTick`).

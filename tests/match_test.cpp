@@ -333,15 +333,15 @@ TEST(Match, CyclesAreTheClockAtMainsReturnOrTheEnd) {
 
 // Larger rounds (match.cpp, "Larger rounds"): with no ball in flight and
 // no queued event before the end, a round lets the plant run eight
-// character times (76,800 ticks) ahead, sixty-four (614,400) while one
-// robot runs alone, and ends there unless a robot acts on the plant. A
+// character times (76,800 ticks) ahead, sixty-four (614,400) in a solo
+// run, and ends there unless a robot acts on the plant. A
 // program whose main returns at once idles from then on (its clock stands
 // at each horizon), so the 1-s run (9,216,000 ticks) is, for two such
 // robots, 9,216,000 / 76,800 = 120 rounds, where one-character rounds took
 // 9,216,000 / 9,600 = 960: each round holds eight sub-rounds, and only the
-// last of the 120 ends at the end-of-run event. For one alone it is
+// last of the 120 ends at the end-of-run event. For one, solo, it is
 // 9,216,000 / 614,400 = 15.
-TEST(Match, IdleRobotsSecondIs120RoundsAndOneAlonesIs15) {
+TEST(Match, IdleRobotsSecondIs120RoundsAndASoloOnesIs15) {
   const auto idle = compileSource("main()\n{\n}\n");
   const auto two =
       scheduler::runMatch(matchConfig({{"A", "idle.dc", idle}, {"B", "idle.dc", idle}}, 1.0));
@@ -357,10 +357,10 @@ TEST(Match, IdleRobotsSecondIs120RoundsAndOneAlonesIs15) {
 
 // Larger rounds, rule (d) (match.cpp): a frame's bytes are taken inside
 // a round, and only the latch of new wheel speeds by its NUL ends it. The
-// robot, alone, sends one 9-byte string at T0 (a few hundred ticks in)
+// robot, solo, sends one 9-byte string at T0 (a few hundred ticks in)
 // and returns; byte k finishes at T0 + 9,600 (k + 1), the NUL (k = 8) at
 // the latch L = T0 + 86,400. Round 1 would run to 614,400 (sixty-four
-// characters: the robot runs alone); bytes 0-7 finish inside it without
+// characters: a solo run); bytes 0-7 finish inside it without
 // ending it, and the latch ends it at L. From L the robot is idle and
 // rounds are 614,400 ticks long up to the end at 9,216,000:
 // 1 + ceil((9,216,000 - L) / 614,400) rounds (16). Before rule (d), when
