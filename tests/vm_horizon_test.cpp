@@ -88,11 +88,13 @@ TEST(Vm, ContinuationCarriesTheRunThroughTheHorizonsItGives) {
 // A continuation that asks at every horizon (cap never set) and one that
 // gives the rule once (cap, step) lead a run through the same horizons.
 // For JMP to itself (boundaries at k x JMP) they are, by hand,
-// h0 = 1000, h(k+1) = min(8000, ceil(hk / JMP) x JMP + 1500); the second
-// is asked at the first and at the cap only. With outport in the loop (a
-// bus call in every sub-round) it is asked at every one.
+// h0 = 1000, h(k+1) = min(40000, ceil(hk / JMP) x JMP + 1500); the second
+// is asked at the first and at the cap only. With divisions in the loop
+// and an outport after every twelve, the horizons it is asked at (the
+// first after each bus call) are the asking run's. With outport in the
+// loop (a bus call in every sub-round) it is asked at every one.
 TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
-  static constexpr vm::Tick kCap = 8000, kStep = 1500;
+  static constexpr vm::Tick kCap = 40000, kStep = 1500;
   struct Horizons final : vm::Continuation {
     using Continuation::Continuation;
     vm::Vm* v = nullptr;
@@ -138,6 +140,24 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
   EXPECT_EQ(q.asking, expected);
   EXPECT_EQ(q.ruled, (std::vector<vm::Tick>{1000, kCap}));
   EXPECT_EQ(q.taken, expected.size() - 2);
+
+  // Divisions (a long instruction, its steps at most kMaxRunOvershoot
+  // apart) and an outport every twelve: horizons fall between a
+  // division's steps too, and the first after each bus call is asked, so
+  // that where the unasked ones led shows: every horizon asked is the
+  // asking run's, and the two together are all of its horizons.
+  Assembler divides;
+  divides.bind("loop");
+  for (int k = 0; k < 12; ++k)
+    divides.op(Op::PUSHW, 1000).op(Op::PUSHW, 7).op(Op::DIVW).op(Op::POP);
+  divides.op(Op::PUSHW, vm::kPortPIODB).op(Op::PUSHW, 0x88).lib(vm::Lib::OUTPORT, 2);
+  divides.jump(Op::JMP, "loop");
+  ASSERT_GT(cost(Op::DIVW), 2 * vm::kMaxRunOvershoot);
+  const Runs d = runBoth(divides.finish());
+  EXPECT_GT(d.taken, 0u);
+  EXPECT_GT(d.ruled.size(), 2u);
+  EXPECT_EQ(d.taken + d.ruled.size(), d.asking.size());
+  EXPECT_TRUE(std::includes(d.asking.begin(), d.asking.end(), d.ruled.begin(), d.ruled.end()));
 
   Assembler busy;
   busy.bind("loop").op(Op::PUSHW, vm::kPortPIODB).op(Op::PUSHW, 0x88);

@@ -500,6 +500,7 @@ struct Vm::State {
   template <bool kProfile>
   Stop run(Tick until, Continuation* more);
   Tick nextHorizon(Continuation& more, Tick reached);
+  bool takeHorizon(Regs& r, Tick& until, Continuation* more);
   // ---- instructions (instructions.h) and superinstructions (vm.cpp) ----
   template <Op O>
   bool exec(Regs& r);

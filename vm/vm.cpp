@@ -298,6 +298,25 @@ Tick Vm::State::nextHorizon(Continuation& more, Tick reached) {
   }
 }
 
+// The horizon reached on the fast path (r.clk >= r.limit), taken there
+// where the slow boundary would only take the next one unasked
+// (nextHorizon): the limit is the horizon, not 0 (something rare is due,
+// a shift's or a copy's steps among them) or PRT0's tick; no copy is
+// left; and with no delay loop under measure, quietUntil() is the clock
+// (a long instruction's steps may be left: L_Long_'s tail, where the
+// boundaries between them are boundaries like any other). True when the
+// run goes on on the fast path.
+[[gnu::always_inline]] inline bool Vm::State::takeHorizon(Regs& r, Tick& until,
+                                                          Continuation* more) {
+  if (!more || r.limit != until || r.clk >= nextTimer || copy.left || measure.loop >= 0 ||
+      touchedHost || until >= more->cap)
+    return false;
+  ++more->taken;
+  until = more->horizon = std::min(more->cap, r.clk + more->step);
+  r.limit = std::min(until, nextTimer);
+  return r.clk < r.limit;
+}
+
 // An unchecked run's piece (State::superinstruction): charged and counted
 // in advance with the pieces after it, which a fault takes back.
 template <int kKind, int kPiece, Op O>
@@ -545,20 +564,12 @@ slowNext:
     r.limit = longLimit;
     longLimit = -1;
     burnTail(r);
+    // A horizon reached between its steps is taken there as at any
+    // boundary (most of histogram.dc's are reached inside a division).
+    while (burn && takeHorizon(r, until, more)) burnTail(r);
     if (!burn && !copy.left && r.clk < r.limit) DISPATCH_NEXT;
   }
-  // The horizon reached on the fast path where the slow boundary would
-  // only take the next one unasked (nextHorizon below): the limit is the
-  // horizon, not 0 (something rare due) or PRT0's tick; no long
-  // instruction's steps or copy are left; and with no delay loop under
-  // measure, quietUntil() is the clock.
-  if (more && r.limit == until && r.clk < nextTimer && !burn && !copy.left && measure.loop < 0 &&
-      !touchedHost && until < more->cap) {
-    ++more->taken;
-    until = more->horizon = std::min(more->cap, r.clk + more->step);
-    r.limit = std::min(until, nextTimer);
-    if (r.clk < r.limit) DISPATCH_NEXT;
-  }
+  if (takeHorizon(r, until, more)) DISPATCH_NEXT;
   save(r);
   goto boundary;
 
