@@ -102,8 +102,9 @@
 // boundary as a new run() would (vm.h), and every record is the same.
 // The VM takes the next horizon itself (vm::Continuation::cap, step)
 // where asking would give the same: it has called nothing here since the
-// last answer, so the queue, the inputs, the exits and every other
-// robot's quiet_ are as they were (nothing else runs meanwhile); it is
+// last answer, in the same run() (runTo acts between runs, at a line
+// injection or main's return), so the queue, the inputs, the exits and
+// every other robot's quiet_ are as they were (nothing else runs); it is
 // before min(queue, the plant's stop), so none of the conditions above
 // ends the chain; and it is not quiet past its clock, so it cannot sit
 // the next sub-round out, and the horizon is min(that cap, the others'
@@ -113,10 +114,11 @@
 // depend on where its time is cut, and the sub-rounds' horizons are the
 // ones the shorter rounds gave, as nothing happened at the ends of those
 // rounds but taking the next horizon. Only the integration thrown away at
-// an input can be longer (by (4)): not in a match, where a robot that
-// faults leaves the other alone (two robots' JSON would then count more
-// integrator steps than before); solo, every program's JSON at 20 s and
-// 180 s is the same, steps included (docs/benchmarks.md).
+// an input can be longer (by (4); not in a match, where a robot that
+// faults leaves the other alone: the JSON's integrator steps grew; solo,
+// every program's JSON is the same, measured: docs/benchmarks.md), and a
+// plant fault ends the run where its round began, up to 64 characters
+// earlier.
 #include "scheduler/match.h"
 
 #include <fmt/format.h>

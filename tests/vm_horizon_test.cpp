@@ -159,6 +159,24 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
   EXPECT_EQ(d.taken + d.ruled.size(), d.asking.size());
   EXPECT_TRUE(std::includes(d.asking.begin(), d.asking.end(), d.ruled.begin(), d.ruled.end()));
 
+  // A breakpoint in the loop: the host may act at every stop (a line
+  // injection, main's return), so each run's first horizon is asked.
+  Assembler stops;
+  stops.bind("loop").op(Op::DBG).jump(Op::JMP, "loop");
+  const vm::Image stopping = stops.finish();
+  TestHost host;
+  vm::Vm v(stopping, host, costs());
+  v.setBreakpoint(0);
+  vm::Tick h = 1000;
+  Horizons ruled{h};
+  ruled.v = &v;
+  ruled.givesRule = true;
+  int runs = 0;
+  while (v.run(h, &ruled) == Stop::Breakpoint) ++runs;
+  EXPECT_GT(runs, 100);
+  EXPECT_EQ(ruled.taken, 0u);
+  EXPECT_EQ(h, kCap);
+
   Assembler busy;
   busy.bind("loop").op(Op::PUSHW, vm::kPortPIODB).op(Op::PUSHW, 0x88);
   busy.lib(vm::Lib::OUTPORT, 2).jump(Op::JMP, "loop");

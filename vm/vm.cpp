@@ -384,6 +384,9 @@ template <int kKind, Op First, Op... Rest>
 template <bool kProfile>
 Stop Vm::State::run(Tick until, Continuation* more) {
   if (fault) return Stop::Fault;
+  // The host may have acted since the last run ended (at a breakpoint, a
+  // host stop): the first horizon of this one is asked.
+  touchedHost = true;
   static const void* const kLabels[] = {
 #define OP(name, shape, pop, push, seq) &&L_##name,
 #include "vm/opcodes.def"

@@ -79,7 +79,8 @@ class Continuation {
   // changed, since nothing else runs meanwhile), reaches a horizon before
   // `cap` and is not quiet past its clock, the next one is
   // min(cap, now() + step), which nextHorizon would have given. A host
-  // sets them in nextHorizon; the first horizon always asks. (Each one
+  // sets them in nextHorizon; the first horizon of every run() always
+  // asks (the host may have acted between runs, after a breakpoint). (Each one
   // taken so is a return to the host's loop saved: bench/programs/
   // histogram.dc's 548,000 horizons cost it 9 % of its CPU time.)
   Tick cap = INT64_MIN;
