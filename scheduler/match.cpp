@@ -277,10 +277,10 @@ void Match::noteQuiet() {
       quiet_[static_cast<size_t>(r->index)] = r->running() ? r->quietUntil() : INT64_MIN;
 }
 
-Tick Match::earliestAction() const {
+Tick Match::earliestAction(int except) const {
   Tick t = INT64_MAX;
-  for (const Tick q : quiet_)
-    if (q != INT64_MIN) t = std::min(t, q);
+  for (size_t k = 0; k < quiet_.size(); ++k)
+    if (static_cast<int>(k) != except && quiet_[k] != INT64_MIN) t = std::min(t, quiet_[k]);
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 
@@ -790,10 +790,10 @@ Tick Match::SubRoundChain::nextHorizon(Tick) {
   horizon = next;
   // The ones after it while the VM calls nothing here and is not quiet
   // past its clock (header comment, (7)): what the lines above give then.
-  cap = std::min(match.queue_.nextTick(), plantTick);
-  for (size_t k = 0; k < match.quiet_.size(); ++k)
-    if (k != static_cast<size_t>(robot.index) && match.quiet_[k] != INT64_MIN)
-      cap = std::min(cap, match.quiet_[k] + kLookahead);
+  // (The others' earliest action falls back to the queue's tick, which
+  // the cap already holds.)
+  cap = std::min(
+      {match.queue_.nextTick(), plantTick, match.earliestAction(robot.index) + kLookahead});
   step = kLookahead;
   return next;
 }

@@ -279,11 +279,8 @@ void Vm::State::unwindSuperinstruction(int kind, int k) {
 // The run's next horizon from its continuation: taken without asking
 // where the continuation says it may (Continuation::cap), else asked.
 Tick Vm::State::nextHorizon(Continuation& more, Tick reached) {
-  if (!touchedHost && reached < more.cap && quietUntil() == now) {
-    ++more.taken;
-    more.horizon = std::min(more.cap, now + more.step);
-    return more.horizon;
-  }
+  if (more.mayTakeUnasked(reached, touchedHost) && quietUntil() == now)
+    return more.takeUnasked(now);
   touchedHost = false;
   return more.nextHorizon(reached);
 }
@@ -309,10 +306,9 @@ Tick Vm::State::nextHorizon(Continuation& more, Tick reached) {
 [[gnu::always_inline]] inline bool Vm::State::takeHorizon(Regs& r, Tick& until,
                                                           Continuation* more) {
   if (!more || r.limit != until || r.clk >= nextTimer || copy.left || measure.loop >= 0 ||
-      touchedHost || until >= more->cap)
+      !more->mayTakeUnasked(until, touchedHost))
     return false;
-  ++more->taken;
-  until = more->horizon = std::min(more->cap, r.clk + more->step);
+  until = more->takeUnasked(r.clk);
   r.limit = std::min(until, nextTimer);
   return r.clk < r.limit;
 }

@@ -28,6 +28,7 @@
 // robot memory. A request not yet accepted when the next tick comes is the
 // same request (PRT0's TIF0 is one flag): that tick is lost, as on the chip.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -80,12 +81,24 @@ class Continuation {
   // `cap` and is not quiet past its clock, the next one is
   // min(cap, now() + step), which nextHorizon would have given. A host
   // sets them in nextHorizon; the first horizon of every run() always
-  // asks (the host may have acted between runs, after a breakpoint). (Each one
-  // taken so is a return to the host's loop saved: bench/programs/
-  // histogram.dc's 548,000 horizons cost it 9 % of its CPU time.)
+  // asks (the host may have acted between runs, after a breakpoint).
+  // (Each one taken so is a return to the host's loop saved:
+  // bench/programs/histogram.dc's 548,000 horizons cost it 9 % of its CPU
+  // time.)
   Tick cap = INT64_MIN;
   Tick step = 0;
   uint64_t taken = 0;  // horizons taken without asking
+  // Whether the horizon `reached` may be left behind without asking, the
+  // VM having made no bus call since the last answer (`touchedHost`).
+  bool mayTakeUnasked(Tick reached, bool touchedHost) const {
+    return !touchedHost && reached < cap;
+  }
+  // The next horizon taken without asking at a boundary at `clock`.
+  Tick takeUnasked(Tick clock) {
+    ++taken;
+    horizon = std::min(cap, clock + step);
+    return horizon;
+  }
 
  protected:
   ~Continuation() = default;
