@@ -99,6 +99,7 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
     using Continuation::Continuation;
     vm::Vm* v = nullptr;
     bool givesRule = false;
+    vm::Tick asksFrom = INT64_MAX;
     std::vector<vm::Tick> asked;
     vm::Tick nextHorizon(vm::Tick h) override {
       asked.push_back(h);
@@ -106,6 +107,7 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
       if (givesRule) {
         cap = kCap;
         step = kStep;
+        askFrom = asksFrom;
       }
       horizon = std::min(kCap, v->now() + kStep);
       return horizon;
@@ -115,7 +117,7 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
     std::vector<vm::Tick> asking, ruled;  // the horizons each was asked at
     uint64_t taken = 0;
   };
-  const auto runBoth = [](const vm::Image& img) {
+  const auto runBoth = [](const vm::Image& img, vm::Tick asksFrom = INT64_MAX) {
     TestHost host, otherHost;
     vm::Vm asks(img, host, costs()), rule(img, otherHost, costs());
     vm::Tick h1 = 1000, h2 = 1000;
@@ -123,6 +125,7 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
     a.v = &asks;
     r.v = &rule;
     r.givesRule = true;
+    r.asksFrom = asksFrom;
     EXPECT_EQ(asks.run(1000, &a), Stop::Horizon);
     EXPECT_EQ(rule.run(1000, &r), Stop::Horizon);
     EXPECT_EQ(h1, kCap);
@@ -140,6 +143,16 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
   EXPECT_EQ(q.asking, expected);
   EXPECT_EQ(q.ruled, (std::vector<vm::Tick>{1000, kCap}));
   EXPECT_EQ(q.taken, expected.size() - 2);
+  // With askFrom = 20,000 (another robot stops sitting out there) it is
+  // asked at the first and at every horizon from 20,000 on: by hand, the
+  // ones of `expected` at or after it.
+  const Runs late = runBoth(quiet.finish(), 20000);
+  EXPECT_EQ(late.asking, expected);
+  std::vector<vm::Tick> fromAsk{1000};
+  for (const vm::Tick h : expected)
+    if (h >= 20000) fromAsk.push_back(h);
+  EXPECT_EQ(late.ruled, fromAsk);
+  EXPECT_GT(fromAsk.size(), 3u);
 
   // Divisions (a long instruction, its steps at most kMaxRunOvershoot
   // apart) and an outport every twelve: horizons fall between a

@@ -87,11 +87,15 @@ class Continuation {
   // time.)
   Tick cap = INT64_MIN;
   Tick step = 0;
+  // And only at horizons before `askFrom`, which the host may set lower
+  // than the cap where a later horizon, not the cap, would change its
+  // answer (another robot that would stop sitting sub-rounds out).
+  Tick askFrom = INT64_MAX;
   uint64_t taken = 0;  // horizons taken without asking
   // Whether the horizon `reached` may be left behind without asking, the
   // VM having made no bus call since the last answer (`touchedHost`).
   bool mayTakeUnasked(Tick reached, bool touchedHost) const {
-    return !touchedHost && reached < cap;
+    return !touchedHost && reached < cap && reached < askFrom;
   }
   // The next horizon taken without asking at a boundary at `clock`.
   Tick takeUnasked(Tick clock) {
