@@ -88,27 +88,36 @@
 // (quietUntil is then the clock) never sit out, and the JSON must be
 // theirs (tests/fast_forward_test.py).
 // (7) Chained sub-rounds. While one robot runs alone (every other has
-// faulted or is held in reset) with no trace, observer or debugger, its VM
-// takes the next sub-round's horizon as it reaches one (vm::Continuation,
-// SubRoundChain) instead of returning to this loop and being run again:
-// 548,000 VM entries become 68,500 in bench/programs/histogram.dc. It does
-// so only where the loop would do nothing but take that horizon: no input
-// made, no queued event and not the plant's stop at the horizon, not every
-// robot exited, and the robot not sitting the next sub-round out; the
+// faulted, is held in reset or sits the sub-round out by (6)) with no
+// trace, observer or debugger, its VM takes the next sub-round's horizon
+// as it reaches one (vm::Continuation, SubRoundChain) instead of
+// returning to this loop and being run again: 548,000 VM entries become
+// 68,500 in bench/programs/histogram.dc. It does so only where the loop
+// would do nothing but take that horizon (and the robot's own bytes, (9)):
+// no input made, no other queued event and not the plant's stop at the
+// horizon, not every robot exited, the robot not sitting the next
+// sub-round out and every other running robot sitting it out; the
 // horizon is the loop's own (noteQuiet, subRoundHorizon, capped by the
-// plant's stop). Samples are taken only with a trace or
-// an observer, and the robots not running do nothing when run. So the same
-// horizons are taken in the same order, the VM's run goes on from its
-// boundary as a new run() would (vm.h), and every record is the same.
+// plant's stop). A robot that sits out keeps its quiet tick (it does not
+// run), so the loop's test for it at the next horizon is the one made
+// here. Samples are taken only with a trace or an observer, and the
+// robots not running do nothing when run. So the same horizons are taken
+// in the same order, the VM's run goes on from its boundary as a new
+// run() would (vm.h), and every record is the same.
 // The VM takes the next horizon itself (vm::Continuation::cap, step)
 // where asking would give the same: it has called nothing here since the
 // last answer, in the same run() (runTo acts between runs, at a line
 // injection or main's return), so the queue, the inputs, the exits and
 // every other robot's quiet_ are as they were (nothing else runs); it is
 // before min(queue, the plant's stop), so none of the conditions above
-// ends the chain; and it is not quiet past its clock, so it cannot sit
-// the next sub-round out, and the horizon is min(that cap, the others'
-// earliest action + one character, its clock + one character).
+// ends the chain; it is not quiet past its clock, so it cannot sit the
+// next sub-round out, and the horizon is min(that cap, the others'
+// earliest action + one character, its clock + one character); and it
+// is at least two overshoots and one character before the quiet tick of
+// every other running robot (Continuation::askFrom), so the next horizon
+// (before its clock + one character, the clock less than an overshoot
+// past the horizon reached) lies an overshoot before that tick, and they
+// sit it out.
 // (8) In a solo run a round lets the plant run further ahead
 // (kSoloRoundLookahead): by (1) the plant's steps, roots and events do not
 // depend on where its time is cut, and the sub-rounds' horizons are the
@@ -119,6 +128,18 @@
 // every program's JSON is the same, measured: docs/benchmarks.md), and a
 // plant fault ends the run where its round began, up to 64 characters
 // earlier.
+// (9) A chained robot takes its own serial bytes due at a horizon
+// (ownByteAt) as rule (d) takes them between sub-rounds, when each is the
+// first event due there and no NUL: such a byte changes only its own
+// robot's link, port and interrupt request (a NUL may latch a frame, and
+// every robot runs to the horizon before it), the other robots sit the
+// sub-round out and read nothing of it, and nothing else runs in between
+// (samples need a trace or an observer). Anything else due there ends the
+// chain, after the bytes taken: the loop then finds the rest as rule (d)
+// would have after them, in the queue's order. So a robot that sends
+// while the other waits in a delay loop, or alone, no longer returns to
+// this loop at every byte it sends (docs/benchmarks.md, issue 42's sixth
+// part: the 180-s match's VM runs, measured).
 #include "scheduler/match.h"
 
 #include <fmt/format.h>
@@ -594,7 +615,7 @@ void Match::rounds(Tick pause) {
       horizon = std::min(horizon, step.tick);
       {
         const PartScope vms(clock_, PartClock::Vm);
-        Robot* const alone = runsAlone();
+        Robot* const alone = runsAlone(horizon);
         for (Robot* r : runOrder_) {
           if (sitsOut(*r, horizon)) {
             r->behind = true;
@@ -687,39 +708,70 @@ void Match::rounds(Tick pause) {
   }
 }
 
-Robot* Match::runsAlone() const {
+Robot* Match::runsAlone(Tick horizon) const {
   if (trace_.on() || config_.observer || config_.debugger) return nullptr;
   Robot* alone = nullptr;
   for (const auto& r : robots_) {
-    if (!r->running()) continue;
+    if (!r->running() || sitsOut(*r, horizon)) continue;
     if (alone) return nullptr;
     alone = r.get();
   }
   return alone;
 }
 
+// Rule (9) of "Larger rounds": the robot's own serial byte due at the
+// horizon, taken as serialBytesInRound takes it, when it is the first
+// event there and no NUL (which may latch a frame). False, with nothing
+// taken, otherwise.
+bool Match::ownByteAt(Robot& r, Tick horizon) {
+  if (queue_.empty() || queue_.nextTick() != horizon) return false;
+  const QueuedEvent& next = queue_.top().payload;
+  if (next.kind != QueuedEvent::Kind::SerialByte || next.robot != r.index ||
+      r.board.serial.nulDone() == horizon)
+    return false;
+  queue_.pop();
+  r.byteDone(horizon);
+  return true;
+}
+
 // The round loop's work after a sub-round's runs (rounds()), where it would
 // only take the next horizon; the horizon itself where it would do more.
 Tick Match::SubRoundChain::nextHorizon(Tick) {
   cap = INT64_MIN;  // the VM asks at the next horizon unless set below
-  // (All have exited only if the robot has: it is the one running.)
+  // (All have exited only if the robot has: the others are held, faulted
+  // or quiet in a delay loop.)
   if (horizon == plantTick || !match.inputs_.empty() ||
-      (match.config_.stopWhenAllExited && robot.result.exited && match.allExited()) ||
-      match.queue_.nextTick() == horizon)
+      (match.config_.stopWhenAllExited && robot.result.exited && match.allExited()))
     return horizon;
+  // Its own bytes due here (rule (9)); anything else due ends the chain.
+  while (match.queue_.nextTick() == horizon)
+    if (!match.ownByteAt(robot, horizon)) return horizon;
   // noteQuiet for the one robot that has run (the others' values stand).
   match.quiet_[static_cast<size_t>(robot.index)] = robot.quietUntil();
   const Tick next = std::min(match.subRoundHorizon(), plantTick);
   if (match.sitsOut(robot, next)) return horizon;
+  // Every other robot still running sits the next sub-round out too.
+  Tick othersQuiet = INT64_MAX;
+  for (const auto& r : match.robots_) {
+    if (r.get() == &robot || !r->running()) continue;
+    if (!match.sitsOut(*r, next)) return horizon;
+    othersQuiet = std::min(othersQuiet, match.quiet_[static_cast<size_t>(r->index)]);
+  }
   ++match.subRounds_;
   horizon = next;
   // The ones after it while the VM calls nothing here and is not quiet
-  // past its clock (header comment, (7)): what the lines above give then.
-  // (The others' earliest action falls back to the queue's tick, which
-  // the cap already holds.)
+  // past its clock (header comment, (7)): what the lines above give then,
+  // before the first at which another robot would not sit out. (The
+  // others' earliest action falls back to the queue's tick, which the cap
+  // already holds.)
   cap = std::min(
       {match.queue_.nextTick(), plantTick, match.earliestAction(robot.index) + kLookahead});
   step = kLookahead;
+  // A horizon taken at `reached` is at most clock + step, the clock less
+  // than a run's overshoot past `reached`: the others sit it out while
+  // it lies an overshoot before their quiet tick.
+  askFrom =
+      othersQuiet == INT64_MAX ? INT64_MAX : othersQuiet - 2 * vm::kMaxRunOvershoot - kLookahead;
   return next;
 }
 

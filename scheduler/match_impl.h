@@ -419,15 +419,16 @@ class Match : public MatchView, private MatchState {
   }
   // Rule (7) of "Larger rounds": the robot that runs alone this
   // sub-round, when its sub-rounds may chain; null otherwise.
-  Robot* runsAlone() const;
+  Robot* runsAlone(Tick horizon) const;
+  bool ownByteAt(Robot& r, Tick horizon);
   // Its VM's continuation: the next sub-round's horizon as it reaches
   // `horizon` (which it sets), or `horizon` where the round loop has more
   // to do (the plant's stop is `plantTick`).
   struct SubRoundChain final : vm::Continuation {
     Match& match;
-    const Robot& robot;
+    Robot& robot;
     Tick plantTick;
-    SubRoundChain(Match& m, const Robot& r, Tick& h, Tick p)
+    SubRoundChain(Match& m, Robot& r, Tick& h, Tick p)
         : Continuation(h), match(m), robot(r), plantTick(p) {}
     Tick nextHorizon(Tick reached) override;
   };
