@@ -112,12 +112,9 @@
 // before min(queue, the plant's stop), so none of the conditions above
 // ends the chain; it is not quiet past its clock, so it cannot sit the
 // next sub-round out, and the horizon is min(that cap, the others'
-// earliest action + one character, its clock + one character); and it
-// is at least two overshoots and one character before the quiet tick of
-// every other running robot (Continuation::askFrom), so the next horizon
-// (before its clock + one character, the clock less than an overshoot
-// past the horizon reached) lies an overshoot before that tick, and they
-// sit it out.
+// earliest action + one character, its clock + one character); and that
+// horizon lies at least an overshoot before the quiet tick of every other
+// running robot (Continuation::unaskedUpTo), so they sit it out.
 // (8) In a solo run a round lets the plant run further ahead
 // (kSoloRoundLookahead): by (1) the plant's steps, roots and events do not
 // depend on where its time is cut, and the sub-rounds' horizons are the
@@ -767,11 +764,9 @@ Tick Match::SubRoundChain::nextHorizon(Tick) {
   cap = std::min(
       {match.queue_.nextTick(), plantTick, match.earliestAction(robot.index) + kLookahead});
   step = kLookahead;
-  // A horizon taken at `reached` is at most clock + step, the clock less
-  // than a run's overshoot past `reached`: the others sit it out while
-  // it lies an overshoot before their quiet tick.
-  askFrom =
-      othersQuiet == INT64_MAX ? INT64_MAX : othersQuiet - 2 * vm::kMaxRunOvershoot - kLookahead;
+  // The others sit a horizon out while it lies an overshoot before their
+  // quiet tick (sitsOut; they have not run, so they are behind it).
+  unaskedUpTo = othersQuiet == INT64_MAX ? INT64_MAX : othersQuiet - vm::kMaxRunOvershoot;
   return next;
 }
 

@@ -7,7 +7,7 @@ scheduler/match.cpp, "Larger rounds", rules (6), (7) and (9): without a
 trace, a robot quiet in a delay loop sits sub-rounds out, and the robot
 left running takes the next sub-round's horizons inside its own VM run,
 asking the scheduler only where a horizon could change its answer: past
-the last horizon the other sits out (Continuation::askFrom). With a trace
+the last horizon the other sits out (Continuation::unaskedUpTo). With a trace
 no robot sits out and no run is chained: every sub-round is the round
 loop's own, so the traced run is the oracle, and the untraced run's JSON
 must be its JSON (but for the wall-clock field).
@@ -21,7 +21,7 @@ sees at once (the decoy adds to B's beacon), applied where the sub-round
 it falls in ends: a chain that ran A past that sub-round without B would
 let A read the field without the decoy. PASSES runs over 20..45 and the
 seed over 1..3, so that A's reads fall at every phase of B's sub-rounds
-(a build that ignored askFrom, or that chained A while B did not sit out,
+(a build that ignored unaskedUpTo, or that chained A while B did not sit out,
 gave a different JSON for several of them). A robot's own serial bytes
 taken inside its chain (rule (9)) are checked by tests/fast_forward_test.py
 (fig92's 77,000 bytes against every program).

@@ -99,7 +99,7 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
     using Continuation::Continuation;
     vm::Vm* v = nullptr;
     bool givesRule = false;
-    vm::Tick asksFrom = INT64_MAX;
+    vm::Tick upTo = INT64_MAX;
     std::vector<vm::Tick> asked;
     vm::Tick nextHorizon(vm::Tick h) override {
       asked.push_back(h);
@@ -107,7 +107,7 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
       if (givesRule) {
         cap = kCap;
         step = kStep;
-        askFrom = asksFrom;
+        unaskedUpTo = upTo;
       }
       horizon = std::min(kCap, v->now() + kStep);
       return horizon;
@@ -117,7 +117,7 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
     std::vector<vm::Tick> asking, ruled;  // the horizons each was asked at
     uint64_t taken = 0;
   };
-  const auto runBoth = [](const vm::Image& img, vm::Tick asksFrom = INT64_MAX) {
+  const auto runBoth = [](const vm::Image& img, vm::Tick upTo = INT64_MAX) {
     TestHost host, otherHost;
     vm::Vm asks(img, host, costs()), rule(img, otherHost, costs());
     vm::Tick h1 = 1000, h2 = 1000;
@@ -125,7 +125,7 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
     a.v = &asks;
     r.v = &rule;
     r.givesRule = true;
-    r.asksFrom = asksFrom;
+    r.upTo = upTo;
     EXPECT_EQ(asks.run(1000, &a), Stop::Horizon);
     EXPECT_EQ(rule.run(1000, &r), Stop::Horizon);
     EXPECT_EQ(h1, kCap);
@@ -143,14 +143,14 @@ TEST(Vm, HorizonsTakenWithoutAskingAreTheOnesTheContinuationGives) {
   EXPECT_EQ(q.asking, expected);
   EXPECT_EQ(q.ruled, (std::vector<vm::Tick>{1000, kCap}));
   EXPECT_EQ(q.taken, expected.size() - 2);
-  // With askFrom = 20,000 (another robot stops sitting out there) it is
-  // asked at the first and at every horizon from 20,000 on: by hand, the
-  // ones of `expected` at or after it.
+  // With unaskedUpTo = 20,000 (another robot stops sitting out after it)
+  // it is asked at the first horizon and at every one whose next lies
+  // past 20,000: by hand, the ones of `expected` followed by one past it.
   const Runs late = runBoth(quiet.finish(), 20000);
   EXPECT_EQ(late.asking, expected);
   std::vector<vm::Tick> fromAsk{1000};
-  for (const vm::Tick h : expected)
-    if (h >= 20000) fromAsk.push_back(h);
+  for (size_t k = 1; k < expected.size(); ++k)
+    if (k + 1 == expected.size() || expected[k + 1] > 20000) fromAsk.push_back(expected[k]);
   EXPECT_EQ(late.ruled, fromAsk);
   EXPECT_GT(fromAsk.size(), 3u);
 

@@ -279,7 +279,7 @@ void Vm::State::unwindSuperinstruction(int kind, int k) {
 // The run's next horizon from its continuation: taken without asking
 // where the continuation says it may (Continuation::cap), else asked.
 Tick Vm::State::nextHorizon(Continuation& more, Tick reached) {
-  if (more.mayTakeUnasked(reached, touchedHost) && quietUntil() == now)
+  if (more.mayTakeUnasked(reached, now, touchedHost) && quietUntil() == now)
     return more.takeUnasked(now);
   touchedHost = false;
   return more.nextHorizon(reached);
@@ -306,7 +306,7 @@ Tick Vm::State::nextHorizon(Continuation& more, Tick reached) {
 [[gnu::always_inline]] inline bool Vm::State::takeHorizon(Regs& r, Tick& until,
                                                           Continuation* more) {
   if (!more || r.limit != until || r.clk >= nextTimer || copy.left || measure.loop >= 0 ||
-      !more->mayTakeUnasked(until, touchedHost))
+      !more->mayTakeUnasked(until, r.clk, touchedHost))
     return false;
   until = more->takeUnasked(r.clk);
   r.limit = std::min(until, nextTimer);

@@ -53,7 +53,9 @@ using timebase::Tick;
 enum class Irq : uint8_t { Pio = 0, Timer = 1, SerialTx = 2 };
 inline constexpr int kIrqCount = 3;
 // The most a run ends after its `until` (Vm::run): an instruction, or a
-// step of a long one, is at most this long.
+// step of a long one, is at most this long; but not after an atomic
+// library call (the serial library's DI ... restore sequences), charged
+// whole with no boundary inside (185 ticks past, measured).
 inline constexpr Tick kMaxRunOvershoot = 100;
 std::string_view irqName(Irq irq);  // "pio_a", "timer", "serial_tx"
 
@@ -87,15 +89,16 @@ class Continuation {
   // time.)
   Tick cap = INT64_MIN;
   Tick step = 0;
-  // And only at horizons before `askFrom`, which the host may set lower
-  // than the cap where a later horizon, not the cap, would change its
-  // answer (another robot that would stop sitting sub-rounds out).
-  Tick askFrom = INT64_MAX;
+  // And only up to `unaskedUpTo`, the latest next horizon the host gives
+  // as the rule above says (where a later one, not the cap, would change
+  // its answer: another robot that would stop sitting sub-rounds out).
+  Tick unaskedUpTo = INT64_MAX;
   uint64_t taken = 0;  // horizons taken without asking
-  // Whether the horizon `reached` may be left behind without asking, the
-  // VM having made no bus call since the last answer (`touchedHost`).
-  bool mayTakeUnasked(Tick reached, bool touchedHost) const {
-    return !touchedHost && reached < cap && reached < askFrom;
+  // Whether the horizon `reached` may be left behind without asking at a
+  // boundary at `clock`, the VM having made no bus call since the last
+  // answer (`touchedHost`).
+  bool mayTakeUnasked(Tick reached, Tick clock, bool touchedHost) const {
+    return !touchedHost && reached < cap && std::min(cap, clock + step) <= unaskedUpTo;
   }
   // The next horizon taken without asking at a boundary at `clock`.
   Tick takeUnasked(Tick clock) {
@@ -205,8 +208,8 @@ class Vm {
   bool sameProgramState(const Vm& other) const;
 
   // Executes every instruction that starts before `until` (so it stops
-  // less than kMaxRunOvershoot ticks after it: no step of an instruction
-  // is longer). A bus access
+  // less than kMaxRunOvershoot ticks after it but after an atomic library
+  // call: no other step of an instruction is longer). A bus access
   // does not end the run: what the host does on one (a port B write, a
   // send) takes effect in the plant or the queue at the end of the host's
   // round, not inside it, so stopping there bought nothing (160,000 of
