@@ -838,7 +838,13 @@ void Match::finish(MatchResult& result) {
     // runs on to the last round's horizon after main returns, and may stand
     // one instruction past the end.
     rr.cycles = static_cast<uint64_t>(rr.exited ? rr.exitTick : std::min(r->now(), result.endTick));
-    rr.vmClock = static_cast<uint64_t>(r->now());
+    // A halted VM idles to whichever horizon ended its last run, which
+    // depends on how long the rounds were (a solo run that stops at main's
+    // return ends before it): what the profile counts ends at the later of
+    // its halt and the end of the run.
+    rr.vmClock = static_cast<uint64_t>(
+        r->vm().halted() ? std::min(r->now(), std::max(r->vm().haltedSince(), result.endTick))
+                         : r->now());
     rr.vmInstructions = r->vm().stats().instructions;
     rr.vmFastForwarded = r->vm().stats().fastForwarded;
     if (config_.profile) {

@@ -283,7 +283,9 @@ struct RobotResult {
   uint64_t cycles = 0;  // the clock at main's return, or at the end of the run
   // The VM's own clock when the run ended: all it charged, including the
   // instruction straddling the end and anything after main returned
-  // (interrupt handlers, halted time). simbot profile adds up to this.
+  // (interrupt handlers, halted time up to the end of the run; a run that
+  // stops at main's return ends at its HALT). simbot profile adds up to
+  // this.
   uint64_t vmClock = 0;
   // Bytecode instructions run (library steps included), and of those the
   // ones fast-forward applied without dispatching them. The second depends

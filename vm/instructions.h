@@ -671,7 +671,10 @@ SIMBOT_INSTRUCTION(RETI) {
 SIMBOT_INSTRUCTION(HALT) {
   save(r);
   pc = r.pc();  // stays on HALT; an interrupt returns here
-  if (!halted) flushConsole();
+  if (!halted) {
+    flushConsole();
+    haltedAt = now;
+  }
   halted = true;
   return false;
 }

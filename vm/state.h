@@ -323,6 +323,7 @@ struct Vm::State {
   bool iff2 = true;
   bool eiShadow = false;
   bool halted = false;
+  Tick haltedAt = 0;      // the end of the HALT that last halted it
   bool hostStop = false;  // Vm::stopAtNextBoundary, during a run
   // Set at the first diverted return: from then on the expression stack
   // need not match the code, so every boundary is slow and checks that the

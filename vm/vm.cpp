@@ -761,6 +761,7 @@ void Vm::cancelRequest(Irq irq) {
 
 bool Vm::pending(Irq irq) const { return s_->pend[static_cast<int>(irq)]; }
 bool Vm::halted() const { return s_->halted; }
+Tick Vm::haltedSince() const { return s_->haltedAt; }
 bool Vm::interruptsEnabled() const { return s_->iff1; }
 uint32_t Vm::pc() const { return s_->currentPc(); }
 int Vm::line() const { return s_->image().lineAt(pc()); }

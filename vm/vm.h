@@ -237,6 +237,8 @@ class Vm {
 
   Tick now() const { return *clock_; }
   bool halted() const;
+  // While halted: the tick its HALT ended (it idles from there).
+  Tick haltedSince() const;
   const Fault* fault() const { return *fault_ ? &**fault_ : nullptr; }  // null unless faulted
   bool interruptsEnabled() const;
   // The instruction, library call or interrupt acceptance under way at the
