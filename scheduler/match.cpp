@@ -295,10 +295,10 @@ void Match::noteQuiet() {
       quiet_[static_cast<size_t>(r->index)] = r->running() ? r->quietUntil() : INT64_MIN;
 }
 
-Tick Match::earliestAction(int except) const {
+Tick Match::earliestAction() const {
   Tick t = INT64_MAX;
-  for (size_t k = 0; k < quiet_.size(); ++k)
-    if (static_cast<int>(k) != except && quiet_[k] != INT64_MIN) t = std::min(t, quiet_[k]);
+  for (const Tick q : quiet_)
+    if (q != INT64_MIN) t = std::min(t, q);
   return t == INT64_MAX ? queue_.nextTick() : t;
 }
 
@@ -716,12 +716,11 @@ Robot* Match::runsAlone(Tick horizon) const {
   return alone;
 }
 
-// Rule (9) of "Larger rounds": the robot's own serial byte due at the
-// horizon, taken as serialBytesInRound takes it, when it is the first
-// event there and no NUL (which may latch a frame). False, with nothing
+// Rule (9) of "Larger rounds": the queue's next event, due at the
+// horizon, taken as serialBytesInRound takes it when it is the robot's own
+// serial byte and no NUL (which may latch a frame). False, with nothing
 // taken, otherwise.
 bool Match::ownByteAt(Robot& r, Tick horizon) {
-  if (queue_.empty() || queue_.nextTick() != horizon) return false;
   const QueuedEvent& next = queue_.top().payload;
   if (next.kind != QueuedEvent::Kind::SerialByte || next.robot != r.index ||
       r.board.serial.nulDone() == horizon)
@@ -747,7 +746,8 @@ Tick Match::SubRoundChain::nextHorizon(Tick) {
   match.quiet_[static_cast<size_t>(robot.index)] = robot.quietUntil();
   const Tick next = std::min(match.subRoundHorizon(), plantTick);
   if (match.sitsOut(robot, next)) return horizon;
-  // Every other robot still running sits the next sub-round out too.
+  // Every other robot still running sits the next sub-round out too (its
+  // quiet tick is its earliest action; the others' are INT64_MIN).
   Tick othersQuiet = INT64_MAX;
   for (const auto& r : match.robots_) {
     if (r.get() == &robot || !r->running()) continue;
@@ -758,15 +758,15 @@ Tick Match::SubRoundChain::nextHorizon(Tick) {
   horizon = next;
   // The ones after it while the VM calls nothing here and is not quiet
   // past its clock (header comment, (7)): what the lines above give then,
-  // before the first at which another robot would not sit out. (The
-  // others' earliest action falls back to the queue's tick, which the cap
-  // already holds.)
-  cap = std::min(
-      {match.queue_.nextTick(), plantTick, match.earliestAction(robot.index) + kLookahead});
+  // up to the last the others sit out (sitsOut: an overshoot before their
+  // quiet tick; they have not run, so they are behind it).
+  cap = std::min(match.queue_.nextTick(), plantTick);
   step = kLookahead;
-  // The others sit a horizon out while it lies an overshoot before their
-  // quiet tick (sitsOut; they have not run, so they are behind it).
-  unaskedUpTo = othersQuiet == INT64_MAX ? INT64_MAX : othersQuiet - vm::kMaxRunOvershoot;
+  unaskedUpTo = INT64_MAX;
+  if (othersQuiet != INT64_MAX) {
+    cap = std::min(cap, othersQuiet + kLookahead);
+    unaskedUpTo = othersQuiet - vm::kMaxRunOvershoot;
+  }
   return next;
 }
 

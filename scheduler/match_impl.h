@@ -399,9 +399,8 @@ class Match : public MatchView, private MatchState {
   // value.
   void noteQuiet();
   // The earliest tick at which a robot that has not faulted can act: the
-  // least of quiet_ (leaving robot `except` out, if one is given; the
-  // queue's next tick when none is left).
-  Tick earliestAction(int except = -1) const;
+  // least of quiet_ (the queue's next tick when none can).
+  Tick earliestAction() const;
   // Rule (6) of "Larger rounds": whether robot r, quiet past the
   // sub-round's horizon, sits it out.
   bool sitsOut(const Robot& r, Tick horizon) const {
