@@ -37,10 +37,12 @@ PROGRAMS = os.path.join(HERE, "programs")
 # after them; crc16 and bfs were written after the fourth part's other
 # changes, its bitwise forms with a constant were then chosen on crc16,
 # and hash was written after them; the fifth part's forms g = x OP k; were
-# chosen on all nineteen, and digits was written after them.
+# chosen on all nineteen, and digits was written after them; the seventh
+# part's forms g OP k were chosen on all twenty, and weekday was written
+# after them.
 ALGORITHMS = ("sieve", "nested", "fib", "sort", "strscan", "structs", "grid", "filter",
               "bubble", "histogram", "matrix", "fletcher", "ring", "insertion", "checksum",
-              "smooth", "crc16", "bfs", "hash", "digits")
+              "smooth", "crc16", "bfs", "hash", "digits", "weekday")
 
 
 def child_cpu():
