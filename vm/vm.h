@@ -98,14 +98,16 @@ class Continuation {
   // boundary at `clock`, the VM having made no bus call since the last
   // answer (`touchedHost`).
   bool mayTakeUnasked(Tick reached, Tick clock, bool touchedHost) const {
-    return !touchedHost && reached < cap && std::min(cap, clock + step) <= unaskedUpTo;
+    return !touchedHost && reached < cap && unaskedAfter(clock) <= unaskedUpTo;
   }
   // The next horizon taken without asking at a boundary at `clock`.
   Tick takeUnasked(Tick clock) {
     ++taken;
-    horizon = std::min(cap, clock + step);
+    horizon = unaskedAfter(clock);
     return horizon;
   }
+  // The horizon the rule above gives after a boundary at `clock`.
+  Tick unaskedAfter(Tick clock) const { return std::min(cap, clock + step); }
 
  protected:
   ~Continuation() = default;
