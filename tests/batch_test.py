@@ -26,17 +26,12 @@ import sys
 import time
 from pathlib import Path
 
+from scriptcheck import check, failures
+
 SIMBOT, ICEMAN, FIG92, SPIRAL, TURRET, OUT = sys.argv[1:7]
 OUT = Path(OUT)
 shutil.rmtree(OUT, ignore_errors=True)
 OUT.mkdir(parents=True)
-failures = []
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 BENCH = [SIMBOT, "bench", ICEMAN, FIG92, "--family", "stationary", "--seeds", "30",

@@ -41,6 +41,8 @@ import sys
 from fractions import Fraction as F
 from pathlib import Path
 
+from scriptcheck import check, failures
+
 SIMBOT, TESTDIR, OUT = sys.argv[1:4]
 TESTDIR = Path(TESTDIR)
 OUT = Path(OUT)
@@ -48,13 +50,6 @@ shutil.rmtree(OUT, ignore_errors=True)
 OUT.mkdir(parents=True)
 PROGRAM = str(TESTDIR / "spin_then_stop.dc")
 N = 9_216_000
-failures = []
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def run(*args):

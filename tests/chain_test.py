@@ -37,6 +37,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from scriptcheck import check, failures
+
 SIMBOT, SOURCE, OUT = sys.argv[1:4]
 OUT = Path(OUT)
 shutil.rmtree(OUT, ignore_errors=True)
@@ -44,13 +46,6 @@ OUT.mkdir(parents=True)
 CHAIN = Path(SOURCE) / "tests" / "chain"
 SCENARIO = CHAIN / "facing.toml"
 DECOYER = CHAIN / "decoyer.dc"
-failures = []
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def summary(reader, seed, trace=None):

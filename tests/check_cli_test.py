@@ -30,6 +30,8 @@ from pathlib import Path
 
 import junitparser
 
+from scriptcheck import check, failures
+
 SIMBOT, SOURCE, SHARED, OUT = sys.argv[1:5]
 SOURCE, SHARED, OUT = Path(SOURCE), Path(SHARED), Path(OUT)
 shutil.rmtree(OUT, ignore_errors=True)
@@ -38,13 +40,6 @@ TPS = 9216000
 ICEMAN = SHARED / "programs/iceman.dc"
 FIG92 = SHARED / "programs/fig92.dc"
 EXAMPLE = SOURCE / "checks/iceman.toml"
-failures = []
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def run(*args):

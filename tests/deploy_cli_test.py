@@ -20,6 +20,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from scriptcheck import check, failures
+
 SIMBOT, SOURCE, SHARED, OUT = sys.argv[1:5]
 OUT = Path(OUT)
 shutil.rmtree(OUT, ignore_errors=True)
@@ -28,13 +30,6 @@ FIG92 = f"{SHARED}/programs/fig92.dc"
 DROPPER = f"{SOURCE}/programs/dropper.dc"
 LIGHT = f"{SOURCE}/profiles/hardware/decoy-light.toml"
 BLOCKS = f"{SOURCE}/profiles/hardware/blocks.toml"
-failures = []
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def run(*args):

@@ -21,6 +21,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from scriptcheck import check, failures
+
 SIMBOT, SOURCE, SHARED, OUT = sys.argv[1:5]
 OUT = Path(OUT)
 shutil.rmtree(OUT, ignore_errors=True)
@@ -29,13 +31,6 @@ ICEMAN = f"{SHARED}/programs/iceman.dc"
 FIG92 = f"{SHARED}/programs/fig92.dc"
 TIMER = f"{SOURCE}/programs/disc_timer.dc"
 LAUNCHER = f"{SOURCE}/profiles/hardware/disc-launcher.toml"
-failures = []
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def run(*args):

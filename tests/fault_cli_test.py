@@ -28,21 +28,16 @@ import subprocess
 import sys
 from pathlib import Path
 
+from scriptcheck import check, failures
+
 SIMBOT, FAULTING, TURRET, ICEMAN, OUT = sys.argv[1:6]
 OUT = Path(OUT)
 shutil.rmtree(OUT, ignore_errors=True)
 OUT.mkdir(parents=True)
-failures = []
 # PROGRAM:LINE: fault: robot R at T s: MESSAGE
 FAULT_LINE = re.compile(
     r"unbound_vector\.dc:\d+: fault: robot [AB] at \d+\.\d{6} s: pio_a interrupt through "
     r"vector 0x10, which no #INT_VEC binds")
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def run(*args):

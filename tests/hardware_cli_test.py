@@ -37,6 +37,8 @@ import sys
 import tomllib
 from pathlib import Path
 
+from scriptcheck import check, failures
+
 SIMBOT, SOURCE, OUT = sys.argv[1:4]
 SOURCE, OUT = Path(SOURCE), Path(OUT)
 shutil.rmtree(OUT, ignore_errors=True)
@@ -44,7 +46,6 @@ OUT.mkdir(parents=True)
 DEFAULT = SOURCE / "profiles/default.toml"
 WEAK = SOURCE / "profiles/hardware/weak-battery.toml"
 DISC = SOURCE / "profiles/hardware/disc-launcher.toml"
-failures = []
 
 # To the internal unit (docs/plant.md: ft, s, ft/s, deg, lb, C, V, A, ohm).
 FACTOR = {"ft": 1, "in": 1 / 12, "m": 1 / 0.3048, "cm": 1 / 30.48, "mm": 1 / 304.8,
@@ -55,12 +56,6 @@ FACTOR = {"ft": 1, "in": 1 / 12, "m": 1 / 0.3048, "cm": 1 / 30.48, "mm": 1 / 304
 PER_ROBOT = ["robot", "bumper", "eyes", "gun", "battery", "controller"]
 PORTS = {"gun1_motor": 3, "gun1_solenoid": 4, "gun2_motor": 7, "gun2_solenoid": 5,
          "disc_shooter": 6}
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def run(*args):

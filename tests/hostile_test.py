@@ -16,19 +16,14 @@ import subprocess
 import sys
 from pathlib import Path
 
+from scriptcheck import check, failures
+
 SIMBOT, SOURCE, OUT = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
 SANITIZED = "--sanitized" in sys.argv
 TIMEOUT = 300 if SANITIZED else 30
 shutil.rmtree(OUT, ignore_errors=True)
 OUT.mkdir(parents=True)
 PROFILE = (SOURCE / "profiles" / "default.toml").read_bytes()
-failures = []
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def limits(mb=500):

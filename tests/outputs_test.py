@@ -42,6 +42,8 @@ import sys
 import time
 from pathlib import Path
 
+from scriptcheck import check, failures
+
 SIMBOT, SOURCE, SHARED, OUT = sys.argv[1:5]
 SANITIZED = "--sanitized" in sys.argv[5:]
 OUT = Path(OUT)
@@ -51,13 +53,6 @@ SPIRAL = Path(SOURCE) / "programs" / "spiral.dc"
 TURRET = Path(SOURCE) / "programs" / "turret.dc"
 ICEMAN = Path(SHARED) / "programs" / "iceman.dc"
 FIG92 = Path(SHARED) / "programs" / "fig92.dc"
-failures = []
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def run(args, timeout=120, **kw):

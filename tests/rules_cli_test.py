@@ -27,19 +27,14 @@ import subprocess
 import sys
 from pathlib import Path
 
+from scriptcheck import check, failures
+
 SIMBOT, SOURCE, ICEMAN, FIG92, OUT = sys.argv[1:6]
 SOURCE, OUT = Path(SOURCE), Path(OUT)
 shutil.rmtree(OUT, ignore_errors=True)
 OUT.mkdir(parents=True)
 FIRE = str(SOURCE / "tests/programs/fire_blind.dc")
 RULES_DIR = SOURCE / "tests/rules"
-failures = []
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def run(*args):

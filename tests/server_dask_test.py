@@ -43,19 +43,14 @@ from fastapi.testclient import TestClient  # noqa: E402
 from simbot_server import db  # noqa: E402
 from simbot_server.app import create_app  # noqa: E402
 
+from scriptcheck import check, failures
+
 START = time.monotonic()
 shutil.rmtree(OUT, ignore_errors=True)
 OUT.mkdir(parents=True)
 PROGRAMS = {"fig": SHARED / "programs/fig92.dc", "ice": SHARED / "programs/iceman.dc",
             "turret": SOURCE / "programs/turret.dc"}
 SECONDS, TOURNAMENT_SEED, LONG_SECONDS = 20, 2024, 1000
-failures = []
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def auth(token):

@@ -51,20 +51,15 @@ from simbot_server import db  # noqa: E402
 from simbot_server.app import create_app  # noqa: E402
 from simbot_server.limits import RateLimits  # noqa: E402
 
+from scriptcheck import check, failures
+
 shutil.rmtree(OUT, ignore_errors=True)
 OUT.mkdir(parents=True)
 DATA = OUT / "data"
 DATABASE = DATA / "simbot.sqlite3"
 MARKER = f"hostile{os.getpid()}x"  # in every name that could become a file
 TABLES = ("settings", "teams", "submissions", "matches", "tournaments")
-failures = []
 statuses = []  # every answer's status: no 5xx, ever
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def esc(text):

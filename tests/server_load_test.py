@@ -58,6 +58,8 @@ from pathlib import Path
 
 import httpx
 
+from scriptcheck import check, failures
+
 p = argparse.ArgumentParser()
 p.add_argument("simbot")
 p.add_argument("source", type=Path)
@@ -77,14 +79,7 @@ REQUEST_TIMEOUT = 60  # an answer later than this is a failure, not a latency
 shutil.rmtree(a.out, ignore_errors=True)
 a.out.mkdir(parents=True)
 DATA = a.out / "data"
-failures = []
 answers = []  # every request: {"kind", "path", "status", "latency_s", "lag_s", ...}
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message, flush=True)
 
 
 def free_port():

@@ -81,9 +81,10 @@ from simbot_server import db, models  # noqa: E402
 from simbot_server.app import create_app  # noqa: E402
 from simbot_server.models import Submission  # noqa: E402
 
+from scriptcheck import check, failures
+
 shutil.rmtree(OUT, ignore_errors=True)
 OUT.mkdir(parents=True)
-failures = []
 
 
 def fresh_database(label, data):
@@ -128,12 +129,6 @@ def stored_text(url):
 
 DATA = OUT / "data"
 URL = fresh_database("api", DATA)
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def auth(token):

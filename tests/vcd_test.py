@@ -21,16 +21,11 @@ import sys
 from fractions import Fraction
 from pathlib import Path
 
+from scriptcheck import check, failures
+
 SIMBOT, ICEMAN, FIG92, OUT = sys.argv[1], sys.argv[2], sys.argv[3], Path(sys.argv[4])
 OUT.mkdir(parents=True, exist_ok=True)
 TICKS_PER_SECOND = 9_216_000
-failures = []
-
-
-def check(ok, message):
-    if not ok:
-        failures.append(message)
-        print("FAIL:", message)
 
 
 def run(*args):
