@@ -1,7 +1,8 @@
 // One match: the round loop described in match.h, the robots' VMs and the
 // trace. The robots' buses (ports, A/D, serial library hooks, interrupt
 // notifications) are in robot_bus.cpp, the plant events' records in
-// plant_records.cpp; the classes in match_impl.h.
+// plant_records.cpp, the result in match_result.cpp; the classes in
+// match_impl.h.
 //
 // Larger rounds. A round is a run of sub-rounds, each exactly one round of
 // the one-character protocol of match.h: every VM runs to h_k = min(next
@@ -137,6 +138,25 @@
 // while the other waits in a delay loop, or alone, no longer returns to
 // this loop at every byte it sends (docs/benchmarks.md, issue 42's sixth
 // part: the 180-s match's VM runs, measured).
+// (10) Two running robots both stop at every horizon: between them the
+// lookahead (in the sense of conservative parallel simulation,
+// Chandy-Misra-Bryant) is zero. Rules (6), (7) and (9) are each robot's
+// lookahead where it has one: a robot quiet past a horizon makes nothing
+// the other sees before its quiet tick, and a robot alone runs on through
+// horizons and its own bytes. A running robot's next instruction, though,
+// may be an input, which reaches the plant at its tick: a port B write
+// that moves anything (a gun motor, a solenoid's stroke, a disc, a block:
+// Arena::setPortB) re-initialises the one integration every robot shares,
+// so every later pose comes from other steps, the other robot's too, by
+// last bits (tests/plant/coupling_test.cpp); a decoy set down shines at
+// once (tests/chain_test.py); an edge handler's entry may bring the
+// referee's turn of the robot. The other robot sees each from the end of the
+// sub-round, (a). So each eye read after a horizon depends on what the
+// other robot did up to it, and neither may pass a horizon before the
+// other has reached it: a non-NUL byte of either ends both runs there, as
+// (d) says. What is left to gain, measured (docs/benchmarks.md, issue 42's
+// eighth part): 4,930 of the 180-s match's 125,150 sub-rounds run both
+// robots, and all of their loop work and VM entries are under 1 % of it.
 #include "scheduler/match.h"
 
 #include <fmt/format.h>
@@ -798,99 +818,6 @@ void Match::faulted(int robot, Tick t) {
   if (at >= config_.endTick) return;  // the run is over before the reload
   robots_[static_cast<size_t>(robot)]->reloadPending = true;
   queue_.schedule(at, EventClass::Reload, {QueuedEvent::Kind::Reload, robot, 0});
-}
-
-void Match::finish(MatchResult& result) {
-  result.rounds = rounds_;
-  result.warnings = warnings_;
-  for (size_t k = 0; k < fired_.size(); ++k) {
-    if (fired_[k]) continue;
-    const Injection& in = config_.injections[k];
-    const RobotSpec& robot = config_.robots[static_cast<size_t>(in.robot)];
-    result.warnings.push_back(
-        in.line > 0
-            ? fmt::format("--inject {} never fired: {} of {} ran {} time(s) before the run ended",
-                          in.text,
-                          in.pass ? "the loop on line " + std::to_string(in.line)
-                                  : "line " + std::to_string(in.line),
-                          robot.program, hitsAt(in, injectionAddress_[k]))
-            : fmt::format("--inject {} never fired: the run ended at {:.6f} s", in.text,
-                          timebase::secondsFromTicks(result.endTick)));
-  }
-  result.integrator = arena_.stats();
-  for (auto& r : robots_) {
-    RobotResult rr = r->result;
-    const size_t at = static_cast<size_t>(r->index);
-    rr.hits = arena_.hits(r->index) - unscoredHits_[at];
-    if (arenaConfig_->referee.judge_scatter) rr.scatterShots = scatterShots_[at];
-    rr.shots = arena_.shots(r->index);
-    // A secondary weapon's shots and hits, apart from the guns' (the
-    // winner is decided on the guns' hits).
-    const plant::SecondaryKind secondary =
-        arenaConfig_->robots[static_cast<size_t>(r->index)].hardware.secondary.kind;
-    if (secondary != plant::SecondaryKind::None)
-      rr.secondary = SecondaryResult{plant::secondaryKindName(secondary),
-                                     arena_.discShots(r->index), arena_.discHits(r->index)};
-    for (const plant::Deployed& item : arena_.deployed())
-      if (item.robot == r->index) ++rr.deployed[static_cast<size_t>(item.kind)];
-    rr.blockPushFt = arena_.blockPushedFt(r->index);
-    // The clock at main's return, or at the end of the run: a VM's clock
-    // runs on to the last round's horizon after main returns, and may stand
-    // one instruction past the end.
-    rr.cycles = static_cast<uint64_t>(rr.exited ? rr.exitTick : std::min(r->now(), result.endTick));
-    // A halted VM idles to whichever horizon ended its last run, which
-    // depends on how long the rounds were (a solo run that stops at main's
-    // return ends before it): what the profile counts ends at the later of
-    // its halt and the end of the run.
-    rr.vmClock = static_cast<uint64_t>(
-        r->vm().halted() ? std::min(r->now(), std::max(r->vm().haltedSince(), result.endTick))
-                         : r->now());
-    rr.vmInstructions = r->vm().stats().instructions;
-    rr.vmFastForwarded = r->vm().stats().fastForwarded;
-    if (config_.profile) {
-      rr.profile = r->vm().profile();
-      rr.serialIsrCycles = r->vm().serialIsrCycles();
-      rr.timerIsrCycles = r->vm().timerIsrCycles();
-    }
-    for (vm::Irq irq : {vm::Irq::Pio, vm::Irq::Timer, vm::Irq::SerialTx})
-      rr.interrupts[std::string(vm::irqName(irq))] +=
-          r->board.interruptCounts[static_cast<size_t>(irq)];
-    if (r->battery) rr.batteryVFinal = r->battery->voltage(result.endTick);
-    // After a plant fault the plant answers only from its last re-initialisation.
-    rr.finalPose =
-        arena_.pose(r->index, std::clamp(result.endTick, arena_.lastReinitTick(), arena_.now()));
-    result.robots.push_back(std::move(rr));
-  }
-  if (result.robots.size() == 2) {
-    const int a = result.robots[0].hits, b = result.robots[1].hits;
-    const bool faultA = result.robots[0].fault.has_value();
-    const bool faultB = result.robots[1].fault.has_value();
-    if (a != b) {
-      result.winner = a > b ? "A" : "B";
-    } else if (faultA != faultB) {
-      result.winner = faultA ? "B" : "A";  // a robot that faulted loses a tied round
-    } else {
-      result.tieBrokenByCoin = true;
-      result.winner = (coin_.next() >> 63) ? "B" : "A";
-    }
-  }
-  if (trace_.on()) {
-    for (const auto& rr : result.robots) {
-      const int i = &rr - result.robots.data();
-      emit(result.endTick,
-           trace::rec::RobotResult{i, rr.hits, rr.shots, rr.framesLatched, rr.framesRejected,
-                                   rr.framesOverwritten, static_cast<int64_t>(rr.cycles),
-                                   rr.fault.has_value(), rr.reloads, rr.exited},
-           {});
-      if (rr.secondary)
-        emit(result.endTick,
-             trace::rec::SecondaryResult{i, rr.secondary->kind, rr.secondary->shots,
-                                         rr.secondary->hits},
-             {});
-    }
-    emit(result.endTick, trace::rec::End{result.winner, result.tieBrokenByCoin}, {});
-  }
-  trace_.close();
 }
 
 }  // namespace detail
