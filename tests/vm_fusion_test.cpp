@@ -202,7 +202,7 @@ TEST(VmSuperinstruction, TheProgramsPrintWhatTheirUnfusedRunsPrint) {
       {"4 5 839 2"},
       {"1 2"},
       {"0 454 2"},
-      {"0 40 11 36 40", "-24", "120 22 38 56", "681 3840 -341", "15 18", "2490"}};
+      {"0 40 11 36 40", "-24", "120 22 38 56", "681 3840 -341", "15 18", "2490", "444 44"}};
   ASSERT_EQ(expected.size(), programs().size());
   for (size_t k = 0; k < programs().size(); ++k) {
     Pair run(programs()[k].image, 0);
