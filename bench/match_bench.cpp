@@ -15,7 +15,8 @@
 // read no clock, as a user's do): vm_s (the VMs running), plant_s
 // (integration, plant inputs, eye readings, including those a VM's A/D read
 // makes), sched_s (the rest: round loop, queue, bookkeeping), which add up
-// to the match's time (not counting compiling the programs).
+// to that run's time, its clock reads included (not counting compiling the
+// programs).
 // BM_Snapshots: what a debugger's snapshot of that match costs (one every
 // half second of 180 s, all kept, as simbot debug keeps them): the heap
 // bytes each snapshot holds (glibc's mallinfo2, in use after less before
@@ -53,9 +54,9 @@ void BM_IcemanVsFig92(benchmark::State& state, const char* profile, bool fastFor
   scheduler::MatchResult last;
   for (auto _ : state) last = scheduler::runMatch(config);
   // The parts come from one more run, not timed: their clock reads cost
-  // about 4 ms of the match's 42 (measured, docs/benchmarks.md).
+  // about 5 ms of the match (46 ms against 41, docs/benchmarks.md).
   config.timeParts = true;
-  const scheduler::MatchResult timed = scheduler::runMatch(config);
+  const scheduler::MatchResult withParts = scheduler::runMatch(config);
   const double simSeconds = static_cast<double>(last.endTick) / scheduler::kTicksPerSecond;
   const double iterations = static_cast<double>(state.iterations());
   uint64_t instructions = 0, fastForwarded = 0;
@@ -77,9 +78,9 @@ void BM_IcemanVsFig92(benchmark::State& state, const char* profile, bool fastFor
   state.counters["reinits"] = static_cast<double>(last.integrator.reinits);
   state.counters["roots"] = static_cast<double>(last.integrator.roots);
   state.counters["rounds"] = static_cast<double>(last.rounds);
-  state.counters["vm_s"] = timed.parts.vm_s;
-  state.counters["plant_s"] = timed.parts.plant_s;
-  state.counters["sched_s"] = timed.parts.scheduler_s;
+  state.counters["vm_s"] = withParts.parts.vm_s;
+  state.counters["plant_s"] = withParts.parts.plant_s;
+  state.counters["sched_s"] = withParts.parts.scheduler_s;
 }
 
 BENCHMARK_CAPTURE(BM_IcemanVsFig92, default_ff, "default", true)

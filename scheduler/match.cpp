@@ -149,14 +149,14 @@
 // Arena::setPortB) re-initialises the one integration every robot shares,
 // so every later pose comes from other steps, the other robot's too, by
 // last bits (tests/plant/coupling_test.cpp); a decoy set down shines at
-// once (tests/chain_test.py); an edge handler's entry may bring the
-// referee's turn of the robot. The other robot sees each from the end of the
-// sub-round, (a). So each eye read after a horizon depends on what the
-// other robot did up to it, and neither may pass a horizon before the
-// other has reached it: a non-NUL byte of either ends both runs there, as
-// (d) says. What is left to gain, measured (docs/benchmarks.md, issue 42's
-// eighth part): 4,930 of the 180-s match's 125,150 sub-rounds run both
-// robots, and all of their loop work and VM entries are under 1 % of it.
+// once (tests/chain_test.py); an edge handler's entry or an injected bump
+// may re-initialise it too, or bring the referee's turn of the robot. The
+// other robot sees each from the end of the sub-round, (a). So each eye
+// read after a horizon depends on what the other robot did up to it, and
+// neither may pass a horizon before the other has reached it: any byte of
+// either, even a non-NUL one that (9) takes inside a chain, ends both runs
+// there. What that leaves to gain is measured in docs/benchmarks.md
+// (issue 42's eighth part).
 #include "scheduler/match.h"
 
 #include <fmt/format.h>

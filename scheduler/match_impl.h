@@ -1,9 +1,9 @@
 // scheduler/match_impl.h -- internal: the classes of one match.
 //
-// A match is its round loop (Match, match.cpp) and its robots, each a board
-// (board/board.h: the VM and the devices its program talks to) and what the
-// match keeps of it (Robot). The robot's bus -- how a
-// VM's port writes, A/D reads, serial library calls and interrupt
+// A match is its round loop (Match, match.cpp; its result, match_result.cpp)
+// and its robots, each a board (board/board.h: the VM and the devices its
+// program talks to) and what the match keeps of it (Robot). The robot's
+// bus -- how a VM's port writes, A/D reads, serial library calls and interrupt
 // notifications become plant inputs, queued events and trace records -- is
 // in robot_bus.cpp, apart from the round loop; both see these classes, in
 // namespace detail. Nothing outside scheduler/ includes this header.

@@ -9,7 +9,6 @@
 // up to it: between two running robots the lookahead is zero.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <cstring>
 
 #include "plant_support.h"
@@ -26,7 +25,7 @@ constexpr std::int64_t kEnd = 3 * simbot::timebase::kTicksPerSecond;
 Pose robot0At(std::int64_t t, std::uint8_t portB) {
   Arena a(config(defaults(), {{-3, 0, 0}, {3, 0, 180}}));
   a.setWheels(0, frame("3fg0frg0"), 0);
-  a.advance(kToggle);
+  while (a.now() < kToggle) a.advance(kToggle);
   if (portB != 0) a.setPortB(1, portB, kToggle);
   while (a.now() < t) a.advance(t);
   return a.state(0, t).pose;
@@ -38,10 +37,12 @@ bool sameBits(const Pose& x, const Pose& y) {
          std::memcmp(&x.heading_deg, &y.heading_deg, sizeof(double)) == 0;
 }
 
-constexpr std::uint8_t kGunMotor2 = 0x80;    // bit 7 (profiles/default.toml)
-constexpr std::uint8_t kDiscShooter = 0x40;  // bit 6: logged only, no launcher
+// The default hardware's bits (plant.h, Hardware): gun motor 2 on bit 7;
+// the disc shooter on bit 6, only logged without a disc launcher.
+constexpr std::uint8_t kGunMotor2 = 0x80;
+constexpr std::uint8_t kDiscShooter = 0x40;
 
-TEST(Coupling, AnotherRobotsInputLeavesThePoseBeforeItsTickAsItWas) {
+TEST(Coupling, AnotherRobotsInputLeavesThePoseUpToItsTickAsItWas) {
   EXPECT_TRUE(sameBits(robot0At(kToggle, 0), robot0At(kToggle, kGunMotor2)));
 }
 
