@@ -18,7 +18,6 @@ Usage: batch_test.py SIMBOT ICEMAN FIG92 SPIRAL TURRET OUTDIR
   twice; and a batch.json that another simbot version wrote, naming both.
 """
 import json
-import os
 import shutil
 import signal
 import subprocess

@@ -36,7 +36,6 @@ Usage: explain_course_test.py SIMBOT SOURCE_DIR ICEMAN FIG92 OUTDIR
 """
 import json
 import math
-import re
 import shutil
 import subprocess
 import sys
